@@ -1,0 +1,55 @@
+"""posturelab: human standing balance on a moving platform.
+
+Sagittal N-link chains on a translating platform, stabilised by
+agonist–antagonist muscle pairs acting as stiffness and viscosity. Starts
+from the ankle-strategy paper (three-link biped, Tables I–II, Figs. 3–10)
+and goes beyond it. Conventions: :mod:`posturelab.conventions`.
+"""
+
+from __future__ import annotations
+
+__version__ = "0.1.0"
+
+from .body import BODY_PRESETS, Body, Segment, get_body, paper_body
+from .dynamics import (
+    angular_acceleration,
+    gravity_vector,
+    kinetic_energy,
+    mass_matrix,
+    platform_vector,
+    potential_energy,
+    state_derivative,
+    velocity_step_response,
+    velocity_terms,
+)
+from .errors import ParameterError, PostureLabError, UnknownNameError
+from .linear import (
+    LinearAnalysis,
+    analyse,
+    analyse_both_sides,
+    disturbance_sensitivity,
+    finite_difference_state_matrix,
+    state_matrix,
+)
+from .muscles import (
+    STIFFNESS_CASES,
+    MusclePair,
+    MuscleSet,
+    get_stiffness_case,
+    joint_torques,
+    pair_torques,
+    paper_muscles,
+)
+
+__all__ = [
+    "__version__",
+    "BODY_PRESETS", "Body", "Segment", "get_body", "paper_body",
+    "angular_acceleration", "gravity_vector", "kinetic_energy", "mass_matrix",
+    "platform_vector", "potential_energy", "state_derivative", "velocity_step_response",
+    "velocity_terms",
+    "ParameterError", "PostureLabError", "UnknownNameError",
+    "LinearAnalysis", "analyse", "analyse_both_sides", "disturbance_sensitivity",
+    "finite_difference_state_matrix", "state_matrix",
+    "STIFFNESS_CASES", "MusclePair", "MuscleSet", "get_stiffness_case", "joint_torques",
+    "pair_torques", "paper_muscles",
+]

@@ -1,0 +1,91 @@
+"""The ``posturelab`` command line: one module per subcommand, each a thin call of the API.
+
+Errors a user can cause (bad input, unknown names, unreadable files) are
+printed as one line on standard error with exit code 2, never a traceback.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+from collections.abc import Sequence
+
+from ..errors import PostureLabError
+
+#: Subcommand name -> module in this package (each defines ``add_parser`` and ``run``).
+SUBCOMMANDS: dict[str, str] = {
+    "poles": "poles",
+    "sensitivity": "sensitivity",
+    "simulate": "simulate",
+    "reproduce": "reproduce",
+    "stability-map": "stability_map",
+    "sweep": "sweep",
+}
+
+
+class UsageError(PostureLabError):
+    """Bad command-line usage."""
+
+
+class OneLineParser(argparse.ArgumentParser):
+    """An ArgumentParser whose errors are one line and exit code 2."""
+
+    def error(self, message: str) -> None:  # type: ignore[override]
+        raise UsageError(f"{self.prog}: {message} (see '{self.prog} --help')")
+
+
+CONVENTIONS_EPILOG = (
+    "Conventions: SI units; link angles θ are absolute from the vertical, positive "
+    "leaning forward (+x); link 1 is the leg (lowest), 3 the torso; state order "
+    "[θ1 θ2 θ3 θ̇1 θ̇2 θ̇3]; y is up; a backward platform motion (ẋ_d < 0) makes the "
+    "body sway forward."
+)
+
+
+def build_parser() -> OneLineParser:
+    """The top-level parser with every available subcommand."""
+    from .. import __version__
+
+    parser = OneLineParser(
+        prog="posturelab",
+        description="Human standing balance on a moving platform: the ankle-strategy paper "
+        "and beyond.",
+        epilog=CONVENTIONS_EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    parser.add_argument("--version", action="version", version=f"posturelab {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=OneLineParser)
+    for name, module_name in SUBCOMMANDS.items():
+        try:
+            module = importlib.import_module(f"{__name__}.{module_name}")
+        except ModuleNotFoundError as exc:  # a subcommand not built yet
+            if exc.name == f"{__name__}.{module_name}":
+                continue
+            raise
+        p = module.add_parser(sub, name)
+        p.set_defaults(_run=module.run)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of the ``posturelab`` console script; returns the exit code."""
+    try:
+        parser = build_parser()
+        args = parser.parse_args(argv)
+        if getattr(args, "_run", None) is None:
+            parser.print_help()
+            return 2
+        return int(args._run(args) or 0)
+    except PostureLabError as exc:
+        print(f"posturelab: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("posturelab: interrupted", file=sys.stderr)
+        return 130
+    except BrokenPipeError:
+        return 1
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -1,0 +1,76 @@
+"""Argument helpers shared by the subcommands (parsing only; no physics here)."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+
+from ..errors import ParameterError
+from ..muscles import PAPER_PAIR_NAMES, STIFFNESS_CASES
+
+GASTROCNEMIUS_HELP = (
+    "two-sided (default) adds the paper's artificial antagonist so the gastrocnemius pair "
+    "acts for either sign of θ2; one-sided lets it act only while θ2 >= 0."
+)
+
+
+def parse_float_list(text: str, field: str, n: int | None = None) -> list[float]:
+    """Parse ``"a,b,c"`` into floats, checking count and finiteness; errors name ``field``."""
+    parts = [p.strip() for p in str(text).split(",")]
+    try:
+        values = [float(p) for p in parts]
+    except ValueError:
+        raise ParameterError(
+            f"{field} must be comma-separated numbers, got {text!r}"
+        ) from None
+    if n is not None and len(values) != n:
+        raise ParameterError(f"{field} must have {n} comma-separated values, got {len(values)}")
+    for v in values:
+        if not math.isfinite(v):
+            raise ParameterError(f"{field} must contain finite numbers, got {v}")
+    return values
+
+
+def add_muscle_arguments(p: argparse.ArgumentParser, *, require: bool = False) -> None:
+    """--case / --stiffness / --viscosity-ratio / --gastrocnemius."""
+    g = p.add_mutually_exclusive_group(required=require)
+    g.add_argument(
+        "--case", metavar="CASE",
+        help=f"Table I stiffness set: {', '.join(STIFFNESS_CASES)}.",
+    )
+    g.add_argument(
+        "--stiffness", metavar="K1,K2,K3,K4,K5",
+        help="five pair stiffnesses [N·m/rad] in the order "
+        + ", ".join(PAPER_PAIR_NAMES) + ".",
+    )
+    p.add_argument(
+        "--viscosity-ratio", type=float, default=0.25, metavar="R",
+        help="pair viscosity = R × pair stiffness [s] (default 0.25, as in the paper).",
+    )
+    p.add_argument(
+        "--gastrocnemius", choices=["two-sided", "one-sided"], default="two-sided",
+        help=GASTROCNEMIUS_HELP,
+    )
+
+
+def muscles_from_args(args: argparse.Namespace):
+    """Build the paper's MuscleSet from --case / --stiffness arguments."""
+    from ..muscles import paper_muscles
+
+    if args.case is None and args.stiffness is None:
+        raise ParameterError("give --case (Table I) or --stiffness K1,K2,K3,K4,K5")
+    stiffness = None
+    if args.stiffness is not None:
+        stiffness = parse_float_list(args.stiffness, "--stiffness [N·m/rad]", 5)
+    return paper_muscles(
+        args.case, stiffness=stiffness, viscosity_ratio=args.viscosity_ratio,
+        gastrocnemius=args.gastrocnemius,
+    )
+
+
+def print_json(obj) -> None:
+    """Print exactly one JSON object on standard output."""
+    json.dump(obj, sys.stdout, allow_nan=False)
+    sys.stdout.write("\n")

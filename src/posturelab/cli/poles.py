@@ -1,0 +1,116 @@
+"""``posturelab poles``: poles of the linearised paper model about upright."""
+
+from __future__ import annotations
+
+import argparse
+
+from ..body import paper_body
+from ..compare import erratum, table2_comparison
+from ..linear import analyse_both_sides
+from . import CONVENTIONS_EPILOG
+from ._common import add_muscle_arguments, muscles_from_args, print_json
+
+DESCRIPTION = """\
+Poles [1/s] of the paper's three-link biped (Appendix A) linearised about upright
+stance (Θ = 0, Θ̇ = 0), with the five muscle pairs acting as stiffness K [N·m/rad]
+and viscosity L = R·K [N·m·s/rad]. The system is stable when every pole has a
+negative real part.
+
+A one-sided gastrocnemius (--gastrocnemius one-sided) has no derivative at upright,
+where its stretch θ2 is exactly 0. It is linearised on both sides of its switch:
+the side θ2 >= 0 where it acts (the poles printed, identical to two-sided) and the
+side θ2 < 0 where it is slack (printed too; 'inactive_side_poles' in JSON). The
+system is reported stable only if both sides are.
+"""
+
+
+def add_parser(sub, name: str) -> argparse.ArgumentParser:
+    p = sub.add_parser(
+        name, help="poles and stability of the linearised model (Table II)",
+        description=DESCRIPTION, epilog=CONVENTIONS_EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    add_muscle_arguments(p)
+    p.add_argument("--all", action="store_true",
+                   help="Table II: every case as printed beside what we compute, errata flagged.")
+    p.add_argument("--json", action="store_true", help="print one JSON object instead of text.")
+    return p
+
+
+def _fmt_pole(z: complex) -> str:
+    if abs(z.imag) < 1e-12:
+        return f"{z.real:.3f}"
+    return f"{z.real:.3f} {'+' if z.imag >= 0 else '-'} {abs(z.imag):.3f}i"
+
+
+def run(args: argparse.Namespace) -> int:
+    if args.all:
+        if args.case is not None or args.stiffness is not None:
+            from . import UsageError
+
+            raise UsageError("posturelab poles: --all takes no --case or --stiffness")
+        return _run_all(args)
+    body = paper_body()
+    muscles = muscles_from_args(args)
+    active, inactive = analyse_both_sides(body, muscles)
+    one_sided = args.gastrocnemius == "one-sided"
+    stable = active.stable and inactive.stable
+    if args.json:
+        out = {
+            "stiffness": [float(x) for x in muscles.stiffnesses],
+            "viscosity_ratio": float(args.viscosity_ratio),
+            "poles": [{"re": float(z.real), "im": float(z.imag)} for z in active.poles],
+            "stable": bool(stable),
+        }
+        if one_sided:
+            out["gastrocnemius"] = "one-sided"
+            out["inactive_side_poles"] = [
+                {"re": float(z.real), "im": float(z.imag)} for z in inactive.poles
+            ]
+        print_json(out)
+        return 0
+    label = f"case {args.case} (Table I)" if args.case else "custom stiffness"
+    pairs = " ".join(f"{n}={k:g}" for n, k in zip(muscles.names, muscles.stiffnesses, strict=True))
+    print(f"{label}: stiffness [N·m/rad] {pairs}; viscosity = {args.viscosity_ratio:g} × stiffness")
+    head = "poles [1/s]" + (" (gastrocnemius acting, θ2 >= 0)" if one_sided else "")
+    print(head + ":")
+    for z in active.poles:
+        print(f"  {_fmt_pole(z)}")
+    if one_sided:
+        print("poles [1/s] (gastrocnemius slack, θ2 < 0):")
+        for z in inactive.poles:
+            print(f"  {_fmt_pole(z)}")
+    worst = max(active.max_real_part, inactive.max_real_part)
+    print(f"stable: {'yes' if stable else 'no'} (largest real part {worst:.3f} 1/s)")
+    return 0
+
+
+def _run_all(args: argparse.Namespace) -> int:
+    rows = table2_comparison(viscosity_ratio=args.viscosity_ratio)
+    if args.json:
+        print_json({"table2": [
+            {"case": r.case, "stiffness": list(r.stiffness), "stable": r.stable,
+             "poles": [{"printed": p.printed, "re": p.computed.real, "im": p.computed.imag,
+                        "agrees": p.agrees, "erratum": p.erratum} for p in r.poles]}
+            for r in rows]})
+        return 0
+    print("Table II: poles [1/s] of the linearised system, printed | computed "
+          f"(viscosity = {args.viscosity_ratio:g} × stiffness)")
+    print("  '!' marks a printed pole that disagrees beyond its printed digits; [n] is the erratum.")
+    flagged: set[int] = set()
+    for r in rows:
+        cells = []
+        for p in r.poles:
+            mark = "" if p.agrees else (f" ![{p.erratum}]" if p.erratum else " !")
+            if p.erratum and not p.agrees:
+                flagged.add(p.erratum)
+            cells.append(f"{p.printed:>12} | {_fmt_pole(p.computed):<18}{mark}")
+        print(f"case {r.case:<3} {'stable' if r.stable else 'UNSTABLE'}")
+        for c in cells:
+            print(f"    {c}")
+    if flagged:
+        print("Disagreements:")
+        for n in sorted(flagged):
+            e = erratum(n)
+            print(f"  [{n}] {e.where}: printed {e.printed}, computed {e.derived}. {e.explanation}")
+    return 0

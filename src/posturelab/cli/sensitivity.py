@@ -1,0 +1,45 @@
+"""``posturelab sensitivity``: the disturbance-severity vector J(Θ)⁻¹H(Θ)."""
+
+from __future__ import annotations
+
+import argparse
+
+from ..body import paper_body
+from ..linear import disturbance_sensitivity
+from . import CONVENTIONS_EPILOG
+from ._common import parse_float_list, print_json
+
+DESCRIPTION = """\
+J(Θ)⁻¹H(Θ) [rad/m] for the paper's three-link body: the change of each link's rate
+[rad/s] per unit change of platform velocity [m/s] (ΔΘ̇ = −J⁻¹H Δẋ_d), evaluated at
+posture Θ (default upright). The paper prints [2.5580, -0.0654, 0.0027] at upright.
+"""
+
+
+def add_parser(sub, name: str) -> argparse.ArgumentParser:
+    p = sub.add_parser(
+        name, help="disturbance severity J⁻¹H at a posture",
+        description=DESCRIPTION, epilog=CONVENTIONS_EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p.add_argument("--posture", metavar="T1,T2,T3", default="0,0,0",
+                   help="link angles θ1,θ2,θ3 [rad] from the vertical, forward positive "
+                   "(default 0,0,0).")
+    p.add_argument("--json", action="store_true", help="print one JSON object instead of text.")
+    return p
+
+
+def run(args: argparse.Namespace) -> int:
+    body = paper_body()
+    posture = parse_float_list(args.posture, "--posture [rad]", body.n_links)
+    value = disturbance_sensitivity(body, posture)
+    if args.json:
+        print_json({"posture": posture, "sensitivity": [float(v) for v in value]})
+        return 0
+    print(f"posture [rad]: {', '.join(f'{x:g}' for x in posture)}")
+    print("J⁻¹H [rad/m] (link rate change per platform velocity change):")
+    for i, v in enumerate(value, 1):
+        print(f"  link {i}: {v:+.4f}")
+    ratios = abs(value[0]) / abs(value[1:])
+    print("ankle-to-higher-link ratios: " + ", ".join(f"{r:.0f}" for r in ratios))
+    return 0

@@ -1,0 +1,199 @@
+"""Equations of motion of a planar N-link chain on a translating platform.
+
+Pure functions over arrays. Angles may carry leading batch axes: ``theta`` of
+shape ``(..., N)`` gives results of shape ``(..., N)`` or ``(..., N, N)``.
+
+The model (DESIGN.md; paper eq. 1 with y up, erratum 3)::
+
+    J(Θ) Θ̈ + B(Θ, Θ̇) Θ̇ − (g + ÿ_d) G(Θ) + ẍ_d H(Θ) = U
+
+with, for links i, j (lowest first), a_i = m_i k_i + (Σ_{j>i} m_j) l_i and
+c_ij = l_i a_j (i < j):
+
+* J_ii = I_i + m_i k_i² + (Σ_{j>i} m_j) l_i²,  J_ij = c_ij cos(θ_j − θ_i)
+* (B Θ̇)_i = Σ_j c_ij sin(θ_i − θ_j) θ̇_j²
+* G_i = a_i sin θ_i,  H_i = a_i cos θ_i
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .body import Body
+
+__all__ = [
+    "mass_matrix",
+    "velocity_terms",
+    "gravity_vector",
+    "platform_vector",
+    "angular_acceleration",
+    "state_derivative",
+    "kinetic_energy",
+    "potential_energy",
+    "velocity_step_response",
+]
+
+
+def mass_matrix(body: Body, theta: np.ndarray) -> np.ndarray:
+    """Inertia matrix J(Θ).
+
+    Parameters
+    ----------
+    body : Body
+        The chain.
+    theta : array_like, shape (..., N)
+        Absolute link angles from the vertical, forward positive. [rad]
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., N, N)
+        Symmetric positive-definite inertia matrix. [kg·m²]
+    """
+    theta = np.asarray(theta, dtype=float)
+    diff = theta[..., None, :] - theta[..., :, None]  # θ_j − θ_i
+    J = body.coupling * np.cos(diff)
+    n = body.n_links
+    J[..., np.arange(n), np.arange(n)] = body.inertia_diagonal
+    return J
+
+
+def velocity_terms(body: Body, theta: np.ndarray, omega: np.ndarray) -> np.ndarray:
+    """Centripetal term B(Θ, Θ̇) Θ̇.
+
+    Parameters
+    ----------
+    theta : array_like, shape (..., N)
+        Link angles. [rad]
+    omega : array_like, shape (..., N)
+        Link angular rates. [rad/s]
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., N)
+        (B Θ̇)_i = Σ_j c_ij sin(θ_i − θ_j) θ̇_j². [N·m]
+    """
+    theta = np.asarray(theta, dtype=float)
+    omega = np.asarray(omega, dtype=float)
+    diff = theta[..., :, None] - theta[..., None, :]  # θ_i − θ_j
+    return np.einsum("...ij,...j->...i", body.coupling * np.sin(diff), omega**2)
+
+
+def gravity_vector(body: Body, theta: np.ndarray) -> np.ndarray:
+    """G(Θ): G_i = a_i sin θ_i. [kg·m]
+
+    Multiplied by (g + ÿ_d) [m/s²] it is the gravitational torque [N·m]
+    that tips each link forward.
+    """
+    return body.gravity_coefficients * np.sin(np.asarray(theta, dtype=float))
+
+
+def platform_vector(body: Body, theta: np.ndarray) -> np.ndarray:
+    """H(Θ): H_i = a_i cos θ_i, the coupling of horizontal platform acceleration. [kg·m]"""
+    return body.gravity_coefficients * np.cos(np.asarray(theta, dtype=float))
+
+
+def angular_acceleration(
+    body: Body,
+    theta: np.ndarray,
+    omega: np.ndarray,
+    joint_torques: np.ndarray | float = 0.0,
+    platform_acceleration_x: np.ndarray | float = 0.0,
+    platform_acceleration_y: np.ndarray | float = 0.0,
+) -> np.ndarray:
+    """Θ̈ from eq. 1: J⁻¹ [U − BΘ̇ + (g + ÿ_d) G − ẍ_d H].
+
+    Parameters
+    ----------
+    theta, omega : array_like, shape (..., N)
+        Link angles [rad] and rates [rad/s].
+    joint_torques : array_like, shape (..., N) or scalar
+        Generalised torques U on the link-angle coordinates. [N·m]
+    platform_acceleration_x : array_like, shape (...) or scalar
+        Horizontal platform acceleration ẍ_d, forward positive. [m/s²]
+    platform_acceleration_y : array_like, shape (...) or scalar
+        Vertical platform acceleration ÿ_d, up positive. [m/s²]
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., N)
+        Link angular accelerations. [rad/s²]
+    """
+    theta = np.asarray(theta, dtype=float)
+    omega = np.asarray(omega, dtype=float)
+    ax = np.asarray(platform_acceleration_x, dtype=float)[..., None]
+    ay = np.asarray(platform_acceleration_y, dtype=float)[..., None]
+    rhs = (
+        np.asarray(joint_torques, dtype=float)
+        - velocity_terms(body, theta, omega)
+        + (body.gravity + ay) * gravity_vector(body, theta)
+        - ax * platform_vector(body, theta)
+    )
+    J = mass_matrix(body, theta)
+    return np.linalg.solve(J, rhs[..., None])[..., 0]
+
+
+def state_derivative(
+    body: Body,
+    state: np.ndarray,
+    joint_torques: np.ndarray | float = 0.0,
+    platform_acceleration_x: np.ndarray | float = 0.0,
+    platform_acceleration_y: np.ndarray | float = 0.0,
+) -> np.ndarray:
+    """Time derivative of the state ``[Θ, Θ̇]``.
+
+    Parameters
+    ----------
+    state : array_like, shape (..., 2N)
+        ``[θ1 … θN, θ̇1 … θ̇N]`` in [rad] and [rad/s].
+    joint_torques, platform_acceleration_x, platform_acceleration_y
+        As in :func:`angular_acceleration`. [N·m], [m/s²], [m/s²]
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 2N)
+        ``[Θ̇, Θ̈]`` in [rad/s] and [rad/s²].
+    """
+    state = np.asarray(state, dtype=float)
+    n = body.n_links
+    theta, omega = state[..., :n], state[..., n:]
+    acc = angular_acceleration(
+        body, theta, omega, joint_torques, platform_acceleration_x, platform_acceleration_y
+    )
+    return np.concatenate([omega, acc], axis=-1)
+
+
+def kinetic_energy(body: Body, theta: np.ndarray, omega: np.ndarray) -> np.ndarray:
+    """Kinetic energy ½ Θ̇ᵀ J(Θ) Θ̇ in the platform frame (platform at rest). [J]"""
+    omega = np.asarray(omega, dtype=float)
+    J = mass_matrix(body, theta)
+    return 0.5 * np.einsum("...i,...ij,...j->...", omega, J, omega)
+
+
+def potential_energy(body: Body, theta: np.ndarray) -> np.ndarray:
+    """Gravitational potential energy g Σ a_i cos θ_i, relative to the ankle. [J]"""
+    return body.gravity * np.sum(platform_vector(body, theta), axis=-1)
+
+
+def velocity_step_response(
+    body: Body, platform_velocity_change: float, theta: np.ndarray | None = None
+) -> np.ndarray:
+    """Jump of link rates caused by a sudden platform velocity change.
+
+    ΔΘ̇ = −J(Θ)⁻¹ H(Θ) Δẋ_d (the paper's "unit impulse" of platform motion).
+
+    Parameters
+    ----------
+    platform_velocity_change : float
+        Δẋ_d, forward positive; a backward platform jerk is negative. [m/s]
+    theta : array_like, shape (N,), optional
+        Posture at the jump; upright (zeros) by default. [rad]
+
+    Returns
+    -------
+    numpy.ndarray, shape (N,)
+        ΔΘ̇. [rad/s]
+    """
+    if theta is None:
+        theta = np.zeros(body.n_links)
+    J = mass_matrix(body, theta)
+    return -np.linalg.solve(J, platform_vector(body, theta)) * platform_velocity_change

@@ -1,0 +1,355 @@
+"""Agonist–antagonist muscle pairs as joint-space stiffness and viscosity.
+
+A co-activated pair is named by the two links it spans, (lo, hi) with
+lo < hi and 0 the foot. Its stretch is θ_hi − θ_lo (its row of the matrix E,
+paper eq. 4). Pair torques and joint torques (paper Appendix C)::
+
+    M = K_d E Θ + L_d E Θ̇          [N·m]   (one entry per pair)
+    U = −Eᵀ M                       [N·m]   (one entry per link)
+    K = Eᵀ K_d E,  L = Eᵀ L_d E     (paper eq. 5)
+
+A *one-sided* pair acts only while its stretch is >= 0 (the real
+gastrocnemius, which acts while θ2 >= 0); a *two-sided* pair acts always
+(the paper's "artificial antagonist").
+
+Table I's nine stiffness sets are the presets ``"1" … "7", "6a", "6b"``
+(:data:`STIFFNESS_CASES`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from functools import cached_property
+from typing import Literal
+
+import numpy as np
+
+from ._validation import finite_array, nonnegative_float
+from .errors import ParameterError, UnknownNameError
+
+__all__ = [
+    "MusclePair",
+    "MuscleSet",
+    "PAPER_PAIRS",
+    "PAPER_PAIR_NAMES",
+    "STIFFNESS_CASES",
+    "TABLE_I_CITATION",
+    "DEFAULT_VISCOSITY_RATIO",
+    "paper_muscles",
+    "get_stiffness_case",
+    "pair_torques",
+    "joint_torques",
+]
+
+#: Viscosity as a fraction of stiffness used throughout the paper (Appendix C). [s]
+DEFAULT_VISCOSITY_RATIO = 0.25
+
+Gastrocnemius = Literal["two-sided", "one-sided"]
+
+
+@dataclass(frozen=True)
+class MusclePair:
+    """One co-activated agonist–antagonist pair.
+
+    Parameters
+    ----------
+    name : str
+        Label, e.g. ``"ankle"``.
+    lo, hi : int
+        Links spanned, ``0 <= lo < hi``; 0 is the foot. The stretch is
+        θ_hi − θ_lo. [-]
+    stiffness : float
+        Pair stiffness, the diagonal entry of K_d. [N·m/rad]
+    viscosity : float
+        Pair viscosity, the diagonal entry of L_d. [N·m·s/rad]
+    one_sided : bool
+        If true the pair acts only while its stretch is >= 0.
+    """
+
+    name: str
+    lo: int
+    hi: int
+    stiffness: float
+    viscosity: float
+    one_sided: bool = False
+
+    def __post_init__(self) -> None:
+        label = f"muscle pair {self.name!r}"
+        if not (isinstance(self.lo, int | np.integer) and isinstance(self.hi, int | np.integer)):
+            raise ParameterError(f"{label} lo and hi must be integers, got {self.lo!r}, {self.hi!r}")
+        if not 0 <= self.lo < self.hi:
+            raise ParameterError(
+                f"{label} span must satisfy 0 <= lo < hi, got (lo, hi) = ({self.lo}, {self.hi})"
+            )
+        object.__setattr__(self, "lo", int(self.lo))
+        object.__setattr__(self, "hi", int(self.hi))
+        object.__setattr__(
+            self, "stiffness", nonnegative_float(f"{label} stiffness", self.stiffness, "N·m/rad")
+        )
+        object.__setattr__(
+            self, "viscosity", nonnegative_float(f"{label} viscosity", self.viscosity, "N·m·s/rad")
+        )
+        object.__setattr__(self, "one_sided", bool(self.one_sided))
+
+
+@dataclass(frozen=True)
+class MuscleSet:
+    """The muscle pairs acting on an N-link chain.
+
+    Parameters
+    ----------
+    pairs : sequence of MusclePair
+        The pairs, in the order of the rows of E.
+    n_links : int
+        Number of links N of the chain they act on; every pair needs hi <= N.
+    """
+
+    pairs: tuple[MusclePair, ...]
+    n_links: int
+
+    def __post_init__(self) -> None:
+        pairs = tuple(self.pairs)
+        if not isinstance(self.n_links, int | np.integer) or self.n_links < 1:
+            raise ParameterError(f"n_links must be an integer >= 1, got {self.n_links!r}")
+        names = [p.name for p in pairs]
+        if len(set(names)) != len(names):
+            raise ParameterError(f"muscle pair names must be unique, got {names}")
+        for p in pairs:
+            if p.hi > self.n_links:
+                raise ParameterError(
+                    f"muscle pair {p.name!r} spans link {p.hi}, but the body has "
+                    f"{self.n_links} links (allowed hi: 1..{self.n_links})"
+                )
+        object.__setattr__(self, "pairs", pairs)
+        object.__setattr__(self, "n_links", int(self.n_links))
+
+    @property
+    def names(self) -> list[str]:
+        """Pair names in row order."""
+        return [p.name for p in self.pairs]
+
+    @cached_property
+    def selection_matrix(self) -> np.ndarray:
+        """E, shape (P, N): row p is +1 at link hi and −1 at link lo (if lo >= 1). [-]"""
+        E = np.zeros((len(self.pairs), self.n_links))
+        for r, p in enumerate(self.pairs):
+            E[r, p.hi - 1] += 1.0
+            if p.lo >= 1:
+                E[r, p.lo - 1] -= 1.0
+        E.setflags(write=False)
+        return E
+
+    @cached_property
+    def stiffnesses(self) -> np.ndarray:
+        """Diagonal of K_d. [N·m/rad]"""
+        return np.array([p.stiffness for p in self.pairs])
+
+    @cached_property
+    def viscosities(self) -> np.ndarray:
+        """Diagonal of L_d. [N·m·s/rad]"""
+        return np.array([p.viscosity for p in self.pairs])
+
+    @cached_property
+    def one_sided_mask(self) -> np.ndarray:
+        """True for pairs that act only while their stretch is >= 0."""
+        return np.array([p.one_sided for p in self.pairs], dtype=bool)
+
+    def stiffness_matrix(self, active: np.ndarray | None = None) -> np.ndarray:
+        """Joint-space stiffness K = Eᵀ K_d E (paper eq. 5). [N·m/rad]
+
+        Parameters
+        ----------
+        active : array_like of bool, shape (P,), optional
+            Which pairs act; all by default.
+        """
+        kd = self.stiffnesses if active is None else self.stiffnesses * np.asarray(active)
+        E = self.selection_matrix
+        return E.T @ (kd[:, None] * E)
+
+    def viscosity_matrix(self, active: np.ndarray | None = None) -> np.ndarray:
+        """Joint-space viscosity L = Eᵀ L_d E. [N·m·s/rad]"""
+        ld = self.viscosities if active is None else self.viscosities * np.asarray(active)
+        E = self.selection_matrix
+        return E.T @ (ld[:, None] * E)
+
+    def stretch(self, theta: np.ndarray) -> np.ndarray:
+        """Pair stretches E Θ, shape (..., P). [rad]"""
+        return np.asarray(theta, dtype=float) @ self.selection_matrix.T
+
+    def active(self, theta: np.ndarray) -> np.ndarray:
+        """Which pairs act at posture ``theta``: two-sided always, one-sided while stretch >= 0."""
+        return ~self.one_sided_mask | (self.stretch(theta) >= 0.0)
+
+    def with_stiffness(self, **stiffness: float) -> MuscleSet:
+        """A copy with some pairs' stiffness replaced (viscosity unchanged), by pair name."""
+        unknown = [k for k in stiffness if k not in self.names]
+        if unknown:
+            raise UnknownNameError(
+                f"unknown muscle pair {unknown[0]!r}; known pairs: {', '.join(self.names)}"
+            )
+        pairs = tuple(
+            MusclePair(p.name, p.lo, p.hi, stiffness.get(p.name, p.stiffness), p.viscosity,
+                       p.one_sided)
+            for p in self.pairs
+        )
+        return MuscleSet(pairs, self.n_links)
+
+    def as_two_sided(self) -> MuscleSet:
+        """A copy in which every pair acts on both sides (artificial antagonists added)."""
+        pairs = tuple(
+            MusclePair(p.name, p.lo, p.hi, p.stiffness, p.viscosity, False) for p in self.pairs
+        )
+        return MuscleSet(pairs, self.n_links)
+
+    def without_one_sided(self) -> MuscleSet:
+        """A copy with the one-sided pairs removed (their inactive side)."""
+        return MuscleSet(tuple(p for p in self.pairs if not p.one_sided), self.n_links)
+
+
+def pair_torques(muscles: MuscleSet, theta: np.ndarray, omega: np.ndarray) -> np.ndarray:
+    """Pair torques M = K_d E Θ + L_d E Θ̇, zero for an inactive one-sided pair.
+
+    Parameters
+    ----------
+    theta, omega : array_like, shape (..., N)
+        Link angles [rad] and rates [rad/s].
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., P)
+        One torque per pair, positive when resisting positive stretch. [N·m]
+    """
+    E = muscles.selection_matrix
+    stretch = np.asarray(theta, dtype=float) @ E.T
+    rate = np.asarray(omega, dtype=float) @ E.T
+    M = muscles.stiffnesses * stretch + muscles.viscosities * rate
+    if muscles.one_sided_mask.any():
+        M = np.where(muscles.one_sided_mask & (stretch < 0.0), 0.0, M)
+    return M
+
+
+def joint_torques(muscles: MuscleSet, theta: np.ndarray, omega: np.ndarray) -> np.ndarray:
+    """Generalised torques U = −Eᵀ M on the link-angle coordinates, shape (..., N). [N·m]"""
+    return -pair_torques(muscles, theta, omega) @ muscles.selection_matrix
+
+
+# ---------------------------------------------------------------------------
+# The paper's five pairs and Table I
+# ---------------------------------------------------------------------------
+
+#: The paper's five pairs (Appendix C, eq. 4; DESIGN.md): name -> (lo, hi, description).
+PAPER_PAIRS: dict[str, tuple[int, int, str]] = {
+    "ankle": (0, 1, "tibialis anterior – soleus; crosses the ankle"),
+    "knee": (1, 2, "vasti – short head of hamstring; crosses the knee"),
+    "hip": (2, 3, "paraspinals – abdominals; crosses the hip"),
+    "quadriceps": (1, 3, "quadriceps – hamstring, two-joint; crosses knee and hip"),
+    "gastrocnemius": (0, 2, "gastrocnemius – tibialis, two-joint; crosses ankle and knee"),
+}
+PAPER_PAIR_NAMES: tuple[str, ...] = tuple(PAPER_PAIRS)
+
+TABLE_I_CITATION = "Ankle-strategy paper, Table I (muscle synergies K for seven experiments)"
+
+#: Table I: pair stiffness [N·m/rad] in the order ankle, knee, hip, quadriceps, gastrocnemius.
+STIFFNESS_CASES: dict[str, tuple[float, float, float, float, float]] = {
+    "1": (500.0, 300.0, 300.0, 300.0, 300.0),
+    "2": (500.0, 300.0, 300.0, 300.0, 0.0),
+    "3": (1000.0, 300.0, 300.0, 300.0, 0.0),
+    "4": (1000.0, 0.0, 300.0, 300.0, 300.0),
+    "5": (1000.0, 0.0, 300.0, 300.0, 0.0),
+    "6": (0.0, 0.0, 300.0, 300.0, 1000.0),
+    "6a": (0.0, 0.0, 600.0, 300.0, 1000.0),
+    "6b": (0.0, 0.0, 300.0, 600.0, 1000.0),
+    "7": (1000.0, 0.0, 0.0, 300.0, 1000.0),
+}
+
+
+def get_stiffness_case(case: str) -> tuple[float, ...]:
+    """Table I stiffness set ``case`` (ankle, knee, hip, quadriceps, gastrocnemius). [N·m/rad]
+
+    Raises
+    ------
+    UnknownNameError
+        If ``case`` is not in Table I; the message lists the known cases.
+    """
+    key = str(case).strip().lower().replace("case", "").replace(" ", "")
+    try:
+        return STIFFNESS_CASES[key]
+    except KeyError:
+        raise UnknownNameError(
+            f"unknown stiffness case {case!r}; known cases (Table I): "
+            f"{', '.join(STIFFNESS_CASES)}"
+        ) from None
+
+
+def paper_muscles(
+    case: str | None = None,
+    *,
+    stiffness: Sequence[float] | Mapping[str, float] | None = None,
+    viscosity_ratio: float = DEFAULT_VISCOSITY_RATIO,
+    viscosity: Sequence[float] | None = None,
+    gastrocnemius: Gastrocnemius = "two-sided",
+) -> MuscleSet:
+    """The paper's five pairs on the three-link body.
+
+    Give either a Table I ``case`` or five ``stiffness`` values.
+
+    Parameters
+    ----------
+    case : str, optional
+        Table I case: ``"1" … "7", "6a", "6b"``.
+    stiffness : sequence of 5 floats or mapping name -> float, optional
+        Pair stiffness in the order ankle, knee, hip, quadriceps,
+        gastrocnemius (or by name; missing names are 0). [N·m/rad]
+    viscosity_ratio : float, optional
+        L_d = ratio · K_d when ``viscosity`` is not given; the paper uses 0.25. [s]
+    viscosity : sequence of 5 floats, optional
+        Per-pair viscosity, overriding ``viscosity_ratio``. [N·m·s/rad]
+    gastrocnemius : {"two-sided", "one-sided"}
+        ``"two-sided"`` adds the paper's artificial antagonist; ``"one-sided"``
+        lets the gastrocnemius act only while θ2 >= 0.
+
+    Returns
+    -------
+    MuscleSet
+    """
+    if (case is None) == (stiffness is None):
+        raise ParameterError("give exactly one of case (Table I) or stiffness (5 values)")
+    if case is not None:
+        k = np.array(get_stiffness_case(case))
+    elif isinstance(stiffness, Mapping):
+        unknown = [n for n in stiffness if n not in PAPER_PAIRS]
+        if unknown:
+            raise UnknownNameError(
+                f"unknown muscle pair {unknown[0]!r}; known pairs: {', '.join(PAPER_PAIR_NAMES)}"
+            )
+        k = np.array([float(stiffness.get(n, 0.0)) for n in PAPER_PAIR_NAMES])
+    else:
+        k = _five("stiffness [N·m/rad]", stiffness)
+    if viscosity is None:
+        ratio = nonnegative_float("viscosity_ratio [s]", viscosity_ratio)
+        v = ratio * k
+    else:
+        v = _five("viscosity [N·m·s/rad]", viscosity)
+    if gastrocnemius not in ("two-sided", "one-sided"):
+        raise ParameterError(
+            f"gastrocnemius must be 'two-sided' or 'one-sided', got {gastrocnemius!r}"
+        )
+    pairs = tuple(
+        MusclePair(name, lo, hi, float(k[i]), float(v[i]),
+                   one_sided=(name == "gastrocnemius" and gastrocnemius == "one-sided"))
+        for i, (name, (lo, hi, _)) in enumerate(PAPER_PAIRS.items())
+    )
+    return MuscleSet(pairs, 3)
+
+
+def _five(name: str, values) -> np.ndarray:
+    arr = np.atleast_1d(finite_array(name, values))
+    if arr.shape != (5,):
+        raise ParameterError(
+            f"{name} must have 5 values (ankle, knee, hip, quadriceps, gastrocnemius), "
+            f"got {arr.size}"
+        )
+    if np.any(arr < 0):
+        raise ParameterError(f"{name} must be >= 0, got {arr[arr < 0][0]:g}")
+    return arr
