@@ -1,0 +1,456 @@
+"""Platform disturbances: velocity steps and acceleration profiles.
+
+Every disturbance is an immutable object with
+
+* ``velocity_change`` — an instantaneous change of platform velocity at
+  t = 0, (Δẋ_d, Δẏ_d) [m/s] (only :class:`VelocityStep` has one; it sets the
+  initial link rates through ΔΘ̇ = −J⁻¹H Δẋ_d);
+* ``acceleration(t)`` — (ẍ_d, ÿ_d) at times ``t`` [m/s²], shape (..., 2);
+* ``breakpoints`` — the times where the acceleration or its slope jumps; the
+  simulator stops and restarts its integrator exactly there so it never
+  steps blindly over a corner.
+
+Sign conventions: x forward, y up. A *backward* platform motion has
+ẋ_d < 0 and makes the body sway forward.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Literal
+
+import numpy as np
+
+from ._validation import finite_array, finite_float, nonnegative_float, positive_float
+from .errors import DataFileError, ParameterError
+
+__all__ = [
+    "Disturbance",
+    "NoDisturbance",
+    "VelocityStep",
+    "HalfSinePulse",
+    "RampAndHold",
+    "SumOfSines",
+    "MeasuredProfile",
+    "CombinedDisturbance",
+    "read_profile_csv",
+    "combine",
+]
+
+Axis = Literal["x", "y"]
+
+
+def _axis(axis: str) -> int:
+    if axis not in ("x", "y"):
+        raise ParameterError(f"axis must be 'x' (horizontal) or 'y' (vertical), got {axis!r}")
+    return 0 if axis == "x" else 1
+
+
+class Disturbance:
+    """Base class: no velocity change, zero acceleration, no breakpoints."""
+
+    #: (Δẋ_d, Δẏ_d) applied at t = 0. [m/s]
+    velocity_change: tuple[float, float] = (0.0, 0.0)
+
+    @property
+    def breakpoints(self) -> tuple[float, ...]:
+        """Times where the acceleration profile has a corner. [s]"""
+        return ()
+
+    @property
+    def max_step(self) -> float:
+        """Largest integrator step that resolves the profile (inf if any). [s]"""
+        return math.inf
+
+    def acceleration(self, t: np.ndarray | float) -> np.ndarray:
+        """Platform acceleration (ẍ_d, ÿ_d) at ``t``, shape (..., 2). [m/s²]"""
+        t = np.asarray(t, dtype=float)
+        return np.zeros(t.shape + (2,))
+
+    def describe(self) -> str:
+        """One-line human description with units."""
+        return "no platform motion"
+
+
+@dataclass(frozen=True)
+class NoDisturbance(Disturbance):
+    """The platform stays still."""
+
+
+@dataclass(frozen=True)
+class VelocityStep(Disturbance):
+    """A sudden platform velocity change at t = 0 (the paper's "unit impulse").
+
+    Parameters
+    ----------
+    velocity : float
+        Δẋ_d (axis x) or Δẏ_d (axis y): the platform's new velocity. A
+        backward step is negative. [m/s]
+    axis : {"x", "y"}
+        Direction of the step.
+    """
+
+    velocity: float
+    axis: Axis = "x"
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "velocity", finite_float("velocity [m/s]", self.velocity))
+        _axis(self.axis)
+
+    @property
+    def velocity_change(self) -> tuple[float, float]:  # type: ignore[override]
+        return (self.velocity, 0.0) if self.axis == "x" else (0.0, self.velocity)
+
+    @classmethod
+    def backward(cls, speed: float = 1.0) -> VelocityStep:
+        """Platform jerked backward at ``speed`` [m/s] (> 0): the body sways forward."""
+        return cls(-positive_float("speed [m/s]", speed))
+
+    @classmethod
+    def forward(cls, speed: float = 1.0) -> VelocityStep:
+        """Platform jerked forward at ``speed`` [m/s] (> 0): the body sways backward."""
+        return cls(positive_float("speed [m/s]", speed))
+
+    def describe(self) -> str:
+        word = {"x": ("forward", "backward"), "y": ("up", "down")}[self.axis]
+        return (f"platform velocity step of {abs(self.velocity):g} m/s "
+                f"{word[0] if self.velocity >= 0 else word[1]} at t = 0")
+
+
+@dataclass(frozen=True)
+class HalfSinePulse(Disturbance):
+    """Acceleration a(t) = peak · sin(π (t − start)/duration) for start <= t <= start + duration.
+
+    Parameters
+    ----------
+    peak_acceleration : float
+        Peak acceleration, signed (negative is backward / down). [m/s²]
+    duration : float
+        Pulse length. [s]
+    start : float
+        Onset time. [s]
+    axis : {"x", "y"}
+    """
+
+    peak_acceleration: float
+    duration: float
+    start: float = 0.0
+    axis: Axis = "x"
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "peak_acceleration",
+                           finite_float("peak_acceleration [m/s²]", self.peak_acceleration))
+        object.__setattr__(self, "duration", positive_float("duration [s]", self.duration))
+        object.__setattr__(self, "start", nonnegative_float("start [s]", self.start))
+        _axis(self.axis)
+
+    @property
+    def breakpoints(self) -> tuple[float, ...]:
+        return (self.start, self.start + self.duration)
+
+    def acceleration(self, t):
+        t = np.asarray(t, dtype=float)
+        s = (t - self.start) / self.duration
+        a = np.where((s >= 0) & (s <= 1), self.peak_acceleration * np.sin(np.pi * s), 0.0)
+        out = np.zeros(t.shape + (2,))
+        out[..., _axis(self.axis)] = a
+        return out
+
+    @property
+    def velocity_gain(self) -> float:
+        """Velocity reached at the end of the pulse, 2·peak·duration/π. [m/s]"""
+        return 2.0 * self.peak_acceleration * self.duration / np.pi
+
+    def describe(self) -> str:
+        return (f"half-sine acceleration pulse, peak {self.peak_acceleration:g} m/s² along "
+                f"{self.axis}, {self.duration:g} s from t = {self.start:g} s")
+
+
+@dataclass(frozen=True)
+class RampAndHold(Disturbance):
+    """The usual lab platform: move by ``displacement`` over ``duration``, then hold.
+
+    The acceleration is one full sine cycle, a(t) = (2π D / T²) sin(2π (t − t0)/T),
+    so acceleration, velocity and displacement all start and end smoothly at
+    zero velocity; the peak velocity 2D/T is reached at mid-move.
+
+    Parameters
+    ----------
+    displacement : float
+        D, signed (negative is backward / down). [m]
+    duration : float
+        T, time of the move. [s]
+    start : float
+        t0, onset. [s]
+    axis : {"x", "y"}
+    """
+
+    displacement: float
+    duration: float
+    start: float = 0.0
+    axis: Axis = "x"
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "displacement",
+                           finite_float("displacement [m]", self.displacement))
+        object.__setattr__(self, "duration", positive_float("duration [s]", self.duration))
+        object.__setattr__(self, "start", nonnegative_float("start [s]", self.start))
+        _axis(self.axis)
+
+    @property
+    def breakpoints(self) -> tuple[float, ...]:
+        return (self.start, self.start + self.duration)
+
+    @property
+    def peak_acceleration(self) -> float:
+        """2πD/T². [m/s²]"""
+        return 2.0 * np.pi * self.displacement / self.duration**2
+
+    def acceleration(self, t):
+        t = np.asarray(t, dtype=float)
+        s = (t - self.start) / self.duration
+        a = np.where((s >= 0) & (s <= 1), self.peak_acceleration * np.sin(2 * np.pi * s), 0.0)
+        out = np.zeros(t.shape + (2,))
+        out[..., _axis(self.axis)] = a
+        return out
+
+    def describe(self) -> str:
+        return (f"ramp-and-hold: {self.displacement:g} m along {self.axis} over "
+                f"{self.duration:g} s from t = {self.start:g} s")
+
+
+@dataclass(frozen=True)
+class SumOfSines(Disturbance):
+    """Acceleration Σ_i A_i sin(2π f_i t + φ_i), for system-identification runs.
+
+    Parameters
+    ----------
+    amplitudes : sequence of float
+        A_i. [m/s²]
+    frequencies : sequence of float
+        f_i, positive. [Hz]
+    phases : sequence of float, optional
+        φ_i; zeros by default. [rad]
+    axis : {"x", "y"}
+    """
+
+    amplitudes: tuple[float, ...]
+    frequencies: tuple[float, ...]
+    phases: tuple[float, ...] | None = None
+    axis: Axis = "x"
+
+    def __post_init__(self) -> None:
+        amp = finite_array("amplitudes [m/s²]", self.amplitudes, (None,))
+        freq = finite_array("frequencies [Hz]", self.frequencies, (None,))
+        if amp.size == 0 or amp.size != freq.size:
+            raise ParameterError(
+                f"amplitudes and frequencies must be non-empty and of equal length, got "
+                f"{amp.size} and {freq.size}"
+            )
+        if np.any(freq <= 0):
+            raise ParameterError(f"frequencies [Hz] must be > 0, got {freq[freq <= 0][0]:g}")
+        ph = (np.zeros_like(amp) if self.phases is None
+              else finite_array("phases [rad]", self.phases, (amp.size,)))
+        object.__setattr__(self, "amplitudes", tuple(amp.tolist()))
+        object.__setattr__(self, "frequencies", tuple(freq.tolist()))
+        object.__setattr__(self, "phases", tuple(ph.tolist()))
+        _axis(self.axis)
+
+    @property
+    def max_step(self) -> float:
+        return 0.05 / max(self.frequencies)
+
+    def acceleration(self, t):
+        t = np.asarray(t, dtype=float)
+        a = np.zeros(t.shape)
+        for amp, f, ph in zip(self.amplitudes, self.frequencies, self.phases, strict=True):
+            a = a + amp * np.sin(2 * np.pi * f * t + ph)
+        out = np.zeros(t.shape + (2,))
+        out[..., _axis(self.axis)] = a
+        return out
+
+    def describe(self) -> str:
+        return (f"sum of {len(self.amplitudes)} sines along {self.axis}, "
+                f"{min(self.frequencies):g}–{max(self.frequencies):g} Hz")
+
+
+@dataclass(frozen=True)
+class MeasuredProfile(Disturbance):
+    """A measured platform acceleration, linearly interpolated between samples.
+
+    Zero before the first and after the last sample.
+
+    Parameters
+    ----------
+    time : array_like, shape (S,)
+        Sample times, strictly increasing. [s]
+    acceleration_x : array_like, shape (S,)
+        ẍ_d. [m/s²]
+    acceleration_y : array_like, shape (S,), optional
+        ÿ_d; zeros by default. [m/s²]
+    source : str
+        Where the profile came from (file name).
+    """
+
+    time: np.ndarray
+    acceleration_x: np.ndarray
+    acceleration_y: np.ndarray | None = None
+    source: str = ""
+    _max_step: float = field(default=math.inf, init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        t = finite_array("time [s]", self.time, (None,))
+        if t.size < 2:
+            raise ParameterError(f"time [s] must have at least 2 samples, got {t.size}")
+        dt = np.diff(t)
+        if np.any(dt <= 0):
+            i = int(np.argmax(dt <= 0))
+            raise ParameterError(
+                f"time [s] must be strictly increasing; sample {i + 2} ({t[i + 1]:g}) "
+                f"follows {t[i]:g}"
+            )
+        ax = finite_array("acceleration_x [m/s²]", self.acceleration_x, (t.size,))
+        ay = (np.zeros_like(t) if self.acceleration_y is None
+              else finite_array("acceleration_y [m/s²]", self.acceleration_y, (t.size,)))
+        for name, arr in (("time", t), ("acceleration_x", ax), ("acceleration_y", ay)):
+            arr.setflags(write=False)
+            object.__setattr__(self, name, arr)
+        object.__setattr__(self, "_max_step", float(dt.min()))
+
+    @property
+    def breakpoints(self) -> tuple[float, ...]:
+        return tuple(self.time.tolist())
+
+    @property
+    def max_step(self) -> float:
+        return self._max_step
+
+    def acceleration(self, t):
+        t = np.asarray(t, dtype=float)
+        out = np.zeros(t.shape + (2,))
+        out[..., 0] = np.interp(t, self.time, self.acceleration_x, left=0.0, right=0.0)
+        out[..., 1] = np.interp(t, self.time, self.acceleration_y, left=0.0, right=0.0)
+        return out
+
+    def describe(self) -> str:
+        src = f" from {self.source}" if self.source else ""
+        return (f"measured acceleration profile{src}: {self.time.size} samples, "
+                f"{self.time[0]:g}–{self.time[-1]:g} s")
+
+
+@dataclass(frozen=True)
+class CombinedDisturbance(Disturbance):
+    """The sum of several disturbances (e.g. a horizontal and a vertical one)."""
+
+    parts: tuple[Disturbance, ...]
+
+    @property
+    def velocity_change(self) -> tuple[float, float]:  # type: ignore[override]
+        v = np.sum([p.velocity_change for p in self.parts], axis=0)
+        return (float(v[0]), float(v[1]))
+
+    @property
+    def breakpoints(self) -> tuple[float, ...]:
+        return tuple(sorted({b for p in self.parts for b in p.breakpoints}))
+
+    @property
+    def max_step(self) -> float:
+        return min((p.max_step for p in self.parts), default=math.inf)
+
+    def acceleration(self, t):
+        return sum(p.acceleration(t) for p in self.parts)
+
+    def describe(self) -> str:
+        return " + ".join(p.describe() for p in self.parts)
+
+
+def combine(*parts: Disturbance) -> Disturbance:
+    """One disturbance from several (a single part is returned as it is)."""
+    if len(parts) == 1:
+        return parts[0]
+    return CombinedDisturbance(tuple(parts))
+
+
+REQUIRED_COLUMNS = ("time", "x_acceleration")
+
+
+def read_profile_csv(path: str | Path) -> MeasuredProfile:
+    """Read a measured platform profile from CSV.
+
+    The file has a header row. Columns, by header name: ``time`` [s],
+    ``x_acceleration`` [m/s²] and optionally ``y_acceleration`` [m/s²]
+    (the aliases ``t``, ``ax``/``xdd`` and ``ay``/``ydd`` are accepted; a
+    ``[unit]`` suffix such as ``time [s]`` is ignored). Time must be strictly
+    increasing and no value may be NaN or missing.
+
+    Raises
+    ------
+    DataFileError
+        With the file name, row and column of the first problem.
+    """
+    path = Path(path)
+    try:
+        with path.open(newline="") as fh:
+            rows = list(csv.reader(fh))
+    except OSError as exc:
+        raise DataFileError(f"cannot read platform profile {str(path)!r}: {exc.strerror}") from None
+    except UnicodeDecodeError:
+        raise DataFileError(f"platform profile {str(path)!r} is not a text CSV file") from None
+    rows = [r for r in rows if r and any(c.strip() for c in r)]
+    if len(rows) < 3:
+        raise DataFileError(
+            f"platform profile {str(path)!r} needs a header row and at least 2 samples"
+        )
+    aliases = {
+        "time": "time", "t": "time",
+        "x_acceleration": "x_acceleration", "ax": "x_acceleration", "xdd": "x_acceleration",
+        "y_acceleration": "y_acceleration", "ay": "y_acceleration", "ydd": "y_acceleration",
+    }
+    header = [aliases.get(h.split("[")[0].strip().lower(), h.strip()) for h in rows[0]]
+    missing = [c for c in REQUIRED_COLUMNS if c not in header]
+    if missing:
+        raise DataFileError(
+            f"platform profile {str(path)!r} lacks column {missing[0]!r}; needs columns "
+            f"time [s], x_acceleration [m/s²] and optionally y_acceleration [m/s²]; "
+            f"found {', '.join(rows[0])}"
+        )
+    idx = {name: header.index(name) for name in ("time", "x_acceleration", "y_acceleration")
+           if name in header}
+    data = {name: [] for name in idx}
+    for lineno, r in enumerate(rows[1:], start=2):
+        for name, j in idx.items():
+            try:
+                v = float(r[j])
+            except (IndexError, ValueError):
+                raise DataFileError(
+                    f"platform profile {str(path)!r} line {lineno}: column {name!r} is not a "
+                    f"number ({r[j] if j < len(r) else 'missing'!r})"
+                ) from None
+            if not math.isfinite(v):
+                raise DataFileError(
+                    f"platform profile {str(path)!r} line {lineno}: column {name!r} is {v}; "
+                    "NaN and inf are not allowed"
+                )
+            data[name].append(v)
+    t = np.array(data["time"])
+    bad = np.nonzero(np.diff(t) <= 0)[0]
+    if bad.size:
+        i = int(bad[0])
+        raise DataFileError(
+            f"platform profile {str(path)!r} line {i + 3}: time {t[i + 1]:g} s does not "
+            f"increase (previous {t[i]:g} s); time must be strictly increasing"
+        )
+    return MeasuredProfile(
+        t, np.array(data["x_acceleration"]),
+        np.array(data["y_acceleration"]) if "y_acceleration" in data else None,
+        source=path.name,
+    )
+
+
+def sample_profile(disturbance: Disturbance, time: Sequence[float]) -> np.ndarray:
+    """Acceleration of ``disturbance`` sampled at ``time`` [s], shape (T, 2). [m/s²]"""
+    return disturbance.acceleration(np.asarray(time, dtype=float))

@@ -1,0 +1,192 @@
+"""Frozen result objects with units on every field, and their export."""
+
+from __future__ import annotations
+
+import csv
+import io
+import os
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .errors import PostureLabError
+
+__all__ = ["SimulationResult", "atomic_write_text", "atomic_write_bytes"]
+
+
+@dataclass(frozen=True)
+class SimulationResult:
+    """The outcome of one nonlinear simulation; arrays have time as the first axis.
+
+    Attributes
+    ----------
+    time : numpy.ndarray, shape (T,)
+        Output sample times. [s]
+    theta : numpy.ndarray, shape (T, N)
+        Absolute link angles, forward positive. [rad]
+    omega : numpy.ndarray, shape (T, N)
+        Link angular rates. [rad/s]
+    pair_torques : numpy.ndarray, shape (T, P)
+        Muscle-pair torques M (zero while a one-sided pair is slack). [N·m]
+    joint_torques : numpy.ndarray, shape (T, N)
+        Generalised torques U = −EᵀM on the link angles. [N·m]
+    joint_moments : numpy.ndarray, shape (T, N)
+        Net muscle moment at the ankle, knee, hip, …: the sum of the torques of
+        the pairs that cross each joint. [N·m]
+    cog_position : numpy.ndarray, shape (T, 2)
+        Centre of gravity (x_c, y_c) relative to the ankle. [m]
+    cog_velocity : numpy.ndarray, shape (T, 2)
+        Its velocity relative to the ankle (ẋ_c, ẏ_c). [m/s]
+    platform_acceleration : numpy.ndarray, shape (T, 2)
+        (ẍ_d, ÿ_d). [m/s²]
+    platform_velocity : numpy.ndarray, shape (T, 2)
+        (ẋ_d, ẏ_d), including any velocity step at t = 0. [m/s]
+    platform_position : numpy.ndarray, shape (T, 2)
+        (x_d, y_d) from 0 at t = 0. [m]
+    pair_names : tuple of str
+        Names of the pairs, in column order of ``pair_torques``.
+    status : str
+        "completed" (ran to the end), "fell" (a fall criterion fired) or
+        "failed" (the integrator failed or the state diverged).
+    message : str
+        What happened, in words.
+    fell : bool
+        True when a fall criterion fired.
+    fall_time : float or None
+        Time of the fall event. [s]
+    fall_reason : str or None
+        Which criterion fired.
+    switch_times : tuple of float
+        Times at which a one-sided pair or the knee stop switched. [s]
+    description : str
+        The run's set-up in words (body, muscles, disturbance).
+    """
+
+    time: np.ndarray
+    theta: np.ndarray
+    omega: np.ndarray
+    pair_torques: np.ndarray
+    joint_torques: np.ndarray
+    joint_moments: np.ndarray
+    cog_position: np.ndarray
+    cog_velocity: np.ndarray
+    platform_acceleration: np.ndarray
+    platform_velocity: np.ndarray
+    platform_position: np.ndarray
+    pair_names: tuple[str, ...]
+    status: str
+    message: str
+    fell: bool
+    fall_time: float | None
+    fall_reason: str | None
+    switch_times: tuple[float, ...] = ()
+    description: str = ""
+
+    @property
+    def n_links(self) -> int:
+        """Number of links N. [-]"""
+        return int(self.theta.shape[1])
+
+    @property
+    def success(self) -> bool:
+        """True unless the integration failed (a fall is a successful simulation)."""
+        return self.status != "failed"
+
+    @property
+    def state(self) -> np.ndarray:
+        """``[Θ, Θ̇]`` at every sample, shape (T, 2N). [rad], [rad/s]"""
+        return np.concatenate([self.theta, self.omega], axis=1)
+
+    @property
+    def final_state(self) -> np.ndarray:
+        """State at the last sample, shape (2N,). [rad], [rad/s]"""
+        return self.state[-1]
+
+    @property
+    def max_abs_theta(self) -> np.ndarray:
+        """Peak |θ_i| over the run, shape (N,). [rad]"""
+        return np.abs(self.theta).max(axis=0)
+
+    def settling_time(self, tolerance: float = 0.01) -> float | None:
+        """Last time any |θ_i| exceeded ``tolerance`` [rad]; None if it never settled. [s]"""
+        outside = np.any(np.abs(self.theta) > tolerance, axis=1)
+        if self.fell or outside[-1]:
+            return None
+        if not outside.any():
+            return 0.0
+        return float(self.time[np.nonzero(outside)[0][-1]])
+
+    def summary(self) -> dict:
+        """Plain-Python summary (the CLI's ``--json``): angles [rad], times [s]."""
+        return {
+            "fell": bool(self.fell),
+            "fall_time": None if self.fall_time is None else float(self.fall_time),
+            "status": self.status,
+            "max_abs_theta": [float(x) for x in self.max_abs_theta],
+            "final_state": [float(x) for x in self.final_state],
+        }
+
+    def columns(self) -> tuple[list[str], np.ndarray]:
+        """CSV column names (with units documented in the README) and the data table."""
+        n = self.n_links
+        names = ["t"] + [f"theta{i + 1}" for i in range(n)] + [f"omega{i + 1}" for i in range(n)]
+        cols = [self.time[:, None], self.theta, self.omega]
+        names += [f"M_{p}" for p in self.pair_names]
+        cols.append(self.pair_torques)
+        names += [f"U{i + 1}" for i in range(n)]
+        cols.append(self.joint_torques)
+        names += [f"joint_moment{i + 1}" for i in range(n)]
+        cols.append(self.joint_moments)
+        names += ["cog_x", "cog_y", "cog_vx", "cog_vy",
+                  "platform_ax", "platform_ay", "platform_vx", "platform_vy",
+                  "platform_x", "platform_y"]
+        cols += [self.cog_position, self.cog_velocity, self.platform_acceleration,
+                 self.platform_velocity, self.platform_position]
+        return names, np.concatenate(cols, axis=1)
+
+    def to_csv_text(self) -> str:
+        """The CSV as text: a header row, then one row per output sample."""
+        names, table = self.columns()
+        buf = io.StringIO()
+        w = csv.writer(buf, lineterminator="\n")
+        w.writerow(names)
+        for row in table:
+            w.writerow([f"{v:.10g}" for v in row])
+        return buf.getvalue()
+
+    def to_csv(self, path: str | Path) -> None:
+        """Write the CSV atomically (temporary file, then rename)."""
+        atomic_write_text(path, self.to_csv_text())
+
+
+def _atomic_write(path: str | Path, data: bytes) -> None:
+    path = Path(path)
+    directory = path.parent if str(path.parent) else Path(".")
+    if not directory.is_dir():
+        raise PostureLabError(f"cannot write {str(path)!r}: directory {str(directory)!r} does not exist")
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=directory)
+    except OSError as exc:
+        raise PostureLabError(f"cannot write {str(path)!r}: {exc.strerror}") from None
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
+        os.replace(tmp, path)
+    except OSError as exc:
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
+        raise PostureLabError(f"cannot write {str(path)!r}: {exc.strerror}") from None
+
+
+def atomic_write_text(path: str | Path, text: str) -> None:
+    """Write ``text`` to ``path`` through a temporary file and a rename."""
+    _atomic_write(path, text.encode("utf-8"))
+
+
+def atomic_write_bytes(path: str | Path, data: bytes) -> None:
+    """Write ``data`` to ``path`` through a temporary file and a rename."""
+    _atomic_write(path, data)
