@@ -50,6 +50,13 @@ __all__ = [
 
 KneeMode = Literal["free", "locked", "stop"]
 
+#: A one-sided pair switches when its stretch passes 0 by this much, and the knee stop engages
+#: this far past its angle: a hysteresis far below any physical resolution that stops a pair
+#: or knee resting exactly at its switch point from switching back and forth. [rad]
+_SWITCH_HYSTERESIS = 1e-12
+#: The knee stop lets go when the free knee acceleration pulls away by more than this. [rad/s²]
+_RELEASE_HYSTERESIS = 1e-9
+
 #: Winter (2009), Biomechanics and Motor Control of Human Movement, 4th ed., Fig. 4.1 / Table 4.1:
 #: foot length = 0.152 × body height. [-]
 FOOT_LENGTH_FRACTION_OF_HEIGHT = 0.152
@@ -385,23 +392,25 @@ def simulate(
                 events.append(ev)
                 kinds.append(("fall", f"centre of gravity passed the {what}"))
         for p in one_sided:
-            def ev_p(tt, xx, _p=p):
-                return E[_p] @ xx[:n]
-            # an acting pair waits for its stretch to fall below 0, a slack one to rise above
+            # An acting pair waits for its stretch to fall below 0, a slack one to rise above.
+            # The tiny hysteresis keeps a pair resting at zero stretch from re-firing.
+            sign = 1.0 if active[p] else -1.0
+            def ev_p(tt, xx, _p=p, _s=sign):
+                return E[_p] @ xx[:n] + _s * _SWITCH_HYSTERESIS
             ev_p.terminal, ev_p.direction = True, (-1 if active[p] else 1)
             events.append(ev_p)
             kinds.append(("pair", int(p)))
         if knee.mode == "stop":
             if not locked:
                 def ev_knee(tt, xx):
-                    return (xx[1] - xx[0]) - knee.stop_angle
+                    return (xx[1] - xx[0]) - knee.stop_angle - _SWITCH_HYSTERESIS
                 ev_knee.terminal, ev_knee.direction = True, 1
                 events.append(ev_knee)
                 kinds.append(("knee-hit", None))
             else:
                 def ev_release(tt, xx, _active=active):
                     _, acc = model.free_acceleration(tt, xx, _active)
-                    return acc[1] - acc[0]
+                    return acc[1] - acc[0] + _RELEASE_HYSTERESIS
                 ev_release.terminal, ev_release.direction = True, -1
                 events.append(ev_release)
                 kinds.append(("knee-release", None))

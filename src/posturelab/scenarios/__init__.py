@@ -1,0 +1,412 @@
+"""Scenario files (TOML) and the paper's experiments as built-in scenarios.
+
+A scenario names everything one simulation needs: body, muscle pairs (or a
+Table I case), disturbance, duration, initial state, knee model, fall
+criteria and solver settings. Unknown keys are rejected with the key named.
+
+Schema (every table optional except where noted; units in brackets)::
+
+    name = "paper-backward-case1"
+    description = "..."
+    source = "Figs. 3–7"
+    duration = 5.0                       # [s] (required)
+
+    [body]
+    preset = "paper"                     # or: segments = [{name, mass, length, com_distance, inertia}, ...]
+    gravity = 9.81                       # [m/s²]
+
+    [muscles]
+    case = "1"                           # Table I; or stiffness = [5 values] [N·m/rad];
+                                         # or pairs = [{name, lo, hi, stiffness, viscosity, one_sided}]
+    viscosity_ratio = 0.25               # [s]
+    gastrocnemius = "two-sided"          # or "one-sided"
+
+    [disturbance]                        # or [[disturbance]] several, summed
+    type = "velocity-step"               # velocity-step | half-sine | ramp-and-hold | sum-of-sines | profile | none
+    velocity = -1.0                      # velocity-step [m/s]; or direction = "backward"/"forward" and speed [m/s]
+    axis = "x"                           # x (horizontal) or y (vertical)
+    # half-sine: peak_acceleration [m/s²], duration [s], start [s]
+    # ramp-and-hold: displacement [m], duration [s], start [s]
+    # sum-of-sines: amplitudes [m/s²], frequencies [Hz], phases [rad]
+    # profile: file = "profile.csv" (relative to the scenario file)
+
+    [initial]
+    posture = [0.1, -0.1, 0.1]           # [rad]
+    rates = [0.0, 0.0, 0.0]              # [rad/s], before any velocity step
+    rates_from = "upright"               # where J⁻¹H is evaluated for a velocity step
+
+    [knee]
+    mode = "free"                        # free | locked | stop
+    stop_angle = 0.0                     # [rad]
+
+    [fall]
+    max_link_angle = 1.0471975511965976  # [rad]
+    base_of_support = "none"             # none | literature | {heel = -0.06, toe = 0.19} [m]
+
+    [solver]
+    rtol = 1e-8
+    atol = 1e-10
+    sample_rate = 1000.0                 # [Hz]
+    method = "DOP853"
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import dataclass, replace
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .._validation import finite_array, finite_float, reject_unknown_keys
+from ..body import Body, Segment, get_body
+from ..errors import ParameterError, PostureLabError, ScenarioError
+from ..muscles import MusclePair, MuscleSet, paper_muscles
+from ..platform import (
+    Disturbance,
+    HalfSinePulse,
+    NoDisturbance,
+    RampAndHold,
+    SumOfSines,
+    VelocityStep,
+    combine,
+    read_profile_csv,
+)
+from ..results import SimulationResult
+from ..simulate import (
+    FOOT_FROM_LITERATURE,
+    BaseOfSupport,
+    FallCriteria,
+    KneeModel,
+    simulate,
+)
+
+__all__ = [
+    "Scenario",
+    "load_scenario",
+    "parse_scenario",
+    "builtin_scenario",
+    "builtin_scenario_names",
+]
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """Everything one simulation needs.
+
+    Attributes
+    ----------
+    name : str
+    description : str
+    source : str
+        The paper figure or lab protocol it reproduces.
+    body : Body
+    muscles : MuscleSet
+    disturbance : Disturbance
+    duration : float
+        [s]
+    initial_state : numpy.ndarray or None
+        ``[Θ, Θ̇]`` before any velocity step. [rad], [rad/s]
+    rates_from : str
+        "upright" or "posture" (see :func:`posturelab.simulate.initial_state_for`).
+    knee : KneeModel
+    fall : FallCriteria
+    rtol, atol : float
+        Integrator tolerances. [-], [rad, rad/s]
+    sample_rate : float
+        [Hz]
+    method : str
+        scipy solve_ivp method.
+    case : str or None
+        The Table I case, when the muscles come from one.
+    """
+
+    name: str
+    description: str
+    source: str
+    body: Body
+    muscles: MuscleSet
+    disturbance: Disturbance
+    duration: float
+    initial_state: np.ndarray | None
+    rates_from: str
+    knee: KneeModel
+    fall: FallCriteria
+    rtol: float = 1e-8
+    atol: float = 1e-10
+    sample_rate: float = 1000.0
+    method: str = "DOP853"
+    case: str | None = None
+
+    def run(self, **overrides: Any) -> SimulationResult:
+        """Simulate this scenario; keyword ``overrides`` replace fields first."""
+        sc = self.replace(**overrides) if overrides else self
+        return simulate(
+            sc.body, sc.muscles, sc.disturbance, sc.duration,
+            initial_state=sc.initial_state, rates_from=sc.rates_from, knee=sc.knee,
+            fall=sc.fall, rtol=sc.rtol, atol=sc.atol, sample_rate=sc.sample_rate,
+            method=sc.method, description=sc.description,
+        )
+
+    def replace(self, **changes: Any) -> Scenario:
+        """A copy with some fields changed; unknown field names are rejected."""
+        fields = set(self.__dataclass_fields__)
+        reject_unknown_keys("Scenario.replace()", changes, fields)
+        return replace(self, **changes)
+
+
+TOP_KEYS = ("name", "description", "source", "duration", "body", "muscles", "disturbance",
+            "initial", "knee", "fall", "solver")
+
+
+def load_scenario(path: str | Path) -> Scenario:
+    """Read a scenario TOML file.
+
+    Raises
+    ------
+    ScenarioError
+        Malformed TOML, an unknown key (named), or a bad value (field named).
+    """
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise ScenarioError(f"cannot read scenario {str(path)!r}: {exc.strerror}") from None
+    except UnicodeDecodeError:
+        raise ScenarioError(f"scenario {str(path)!r} is not UTF-8 text") from None
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ScenarioError(f"scenario {str(path)!r} is not valid TOML: {exc}") from None
+    return parse_scenario(data, base_dir=path.parent, origin=str(path))
+
+
+def parse_scenario(data: dict, base_dir: Path | None = None, origin: str = "scenario") -> Scenario:
+    """Build a :class:`Scenario` from a parsed TOML mapping (see the module schema)."""
+    try:
+        return _parse(data, base_dir or Path("."), origin)
+    except ScenarioError:
+        raise
+    except PostureLabError as exc:
+        raise ScenarioError(f"{origin}: {exc}") from None
+
+
+def _table(data: dict, key: str, allowed: tuple[str, ...], origin: str) -> dict:
+    value = data.get(key, {})
+    if not isinstance(value, dict):
+        raise ScenarioError(f"{origin}: [{key}] must be a table")
+    _reject(value, allowed, f"[{key}]", origin)
+    return value
+
+
+def _reject(d: dict, allowed, where: str, origin: str) -> None:
+    unknown = [k for k in d if k not in allowed]
+    if unknown:
+        raise ScenarioError(
+            f"{origin}: unknown key {unknown[0]!r} in {where}; allowed: {', '.join(allowed)}"
+        )
+
+
+def _parse(data: dict, base_dir: Path, origin: str) -> Scenario:
+    _reject(data, TOP_KEYS, "the top level", origin)
+    if "duration" not in data:
+        raise ScenarioError(f"{origin}: missing required key 'duration' [s]")
+    duration = finite_float("duration [s]", data["duration"])
+    if duration <= 0:
+        raise ScenarioError(f"{origin}: duration [s] must be > 0, got {duration:g}")
+
+    body = _parse_body(_table(data, "body", ("preset", "segments", "gravity"), origin), origin)
+    mt = _table(data, "muscles", ("case", "stiffness", "pairs", "viscosity_ratio",
+                                  "gastrocnemius"), origin)
+    muscles, case = _parse_muscles(mt, body, origin)
+    disturbance = _parse_disturbances(data.get("disturbance"), base_dir, origin)
+
+    it = _table(data, "initial", ("posture", "rates", "rates_from"), origin)
+    n = body.n_links
+    initial = None
+    if "posture" in it or "rates" in it:
+        posture = finite_array("initial.posture [rad]", it.get("posture", [0.0] * n), (n,))
+        rates = finite_array("initial.rates [rad/s]", it.get("rates", [0.0] * n), (n,))
+        initial = np.concatenate([posture, rates])
+    rates_from = it.get("rates_from", "upright")
+    if rates_from not in ("upright", "posture"):
+        raise ScenarioError(f"{origin}: initial.rates_from must be 'upright' or 'posture', "
+                            f"got {rates_from!r}")
+
+    kt = _table(data, "knee", ("mode", "stop_angle"), origin)
+    knee = KneeModel(kt.get("mode", "free"), kt.get("stop_angle", 0.0))
+
+    ft = _table(data, "fall", ("max_link_angle", "base_of_support"), origin)
+    bos_spec = ft.get("base_of_support", "none")
+    if bos_spec == "none":
+        bos = None
+    elif bos_spec == "literature":
+        bos = FOOT_FROM_LITERATURE
+    elif isinstance(bos_spec, dict):
+        _reject(bos_spec, ("heel", "toe"), "fall.base_of_support", origin)
+        if "heel" not in bos_spec or "toe" not in bos_spec:
+            raise ScenarioError(f"{origin}: fall.base_of_support needs heel and toe [m]")
+        bos = BaseOfSupport(bos_spec["heel"], bos_spec["toe"], source=origin)
+    else:
+        raise ScenarioError(f"{origin}: fall.base_of_support must be 'none', 'literature' or "
+                            f"{{heel = …, toe = …}}, got {bos_spec!r}")
+    fall = FallCriteria(ft.get("max_link_angle", math.pi / 3), bos)
+
+    st = _table(data, "solver", ("rtol", "atol", "sample_rate", "method"), origin)
+    method = st.get("method", "DOP853")
+    if method not in ("DOP853", "RK45", "RK23", "Radau", "BDF", "LSODA"):
+        raise ScenarioError(f"{origin}: solver.method must be one of DOP853, RK45, RK23, Radau, "
+                            f"BDF, LSODA; got {method!r}")
+    return Scenario(
+        name=str(data.get("name", Path(origin).stem)),
+        description=str(data.get("description", "")),
+        source=str(data.get("source", "")),
+        body=body, muscles=muscles, disturbance=disturbance, duration=duration,
+        initial_state=initial, rates_from=rates_from, knee=knee, fall=fall,
+        rtol=finite_float("solver.rtol", st.get("rtol", 1e-8)),
+        atol=finite_float("solver.atol", st.get("atol", 1e-10)),
+        sample_rate=finite_float("solver.sample_rate [Hz]", st.get("sample_rate", 1000.0)),
+        method=method, case=case,
+    )
+
+
+def _parse_body(bt: dict, origin: str) -> Body:
+    if "preset" in bt and "segments" in bt:
+        raise ScenarioError(f"{origin}: [body] takes preset or segments, not both")
+    gravity = bt.get("gravity")
+    if "segments" in bt:
+        segs = bt["segments"]
+        if not isinstance(segs, list) or not segs:
+            raise ScenarioError(f"{origin}: body.segments must be a non-empty array of tables")
+        out = []
+        for i, s in enumerate(segs):
+            if not isinstance(s, dict):
+                raise ScenarioError(f"{origin}: body.segments[{i}] must be a table")
+            keys = ("name", "mass", "length", "com_distance", "inertia")
+            _reject(s, keys, f"body.segments[{i}]", origin)
+            missing = [k for k in keys[1:] if k not in s]
+            if missing:
+                raise ScenarioError(f"{origin}: body.segments[{i}] lacks {missing[0]!r}")
+            out.append(Segment(str(s.get("name", f"link{i + 1}")), s["mass"], s["length"],
+                               s["com_distance"], s["inertia"]))
+        body = Body(tuple(out), name="scenario")
+    else:
+        body = get_body(str(bt.get("preset", "paper")))
+    if gravity is not None:
+        body = body.with_gravity(gravity)
+    return body
+
+
+def _parse_muscles(mt: dict, body: Body, origin: str) -> tuple[MuscleSet, str | None]:
+    given = [k for k in ("case", "stiffness", "pairs") if k in mt]
+    if len(given) != 1:
+        raise ScenarioError(f"{origin}: [muscles] needs exactly one of case, stiffness, pairs")
+    if "pairs" in mt:
+        pairs = []
+        for i, p in enumerate(mt["pairs"]):
+            if not isinstance(p, dict):
+                raise ScenarioError(f"{origin}: muscles.pairs[{i}] must be a table")
+            keys = ("name", "lo", "hi", "stiffness", "viscosity", "one_sided")
+            _reject(p, keys, f"muscles.pairs[{i}]", origin)
+            for k in ("lo", "hi", "stiffness"):
+                if k not in p:
+                    raise ScenarioError(f"{origin}: muscles.pairs[{i}] lacks {k!r}")
+            ratio = finite_float("muscles.viscosity_ratio [s]", mt.get("viscosity_ratio", 0.25))
+            visc = p.get("viscosity", ratio * finite_float("stiffness", p["stiffness"]))
+            pairs.append(MusclePair(str(p.get("name", f"pair{i + 1}")), p["lo"], p["hi"],
+                                    p["stiffness"], visc, bool(p.get("one_sided", False))))
+        return MuscleSet(tuple(pairs), body.n_links), None
+    if body.n_links != 3:
+        raise ScenarioError(f"{origin}: muscles.case / muscles.stiffness are the paper's five "
+                            f"pairs on 3 links; this body has {body.n_links}: use muscles.pairs")
+    case = mt.get("case")
+    return paper_muscles(
+        None if case is None else str(case), stiffness=mt.get("stiffness"),
+        viscosity_ratio=mt.get("viscosity_ratio", 0.25),
+        gastrocnemius=mt.get("gastrocnemius", "two-sided"),
+    ), (None if case is None else str(case))
+
+
+DISTURBANCE_KEYS = {
+    "none": (),
+    "velocity-step": ("velocity", "direction", "speed", "axis"),
+    "half-sine": ("peak_acceleration", "duration", "start", "axis"),
+    "ramp-and-hold": ("displacement", "duration", "start", "axis"),
+    "sum-of-sines": ("amplitudes", "frequencies", "phases", "axis"),
+    "profile": ("file",),
+}
+
+
+def _parse_disturbances(spec, base_dir: Path, origin: str) -> Disturbance:
+    if spec is None:
+        return NoDisturbance()
+    specs = spec if isinstance(spec, list) else [spec]
+    return combine(*[_parse_disturbance(s, base_dir, origin, i) for i, s in enumerate(specs)])
+
+
+def _parse_disturbance(d, base_dir: Path, origin: str, i: int) -> Disturbance:
+    if not isinstance(d, dict):
+        raise ScenarioError(f"{origin}: [disturbance] must be a table")
+    kind = d.get("type")
+    if kind not in DISTURBANCE_KEYS:
+        raise ScenarioError(f"{origin}: disturbance.type must be one of "
+                            f"{', '.join(DISTURBANCE_KEYS)}; got {kind!r}")
+    _reject(d, ("type",) + DISTURBANCE_KEYS[kind], f"[disturbance] of type {kind!r}", origin)
+    axis = d.get("axis", "x")
+    try:
+        if kind == "none":
+            return NoDisturbance()
+        if kind == "velocity-step":
+            if "velocity" in d:
+                if "direction" in d or "speed" in d:
+                    raise ScenarioError(f"{origin}: give velocity, or direction and speed")
+                return VelocityStep(d["velocity"], axis)
+            direction = d.get("direction")
+            speed = d.get("speed", 1.0)
+            if direction == "backward":
+                return VelocityStep.backward(speed)
+            if direction == "forward":
+                return VelocityStep.forward(speed)
+            raise ScenarioError(f"{origin}: velocity-step needs velocity [m/s] or direction "
+                                f"'backward'/'forward'; got direction {direction!r}")
+        if kind == "half-sine":
+            return HalfSinePulse(_need(d, "peak_acceleration", origin),
+                                 _need(d, "duration", origin), d.get("start", 0.0), axis)
+        if kind == "ramp-and-hold":
+            return RampAndHold(_need(d, "displacement", origin), _need(d, "duration", origin),
+                               d.get("start", 0.0), axis)
+        if kind == "sum-of-sines":
+            return SumOfSines(tuple(_need(d, "amplitudes", origin)),
+                              tuple(_need(d, "frequencies", origin)),
+                              None if "phases" not in d else tuple(d["phases"]), axis)
+        file = Path(str(_need(d, "file", origin)))
+        return read_profile_csv(file if file.is_absolute() else base_dir / file)
+    except ParameterError as exc:
+        raise ScenarioError(f"{origin}: disturbance: {exc}") from None
+
+
+def _need(d: dict, key: str, origin: str):
+    if key not in d:
+        raise ScenarioError(f"{origin}: disturbance of type {d.get('type')!r} lacks {key!r}")
+    return d[key]
+
+
+def builtin_scenario_names() -> list[str]:
+    """Names of the scenarios shipped with posturelab."""
+    root = resources.files(__package__) / "builtin"
+    return sorted(p.name[:-5] for p in root.iterdir() if p.name.endswith(".toml"))
+
+
+def builtin_scenario(name: str) -> Scenario:
+    """A shipped scenario by name; an unknown name lists the known ones."""
+    from ..errors import UnknownNameError
+
+    names = builtin_scenario_names()
+    if name not in names:
+        raise UnknownNameError(f"unknown built-in scenario {name!r}; known: {', '.join(names)}")
+    res = resources.files(__package__) / "builtin" / f"{name}.toml"
+    with resources.as_file(res) as path:
+        return load_scenario(path)
