@@ -298,7 +298,8 @@ def simulate(
     Returns
     -------
     SimulationResult
-        A fall is reported in ``fell``/``fall_time``/``status``; a failed
+        A fall is reported in ``fell``/``fall_time``/``status`` and the
+        state at the fall is the last sample (off the regular grid); a failed
         integration in ``status == "failed"`` with a ``message``.
     """
     disturbance = NoDisturbance() if disturbance is None else disturbance
@@ -446,6 +447,10 @@ def simulate(
             x = sol.y_events[fired[0]][-1].copy()
             t = seg_end
             if kind == "fall":
+                # the state at the fall itself closes the series (it is off the sample grid)
+                if not times or times[-1][-1] < seg_end - 1e-12:
+                    times.append(np.array([seg_end]))
+                    states.append(x[None, :])
                 fell, fall_time, fall_reason = True, seg_end, info
                 status = "fell"
                 message = f"fell at t = {seg_end:.4f} s: {info}"

@@ -1,0 +1,231 @@
+"""``posturelab simulate``: one nonlinear simulation, to CSV / JSON / PNG / GIF."""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+
+import numpy as np
+
+from ..body import paper_body
+from ..errors import ParameterError
+from ..paper import BACKWARD_INITIAL_STATE
+from ..platform import NoDisturbance, VelocityStep, read_profile_csv
+from ..scenarios import Scenario, builtin_scenario, builtin_scenario_names, load_scenario
+from ..simulate import FOOT_FROM_LITERATURE, BaseOfSupport, FallCriteria, KneeModel
+from . import CONVENTIONS_EPILOG, UsageError
+from ._common import add_muscle_arguments, muscles_from_args, parse_float_list, print_json
+
+DESCRIPTION = """\
+Simulate the paper's three-link biped (or a scenario file) under muscle-pair feedback
+and platform motion, with adaptive Runge–Kutta integration (scipy DOP853).
+
+Disturbances: --disturbance backward|forward is the paper's "unit impulse", a sudden
+platform velocity change of --speed m/s (default 1); the link rates jump by
+−J⁻¹H·Δẋ_d (J⁻¹H at upright as the paper does; --rates-from posture for the exact
+value). These start from the paper's slightly flexed posture [0.1, −0.1, 0.1] rad
+unless --initial-posture is given. --platform-profile FILE.csv reads a measured
+acceleration (columns time [s], x_acceleration [m/s²], optional y_acceleration
+[m/s²]) and starts upright at rest unless told otherwise.
+
+A fall is any |θ_i| beyond --max-link-angle (default 1.047 rad = 60°) or, with
+--foot, the centre of gravity leaving the base of support; the run stops there.
+Output CSV columns: t [s], theta1..3 [rad], omega1..3 [rad/s], M_<pair> [N·m],
+U1..3 [N·m], joint_moment1..3 [N·m], cog_x, cog_y [m], cog_vx, cog_vy [m/s],
+platform_ax, platform_ay [m/s²], platform_vx, platform_vy [m/s], platform_x,
+platform_y [m].
+"""
+
+
+def add_parser(sub, name: str) -> argparse.ArgumentParser:
+    p = sub.add_parser(
+        name, help="simulate a platform disturbance (nonlinear model)",
+        description=DESCRIPTION, epilog=CONVENTIONS_EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    src = p.add_argument_group("what to simulate")
+    src.add_argument("--scenario", metavar="FILE.toml",
+                     help="a scenario file (see the README); replaces the model options below.")
+    src.add_argument("--builtin", metavar="NAME",
+                     help="a built-in scenario: " + ", ".join(builtin_scenario_names()) + ".")
+    add_muscle_arguments(p)
+    src.add_argument("--disturbance", choices=["backward", "forward", "none"],
+                     help="platform velocity step of --speed m/s at t = 0 (backward: the "
+                     "platform moves back, the body sways forward).")
+    src.add_argument("--speed", type=float, default=1.0,
+                     help="size of the velocity step [m/s] (default 1).")
+    src.add_argument("--platform-profile", metavar="FILE.csv",
+                     help="measured platform acceleration (time [s], x_acceleration [m/s²], "
+                     "optional y_acceleration [m/s²]).")
+    src.add_argument("--initial-posture", metavar="T1,T2,T3",
+                     help="initial link angles [rad] (forward positive).")
+    src.add_argument("--initial-rates", metavar="W1,W2,W3",
+                     help="initial link rates before any velocity step [rad/s].")
+    src.add_argument("--rates-from", choices=["upright", "posture"], default="upright",
+                     help="evaluate J⁻¹H for the velocity step at upright (the paper) or at the "
+                     "initial posture (exact).")
+    src.add_argument("--knee", choices=["free", "locked", "stop"], default="free",
+                     help="free (the paper), locked (θ2 − θ1 constant), or a hyper-extension stop "
+                     "at θ2 − θ1 = 0.")
+    src.add_argument("--foot", metavar="none|literature|HEEL,TOE", default="none",
+                     help="base of support for the fall test: none (the paper; the foot never "
+                     "tips), literature (heel −0.063 m, toe 0.188 m: a 1.65 m person) or "
+                     "HEEL,TOE [m] relative to the ankle.")
+    src.add_argument("--max-link-angle", type=float, default=None, metavar="RAD",
+                     help="fall when any |θ_i| exceeds this [rad] (default π/3).")
+    run = p.add_argument_group("integration")
+    run.add_argument("--duration", type=float, default=None, help="simulated time [s] (default 5).")
+    run.add_argument("--rtol", type=float, default=None, help="relative tolerance (default 1e-8).")
+    run.add_argument("--atol", type=float, default=None,
+                     help="absolute tolerance [rad, rad/s] (default 1e-10).")
+    run.add_argument("--sample-rate", type=float, default=None,
+                     help="output samples per second [Hz] (default 1000).")
+    out = p.add_argument_group("output")
+    out.add_argument("--out", metavar="RUN.csv", help="write the time series as CSV.")
+    out.add_argument("--plot", metavar="RUN.png", help="write a 2×2 summary figure (PNG/SVG/PDF).")
+    out.add_argument("--animate", metavar="RUN.gif", help="write a stick-figure animation (GIF).")
+    out.add_argument("--json", action="store_true",
+                     help='print one JSON summary: {"fell", "fall_time", "status", '
+                     '"max_abs_theta", "final_state"}.')
+    return p
+
+
+MODEL_OPTIONS = ("case", "stiffness", "disturbance", "platform_profile", "initial_posture",
+                 "initial_rates")
+
+
+def scenario_from_args(args: argparse.Namespace) -> Scenario:
+    """Build the scenario the arguments describe (a file, a built-in, or the options)."""
+    if args.scenario and args.builtin:
+        raise UsageError("posturelab simulate: give --scenario or --builtin, not both")
+    if args.scenario or args.builtin:
+        clash = [o for o in MODEL_OPTIONS if getattr(args, o) is not None]
+        if clash:
+            raise UsageError(f"posturelab simulate: --{clash[0].replace('_', '-')} cannot be "
+                             "combined with a scenario; edit the scenario instead")
+        sc = load_scenario(args.scenario) if args.scenario else builtin_scenario(args.builtin)
+    else:
+        sc = _scenario_from_options(args)
+    overrides = {}
+    for name in ("duration", "rtol", "atol", "sample_rate"):
+        value = getattr(args, name)
+        if value is not None:
+            overrides[name] = value
+    if overrides:
+        sc = sc.replace(**overrides)
+    if args.max_link_angle is not None or args.foot != "none":
+        sc = sc.replace(fall=FallCriteria(
+            args.max_link_angle if args.max_link_angle is not None else sc.fall.max_link_angle,
+            _foot(args.foot) if args.foot != "none" else sc.fall.base_of_support))
+    if args.knee != "free":
+        sc = sc.replace(knee=KneeModel(args.knee))
+    if args.rates_from != "upright":
+        sc = sc.replace(rates_from=args.rates_from)
+    _check_numbers(sc)
+    return sc
+
+
+def _check_numbers(sc: Scenario) -> None:
+    if not (math.isfinite(sc.duration) and sc.duration > 0):
+        raise ParameterError(f"--duration [s] must be > 0, got {sc.duration:g}")
+
+
+def _foot(text: str) -> BaseOfSupport:
+    if text == "literature":
+        return FOOT_FROM_LITERATURE
+    heel, toe = parse_float_list(text, "--foot HEEL,TOE [m]", 2)
+    return BaseOfSupport(heel, toe, source="--foot")
+
+
+def _scenario_from_options(args: argparse.Namespace) -> Scenario:
+    if args.case is None and args.stiffness is None:
+        raise UsageError("posturelab simulate: give --case or --stiffness (or --scenario / "
+                         "--builtin)")
+    if args.disturbance not in (None, "none") and args.platform_profile:
+        raise UsageError("posturelab simulate: give --disturbance or --platform-profile, not both")
+    body = paper_body()
+    muscles = muscles_from_args(args)
+    n = body.n_links
+    if args.platform_profile:
+        disturbance = read_profile_csv(args.platform_profile)
+        default_posture = [0.0] * n
+    elif args.disturbance in ("backward", "forward"):
+        step = VelocityStep.backward if args.disturbance == "backward" else VelocityStep.forward
+        disturbance = step(args.speed)
+        default_posture = list(BACKWARD_INITIAL_STATE[:n])
+    else:
+        disturbance = NoDisturbance()
+        default_posture = [0.0] * n
+    posture = (parse_float_list(args.initial_posture, "--initial-posture [rad]", n)
+               if args.initial_posture else default_posture)
+    rates = (parse_float_list(args.initial_rates, "--initial-rates [rad/s]", n)
+             if args.initial_rates else [0.0] * n)
+    label = f"case {args.case}" if args.case else "custom stiffness"
+    return Scenario(
+        name="cli", description=f"{label}, {disturbance.describe()}", source="command line",
+        body=body, muscles=muscles, disturbance=disturbance, duration=5.0,
+        initial_state=np.array(posture + rates), rates_from="upright", knee=KneeModel(),
+        fall=FallCriteria(), case=args.case,
+    )
+
+
+def run(args: argparse.Namespace) -> int:
+    sc = scenario_from_args(args)
+    outputs = [p for p in (args.out, args.plot, args.animate) if p]
+    _check_writable(outputs)
+    result = sc.run()
+    if args.out:
+        result.to_csv(args.out)
+    if args.plot:
+        _save_figure(result, args.plot)
+    if args.animate:
+        from ..animation import animate
+
+        animate(result, sc.body, args.animate)
+    if args.json:
+        print_json(result.summary())
+    else:
+        peaks = ", ".join(f"{x:.4f}" for x in result.max_abs_theta)
+        print(f"{sc.description}")
+        print(f"status: {result.status} ({result.message})")
+        print(f"peak |θ| [rad]: {peaks}")
+        print("final state [rad, rad/s]: " + ", ".join(f"{x:.4g}" for x in result.final_state))
+        for path in outputs:
+            print(f"wrote {path}")
+    if result.status == "failed":
+        print(f"posturelab: warning: {result.message}", file=sys.stderr)
+        return 1
+    return 0
+
+
+def _check_writable(paths: list[str]) -> None:
+    """Fail early, before simulating, when an output's directory is missing or read-only."""
+    import os
+    from pathlib import Path
+
+    for p in paths:
+        d = Path(p).parent if str(Path(p).parent) else Path(".")
+        if not d.is_dir():
+            raise ParameterError(f"cannot write {p!r}: directory {str(d)!r} does not exist")
+        if not os.access(d, os.W_OK):
+            raise ParameterError(f"cannot write {p!r}: directory {str(d)!r} is not writable")
+        if Path(p).is_dir():
+            raise ParameterError(f"cannot write {p!r}: it is a directory")
+
+
+def _save_figure(result, path: str) -> None:
+    """Render the 2×2 overview and write it atomically (format from the suffix)."""
+    import io
+    from pathlib import Path
+
+    from ..plots import plot_run_overview
+    from ..results import atomic_write_bytes
+
+    fmt = Path(path).suffix.lstrip(".").lower() or "png"
+    if fmt not in ("png", "svg", "pdf"):
+        raise ParameterError(f"--plot must end in .png, .svg or .pdf, got {path!r}")
+    fig = plot_run_overview(result)
+    buf = io.BytesIO()
+    fig.savefig(buf, format=fmt, dpi=110)
+    atomic_write_bytes(path, buf.getvalue())

@@ -1,0 +1,112 @@
+"""Scenario files: schema, unknown keys, built-ins."""
+
+import numpy as np
+import pytest
+
+from posturelab.errors import ScenarioError, UnknownNameError
+from posturelab.platform import MeasuredProfile, VelocityStep
+from posturelab.scenarios import builtin_scenario, builtin_scenario_names, load_scenario
+
+MINIMAL = """
+duration = 2.0
+[muscles]
+case = "1"
+[disturbance]
+type = "velocity-step"
+direction = "backward"
+speed = 0.5
+"""
+
+
+def write(tmp_path, text, name="s.toml"):
+    p = tmp_path / name
+    p.write_text(text)
+    return p
+
+
+def test_builtin_scenarios_cover_the_papers_figures():
+    names = builtin_scenario_names()
+    for n in ("paper-backward-case1", "paper-forward-case1", "paper-forward-case2",
+              "paper-forward-case3"):
+        assert n in names
+    sc = builtin_scenario("paper-backward-case1")
+    assert sc.case == "1" and sc.duration == 5.0
+    assert isinstance(sc.disturbance, VelocityStep) and sc.disturbance.velocity == -1.0
+    np.testing.assert_allclose(sc.initial_state, [0.1, -0.1, 0.1, 0, 0, 0])
+    fwd = builtin_scenario("paper-forward-case1")
+    assert fwd.disturbance.velocity == 1.0
+
+
+def test_unknown_builtin_lists_known():
+    with pytest.raises(UnknownNameError, match="paper-backward-case1"):
+        builtin_scenario("nope")
+
+
+def test_minimal_scenario_runs(tmp_path):
+    sc = load_scenario(write(tmp_path, MINIMAL))
+    r = sc.run(sample_rate=100)
+    assert r.status == "completed"
+    assert r.theta[5, 0] > 0  # backward platform: forward sway
+
+
+def test_full_scenario(tmp_path):
+    (tmp_path / "prof.csv").write_text("time,x_acceleration\n0,0\n0.1,-2\n0.2,0\n")
+    text = """
+name = "custom"
+duration = 1.0
+[body]
+segments = [
+  {name = "leg", mass = 5, length = 0.4, com_distance = 0.2, inertia = 0.2},
+  {name = "trunk", mass = 50, length = 0.8, com_distance = 0.4, inertia = 3.0},
+]
+[muscles]
+pairs = [{name = "ankle", lo = 0, hi = 1, stiffness = 900}, {name = "hip", lo = 1, hi = 2, stiffness = 300, viscosity = 40}]
+[[disturbance]]
+type = "profile"
+file = "prof.csv"
+[[disturbance]]
+type = "half-sine"
+peak_acceleration = 0.5
+duration = 0.2
+axis = "y"
+[knee]
+mode = "free"
+[fall]
+base_of_support = {heel = -0.05, toe = 0.2}
+[solver]
+rtol = 1e-7
+sample_rate = 200
+"""
+    sc = load_scenario(write(tmp_path, text))
+    assert sc.body.n_links == 2
+    assert sc.muscles.viscosities[0] == pytest.approx(225.0)  # default ratio 0.25
+    assert sc.fall.base_of_support.toe == 0.2
+    assert any(isinstance(p, MeasuredProfile) for p in sc.disturbance.parts)
+    assert sc.run().time.size > 1
+
+
+@pytest.mark.parametrize("text,needle", [
+    (MINIMAL + "colour = 'red'\n", "unknown key 'colour'"),
+    (MINIMAL.replace("speed = 0.5", "speed = 0.5\nspeeed = 1"), "unknown key 'speeed'"),
+    (MINIMAL + "[fall]\nmax_angle = 1\n", "unknown key 'max_angle'"),
+    ("duration = 1\n[muscles]\ncase = '1'\n[body]\npreset = 'paper'\nheight = 2\n",
+     "unknown key 'height'"),
+    ("[muscles]\ncase = '1'\n", "duration"),
+    ("duration = -1\n[muscles]\ncase = '1'\n", "duration"),
+    ("duration = 1\n[muscles]\ncase = '12'\n", "known cases"),
+    ("duration = 1\n[muscles]\ncase = '1'\n[body]\npreset = 'giant'\n", "known presets"),
+    ("duration = 1\n[muscles]\ncase = '1'\n[disturbance]\ntype = 'earthquake'\n",
+     "disturbance.type"),
+    ("duration = 1 [\n", "not valid TOML"),
+    ("duration = 1\n[muscles]\ncase = '1'\nstiffness = [1,2,3,4,5]\n", "exactly one"),
+])
+def test_bad_scenarios(tmp_path, text, needle):
+    with pytest.raises(ScenarioError, match=needle):
+        load_scenario(write(tmp_path, text))
+
+
+def test_unknown_replace_field():
+    from posturelab.errors import ParameterError
+
+    with pytest.raises(ParameterError, match="durration"):
+        builtin_scenario("paper-forward-case1").replace(durration=2)
