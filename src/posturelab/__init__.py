@@ -10,6 +10,7 @@ from __future__ import annotations
 
 __version__ = "0.1.0"
 
+from .anthropometry import body_from_anthropometry, lump
 from .body import BODY_PRESETS, Body, Segment, get_body, paper_body
 from .dynamics import (
     angular_acceleration,
@@ -43,6 +44,7 @@ from .muscles import (
 
 __all__ = [
     "__version__",
+    "body_from_anthropometry", "lump",
     "BODY_PRESETS", "Body", "Segment", "get_body", "paper_body",
     "angular_acceleration", "gravity_vector", "kinetic_energy", "mass_matrix",
     "platform_vector", "potential_energy", "state_derivative", "velocity_step_response",
