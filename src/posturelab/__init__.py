@@ -12,6 +12,7 @@ __version__ = "0.1.0"
 
 from .anthropometry import body_from_anthropometry, lump
 from .body import BODY_PRESETS, Body, Segment, get_body, paper_body
+from .com import centre_of_gravity, centre_of_gravity_velocity, physiological_state
 from .dynamics import (
     angular_acceleration,
     gravity_vector,
@@ -41,6 +42,26 @@ from .muscles import (
     pair_torques,
     paper_muscles,
 )
+from .platform import (
+    CombinedDisturbance,
+    HalfSinePulse,
+    MeasuredProfile,
+    NoDisturbance,
+    RampAndHold,
+    SumOfSines,
+    VelocityStep,
+    read_profile_csv,
+)
+from .results import SimulationResult
+from .scenarios import Scenario, builtin_scenario, builtin_scenario_names, load_scenario
+from .simulate import (
+    FOOT_FROM_LITERATURE,
+    BaseOfSupport,
+    FallCriteria,
+    KneeModel,
+    base_of_support_for_height,
+    simulate,
+)
 
 __all__ = [
     "__version__",
@@ -54,4 +75,10 @@ __all__ = [
     "finite_difference_state_matrix", "state_matrix",
     "STIFFNESS_CASES", "MusclePair", "MuscleSet", "get_stiffness_case", "joint_torques",
     "pair_torques", "paper_muscles",
+    "centre_of_gravity", "centre_of_gravity_velocity", "physiological_state",
+    "CombinedDisturbance", "HalfSinePulse", "MeasuredProfile", "NoDisturbance", "RampAndHold",
+    "SumOfSines", "VelocityStep", "read_profile_csv",
+    "SimulationResult", "Scenario", "builtin_scenario", "builtin_scenario_names", "load_scenario",
+    "FOOT_FROM_LITERATURE", "BaseOfSupport", "FallCriteria", "KneeModel",
+    "base_of_support_for_height", "simulate",
 ]

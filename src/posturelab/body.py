@@ -134,9 +134,15 @@ class Body:
         names : sequence of str, optional
             Link names; default ``link1 … linkN``.
         """
-        arrays = [list(masses), list(lengths), list(com_distances), list(inertias)]
-        n = len(arrays[0])
         labels = ["masses", "lengths", "com_distances", "inertias"]
+        arrays = []
+        for lab, values in zip(labels, (masses, lengths, com_distances, inertias), strict=True):
+            if isinstance(values, str) or np.ndim(values) != 1:
+                raise ParameterError(
+                    f"{lab} must be a sequence with one value per link, got {values!r}"
+                )
+            arrays.append(list(values))
+        n = len(arrays[0])
         for lab, arr in zip(labels, arrays, strict=True):
             if len(arr) != n:
                 raise ParameterError(f"{lab} must have {n} entries (one per link), got {len(arr)}")

@@ -68,10 +68,34 @@ def build_parser() -> OneLineParser:
     return parser
 
 
+#: Options whose value is a comma-separated list that may start with a minus sign.
+LIST_OPTIONS = ("--posture", "--stiffness", "--initial-posture", "--initial-rates", "--foot",
+                "--viscosity")
+
+
+def _join_negative_lists(argv: list[str]) -> list[str]:
+    """Turn ``--posture -0.1,0.2,0`` into ``--posture=-0.1,0.2,0`` (argparse would take the
+    value for an option because it starts with '-')."""
+    out: list[str] = []
+    i = 0
+    while i < len(argv):
+        tok = argv[i]
+        nxt = argv[i + 1] if i + 1 < len(argv) else None
+        if tok in LIST_OPTIONS and nxt is not None and nxt.startswith("-") and len(nxt) > 1 \
+                and (nxt[1].isdigit() or nxt[1] == "."):
+            out.append(f"{tok}={nxt}")
+            i += 2
+            continue
+        out.append(tok)
+        i += 1
+    return out
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``posturelab`` console script; returns the exit code."""
     try:
         parser = build_parser()
+        argv = _join_negative_lists(list(sys.argv[1:] if argv is None else argv))
         args = parser.parse_args(argv)
         if getattr(args, "_run", None) is None:
             parser.print_help()
