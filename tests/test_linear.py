@@ -39,7 +39,7 @@ def random_body(rng, n, gravity=9.81):
     )
 
 
-def random_muscles(rng, n, one_sided=False):
+def random_muscles(rng, n):
     """1..6 random pairs (lo, hi) with 0 <= lo < hi <= n, random stiffness and viscosity."""
     spans = [(lo, hi) for hi in range(1, n + 1) for lo in range(hi)]
     count = int(rng.integers(1, 7))
@@ -47,7 +47,7 @@ def random_muscles(rng, n, one_sided=False):
     for p in range(count):
         lo, hi = spans[int(rng.integers(len(spans)))]
         pairs.append(MusclePair(f"p{p}", lo, hi, rng.uniform(0.0, 2000.0),
-                                rng.uniform(0.0, 500.0), one_sided and p == 0))
+                                rng.uniform(0.0, 500.0)))
     return MuscleSet(tuple(pairs), n)
 
 

@@ -60,7 +60,10 @@ segments = [
   {name = "trunk", mass = 50, length = 0.8, com_distance = 0.4, inertia = 3.0},
 ]
 [muscles]
-pairs = [{name = "ankle", lo = 0, hi = 1, stiffness = 900}, {name = "hip", lo = 1, hi = 2, stiffness = 300, viscosity = 40}]
+pairs = [
+  {name = "ankle", lo = 0, hi = 1, stiffness = 900},
+  {name = "hip", lo = 1, hi = 2, stiffness = 300, viscosity = 40},
+]
 [[disturbance]]
 type = "profile"
 file = "prof.csv"

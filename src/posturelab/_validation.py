@@ -82,7 +82,9 @@ def finite_array(name: str, value: Any, shape: tuple[int | None, ...] | None = N
     return arr
 
 
-def reject_unknown_keys(where: str, given: Mapping[str, Any] | Iterable[str], allowed: Iterable[str]) -> None:
+def reject_unknown_keys(
+    where: str, given: Mapping[str, Any] | Iterable[str], allowed: Iterable[str]
+) -> None:
     """Raise if ``given`` has a key that is not in ``allowed``."""
     allowed = list(allowed)
     unknown = [k for k in given if k not in allowed]

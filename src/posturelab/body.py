@@ -58,7 +58,8 @@ class Segment:
         label = f"segment {self.name!r}"
         object.__setattr__(self, "mass", positive_float(f"{label} mass [kg]", self.mass))
         object.__setattr__(self, "length", positive_float(f"{label} length [m]", self.length))
-        object.__setattr__(self, "inertia", positive_float(f"{label} inertia [kg·m²]", self.inertia))
+        inertia = positive_float(f"{label} inertia [kg·m²]", self.inertia)
+        object.__setattr__(self, "inertia", inertia)
         com = finite_float(f"{label} com_distance [m]", self.com_distance)
         if not 0.0 <= com <= self.length:
             raise ParameterError(

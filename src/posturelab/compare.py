@@ -73,9 +73,8 @@ def table2_comparison(body: Body | None = None, viscosity_ratio: float = 0.25) -
             ok = abs(pv.real - value.real) <= tol * (1 + 1e-9) and abs(
                 pv.imag - value.imag
             ) <= tol * (1 + 1e-9)
-            entries.append(
-                PoleComparison(text, complex(value), tol, bool(ok), TABLE_II_ERRATA.get((case, col)))
-            )
+            flag = TABLE_II_ERRATA.get((case, col))
+            entries.append(PoleComparison(text, complex(value), tol, bool(ok), flag))
         rows.append(Table2Row(case, STIFFNESS_CASES[case], tuple(entries), res.stable))
     return rows
 

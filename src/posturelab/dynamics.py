@@ -193,7 +193,10 @@ def velocity_step_response(
     numpy.ndarray, shape (N,)
         ΔΘ̇. [rad/s]
     """
-    if theta is None:
-        theta = np.zeros(body.n_links)
+    from ._validation import finite_array, finite_float
+
+    dv = finite_float("platform_velocity_change [m/s]", platform_velocity_change)
+    theta = (np.zeros(body.n_links) if theta is None
+             else finite_array("theta [rad]", theta, (body.n_links,)))
     J = mass_matrix(body, theta)
-    return -np.linalg.solve(J, platform_vector(body, theta)) * platform_velocity_change
+    return -np.linalg.solve(J, platform_vector(body, theta)) * dv

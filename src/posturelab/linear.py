@@ -194,6 +194,7 @@ def analyse(body: Body, muscles: MuscleSet, one_sided: OneSided = "active") -> L
     with np.errstate(invalid="ignore", divide="ignore"):
         zeta = np.where(mag > 0, -poles.real / np.where(mag > 0, mag, 1.0), np.nan)
     load = body.load_stiffness
+    used = _effective(muscles, one_sided)
     return LinearAnalysis(
         poles=poles,
         stable=bool(np.all(poles.real < 0.0)),
@@ -201,9 +202,9 @@ def analyse(body: Body, muscles: MuscleSet, one_sided: OneSided = "active") -> L
         natural_frequencies=mag,
         damping_ratios=zeta,
         state_matrix=A,
-        pair_names=tuple(muscles.names),
-        pair_stiffness=muscles.stiffnesses.copy(),
-        pair_stiffness_fraction_of_load=muscles.stiffnesses / load,
+        pair_names=tuple(used.names),
+        pair_stiffness=used.stiffnesses.copy(),
+        pair_stiffness_fraction_of_load=used.stiffnesses / load,
         load_stiffness=load,
         one_sided=one_sided,
     )

@@ -77,7 +77,9 @@ class MusclePair:
     def __post_init__(self) -> None:
         label = f"muscle pair {self.name!r}"
         if not (isinstance(self.lo, int | np.integer) and isinstance(self.hi, int | np.integer)):
-            raise ParameterError(f"{label} lo and hi must be integers, got {self.lo!r}, {self.hi!r}")
+            raise ParameterError(
+                f"{label} lo and hi must be integers, got {self.lo!r}, {self.hi!r}"
+            )
         if not 0 <= self.lo < self.hi:
             raise ParameterError(
                 f"{label} span must satisfy 0 <= lo < hi, got (lo, hi) = ({self.lo}, {self.hi})"

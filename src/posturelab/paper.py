@@ -12,7 +12,6 @@ from dataclasses import dataclass
 import numpy as np
 
 __all__ = [
-    "PrintedValue",
     "TABLE_II_PRINTED",
     "TABLE_II_SOURCE",
     "SENSITIVITY_PRINTED",

@@ -165,7 +165,9 @@ def _atomic_write(path: str | Path, data: bytes) -> None:
     path = Path(path)
     directory = path.parent if str(path.parent) else Path(".")
     if not directory.is_dir():
-        raise PostureLabError(f"cannot write {str(path)!r}: directory {str(directory)!r} does not exist")
+        raise PostureLabError(
+            f"cannot write {str(path)!r}: directory {str(directory)!r} does not exist"
+        )
     try:
         fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=directory)
     except OSError as exc:

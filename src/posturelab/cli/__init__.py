@@ -32,7 +32,8 @@ class OneLineParser(argparse.ArgumentParser):
     """An ArgumentParser whose errors are one line and exit code 2."""
 
     def error(self, message: str) -> None:  # type: ignore[override]
-        raise UsageError(f"{self.prog}: {message} (see '{self.prog} --help')")
+        where = "" if self.prog == "posturelab" else f"{self.prog.removeprefix('posturelab ')}: "
+        raise UsageError(f"{where}{message} (see '{self.prog} --help')")
 
 
 CONVENTIONS_EPILOG = (

@@ -48,7 +48,7 @@ def run(args: argparse.Namespace) -> int:
         if args.case is not None or args.stiffness is not None:
             from . import UsageError
 
-            raise UsageError("posturelab poles: --all takes no --case or --stiffness")
+            raise UsageError("poles: --all takes no --case or --stiffness")
         return _run_all(args)
     body = paper_body()
     muscles = muscles_from_args(args)
@@ -96,7 +96,8 @@ def _run_all(args: argparse.Namespace) -> int:
         return 0
     print("Table II: poles [1/s] of the linearised system, printed | computed "
           f"(viscosity = {args.viscosity_ratio:g} × stiffness)")
-    print("  '!' marks a printed pole that disagrees beyond its printed digits; [n] is the erratum.")
+    print("  '!' marks a printed pole that disagrees beyond its printed digits; "
+          "[n] is the erratum.")
     flagged: set[int] = set()
     for r in rows:
         cells = []

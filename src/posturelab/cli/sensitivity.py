@@ -40,6 +40,6 @@ def run(args: argparse.Namespace) -> int:
     print("J⁻¹H [rad/m] (link rate change per platform velocity change):")
     for i, v in enumerate(value, 1):
         print(f"  link {i}: {v:+.4f}")
-    ratios = abs(value[0]) / abs(value[1:])
-    print("ankle-to-higher-link ratios: " + ", ".join(f"{r:.0f}" for r in ratios))
+    ratios = [f"{abs(value[0]) / abs(v):.0f}" if v != 0 else "inf" for v in value[1:]]
+    print("ankle-to-higher-link ratios: " + ", ".join(ratios))
     return 0

@@ -98,11 +98,11 @@ MODEL_OPTIONS = ("case", "stiffness", "disturbance", "platform_profile", "initia
 def scenario_from_args(args: argparse.Namespace) -> Scenario:
     """Build the scenario the arguments describe (a file, a built-in, or the options)."""
     if args.scenario and args.builtin:
-        raise UsageError("posturelab simulate: give --scenario or --builtin, not both")
+        raise UsageError("simulate: give --scenario or --builtin, not both")
     if args.scenario or args.builtin:
         clash = [o for o in MODEL_OPTIONS if getattr(args, o) is not None]
         if clash:
-            raise UsageError(f"posturelab simulate: --{clash[0].replace('_', '-')} cannot be "
+            raise UsageError(f"simulate: --{clash[0].replace('_', '-')} cannot be "
                              "combined with a scenario; edit the scenario instead")
         sc = load_scenario(args.scenario) if args.scenario else builtin_scenario(args.builtin)
     else:
@@ -140,10 +140,10 @@ def _foot(text: str) -> BaseOfSupport:
 
 def _scenario_from_options(args: argparse.Namespace) -> Scenario:
     if args.case is None and args.stiffness is None:
-        raise UsageError("posturelab simulate: give --case or --stiffness (or --scenario / "
+        raise UsageError("simulate: give --case or --stiffness (or --scenario / "
                          "--builtin)")
     if args.disturbance not in (None, "none") and args.platform_profile:
-        raise UsageError("posturelab simulate: give --disturbance or --platform-profile, not both")
+        raise UsageError("simulate: give --disturbance or --platform-profile, not both")
     body = paper_body()
     muscles = muscles_from_args(args)
     n = body.n_links

@@ -12,18 +12,22 @@ Schema (every table optional except where noted; units in brackets)::
     duration = 5.0                       # [s] (required)
 
     [body]
-    preset = "paper"                     # or: segments = [{name, mass, length, com_distance, inertia}, ...]
+    preset = "paper"                     # or: segments = [{name, mass, length,
+                                         #                  com_distance, inertia}, ...]
     gravity = 9.81                       # [m/s²]
 
     [muscles]
     case = "1"                           # Table I; or stiffness = [5 values] [N·m/rad];
-                                         # or pairs = [{name, lo, hi, stiffness, viscosity, one_sided}]
+                                         # or pairs = [{name, lo, hi, stiffness,
+                                         #              viscosity, one_sided}]
     viscosity_ratio = 0.25               # [s]
     gastrocnemius = "two-sided"          # or "one-sided"
 
     [disturbance]                        # or [[disturbance]] several, summed
-    type = "velocity-step"               # velocity-step | half-sine | ramp-and-hold | sum-of-sines | profile | none
-    velocity = -1.0                      # velocity-step [m/s]; or direction = "backward"/"forward" and speed [m/s]
+    type = "velocity-step"               # velocity-step | half-sine | ramp-and-hold |
+                                         # sum-of-sines | profile | none
+    velocity = -1.0                      # velocity-step [m/s]; or direction =
+                                         # "backward"/"forward" and speed [m/s]
     axis = "x"                           # x (horizontal) or y (vertical)
     # half-sine: peak_acceleration [m/s²], duration [s], start [s]
     # ramp-and-hold: displacement [m], duration [s], start [s]
