@@ -13,7 +13,7 @@ import numpy as np
 
 from .errors import PostureLabError
 
-__all__ = ["SimulationResult", "atomic_write_text", "atomic_write_bytes"]
+__all__ = ["SimulationResult", "atomic_write_text", "atomic_write_bytes", "new_file_mode"]
 
 
 @dataclass(frozen=True)
@@ -161,6 +161,16 @@ class SimulationResult:
         atomic_write_text(path, self.to_csv_text())
 
 
+def new_file_mode() -> int:
+    """Permission bits a newly created file gets under the current umask (0o644 for 022).
+
+    ``tempfile.mkstemp`` creates 0600 files; atomic writes set this mode before renaming.
+    """
+    mask = os.umask(0)
+    os.umask(mask)
+    return 0o666 & ~mask
+
+
 def _atomic_write(path: str | Path, data: bytes) -> None:
     path = Path(path)
     directory = path.parent if str(path.parent) else Path(".")
@@ -175,6 +185,7 @@ def _atomic_write(path: str | Path, data: bytes) -> None:
     try:
         with os.fdopen(fd, "wb") as fh:
             fh.write(data)
+        os.chmod(tmp, new_file_mode())
         os.replace(tmp, path)
     except OSError as exc:
         try:

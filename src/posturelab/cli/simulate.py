@@ -178,7 +178,11 @@ def run(args: argparse.Namespace) -> int:
     if args.out:
         result.to_csv(args.out)
     if args.plot:
-        _save_figure(result, args.plot)
+        from ..plots import plot_run_overview, save_figure
+
+        fig = plot_run_overview(result, link_names=[s.name for s in sc.body.segments],
+                                base_of_support=sc.fall.base_of_support)
+        save_figure(fig, args.plot)
     if args.animate:
         from ..animation import animate
 
@@ -213,19 +217,3 @@ def _check_writable(paths: list[str]) -> None:
         if Path(p).is_dir():
             raise ParameterError(f"cannot write {p!r}: it is a directory")
 
-
-def _save_figure(result, path: str) -> None:
-    """Render the 2×2 overview and write it atomically (format from the suffix)."""
-    import io
-    from pathlib import Path
-
-    from ..plots import plot_run_overview
-    from ..results import atomic_write_bytes
-
-    fmt = Path(path).suffix.lstrip(".").lower() or "png"
-    if fmt not in ("png", "svg", "pdf"):
-        raise ParameterError(f"--plot must end in .png, .svg or .pdf, got {path!r}")
-    fig = plot_run_overview(result)
-    buf = io.BytesIO()
-    fig.savefig(buf, format=fmt, dpi=110)
-    atomic_write_bytes(path, buf.getvalue())

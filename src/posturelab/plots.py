@@ -1,0 +1,502 @@
+"""Figures of a simulation run (the paper's Figs. 3–10 and an overview).
+
+Every ``plot_*`` function draws on an Axes you give it (or on a new
+:class:`matplotlib.figure.Figure` it creates) and returns what it drew on; it
+never calls ``pyplot.show`` and never touches pyplot's global state, so it is
+safe in scripts, tests and servers (Agg). Every axis is labelled with its
+unit in brackets.
+
+============================  ==========================================  ==========
+function                      what                                         paper
+============================  ==========================================  ==========
+:func:`plot_time_histories`   angles [rad] and rates [rad/s] vs time [s]   Fig. 3
+:func:`plot_angle_angle`      θ2, θ3 against θ1 [rad]                      Fig. 4
+:func:`plot_pair_torques`     muscle-pair torques M [N·m] vs time [s]      Figs. 5, 6
+:func:`plot_cog_phase`        CoG velocity ẋ_c [m/s] vs position x_c [m]  Figs. 7–10
+:func:`plot_run_overview`     a 2×2 summary of one run                     —
+============================  ==========================================  ==========
+
+Conventions (see :mod:`posturelab.conventions`): angles are absolute from the
+vertical, positive leaning forward; the centre of gravity is relative to the
+ankle, x forward.
+"""
+
+from __future__ import annotations
+
+import io
+import textwrap
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+from matplotlib.axes import Axes
+from matplotlib.figure import Figure
+
+from .errors import ParameterError, UnknownNameError
+from .results import SimulationResult, atomic_write_bytes
+from .simulate import BaseOfSupport
+
+__all__ = [
+    "new_figure",
+    "plot_time_histories",
+    "plot_angle_angle",
+    "plot_pair_torques",
+    "plot_cog_phase",
+    "plot_run_overview",
+    "figure_bytes",
+    "save_figure",
+    "LINK_COLORS",
+    "PAIR_COLORS",
+]
+
+#: One colour per link, the same in every figure (link 1 = leg first). [-]
+LINK_COLORS: tuple[str, ...] = ("#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#8c564b",
+                                "#e377c2", "#7f7f7f", "#bcbd22")
+#: One colour per paper muscle pair, the same in every figure.
+PAIR_COLORS: dict[str, str] = {
+    "ankle": "#1f77b4",
+    "knee": "#ff7f0e",
+    "hip": "#2ca02c",
+    "quadriceps": "#9467bd",
+    "gastrocnemius": "#d62728",
+}
+_OTHER_COLORS = ("#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf")
+_FALL_COLOR = "#c00000"
+_START_COLOR = "#2ca02c"
+
+
+def new_figure(nrows: int = 1, ncols: int = 1, *, figsize: tuple[float, float] = (7.0, 4.5),
+               sharex: bool = False) -> tuple[Figure, Axes | np.ndarray]:
+    """A new pyplot-free Figure (constrained layout) and its Axes.
+
+    Parameters
+    ----------
+    nrows, ncols : int
+        Grid of axes.
+    figsize : (float, float)
+        Width and height. [inch]
+    sharex : bool
+        Share the x axis between the panels.
+
+    Returns
+    -------
+    (Figure, Axes or numpy.ndarray of Axes)
+    """
+    fig = Figure(figsize=figsize, layout="constrained")
+    axes = fig.subplots(nrows, ncols, sharex=sharex, squeeze=True)
+    return fig, axes
+
+
+def _theta(i: int) -> str:
+    return rf"$\theta_{{{i}}}$"
+
+
+def _link_label(i: int, link_names: Sequence[str] | None, rate: bool = False) -> str:
+    sym = rf"$\dot{{\theta}}_{{{i + 1}}}$" if rate else _theta(i + 1)
+    if link_names is not None and i < len(link_names):
+        return f"{sym} ({link_names[i]})"
+    return sym
+
+
+def _mark_fall(ax: Axes, result: SimulationResult, label: bool = True) -> None:
+    if result.fell and result.fall_time is not None:
+        ax.axvline(result.fall_time, color=_FALL_COLOR, ls=":", lw=1.5,
+                   label=f"fall at t = {result.fall_time:.2f} s" if label else None)
+
+
+def _check_result(result: SimulationResult) -> None:
+    if not isinstance(result, SimulationResult):
+        raise ParameterError(f"result must be a SimulationResult, got {type(result).__name__}")
+    if result.time.size == 0:
+        raise ParameterError("result holds no samples to plot")
+
+
+def plot_time_histories(
+    result: SimulationResult,
+    axes: Axes | Sequence[Axes] | None = None,
+    *,
+    link_names: Sequence[str] | None = None,
+    title: str | None = None,
+) -> Axes | np.ndarray:
+    """Link angles [rad] and angular rates [rad/s] against time [s] (paper Fig. 3).
+
+    Parameters
+    ----------
+    result : SimulationResult
+        The run.
+    axes : Axes or sequence of two Axes, optional
+        Two Axes: angles on the first, rates on the second. One Axes: both on
+        it (angles solid, rates dashed). None: a new two-panel figure.
+    link_names : sequence of str, optional
+        Names for the legend, e.g. ``("leg", "thigh", "torso")``.
+    title : str, optional
+        Title of the (first) panel; a default names the figure.
+
+    Returns
+    -------
+    Axes or numpy.ndarray of Axes
+        What was drawn on (the new pair of Axes when ``axes`` is None).
+    """
+    _check_result(result)
+    created = axes is None
+    if created:
+        _, axes = new_figure(2, 1, figsize=(7.0, 5.5), sharex=True)
+    single = isinstance(axes, Axes)
+    if single:
+        ax_a = ax_r = axes
+    else:
+        seq = list(np.ravel(np.asarray(axes, dtype=object)))
+        if len(seq) != 2 or not all(isinstance(a, Axes) for a in seq):
+            raise ParameterError("axes must be one Axes or a sequence of two Axes "
+                                 "(angles, rates)")
+        ax_a, ax_r = seq
+    t = result.time
+    n = result.n_links
+    for i in range(n):
+        c = LINK_COLORS[i % len(LINK_COLORS)]
+        ax_a.plot(t, result.theta[:, i], color=c, lw=1.6, label=_link_label(i, link_names))
+    for i in range(n):
+        c = LINK_COLORS[i % len(LINK_COLORS)]
+        ax_r.plot(t, result.omega[:, i], color=c, lw=1.4, ls="--" if single else "-",
+                  label=_link_label(i, link_names, rate=True))
+    for ax in {id(ax_a): ax_a, id(ax_r): ax_r}.values():
+        ax.axhline(0.0, color="0.6", lw=0.7, zorder=0)
+        _mark_fall(ax, result)
+        ax.grid(True, alpha=0.3)
+    if single:
+        ax_a.set_ylabel("angle [rad] (solid), rate [rad/s] (dashed)")
+        ax_a.set_xlabel("time t [s]")
+        ax_a.legend(ncol=2, fontsize="small")
+    else:
+        ax_a.set_ylabel(r"link angle $\theta_i$ [rad]")
+        ax_r.set_ylabel(r"angular rate $\dot{\theta}_i$ [rad/s]")
+        ax_r.set_xlabel("time t [s]")
+        ax_a.legend(fontsize="small", loc="upper right")
+        ax_r.legend(fontsize="small", loc="upper right")
+        ax_r.set_title("Angular rates", fontsize="medium")
+        ax_a.set_xlabel("time t [s]")
+        if created:  # shared time axis: the label and ticks show under the lower panel only
+            ax_a.xaxis.label.set_visible(False)
+    ax_a.set_title(title or "Link angles (absolute, forward positive)", fontsize="medium")
+    return axes
+
+
+def plot_angle_angle(
+    result: SimulationResult,
+    ax: Axes | None = None,
+    *,
+    link_names: Sequence[str] | None = None,
+    title: str | None = None,
+) -> Axes:
+    """θ2 … θN against θ1 [rad] (paper Fig. 4).
+
+    The dashed diagonal θ = θ1 is where a link is parallel to the leg: a
+    curve for θ2 on it means a straight knee (θ2 − θ1 = 0). The start of the
+    run is marked with a circle, the end with a square (a cross for a fall).
+
+    Parameters
+    ----------
+    result : SimulationResult
+        A run of a chain with at least two links.
+    ax : Axes, optional
+        Where to draw; a new figure when None.
+    link_names : sequence of str, optional
+        Names for the legend.
+    title : str, optional
+        Panel title.
+
+    Returns
+    -------
+    Axes
+    """
+    _check_result(result)
+    if result.n_links < 2:
+        raise ParameterError("plot_angle_angle needs a chain of at least 2 links")
+    if ax is None:
+        _, ax = new_figure(figsize=(6.0, 5.0))
+    th = result.theta
+    x = th[:, 0]
+    lo = float(min(x.min(), th.min()))
+    hi = float(max(x.max(), th.max()))
+    ax.plot([lo, hi], [lo, hi], color="0.5", ls="--", lw=1.0,
+            label=r"$\theta = \theta_1$ (link parallel to leg; for $\theta_2$: knee straight)")
+    end_marker = "X" if result.fell else "s"
+    for i in range(1, result.n_links):
+        c = LINK_COLORS[i % len(LINK_COLORS)]
+        ax.plot(x, th[:, i], color=c, lw=1.6, label=_link_label(i, link_names))
+        ax.plot(x[0], th[0, i], "o", color=c, mec="k", ms=7)
+        ax.plot(x[-1], th[-1, i], end_marker, color=c, mec="k", ms=7)
+    ax.plot([], [], "o", color="w", mec="k", label="start (t = 0)")
+    ax.plot([], [], end_marker, color="w", mec="k",
+            label=(f"fall (t = {result.fall_time:.2f} s)" if result.fell
+                   else f"end (t = {result.time[-1]:.3g} s)"))
+    ax.axhline(0.0, color="0.7", lw=0.7, zorder=0)
+    ax.axvline(0.0, color="0.7", lw=0.7, zorder=0)
+    ax.set_xlabel(r"leg angle $\theta_1$ [rad]")
+    ax.set_ylabel(r"link angles $\theta_2, \ldots, \theta_N$ [rad]" if result.n_links > 3
+                  else (r"$\theta_2$, $\theta_3$ [rad]" if result.n_links == 3
+                        else r"$\theta_2$ [rad]"))
+    ax.set_title(title or r"Link angles against the leg angle $\theta_1$", fontsize="medium")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize="small", loc="best")
+    return ax
+
+
+def plot_pair_torques(
+    result: SimulationResult,
+    pairs: Sequence[str] | None = ("ankle", "knee", "hip", "gastrocnemius"),
+    ax: Axes | None = None,
+    *,
+    title: str | None = None,
+) -> Axes:
+    """Muscle-pair torques M [N·m] against time [s] (paper Figs. 5 and 6).
+
+    M = K_d E Θ + L_d E Θ̇ for each pair: positive when the pair resists a
+    positive stretch. The paper's Fig. 5 shows the ankle, knee and hip pairs
+    and the gastrocnemius (the default); Fig. 6 the quadriceps alone
+    (``pairs=("quadriceps",)``).
+
+    Parameters
+    ----------
+    result : SimulationResult
+        The run.
+    pairs : sequence of str or None
+        Pair names, from ``result.pair_names``; None plots every pair.
+    ax : Axes, optional
+        Where to draw; a new figure when None.
+    title : str, optional
+        Panel title.
+
+    Returns
+    -------
+    Axes
+
+    Raises
+    ------
+    UnknownNameError
+        A name not among ``result.pair_names`` (the message lists them).
+    """
+    _check_result(result)
+    names = list(result.pair_names) if pairs is None else [str(p) for p in pairs]
+    if isinstance(pairs, str):
+        names = [pairs]
+    for p in names:
+        if p not in result.pair_names:
+            raise UnknownNameError(f"unknown muscle pair {p!r}; this run has: "
+                                   f"{', '.join(result.pair_names)}")
+    if ax is None:
+        _, ax = new_figure(figsize=(7.0, 4.5))
+    t = result.time
+    for k, p in enumerate(names):
+        j = result.pair_names.index(p)
+        c = PAIR_COLORS.get(p, _OTHER_COLORS[k % len(_OTHER_COLORS)])
+        ax.plot(t, result.pair_torques[:, j], color=c, lw=1.6, label=f"{p} pair")
+    ax.axhline(0.0, color="0.6", lw=0.7, zorder=0)
+    _mark_fall(ax, result)
+    ax.set_xlabel("time t [s]")
+    ax.set_ylabel("muscle-pair torque M [N·m]")
+    default = ("Muscle-pair torque: " + names[0]) if len(names) == 1 else "Muscle-pair torques"
+    ax.set_title(title or default, fontsize="medium")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize="small", loc="upper right")
+    return ax
+
+
+def _foot(base_of_support) -> tuple[float, float, str] | None:
+    if base_of_support is None:
+        return None
+    if isinstance(base_of_support, BaseOfSupport):
+        return base_of_support.heel, base_of_support.toe, "base of support"
+    try:
+        heel, toe = (float(v) for v in base_of_support)
+    except (TypeError, ValueError):
+        raise ParameterError("base_of_support must be a BaseOfSupport or (heel, toe) [m]") \
+            from None
+    if not heel < 0.0 < toe:
+        raise ParameterError(f"base_of_support must have heel < 0 < toe [m], got ({heel:g}, "
+                             f"{toe:g})")
+    return heel, toe, "base of support"
+
+
+def plot_cog_phase(
+    result: SimulationResult,
+    ax: Axes | None = None,
+    *,
+    base_of_support: BaseOfSupport | tuple[float, float] | None = None,
+    foot_label: str | None = None,
+    label: str | None = None,
+    color: str = "#1f77b4",
+    mark_ends: bool = True,
+    legend: str | None = "below",
+    title: str | None = None,
+) -> Axes:
+    """Horizontal centre-of-gravity velocity [m/s] against position [m] (Figs. 7–10).
+
+    Position and velocity are relative to the ankle (x forward). The start is
+    marked with a green circle, the end with a black square (a red cross for
+    a fall), upright rest (0, 0) with a plus.
+
+    Parameters
+    ----------
+    result : SimulationResult
+        The run.
+    ax : Axes, optional
+        Where to draw; a new figure when None. Call again with the same ``ax``
+        to overlay runs (give each a ``label`` and ``color``).
+    base_of_support : BaseOfSupport or (heel, toe), optional
+        If given, the foot [heel, toe] [m] is shaded.
+    foot_label : str, optional
+        Legend text of the shaded foot.
+    label : str, optional
+        Legend text of the trajectory.
+    color : str
+        Colour of the trajectory.
+    mark_ends : bool
+        Mark the start and end of the run.
+    legend : {"below", "best"} or None
+        Legend under the axes (default; it never hides the trajectory), inside
+        at matplotlib's "best" place, or none.
+    title : str, optional
+        Panel title.
+
+    Returns
+    -------
+    Axes
+    """
+    _check_result(result)
+    foot = _foot(base_of_support)
+    if ax is None:
+        _, ax = new_figure(figsize=(6.5, 5.0))
+    x = result.cog_position[:, 0]
+    v = result.cog_velocity[:, 0]
+    if foot is not None:
+        heel, toe, _ = foot
+        ax.axvspan(heel, toe, color="#f2c14e", alpha=0.25, lw=0,
+                   label=foot_label or f"base of support (heel {heel:+.3f} m, toe {toe:+.3f} m)")
+        for edge, name in ((heel, "heel"), (toe, "toe")):
+            ax.axvline(edge, color="#b8860b", lw=1.0, ls="-", zorder=1)
+            ax.annotate(name, (edge, 1.0), xycoords=("data", "axes fraction"),
+                        xytext=(0, -3), textcoords="offset points", ha="center", va="top",
+                        fontsize="small", color="#8a6408")
+    ax.plot(x, v, color=color, lw=1.6, label=label or "centre of gravity")
+    if mark_ends:
+        ax.plot(x[0], v[0], "o", color=_START_COLOR, mec="k", ms=8, zorder=5,
+                label=f"start (t = 0): x = {x[0]:+.3f} m, v = {v[0]:+.3f} m/s")
+        if result.fell:
+            ax.plot(x[-1], v[-1], "X", color=_FALL_COLOR, mec="k", ms=10, zorder=5,
+                    label=f"fall (t = {result.fall_time:.2f} s)")
+        else:
+            ax.plot(x[-1], v[-1], "s", color="k", ms=6, zorder=5,
+                    label=f"end (t = {result.time[-1]:.3g} s)")
+        ax.plot(0.0, 0.0, "+", color="k", ms=12, mew=1.5, zorder=4, label="upright at rest")
+    ax.axhline(0.0, color="0.7", lw=0.7, zorder=0)
+    ax.axvline(0.0, color="0.7", lw=0.7, zorder=0)
+    ax.set_xlabel(r"horizontal CoG position $x_c$ (from the ankle) [m]")
+    ax.set_ylabel(r"horizontal CoG velocity $\dot{x}_c$ [m/s]")
+    ax.set_title(title or "Centre of gravity: horizontal phase plane", fontsize="medium")
+    ax.grid(True, alpha=0.3)
+    handles, labels = ax.get_legend_handles_labels()
+    seen: dict[str, object] = {}
+    for h, lab in zip(handles, labels, strict=True):  # overlays: one entry per label
+        seen.setdefault(lab, h)
+    if legend == "below":
+        ncol = 2 if max(len(lab) for lab in seen) <= 45 else 1
+        ax.legend(list(seen.values()), list(seen), fontsize="small", loc="upper center",
+                  bbox_to_anchor=(0.5, -0.14), ncol=ncol, frameon=False)
+    elif legend == "best":
+        ax.legend(list(seen.values()), list(seen), fontsize="small", loc="best")
+    elif legend is not None:
+        raise ParameterError(f"legend must be 'below', 'best' or None, got {legend!r}")
+    return ax
+
+
+def plot_run_overview(
+    result: SimulationResult,
+    *,
+    link_names: Sequence[str] | None = None,
+    base_of_support: BaseOfSupport | tuple[float, float] | None = None,
+    title: str | None = None,
+) -> Figure:
+    """A 2×2 summary of one run: angles, rates, pair torques, CoG phase plane.
+
+    Used by ``posturelab simulate --plot run.png``.
+
+    Parameters
+    ----------
+    result : SimulationResult
+        The run.
+    link_names : sequence of str, optional
+        Names for the legends.
+    base_of_support : BaseOfSupport or (heel, toe), optional
+        Shade the foot [m] in the phase plane.
+    title : str, optional
+        Figure title; by default the run's description and outcome.
+
+    Returns
+    -------
+    Figure
+    """
+    _check_result(result)
+    fig, axes = new_figure(2, 2, figsize=(11.0, 8.0))
+    plot_time_histories(result, [axes[0, 0], axes[0, 1]], link_names=link_names)
+    axes[0, 0].set_xlabel("time t [s]")
+    plot_pair_torques(result, None, axes[1, 0])
+    plot_cog_phase(result, axes[1, 1], base_of_support=base_of_support)
+    head = title or result.description or "posturelab run"
+    outcome = result.message or result.status
+    fig.suptitle(textwrap.fill(f"{head} — {outcome}", 110), fontsize="medium")
+    return fig
+
+
+def figure_bytes(fig: Figure, fmt: str = "png", dpi: float = 110) -> bytes:
+    """Render ``fig`` to bytes (PNG, SVG, PDF, …) without pyplot.
+
+    Dates and other volatile metadata are left out so equal figures give
+    equal bytes.
+
+    Parameters
+    ----------
+    fig : Figure
+    fmt : str
+        A matplotlib output format: "png", "svg", "pdf".
+    dpi : float
+        Resolution of raster output. [dots/inch]
+    """
+    import matplotlib
+
+    buf = io.BytesIO()
+    meta = {"png": {"Software": None}, "svg": {"Date": None}, "pdf": {"CreationDate": None}}
+    with matplotlib.rc_context({"svg.hashsalt": "posturelab", "svg.fonttype": "path"}):
+        fig.savefig(buf, format=fmt, dpi=dpi, metadata=meta.get(fmt))
+    return buf.getvalue()
+
+
+def save_figure(fig: Figure, path: str | Path, dpi: float = 110) -> Path:
+    """Save ``fig`` atomically (temporary file, then rename); format from the suffix.
+
+    Parameters
+    ----------
+    fig : Figure
+    path : str or Path
+        Output file; ``.png``, ``.svg`` or ``.pdf``.
+    dpi : float
+        Resolution of raster output. [dots/inch]
+
+    Returns
+    -------
+    Path
+        The written file.
+
+    Raises
+    ------
+    ParameterError
+        An unsupported suffix.
+    PostureLabError
+        The file cannot be written (the message names it).
+    """
+    path = Path(path)
+    fmt = path.suffix.lower().lstrip(".")
+    if fmt not in ("png", "svg", "pdf"):
+        raise ParameterError(f"figure file {str(path)!r} must end in .png, .svg or .pdf")
+    atomic_write_bytes(path, figure_bytes(fig, fmt, dpi))
+    return path

@@ -1,0 +1,162 @@
+"""``reproduce_paper`` and ``posturelab reproduce``: the regenerated paper.
+
+The report is built once per module (about 6 s) and inspected by several
+tests. The Table II numbers themselves are tested in test_paper_numbers.py;
+here we check that the report carries them, flags the errata, and never
+leaves a half-written output behind.
+"""
+
+from __future__ import annotations
+
+import csv
+import subprocess
+import sys
+
+import pytest
+
+from posturelab.cli import main
+from posturelab.errors import PostureLabError
+from posturelab.paper import TABLE_II_PRINTED
+from posturelab.report import reproduce_paper
+
+FIGS = [f"fig{n:02d}" for n in range(3, 11)]
+
+
+@pytest.fixture(scope="module")
+def built(tmp_path_factory):
+    out = tmp_path_factory.mktemp("paper") / "new" / "out"  # parents created too
+    calls = []
+    report = reproduce_paper(out, progress=lambda i, n, msg: calls.append((i, n, msg)))
+    return out, report, calls
+
+
+def test_files_written(built):
+    out, report, _ = built
+    names = {p.name for p in out.iterdir()}
+    expected = {"index.html", "table2.csv"} | {f"{f}.png" for f in FIGS} | {
+        f"{f}.svg" for f in FIGS}
+    assert expected <= names
+    assert not [n for n in names if n.startswith(".")]  # no temporary left
+    assert report.index_html == out / "index.html"
+    for f in FIGS:
+        assert (out / f"{f}.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+        assert b"<svg" in (out / f"{f}.svg").read_bytes()[:2000]
+
+
+def test_progress_reported(built):
+    _, _, calls = built
+    total = calls[0][1]
+    assert [c[0] for c in calls] == list(range(1, total + 1))
+    assert all(c[1] == total for c in calls)
+    assert any("Fig. 5" in c[2] for c in calls)
+
+
+def test_table2_csv(built):
+    """54 rows, one per printed pole of Table II, errata 1, 2 and 7 flagged."""
+    out, report, _ = built
+    with open(out / "table2.csv", newline="", encoding="utf-8") as fh:
+        rows = list(csv.DictReader(fh))
+    assert list(rows[0]) == ["case", "column", "printed", "computed_re", "computed_im",
+                             "agrees", "erratum"]
+    assert len(rows) == sum(len(v) for v in TABLE_II_PRINTED.values()) == 54
+    bad = {(r["case"], r["column"]): r["erratum"] for r in rows if r["agrees"] == "no"}
+    assert bad == {("3", "3"): "1", ("6b", "3"): "2", ("3", "1"): "7"}
+    case3 = next(r for r in rows if r["case"] == "3" and r["column"] == "3")
+    assert case3["printed"] == "-0.90"
+    assert float(case3["computed_re"]) == pytest.approx(-0.092, abs=5e-4)
+    assert report.table2_total == 54 and report.table2_agree == 51
+
+
+def test_html_contents(built):
+    out, report, _ = built
+    page = (out / "index.html").read_text(encoding="utf-8")
+    assert page.startswith("<!DOCTYPE html>")
+    # self-contained: the figures are embedded
+    assert page.count("data:image/png;base64,") >= len(FIGS)
+    assert "<img alt='Fig. 3'" in page and "src='fig03.png'" not in page
+    # Table II errata, printed beside computed
+    assert "-0.90" in page and "-0.092" in page
+    assert "-3.26" in page and "-3.752" in page
+    # J⁻¹H printed and at the flexed posture (erratum 5)
+    assert "2.5580" in page and "2.268" in page
+    # erratum 4: the text says case 3; the unstable forward case is case 2
+    assert "the instability of the biped in Case 3" in page
+    for n in range(3, 11):
+        assert f"Paper, Fig. {n}:" in page
+    assert "one-sided" in page and "toe" in page
+
+
+def test_figure_verdicts(built):
+    """The verdicts follow from the runs (Figs. 8–10 as the paper says, erratum 4)."""
+    _, report, _ = built
+    v = {c.number: c for c in report.checks}
+    assert sorted(v) == list(range(3, 11))
+    assert v[3].verdict == "supported"
+    assert v[8].verdict == "supported"
+    assert v[9].verdict == "supported" and "falls at t = 1.1" in v[9].evidence
+    assert v[10].verdict == "supported"
+    assert "case 2 falls" in report.findings[0]  # one-sided gastrocnemius = case 2
+    assert "51 of 54" in report.summary()
+
+
+def test_output_is_a_file(tmp_path):
+    f = tmp_path / "file"
+    f.write_text("x")
+    with pytest.raises(PostureLabError, match="not a directory"):
+        reproduce_paper(f)
+    assert f.read_text() == "x"
+
+
+def test_failure_leaves_nothing(tmp_path, monkeypatch):
+    """A failure half-way removes the temporary files and the directory it created."""
+    import posturelab.report as rep
+
+    def boom(*args, **kwargs):
+        raise PostureLabError("simulated failure")
+
+    monkeypatch.setattr(rep, "_check_fig9", boom)
+    out = tmp_path / "a" / "b"
+    with pytest.raises(PostureLabError, match="simulated failure"):
+        rep.reproduce_paper(out)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_cli_unwritable_location(tmp_path, capsys):
+    blocker = tmp_path / "regular-file"
+    blocker.write_text("")
+    code = main(["reproduce", "--out", str(blocker / "sub" / "out")])
+    captured = capsys.readouterr()
+    assert code == 2
+    err_lines = [ln for ln in captured.err.splitlines() if ln.strip()]
+    assert len(err_lines) == 1 and err_lines[0].startswith("posturelab: error:")
+    assert captured.out == ""
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["regular-file"]
+
+
+def test_cli_out_is_a_file(tmp_path):
+    blocker = tmp_path / "regular-file"
+    blocker.write_text("")
+    proc = subprocess.run([sys.executable, "-m", "posturelab", "reproduce", "--out",
+                           str(blocker)], capture_output=True, text=True)
+    assert proc.returncode == 2
+    assert proc.stderr.count("\n") == 1 and "not a directory" in proc.stderr
+
+
+def test_cli_prints_path_and_summary(built, monkeypatch, capsys):
+    """stdout: the path of index.html, then one paragraph; progress lines on stderr."""
+    import posturelab.report as rep
+
+    out, report, _ = built
+
+    def fake(out_dir, progress=None):
+        progress(1, 2, "Fig. 3")
+        progress(2, 2, "write")
+        return report
+
+    monkeypatch.setattr(rep, "reproduce_paper", fake)
+    assert main(["reproduce", "--out", str(out)]) == 0
+    captured = capsys.readouterr()
+    lines = captured.out.splitlines()
+    assert lines[0] == str(out / "index.html")
+    assert len(lines) == 2 and "51 of 54" in lines[1] and "Errata (7" in lines[1]
+    assert "[1/2] Fig. 3" in captured.err
