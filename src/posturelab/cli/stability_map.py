@@ -1,0 +1,327 @@
+"""``posturelab stability-map``: stability of the linearised model over two parameters."""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import sys
+import tempfile
+from pathlib import Path
+from typing import IO
+
+from ..errors import ParameterError, UnknownNameError
+from ..muscles import PAPER_PAIR_NAMES
+from . import CONVENTIONS_EPILOG
+
+#: Axis names: the paper's five pairs (stiffness [N·m/rad]) and the viscosity ratio [s]
+#: (the same as posturelab.batch_linear.GRID_PARAMETERS, which imports numba).
+PARAMETER_NAMES: tuple[str, ...] = (*PAPER_PAIR_NAMES, "viscosity_ratio")
+
+DESCRIPTION = """\
+Map the stability of the paper's three-link biped linearised about upright over two
+parameters. Each axis is NAME:LO:HI with NAME one of
+  ankle, knee, hip, quadriceps, gastrocnemius   a muscle pair's stiffness [N·m/rad]
+  viscosity_ratio                               pair viscosity / pair stiffness [s]
+Every other parameter is taken from a Table I case (--case, default 1), with
+viscosity = 0.25 × stiffness unless --viscosity-ratio is given.
+
+Writes the figure --out (colour = largest real part of the poles [1/s], stable region
+outlined, Table I cases that lie in the plane marked) and a CSV beside it with the same
+stem (columns: x name, y name, max_real_part [1/s], stable [1 or 0]). Stable means every
+pole has real part < -δ, δ = 1e-9 × the poles' magnitude scale [1/s] (a set with
+undamped poles on the imaginary axis is not stable; see posturelab.batch_linear).
+
+Example: posturelab stability-map --x ankle:0:2000 --y gastrocnemius:0:1000 --out map.png
+"""
+
+MAX_RESOLUTION = 5000
+
+
+def add_parser(sub, name: str) -> argparse.ArgumentParser:
+    p = sub.add_parser(
+        name, help="stability map of the linearised model over two parameters",
+        description=DESCRIPTION, epilog=CONVENTIONS_EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p.add_argument("--x", required=True, metavar="NAME:LO:HI",
+                   help="horizontal axis: parameter name and range (e.g. ankle:0:2000).")
+    p.add_argument("--y", required=True, metavar="NAME:LO:HI",
+                   help="vertical axis: parameter name and range (e.g. gastrocnemius:0:1000).")
+    p.add_argument("--resolution", default="200", metavar="R",
+                   help=f"grid points per axis, 2..{MAX_RESOLUTION} (default 200).")
+    p.add_argument("--out", required=True, metavar="FILE",
+                   help="figure file (.png, .pdf, .svg, ...); the CSV is written beside it "
+                   "as FILE with suffix .csv.")
+    p.add_argument("--case", default="1", metavar="CASE",
+                   help="Table I case for the parameters not swept (default 1).")
+    p.add_argument("--viscosity-ratio", default=None, metavar="R",
+                   help="pair viscosity = R × pair stiffness [s] when viscosity_ratio is not "
+                   "an axis (default 0.25, as in the paper).")
+    p.add_argument("--progress", action="store_true",
+                   help="show a progress bar on standard error even when it is not a terminal.")
+    return p
+
+
+# ---- argument parsing -------------------------------------------------------
+
+
+def parse_axis(text: str, flag: str):
+    """Parse ``NAME:LO:HI`` into a :class:`posturelab.batch_linear.ParameterRange`."""
+    from ..batch_linear import ParameterRange
+
+    parts = str(text).split(":")
+    if len(parts) != 3:
+        raise ParameterError(f"{flag} must be NAME:LO:HI (e.g. ankle:0:2000), got {text!r}")
+    name = parts[0].strip().lower().replace("-", "_")
+    if name not in PARAMETER_NAMES:
+        raise UnknownNameError(
+            f"{flag}: unknown parameter {parts[0].strip()!r}; known parameters: "
+            f"{', '.join(PARAMETER_NAMES)}"
+        )
+    bounds = []
+    for label, value in (("LO", parts[1]), ("HI", parts[2])):
+        try:
+            number = float(value)
+        except ValueError:
+            raise ParameterError(
+                f"{flag} {label} must be a number, got {value.strip()!r} in {text!r}"
+            ) from None
+        if not math.isfinite(number):
+            raise ParameterError(f"{flag} {label} must be finite, got {value.strip()!r}")
+        bounds.append(number)
+    low, high = bounds
+    unit = "s" if name == "viscosity_ratio" else "N·m/rad"
+    if low < 0:
+        raise ParameterError(f"{flag} LO must be >= 0 [{unit}], got {low:g}")
+    if not low < high:
+        raise ParameterError(f"{flag} must have LO < HI [{unit}], got {low:g}:{high:g}")
+    return ParameterRange(name, low, high)
+
+
+def parse_resolution(text: str) -> int:
+    """``--resolution``: an integer in [2, MAX_RESOLUTION]."""
+    try:
+        value = int(str(text).strip())
+    except ValueError:
+        raise ParameterError(
+            f"--resolution must be an integer in [2, {MAX_RESOLUTION}], got {text!r}"
+        ) from None
+    if not 2 <= value <= MAX_RESOLUTION:
+        raise ParameterError(f"--resolution must be in [2, {MAX_RESOLUTION}], got {value}")
+    return value
+
+
+def parse_viscosity_ratio(text: str | None) -> float | None:
+    """``--viscosity-ratio``: a finite number >= 0 [s], or None for the paper's 0.25."""
+    if text is None:
+        return None
+    try:
+        value = float(text)
+    except ValueError:
+        raise ParameterError(f"--viscosity-ratio must be a number [s], got {text!r}") from None
+    if not math.isfinite(value) or value < 0:
+        raise ParameterError(f"--viscosity-ratio must be a finite number >= 0 [s], got {text}")
+    return value
+
+
+def output_paths(out: str) -> tuple[Path, Path, str]:
+    """Figure path, CSV path beside it, and the figure format; checks the directory."""
+    from matplotlib.figure import Figure
+
+    figure = Path(out)
+    fmt = figure.suffix.lower().lstrip(".")
+    supported = Figure().canvas.get_supported_filetypes()
+    if fmt not in supported or fmt == "csv":
+        raise ParameterError(
+            f"--out must end in a figure suffix ({', '.join('.' + s for s in sorted(supported))})"
+            f", got {out!r}"
+        )
+    directory = figure.parent
+    if not directory.is_dir():
+        raise ParameterError(f"--out directory {str(directory)!r} does not exist")
+    if figure.is_dir():
+        raise ParameterError(f"--out {out!r} is a directory")
+    return figure, figure.with_suffix(".csv"), fmt
+
+
+# ---- progress bar -------------------------------------------------------------
+
+
+class ProgressBar:
+    """A one-line text progress bar, redrawn in place with carriage returns.
+
+    Parameters
+    ----------
+    stream : text stream
+        Where to draw (standard error).
+    label : str
+        Text before the bar.
+    unit : str
+        What is counted, e.g. "sets" or "rows".
+    width : int
+        Bar width in characters.
+    """
+
+    def __init__(self, stream: IO[str], label: str, unit: str = "sets", width: int = 30) -> None:
+        self.stream = stream
+        self.label = label
+        self.unit = unit
+        self.width = width
+        self._shown = -1
+
+    def __call__(self, done: int, total: int) -> None:
+        permille = 1000 if total <= 0 else int(1000 * done / total)
+        if permille == self._shown:
+            return
+        self._shown = permille
+        filled = self.width * permille // 1000
+        bar = "#" * filled + "-" * (self.width - filled)
+        self.stream.write(f"\r{self.label} [{bar}] {permille / 10:5.1f}% "
+                          f"({done:,}/{total:,} {self.unit})")
+        if done >= total:
+            self.stream.write("\n")
+        self.stream.flush()
+
+
+# ---- figure -------------------------------------------------------------------
+
+
+def plot_stability_map(smap, figure_file, fmt: str) -> None:
+    """Draw ``smap`` (a :class:`posturelab.batch_linear.StabilityMap`) to ``figure_file``.
+
+    Colour is the largest real part of the poles [1/s] (diverging at 0: blue decays,
+    red grows); the stable region is outlined in black; Table I cases lying in the
+    plane are marked.
+    """
+    from matplotlib.colors import TwoSlopeNorm
+    from matplotlib.figure import Figure
+    from matplotlib.lines import Line2D
+
+    grid = smap.grid
+    xs, ys = grid.x_values, grid.y_values
+    values = smap.max_real_part
+    low, high = float(values.min()), float(values.max())
+    if low < 0.0 < high:
+        norm = TwoSlopeNorm(vmin=low, vcenter=0.0, vmax=high)
+    else:
+        span = max(abs(low), abs(high), 1e-12)
+        norm = TwoSlopeNorm(vmin=-span, vcenter=0.0, vmax=span)
+    dx, dy = xs[1] - xs[0], ys[1] - ys[0]
+    extent = (xs[0] - dx / 2, xs[-1] + dx / 2, ys[0] - dy / 2, ys[-1] + dy / 2)
+
+    fig = Figure(figsize=(7.5, 5.8), layout="constrained")
+    ax = fig.add_subplot()
+    image = ax.imshow(values, origin="lower", extent=extent, aspect="auto",
+                      interpolation="nearest", cmap="RdBu_r", norm=norm)
+    fig.colorbar(image, ax=ax, label="largest real part of the poles [1/s]")
+    handles = []
+    if smap.stable.any() and not smap.stable.all():
+        ax.contour(xs, ys, smap.stable.astype(float), levels=[0.5], colors="k", linewidths=1.5)
+        handles.append(Line2D([], [], color="k", lw=1.5, label="stable region boundary"))
+    points = grid.table_i_points()
+    if points:
+        px = [p[1] for p in points]
+        py = [p[2] for p in points]
+        ax.plot(px, py, "o", ms=7, mfc="gold", mec="k", clip_on=False, zorder=5)
+        for case, x, y in points:
+            ax.annotate(f"case {case}", (x, y), xytext=(5, 5), textcoords="offset points",
+                        fontsize=9, annotation_clip=False,
+                        bbox=dict(boxstyle="round,pad=0.2", fc="w", alpha=0.7))
+        handles.append(Line2D([], [], ls="", marker="o", ms=7, mfc="gold", mec="k",
+                              label="Table I cases"))
+    ax.set_xlabel(grid.x.label)
+    ax.set_ylabel(grid.y.label)
+    fixed = []
+    if "viscosity_ratio" not in (grid.x.name, grid.y.name):
+        fixed.append(f"viscosity ratio {grid.base_viscosity_ratio:g} s")
+    others = [f"{n} {v:g}" for n, v in zip(PAPER_PAIR_NAMES, grid.base_stiffness, strict=True)
+              if n not in (grid.x.name, grid.y.name)]
+    ax.set_title(
+        f"Linearised stability about upright; others from Table I case {grid.base_case}\n"
+        f"({', '.join(others)} N·m/rad{'; ' + fixed[0] if fixed else ''}); "
+        f"{100 * smap.stable_fraction:.1f}% stable",
+        fontsize=9,
+    )
+    if handles:
+        ax.legend(handles=handles, loc="upper right", fontsize=8, framealpha=0.8)
+    state = "all stable" if smap.stable.all() else "none stable" if not smap.stable.any() else ""
+    if state:
+        ax.text(0.02, 0.02, state, transform=ax.transAxes, fontsize=9,
+                bbox=dict(boxstyle="round", fc="w", alpha=0.8))
+    fig.savefig(figure_file, format=fmt, dpi=150)
+
+
+# ---- run ------------------------------------------------------------------------
+
+
+def _temporary_beside(path: Path) -> Path:
+    """Create an empty temporary file in ``path``'s directory (checks it is writable).
+
+    It gets the permissions a newly created file would (0666 minus the umask),
+    not mkstemp's private 0600, since it replaces the output.
+    """
+    try:
+        fd, name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    except OSError as exc:
+        raise ParameterError(
+            f"cannot write --out {str(path)!r}: {exc.strerror or exc}"
+        ) from None
+    try:
+        umask = os.umask(0)
+        os.umask(umask)
+        os.fchmod(fd, 0o666 & ~umask)
+    finally:
+        os.close(fd)
+    return Path(name)
+
+
+def run(args: argparse.Namespace) -> int:
+    x = parse_axis(args.x, "--x")
+    y = parse_axis(args.y, "--y")
+    if x.name == y.name:
+        raise ParameterError(f"--x and --y must be different parameters, both are {x.name!r}")
+    resolution = parse_resolution(args.resolution)
+    ratio = parse_viscosity_ratio(args.viscosity_ratio)
+    if ratio is not None and "viscosity_ratio" in (x.name, y.name):
+        raise ParameterError(
+            "--viscosity-ratio cannot be given when viscosity_ratio is an axis"
+        )
+    figure_path, csv_path, fmt = output_paths(args.out)
+
+    from ..batch_linear import parameter_grid, stability_map
+
+    parameter_grid(x, y, resolution, case=args.case, viscosity_ratio=ratio)  # validates --case
+
+    temporaries: list[Path] = []
+    try:
+        # Created first: an unwritable directory fails before the computation.
+        tmp_figure = _temporary_beside(figure_path)
+        temporaries.append(tmp_figure)
+        tmp_csv = _temporary_beside(csv_path)
+        temporaries.append(tmp_csv)
+
+        show = args.progress or sys.stderr.isatty()
+        progress = ProgressBar(sys.stderr, "stability-map") if show else None
+        smap = stability_map(x, y, resolution, case=args.case, viscosity_ratio=ratio,
+                             progress=progress)
+        with open(tmp_csv, "w", encoding="utf-8", newline="") as stream:
+            smap.write_csv(stream, progress=ProgressBar(sys.stderr, "writing CSV  ", "rows")
+                           if show else None)
+        with open(tmp_figure, "wb") as stream:
+            plot_stability_map(smap, stream, fmt)
+        os.replace(tmp_csv, csv_path)
+        temporaries.remove(tmp_csv)
+        os.replace(tmp_figure, figure_path)
+        temporaries.remove(tmp_figure)
+    except OSError as exc:
+        raise ParameterError(f"cannot write --out {args.out!r}: {exc.strerror or exc}") from None
+    finally:
+        for tmp in temporaries:
+            tmp.unlink(missing_ok=True)
+    ny, nx = smap.grid.shape
+    print(f"wrote {figure_path} and {csv_path}: {nx} × {ny} parameter sets, "
+          f"{100 * smap.stable_fraction:.1f}% stable "
+          f"(largest real part {smap.max_real_part.min():.3g} .. "
+          f"{smap.max_real_part.max():.3g} 1/s)")
+    return 0

@@ -1,0 +1,176 @@
+"""The ``stability-map`` subcommand: outputs, one-line errors (exit 2), nothing half-written.
+
+The map's numbers are checked against linear.analyse in test_batch_linear.py; here
+the CSV is checked against the same single-case path at a few points.
+"""
+
+import csv
+
+import numpy as np
+import pytest
+
+from posturelab.cli import main
+from posturelab.cli import stability_map as cli_map
+from posturelab.linear import analyse
+from posturelab.muscles import paper_muscles
+
+PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
+
+
+def run(capsys, *argv):
+    """Run the CLI in-process; return (exit code, stdout, stderr)."""
+    code = main(list(argv))
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def read_csv(path):
+    with open(path, newline="", encoding="utf-8") as f:
+        rows = list(csv.reader(f))
+    return rows[0], rows[1:]
+
+
+def test_small_map_writes_png_and_csv(tmp_path, capsys, body):
+    out = tmp_path / "map.png"
+    code, stdout, stderr = run(capsys, "stability-map", "--x", "ankle:0:2000",
+                               "--y", "gastrocnemius:0:1000", "--resolution", "6",
+                               "--out", str(out))
+    assert code == 0, stderr
+    assert stderr == ""  # no progress bar: stderr is not a terminal
+    assert "map.png" in stdout and "map.csv" in stdout
+    assert out.read_bytes()[:8] == PNG_MAGIC
+    header, rows = read_csv(tmp_path / "map.csv")
+    assert header == ["ankle", "gastrocnemius", "max_real_part", "stable"]
+    assert len(rows) == 36
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["map.csv", "map.png"]
+    plain = tmp_path / "plain"
+    plain.write_text("")  # outputs get the mode of a normally created file, not 0600
+    assert out.stat().st_mode & 0o777 == plain.stat().st_mode & 0o777
+    plain.unlink()
+    for ankle, gastro, max_real, stable in rows[::7]:
+        single = analyse(body, paper_muscles(
+            stiffness=[float(ankle), 300, 300, 300, float(gastro)]))
+        assert stable == ("1" if single.stable else "0")
+        assert float(max_real) == pytest.approx(single.max_real_part, abs=1e-8)
+
+
+def test_viscosity_axis_case_and_svg(tmp_path, capsys):
+    out = tmp_path / "ratio.svg"
+    code, _, stderr = run(capsys, "stability-map", "--x", "viscosity_ratio:0.05:0.5",
+                          "--y", "hip:0:1000", "--resolution", "3", "--case", "6a",
+                          "--out", str(out), "--progress")
+    assert code == 0, stderr
+    assert "100.0%" in stderr  # --progress draws the bar even off a terminal
+    assert out.read_text(encoding="utf-8").lstrip().startswith("<?xml")
+    header, rows = read_csv(tmp_path / "ratio.csv")
+    assert header == ["viscosity_ratio", "hip", "max_real_part", "stable"]
+    assert np.allclose(sorted({float(r[0]) for r in rows}), [0.05, 0.275, 0.5])
+
+
+def test_fixed_viscosity_ratio(tmp_path, capsys):
+    code, _, stderr = run(capsys, "stability-map", "--x", "ankle:0:2000", "--y", "knee:0:500",
+                          "--resolution", "2", "--viscosity-ratio", "0",
+                          "--out", str(tmp_path / "m.png"))
+    assert code == 0, stderr
+    _, rows = read_csv(tmp_path / "m.csv")
+    assert {r[3] for r in rows} == {"0"}  # no damping: never asymptotically stable
+
+
+@pytest.mark.parametrize("argv,message", [
+    (["--x", "ankel:0:1", "--y", "hip:0:1"],
+     "unknown parameter 'ankel'; known parameters: ankle, knee, hip, quadriceps, "
+     "gastrocnemius, viscosity_ratio"),
+    (["--x", "ankle:2000:0", "--y", "hip:0:1"], "LO < HI"),
+    (["--x", "ankle:0:abc", "--y", "hip:0:1"], "HI must be a number"),
+    (["--x", "ankle:0", "--y", "hip:0:1"], "NAME:LO:HI"),
+    (["--x", "ankle:-5:10", "--y", "hip:0:1"], "LO must be >= 0"),
+    (["--x", "ankle:0:nan", "--y", "hip:0:1"], "finite"),
+    (["--x", "hip:0:1", "--y", "hip:0:1"], "different parameters"),
+    (["--x", "ankle:0:1", "--y", "hip:0:1", "--resolution", "1"], "[2, 5000]"),
+    (["--x", "ankle:0:1", "--y", "hip:0:1", "--resolution", "5001"], "[2, 5000]"),
+    (["--x", "ankle:0:1", "--y", "hip:0:1", "--resolution", "ten"], "integer"),
+    (["--x", "ankle:0:1", "--y", "hip:0:1", "--case", "8"], "known cases"),
+    (["--x", "ankle:0:1", "--y", "hip:0:1", "--viscosity-ratio", "-1"], ">= 0"),
+    (["--x", "viscosity_ratio:0:1", "--y", "hip:0:1", "--viscosity-ratio", "0.3"], "axis"),
+])
+def test_bad_input_one_line_exit_2(tmp_path, capsys, argv, message):
+    code, stdout, stderr = run(capsys, "stability-map", *argv,
+                               "--out", str(tmp_path / "map.png"))
+    assert code == 2
+    assert stdout == ""
+    assert stderr.count("\n") == 1 and stderr.startswith("posturelab: error: ")
+    assert message in stderr
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("out,message", [
+    ("missing_dir/map.png", "does not exist"),
+    ("a_file.txt/map.png", "does not exist"),
+    ("map.csv", "figure suffix"),
+    ("map", "figure suffix"),
+    ("map.xyz", "figure suffix"),
+])
+def test_bad_out_one_line_exit_2(tmp_path, capsys, out, message):
+    (tmp_path / "a_file.txt").write_text("not a directory")
+    code, _, stderr = run(capsys, "stability-map", "--x", "ankle:0:1", "--y", "hip:0:1",
+                          "--resolution", "2", "--out", str(tmp_path / out))
+    assert code == 2
+    assert stderr.count("\n") == 1 and message in stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a_file.txt"]
+
+
+def test_write_failure_leaves_nothing_and_keeps_old_files(tmp_path, capsys, monkeypatch):
+    """A failure while writing: one-line error, old outputs untouched, no temporaries."""
+    (tmp_path / "map.png").write_bytes(b"old figure")
+    (tmp_path / "map.csv").write_text("old csv")
+
+    def disk_full(*args, **kwargs):
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(cli_map, "plot_stability_map", disk_full)
+    code, _, stderr = run(capsys, "stability-map", "--x", "ankle:0:1", "--y", "hip:0:1",
+                          "--resolution", "2", "--out", str(tmp_path / "map.png"))
+    assert code == 2
+    assert stderr.count("\n") == 1 and "No space left on device" in stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["map.csv", "map.png"]
+    assert (tmp_path / "map.png").read_bytes() == b"old figure"
+    assert (tmp_path / "map.csv").read_text() == "old csv"
+
+
+def test_interrupt_leaves_nothing(tmp_path, capsys, monkeypatch):
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(cli_map, "plot_stability_map", interrupted)
+    code, _, _ = run(capsys, "stability-map", "--x", "ankle:0:1", "--y", "hip:0:1",
+                     "--resolution", "2", "--out", str(tmp_path / "map.png"))
+    assert code == 130
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_progress_bar_draws_in_place():
+    import io
+
+    stream = io.StringIO()
+    bar = cli_map.ProgressBar(stream, "map", "sets", width=10)
+    for done in (0, 5, 5, 10):
+        bar(done, 10)
+    text = stream.getvalue()
+    assert text.count("\r") == 3  # the repeated 5/10 is not redrawn
+    assert "[#####-----]  50.0%" in text and text.endswith("(10/10 sets)\n")
+
+
+def test_real_subprocess_bad_axis_is_one_line(tmp_path):
+    """The installed entry point: a bad axis gives one line on stderr and exit 2."""
+    import subprocess
+    import sys
+
+    proc = subprocess.run(
+        [sys.executable, "-m", "posturelab", "stability-map", "--x", "ankle:5:1",
+         "--y", "hip:0:1", "--out", str(tmp_path / "m.png")],
+        capture_output=True, encoding="utf-8", timeout=120, check=False,
+    )
+    assert proc.returncode == 2
+    assert proc.stdout == ""
+    assert proc.stderr.strip().count("\n") == 0 and "LO < HI" in proc.stderr
+    assert list(tmp_path.iterdir()) == []
