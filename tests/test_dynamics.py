@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
+from _bodies import random_body
 from posturelab.body import Body, paper_body
 from posturelab.dynamics import (
     angular_acceleration,
@@ -26,15 +27,6 @@ from posturelab.dynamics import (
 SEED = 12345
 
 
-def random_body(rng, n, gravity=9.81):
-    lengths = rng.uniform(0.2, 0.9, n)
-    return Body.from_arrays(
-        masses=rng.uniform(1.0, 40.0, n),
-        lengths=lengths,
-        com_distances=rng.uniform(0.0, 1.0, n) * lengths,
-        inertias=rng.uniform(0.05, 3.0, n),
-        gravity=gravity,
-    )
 
 
 def com_kinematics(body, theta, omega):

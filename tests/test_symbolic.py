@@ -35,6 +35,7 @@ from sympy.physics.mechanics import (
     msubs,
 )
 
+from _bodies import random_body
 from posturelab.body import Body, paper_body
 from posturelab.dynamics import (
     angular_acceleration,
@@ -117,15 +118,6 @@ def derivation(request):
     return Derivation(request.param)
 
 
-def random_body(rng, n, gravity=None):
-    lengths = rng.uniform(0.2, 0.9, n)
-    return Body.from_arrays(
-        masses=rng.uniform(1.0, 40.0, n),
-        lengths=lengths,
-        com_distances=rng.uniform(0.0, 1.0, n) * lengths,
-        inertias=rng.uniform(0.05, 3.0, n),
-        gravity=rng.uniform(5.0, 15.0) if gravity is None else gravity,
-    )
 
 
 def samples(n, seed=12345):
@@ -133,7 +125,7 @@ def samples(n, seed=12345):
     rng = np.random.default_rng(seed + n)
     for _ in range(N_SAMPLES):
         yield (
-            random_body(rng, n),
+            random_body(rng, n, gravity=None),
             rng.uniform(-np.pi, np.pi, n),
             rng.normal(0.0, 3.0, n),
             rng.normal(0.0, 100.0, n),
@@ -188,7 +180,7 @@ def test_angular_acceleration_equals_symbolic(derivation):
 def test_joint_torque_enters_as_generalised_force(derivation):
     """With g = 0 and the body at rest, the forcing is exactly U (U is the generalised force)."""
     rng = np.random.default_rng(12345)
-    body = random_body(rng, derivation.n)
+    body = random_body(rng, derivation.n, gravity=None)
     u = rng.normal(0.0, 10.0, derivation.n)
     theta = rng.uniform(-1.0, 1.0, derivation.n)
     close(derivation.forcing(body, theta, np.zeros(derivation.n), u, g=0.0), u)

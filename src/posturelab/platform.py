@@ -121,8 +121,41 @@ class VelocityStep(Disturbance):
                 f"{word[0] if self.velocity >= 0 else word[1]} at t = 0")
 
 
+class _SinePulse(Disturbance):
+    """A sine-shaped acceleration on [start, start + duration], zero elsewhere (shared code)."""
+
+    #: Cycles of the sine within the pulse: ½ for a half-sine, 1 for ramp-and-hold. [-]
+    _cycles: float = 0.5
+    start: float
+    duration: float
+    axis: str
+
+    def _validate_window(self) -> None:
+        object.__setattr__(self, "duration", positive_float("duration [s]", self.duration))
+        object.__setattr__(self, "start", nonnegative_float("start [s]", self.start))
+        _axis(self.axis)
+
+    @property
+    def breakpoints(self) -> tuple[float, ...]:
+        return (self.start, self.start + self.duration)
+
+    @property
+    def peak_acceleration_value(self) -> float:
+        """Amplitude of the sine. [m/s²]"""
+        raise NotImplementedError
+
+    def acceleration(self, t):
+        t = np.asarray(t, dtype=float)
+        s = (t - self.start) / self.duration
+        a = np.where((s >= 0) & (s <= 1),
+                     self.peak_acceleration_value * np.sin(2 * np.pi * self._cycles * s), 0.0)
+        out = np.zeros(t.shape + (2,))
+        out[..., _axis(self.axis)] = a
+        return out
+
+
 @dataclass(frozen=True)
-class HalfSinePulse(Disturbance):
+class HalfSinePulse(_SinePulse):
     """Acceleration a(t) = peak · sin(π (t − start)/duration) for start <= t <= start + duration.
 
     Parameters
@@ -140,25 +173,16 @@ class HalfSinePulse(Disturbance):
     duration: float
     start: float = 0.0
     axis: Axis = "x"
+    _cycles = 0.5
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "peak_acceleration",
                            finite_float("peak_acceleration [m/s²]", self.peak_acceleration))
-        object.__setattr__(self, "duration", positive_float("duration [s]", self.duration))
-        object.__setattr__(self, "start", nonnegative_float("start [s]", self.start))
-        _axis(self.axis)
+        self._validate_window()
 
     @property
-    def breakpoints(self) -> tuple[float, ...]:
-        return (self.start, self.start + self.duration)
-
-    def acceleration(self, t):
-        t = np.asarray(t, dtype=float)
-        s = (t - self.start) / self.duration
-        a = np.where((s >= 0) & (s <= 1), self.peak_acceleration * np.sin(np.pi * s), 0.0)
-        out = np.zeros(t.shape + (2,))
-        out[..., _axis(self.axis)] = a
-        return out
+    def peak_acceleration_value(self) -> float:
+        return self.peak_acceleration
 
     @property
     def velocity_gain(self) -> float:
@@ -171,7 +195,7 @@ class HalfSinePulse(Disturbance):
 
 
 @dataclass(frozen=True)
-class RampAndHold(Disturbance):
+class RampAndHold(_SinePulse):
     """The usual lab platform: move by ``displacement`` over ``duration``, then hold.
 
     The acceleration is one full sine cycle, a(t) = (2π D / T²) sin(2π (t − t0)/T),
@@ -193,30 +217,21 @@ class RampAndHold(Disturbance):
     duration: float
     start: float = 0.0
     axis: Axis = "x"
+    _cycles = 1.0
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "displacement",
                            finite_float("displacement [m]", self.displacement))
-        object.__setattr__(self, "duration", positive_float("duration [s]", self.duration))
-        object.__setattr__(self, "start", nonnegative_float("start [s]", self.start))
-        _axis(self.axis)
-
-    @property
-    def breakpoints(self) -> tuple[float, ...]:
-        return (self.start, self.start + self.duration)
+        self._validate_window()
 
     @property
     def peak_acceleration(self) -> float:
         """2πD/T². [m/s²]"""
         return 2.0 * np.pi * self.displacement / self.duration**2
 
-    def acceleration(self, t):
-        t = np.asarray(t, dtype=float)
-        s = (t - self.start) / self.duration
-        a = np.where((s >= 0) & (s <= 1), self.peak_acceleration * np.sin(2 * np.pi * s), 0.0)
-        out = np.zeros(t.shape + (2,))
-        out[..., _axis(self.axis)] = a
-        return out
+    @property
+    def peak_acceleration_value(self) -> float:
+        return self.peak_acceleration
 
     def describe(self) -> str:
         return (f"ramp-and-hold: {self.displacement:g} m along {self.axis} over "
