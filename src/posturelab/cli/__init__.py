@@ -21,6 +21,7 @@ SUBCOMMANDS: dict[str, str] = {
     "reproduce": "reproduce",
     "stability-map": "stability_map",
     "sweep": "sweep",
+    "fit": "fit",
 }
 
 

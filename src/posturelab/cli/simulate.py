@@ -44,6 +44,19 @@ def add_parser(sub, name: str) -> argparse.ArgumentParser:
         description=DESCRIPTION, epilog=CONVENTIONS_EPILOG,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
+    add_experiment_arguments(p)
+    out = p.add_argument_group("output")
+    out.add_argument("--out", metavar="RUN.csv", help="write the time series as CSV.")
+    out.add_argument("--plot", metavar="RUN.png", help="write a 2×2 summary figure (PNG/SVG/PDF).")
+    out.add_argument("--animate", metavar="RUN.gif", help="write a stick-figure animation (GIF).")
+    out.add_argument("--json", action="store_true",
+                     help='print one JSON summary: {"fell", "fall_time", "status", '
+                     '"max_abs_theta", "final_state"}.')
+    return p
+
+
+def add_experiment_arguments(p: argparse.ArgumentParser) -> None:
+    """The options that describe one experiment (shared with ``posturelab fit``)."""
     src = p.add_argument_group("what to simulate")
     src.add_argument("--scenario", metavar="FILE.toml",
                      help="a scenario file (see the README); replaces the model options below.")
@@ -81,14 +94,6 @@ def add_parser(sub, name: str) -> argparse.ArgumentParser:
                      help="absolute tolerance [rad, rad/s] (default 1e-10).")
     run.add_argument("--sample-rate", type=float, default=None,
                      help="output samples per second [Hz] (default 1000).")
-    out = p.add_argument_group("output")
-    out.add_argument("--out", metavar="RUN.csv", help="write the time series as CSV.")
-    out.add_argument("--plot", metavar="RUN.png", help="write a 2×2 summary figure (PNG/SVG/PDF).")
-    out.add_argument("--animate", metavar="RUN.gif", help="write a stick-figure animation (GIF).")
-    out.add_argument("--json", action="store_true",
-                     help='print one JSON summary: {"fell", "fall_time", "status", '
-                     '"max_abs_theta", "final_state"}.')
-    return p
 
 
 MODEL_OPTIONS = ("case", "stiffness", "disturbance", "platform_profile", "initial_posture",

@@ -1,0 +1,99 @@
+"""Fitting pair stiffness to measured angles: recovery of known gains from synthetic data."""
+
+import json
+
+import numpy as np
+import pytest
+
+import posturelab as pl
+from posturelab.cli import main
+from posturelab.identify import fit_stiffness, read_trajectory_csv
+
+
+@pytest.fixture(scope="module")
+def experiment():
+    """A 2 s backward-step run of case 1 sampled at 50 Hz: the 'measurement'."""
+    sc = pl.builtin_scenario("paper-backward-case1").replace(duration=2.0, sample_rate=50)
+    return sc, sc.run()
+
+
+def test_noise_free_data_recovers_gains_exactly(experiment):
+    sc, truth = experiment
+    start = sc.replace(muscles=pl.paper_muscles(stiffness=[800, 300, 300, 300, 100]))
+    fit = fit_stiffness(start, truth.time, truth.theta, ["ankle", "gastrocnemius"])
+    assert fit.success
+    np.testing.assert_allclose(fit.estimates, [500.0, 300.0], rtol=1e-5)
+    assert fit.residual_rms < 1e-7
+
+
+def test_noisy_data_true_values_inside_confidence_intervals(experiment):
+    """Seeded 2 mrad noise: each true value lies within its 95 % interval, which is narrow."""
+    sc, truth = experiment
+    rng = np.random.default_rng(20261122)
+    noisy = truth.theta + rng.normal(0.0, 0.002, truth.theta.shape)
+    start = sc.replace(muscles=pl.paper_muscles(stiffness=[700, 300, 300, 300, 200]))
+    fit = fit_stiffness(start, truth.time, noisy, ["ankle", "gastrocnemius", "viscosity_ratio"])
+    truth_values = np.array([500.0, 300.0, 0.25])
+    lo, hi = fit.confidence_intervals.T
+    assert np.all(lo <= truth_values) and np.all(truth_values <= hi)
+    assert np.all(fit.standard_errors / truth_values < 0.05)
+    # the residual RMS estimates the noise level
+    assert fit.residual_rms == pytest.approx(0.002, rel=0.15)
+    assert fit.correlation.shape == (3, 3)
+    np.testing.assert_allclose(np.diag(fit.correlation), 1.0)
+
+
+def test_unidentifiable_parameter_reported():
+    """A one-sided gastrocnemius that stays slack (θ2 < 0 throughout) leaves no trace in the
+    angles: its stiffness is reported as not identifiable (NaN standard error)."""
+    sc = pl.builtin_scenario("paper-forward-case1").replace(
+        muscles=pl.paper_muscles("1", gastrocnemius="one-sided"), duration=1.0, sample_rate=50)
+    data = sc.run()
+    assert np.all(data.theta[:, 1] < 0)
+    fit = fit_stiffness(sc, data.time, data.theta, ["ankle", "gastrocnemius"])
+    assert fit.estimates[0] == pytest.approx(500.0, rel=1e-5)
+    assert np.isfinite(fit.standard_errors[0])
+    assert not np.isfinite(fit.standard_errors[1])
+    assert fit.to_dict()["parameters"]["gastrocnemius"]["ci95"] is None
+
+
+@pytest.mark.parametrize("kwargs,needle", [
+    ({"free": ["ankel"]}, "unknown parameter"),
+    ({"free": []}, "at least one"),
+    ({"free": ["ankle", "ankle"]}, "unique"),
+    ({"theta": np.zeros((5, 2))}, "theta"),
+    ({"time": [0.0, 3.0, 9.0]}, "duration"),
+])
+def test_bad_fit_input(experiment, kwargs, needle):
+    sc, truth = experiment
+    args = {"time": truth.time, "theta": truth.theta, "free": ["ankle"]} | kwargs
+    if "time" in kwargs and "theta" not in kwargs:
+        args["theta"] = np.zeros((len(args["time"]), 3))
+    with pytest.raises(pl.PostureLabError, match=needle):
+        fit_stiffness(sc, args["time"], args["theta"], args["free"])
+
+
+def test_cli_fit_round_trip(tmp_path, capsys):
+    data = tmp_path / "meas.csv"
+    assert main(["simulate", "--case", "1", "--disturbance", "backward", "--duration", "1.5",
+                 "--sample-rate", "50", "--out", str(data)]) == 0
+    capsys.readouterr()
+    report = tmp_path / "fit.json"
+    code = main(["fit", "--data", str(data), "--stiffness", "700,300,300,300,300",
+                 "--disturbance", "backward", "--free", "ankle", "--json",
+                 "--report", str(report)])
+    out = json.loads(capsys.readouterr().out)
+    assert code == 0
+    assert out["parameters"]["ankle"]["estimate"] == pytest.approx(500.0, rel=1e-4)
+    assert json.loads(report.read_text())["parameters"]["ankle"]["unit"] == "N·m/rad"
+    t, theta = read_trajectory_csv(data, 3)
+    assert theta.shape == (t.size, 3)
+
+
+def test_cli_fit_bad_input_one_line(tmp_path, capsys):
+    data = tmp_path / "m.csv"
+    data.write_text("t,theta1,theta2\n0,0,0\n0.1,0,0\n")
+    code = main(["fit", "--data", str(data), "--case", "1", "--disturbance", "backward",
+                 "--free", "ankle"])
+    err = capsys.readouterr().err
+    assert code == 2 and "theta3" in err and len(err.strip().splitlines()) == 1
