@@ -62,6 +62,13 @@ class SimulationResult:
         Times at which a one-sided pair or the knee stop switched. [s]
     description : str
         The run's set-up in words (body, muscles, disturbance).
+    angular_acceleration : numpy.ndarray, shape (T, N), optional
+        Link angular accelerations. [rad/s²]
+    ground_reaction : numpy.ndarray, shape (T, 2), optional
+        Horizontal and vertical force of the platform on the foot. [N]
+    centre_of_pressure : numpy.ndarray, shape (T,), optional
+        Centre of pressure under the massless foot, x_p = τ_ankle / F_y,
+        relative to the ankle. [m]
     """
 
     time: np.ndarray
@@ -83,6 +90,9 @@ class SimulationResult:
     fall_reason: str | None
     switch_times: tuple[float, ...] = ()
     description: str = ""
+    angular_acceleration: np.ndarray | None = None
+    ground_reaction: np.ndarray | None = None
+    centre_of_pressure: np.ndarray | None = None
 
     @property
     def n_links(self) -> int:
@@ -144,6 +154,9 @@ class SimulationResult:
                   "platform_x", "platform_y"]
         cols += [self.cog_position, self.cog_velocity, self.platform_acceleration,
                  self.platform_velocity, self.platform_position]
+        if self.centre_of_pressure is not None:
+            names += ["cop_x", "ground_fx", "ground_fy"]
+            cols += [self.centre_of_pressure[:, None], self.ground_reaction]
         return names, np.concatenate(cols, axis=1)
 
     def to_csv_text(self) -> str:

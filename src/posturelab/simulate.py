@@ -128,14 +128,22 @@ class FallCriteria:
         If given, a fall also when the centre of gravity's horizontal
         projection leaves [heel, toe] (the foot would tip). None (default)
         is the paper's model: the foot never tips.
+    centre_of_pressure : bool
+        With a base of support, also a fall when the centre of pressure under
+        the (massless) foot leaves [heel, toe]: the ankle moment exceeds what
+        the ground can react and the foot starts to tip, even while the
+        centre of gravity is still above the foot.
     """
 
     max_link_angle: float = math.pi / 3
     base_of_support: BaseOfSupport | None = None
+    centre_of_pressure: bool = False
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "max_link_angle", float_in_range(
             "max_link_angle [rad]", self.max_link_angle, 0.0, math.pi, include_low=False))
+        if self.centre_of_pressure and self.base_of_support is None:
+            raise ParameterError("centre_of_pressure needs a base_of_support (heel and toe)")
 
 
 @dataclass(frozen=True)
@@ -170,27 +178,63 @@ class KneeModel:
 # ---------------------------------------------------------------------------
 
 
+def joint_crossing_matrix(muscles: MuscleSet) -> np.ndarray:
+    """C (P, N): C[p, j] = 1 when pair p crosses joint j (0 = ankle, 1 = knee, …). [-]
+
+    Joint j lies between link j (0 = the foot) and link j + 1; the net muscle
+    moment at the joints is τ = Cᵀ M.
+    """
+    crosses = np.zeros((len(muscles.pairs), muscles.n_links))
+    for r, p in enumerate(muscles.pairs):
+        crosses[r, p.lo:p.hi] = 1.0
+    return crosses
+
+
+def moments_to_link_torques(moments: np.ndarray) -> np.ndarray:
+    """Generalised torques on the link angles from joint moments: U_i = −τ_i + τ_{i+1}. [N·m]
+
+    Equal to −EᵀM when τ = CᵀM (see :func:`joint_crossing_matrix`).
+    """
+    moments = np.asarray(moments, dtype=float)
+    above = np.concatenate([moments[..., 1:], np.zeros(moments.shape[:-1] + (1,))], axis=-1)
+    return above - moments
+
+
 @dataclass
 class _Model:
     body: Body
     muscles: MuscleSet
     disturbance: Disturbance
     knee_row: np.ndarray | None  # C (N,) for the knee constraint, or None
+    limits: np.ndarray | None = None  # (N,) largest |joint moment| [N·m], inf where none
     E: np.ndarray = field(init=False)
+    crossing: np.ndarray = field(init=False)
 
     def __post_init__(self) -> None:
         self.E = self.muscles.selection_matrix
+        self.crossing = joint_crossing_matrix(self.muscles)
 
-    def torques(self, theta, omega, active):
-        stretch = self.E @ theta
-        rate = self.E @ omega
-        M = (self.muscles.stiffnesses * stretch + self.muscles.viscosities * rate) * active
-        return M, -(self.E.T @ M)
+    def raw_moments(self, theta, omega, active):
+        """Unsaturated joint moments τ = Cᵀ M. [N·m]"""
+        M = (self.muscles.stiffnesses * (self.E @ theta)
+             + self.muscles.viscosities * (self.E @ omega)) * active
+        return M @ self.crossing
 
-    def free_acceleration(self, t, x, active):
+    def torques(self, theta, omega, active, saturation=None):
+        if self.limits is None:
+            M = (self.muscles.stiffnesses * (self.E @ theta)
+                 + self.muscles.viscosities * (self.E @ omega)) * active
+            return None, -(self.E.T @ M)
+        tau = self.raw_moments(theta, omega, active)
+        if saturation is not None:
+            bound = np.where(np.isfinite(self.limits), self.limits, 0.0)
+            tau = np.where(saturation != 0, saturation * bound, tau)
+        return tau, moments_to_link_torques(tau)
+
+    def free_acceleration(self, t, x, active, saturation=None):
         n = self.body.n_links
         theta, omega = x[:n], x[n:]
-        _, U = self.torques(theta, omega, active)
+        _, U = self.torques(theta, omega, active, saturation)
         a = self.disturbance.acceleration(t)
         rhs = (U - velocity_terms(self.body, theta, omega)
                + (self.body.gravity + a[1]) * gravity_vector(self.body, theta)
@@ -198,8 +242,8 @@ class _Model:
         J = mass_matrix(self.body, theta)
         return J, np.linalg.solve(J, rhs)
 
-    def acceleration(self, t, x, active, locked):
-        J, acc = self.free_acceleration(t, x, active)
+    def acceleration(self, t, x, active, locked, saturation=None):
+        J, acc = self.free_acceleration(t, x, active, saturation)
         if locked:
             C = self.knee_row
             JiC = np.linalg.solve(J, C)
@@ -212,6 +256,23 @@ class _Model:
         J = mass_matrix(self.body, theta)
         JiC = np.linalg.solve(J, C)
         return omega - JiC * (C @ omega) / (C @ JiC)
+
+    def centre_of_pressure(self, t, x, active, locked, saturation=None):
+        """x_p = τ_ankle / F_y under the massless foot, relative to the ankle. [m]"""
+        n = self.body.n_links
+        theta, omega = x[:n], x[n:]
+        acc = self.acceleration(t, x, active, locked, saturation)
+        if self.limits is None:
+            M = (self.muscles.stiffnesses * (self.E @ theta)
+                 + self.muscles.viscosities * (self.E @ omega)) * active
+            tau0 = M @ self.crossing[:, 0]
+        else:
+            tau0 = self.torques(theta, omega, active, saturation)[0][0]
+        a = self.body.gravity_coefficients
+        ay = self.disturbance.acceleration(t)[1]
+        fy = (self.body.total_mass * (self.body.gravity + ay)
+              - acc @ (a * np.sin(theta)) - (a * np.cos(theta)) @ omega**2)
+        return tau0 / fy
 
 
 def initial_state_for(
@@ -257,6 +318,7 @@ def simulate(
     rates_from: Literal["upright", "posture"] = "upright",
     knee: KneeModel | None = None,
     fall: FallCriteria | None = None,
+    torque_limits: np.ndarray | None = None,
     rtol: float = 1e-8,
     atol: float = 1e-10,
     sample_rate: float = 1000.0,
@@ -284,6 +346,10 @@ def simulate(
         Free (default), locked, or with a hyper-extension stop. Needs N >= 2.
     fall : FallCriteria, optional
         Fall criteria; default: any |θ_i| > π/3, no foot limit (the paper's model).
+    torque_limits : array_like, shape (N,), optional
+        Largest net muscle moment at the ankle, knee, hip, … (the sum of the
+        pairs crossing each joint); ``inf`` for no limit. A joint saturates and
+        lets go at events, never inside the right-hand side. [N·m]
     rtol, atol : float
         Integrator tolerances (relative [-], absolute [rad, rad/s]).
     sample_rate : float
@@ -322,7 +388,17 @@ def simulate(
     if knee.mode != "free":
         knee_row = np.zeros(n)
         knee_row[0], knee_row[1] = -1.0, 1.0
-    model = _Model(body, muscles, disturbance, knee_row)
+    limits = None
+    if torque_limits is not None:
+        limits = np.asarray(torque_limits, dtype=float)
+        if limits.shape != (n,) or np.any(np.isnan(limits)) or np.any(limits <= 0):
+            raise ParameterError(
+                f"torque_limits [N·m] must be {n} numbers > 0 (inf for none), got "
+                f"{np.asarray(torque_limits).tolist()}"
+            )
+        if np.all(np.isinf(limits)):
+            limits = None
+    model = _Model(body, muscles, disturbance, knee_row, limits)
 
     locked = knee.mode == "locked"
     if knee.mode == "locked":
@@ -350,6 +426,14 @@ def simulate(
         return act
 
     active = active_from(x)
+    limited = [] if limits is None else [j for j in range(n) if np.isfinite(limits[j])]
+    saturation = np.zeros(n)
+    if limited:
+        tau0 = model.raw_moments(x[:n], x[n:], active)
+        for j in limited:
+            if abs(tau0[j]) > limits[j]:
+                saturation[j] = np.sign(tau0[j])
+    locked_flags: list[np.ndarray] = []
     grid = np.arange(0.0, duration + 0.5 / sample_rate, 1.0 / sample_rate)
     grid = grid[grid <= duration + 1e-12]
     stops = sorted({b for b in disturbance.breakpoints if 0.0 < b < duration} | {duration})
@@ -368,12 +452,24 @@ def simulate(
     a_coef = body.gravity_coefficients
     mtot = body.total_mass
 
+    initial_fall = _outside_at_start(model, fall, x, active, locked,
+                                     saturation.copy() if limited else None)
+    if initial_fall is not None:
+        times.append(np.array([0.0]))
+        states.append(x[None, :])
+        locked_flags.append(np.array([locked]))
+        fell, fall_time, fall_reason = True, 0.0, initial_fall
+        status, message = "fell", f"fell at t = 0 s: {initial_fall}"
+        t = duration  # nothing to integrate
+
     while t < duration:
         t_end = next(s for s in stops if s > t + 1e-12) if any(s > t + 1e-12 for s in stops) \
             else duration
 
-        def rhs(tt, xx, _active=active, _locked=locked):
-            return np.concatenate([xx[n:], model.acceleration(tt, xx, _active, _locked)])
+        sat = saturation.copy() if limited else None
+
+        def rhs(tt, xx, _active=active, _locked=locked, _sat=sat):
+            return np.concatenate([xx[n:], model.acceleration(tt, xx, _active, _locked, _sat)])
 
         events, kinds = [], []
         for i in range(n):
@@ -392,6 +488,34 @@ def simulate(
                 ev.terminal, ev.direction = True, -1
                 events.append(ev)
                 kinds.append(("fall", f"centre of gravity passed the {what}"))
+            if fall.centre_of_pressure:
+                def ev_cop_toe(tt, xx, _a=active, _l=locked, _s=sat):
+                    return bos.toe - model.centre_of_pressure(tt, xx, _a, _l, _s)
+                def ev_cop_heel(tt, xx, _a=active, _l=locked, _s=sat):
+                    return model.centre_of_pressure(tt, xx, _a, _l, _s) - bos.heel
+                for ev, what in ((ev_cop_toe, f"toe ({bos.toe:.3f} m)"),
+                                 (ev_cop_heel, f"heel ({bos.heel:.3f} m)")):
+                    ev.terminal, ev.direction = True, -1
+                    events.append(ev)
+                    kinds.append(("fall", f"centre of pressure passed the {what}: the foot tips"))
+        for j in limited:
+            # a free joint saturates when |τ| reaches its limit; a saturated one lets go when
+            # the unsaturated moment comes back inside (hysteresis as for the one-sided pairs)
+            if saturation[j] == 0:
+                for side in (1.0, -1.0):
+                    def ev_sat(tt, xx, _j=j, _side=side, _a=active):
+                        tau = model.raw_moments(xx[:n], xx[n:], _a)[_j]
+                        return _side * tau - limits[_j] - _SWITCH_HYSTERESIS
+                    ev_sat.terminal, ev_sat.direction = True, 1
+                    events.append(ev_sat)
+                    kinds.append(("saturate", (j, side)))
+            else:
+                def ev_unsat(tt, xx, _j=j, _side=saturation[j], _a=active):
+                    tau = model.raw_moments(xx[:n], xx[n:], _a)[_j]
+                    return _side * tau - limits[_j] + _SWITCH_HYSTERESIS
+                ev_unsat.terminal, ev_unsat.direction = True, -1
+                events.append(ev_unsat)
+                kinds.append(("saturate", (j, 0.0)))
         for p in one_sided:
             # An acting pair waits for its stretch to fall below 0, a slack one to rise above.
             # The tiny hysteresis keeps a pair resting at zero stretch from re-firing.
@@ -409,8 +533,8 @@ def simulate(
                 events.append(ev_knee)
                 kinds.append(("knee-hit", None))
             else:
-                def ev_release(tt, xx, _active=active):
-                    _, acc = model.free_acceleration(tt, xx, _active)
+                def ev_release(tt, xx, _active=active, _sat=sat):
+                    _, acc = model.free_acceleration(tt, xx, _active, _sat)
                     return acc[1] - acc[0] + _RELEASE_HYSTERESIS
                 ev_release.terminal, ev_release.direction = True, -1
                 events.append(ev_release)
@@ -429,6 +553,7 @@ def simulate(
         if sel.any():
             times.append(grid[sel])
             states.append(sol.sol(grid[sel]).T)
+            locked_flags.append(np.full(int(sel.sum()), locked))
             grid = grid[~sel | (grid > seg_end + 1e-12)]
             grid = grid[grid > seg_end - 1e-12] if sol.status == 1 else grid
         if sol.status == -1:
@@ -451,6 +576,7 @@ def simulate(
                 if not times or times[-1][-1] < seg_end - 1e-12:
                     times.append(np.array([seg_end]))
                     states.append(x[None, :])
+                    locked_flags.append(np.array([locked]))
                 fell, fall_time, fall_reason = True, seg_end, info
                 status = "fell"
                 message = f"fell at t = {seg_end:.4f} s: {info}"
@@ -471,15 +597,47 @@ def simulate(
                 locked = True
             elif kind == "knee-release":
                 locked = False
+            elif kind == "saturate":
+                joint, side = info
+                saturation = saturation.copy()
+                saturation[joint] = side
             continue
         t = t_end
 
     return _assemble(body, muscles, disturbance, times, states, status, message, fell,
-                     fall_time, fall_reason, switch_times, description)
+                     fall_time, fall_reason, switch_times, description,
+                     locked=np.concatenate(locked_flags) if locked_flags else None,
+                     knee_row=knee_row, torque_limits=limits)
+
+
+def _outside_at_start(model, fall, x, active, locked, saturation) -> str | None:
+    """A fall criterion already violated at t = 0 (events only see crossings)."""
+    n = model.body.n_links
+    over = np.nonzero(np.abs(x[:n]) > fall.max_link_angle)[0]
+    if over.size:
+        return f"link {over[0] + 1} angle beyond ±{fall.max_link_angle:.3g} rad at the start"
+    bos = fall.base_of_support
+    if bos is None:
+        return None
+    xc = model.body.gravity_coefficients @ np.sin(x[:n]) / model.body.total_mass
+    if not bos.heel <= xc <= bos.toe:
+        return f"centre of gravity ({xc:.3f} m) outside the foot at the start"
+    if fall.centre_of_pressure:
+        xp = model.centre_of_pressure(0.0, x, active, locked, saturation)
+        if not bos.heel <= xp <= bos.toe:
+            return (f"centre of pressure ({xp:.3f} m) outside the foot at the start: "
+                    "the foot tips")
+    return None
 
 
 def _assemble(body, muscles, disturbance, times, states, status, message, fell, fall_time,
-              fall_reason, switch_times, description) -> SimulationResult:
+              fall_reason, switch_times, description, *, locked=None, knee_row=None,
+              torque_limits=None) -> SimulationResult:
+    """Derived series of a run: torques, accelerations, ground reaction, CoG, platform.
+
+    ``locked`` (T,) marks samples where the knee constraint held (its row
+    ``knee_row``); ``torque_limits`` (N,) saturates the joint moments. [N·m]
+    """
     n = body.n_links
     if times:
         time = np.concatenate(times)
@@ -491,12 +649,32 @@ def _assemble(body, muscles, disturbance, times, states, status, message, fell, 
     from .muscles import pair_torques as _pair_torques
 
     M = _pair_torques(muscles, theta, omega)
-    U = -M @ muscles.selection_matrix
-    crosses = np.zeros((len(muscles.pairs), n))
-    for r, p in enumerate(muscles.pairs):
-        crosses[r, p.lo:p.hi] = 1.0  # joint j (0 = ankle) lies between links j and j+1
-    moments = M @ crosses
+    moments = M @ joint_crossing_matrix(muscles)
+    if torque_limits is not None:
+        moments = np.clip(moments, -torque_limits, torque_limits)
+        U = moments_to_link_torques(moments)
+    else:
+        U = -M @ muscles.selection_matrix
     acc = disturbance.acceleration(time)
+    rhs = (U - velocity_terms(body, theta, omega)
+           + (body.gravity + acc[:, 1:2]) * gravity_vector(body, theta)
+           - acc[:, 0:1] * platform_vector(body, theta))
+    J = mass_matrix(body, theta)
+    alpha = np.linalg.solve(J, rhs[..., None])[..., 0] if time.size else np.zeros((0, n))
+    if locked is not None and knee_row is not None and np.any(locked):
+        JiC = np.linalg.solve(J[locked], np.broadcast_to(knee_row, (int(locked.sum()), n))[
+            ..., None])[..., 0]
+        alpha[locked] -= JiC * ((alpha[locked] @ knee_row) / (JiC @ knee_row))[:, None]
+    a_coef = body.gravity_coefficients
+    s, c = np.sin(theta), np.cos(theta)
+    cog_acc_x = (np.sum(alpha * a_coef * c, axis=1)
+                 - np.sum(a_coef * s * omega**2, axis=1)) / body.total_mass
+    cog_acc_y = (-np.sum(alpha * a_coef * s, axis=1)
+                 - np.sum(a_coef * c * omega**2, axis=1)) / body.total_mass
+    ground = body.total_mass * np.column_stack(
+        [acc[:, 0] + cog_acc_x, body.gravity + acc[:, 1] + cog_acc_y])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        cop = np.where(ground[:, 1] > 0, moments[:, 0] / ground[:, 1], np.nan)
     vel = np.zeros_like(acc)
     pos = np.zeros_like(acc)
     if time.size > 1:
@@ -506,7 +684,7 @@ def _assemble(body, muscles, disturbance, times, states, status, message, fell, 
         pos[1:] = np.cumsum(0.5 * (vel[1:] + vel[:-1]) * dt, axis=0)
     elif time.size == 1:
         vel[:] = disturbance.velocity_change
-    for arr in (time, theta, omega):
+    for arr in (time, theta, omega, alpha):
         arr.setflags(write=False)
     return SimulationResult(
         time=time, theta=theta, omega=omega, pair_torques=M, joint_torques=U,
@@ -517,4 +695,5 @@ def _assemble(body, muscles, disturbance, times, states, status, message, fell, 
         pair_names=tuple(muscles.names), status=status, message=message, fell=fell,
         fall_time=fall_time, fall_reason=fall_reason, switch_times=tuple(switch_times),
         description=description or disturbance.describe(),
+        angular_acceleration=alpha, ground_reaction=ground, centre_of_pressure=cop,
     )

@@ -33,6 +33,26 @@ def parse_float_list(text: str, field: str, n: int | None = None) -> list[float]
     return values
 
 
+def parse_limit_list(text: str, field: str, n: int) -> list[float]:
+    """Parse ``"120,inf,80"``: n positive numbers, ``inf``/``none`` meaning no limit."""
+    parts = [p.strip().lower() for p in str(text).split(",")]
+    if len(parts) != n:
+        raise ParameterError(f"{field} must have {n} comma-separated values, got {len(parts)}")
+    out = []
+    for p in parts:
+        if p in ("inf", "none"):
+            out.append(math.inf)
+            continue
+        try:
+            v = float(p)
+        except ValueError:
+            raise ParameterError(f"{field} must be numbers or 'inf', got {p!r}") from None
+        if not (math.isfinite(v) and v > 0):
+            raise ParameterError(f"{field} must be > 0 (or 'inf'), got {p!r}")
+        out.append(v)
+    return out
+
+
 def add_muscle_arguments(p: argparse.ArgumentParser, *, require: bool = False) -> None:
     """--case / --stiffness / --viscosity-ratio / --gastrocnemius."""
     g = p.add_mutually_exclusive_group(required=require)

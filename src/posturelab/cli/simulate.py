@@ -15,7 +15,13 @@ from ..platform import NoDisturbance, VelocityStep, read_profile_csv
 from ..scenarios import Scenario, builtin_scenario, builtin_scenario_names, load_scenario
 from ..simulate import FOOT_FROM_LITERATURE, BaseOfSupport, FallCriteria, KneeModel
 from . import CONVENTIONS_EPILOG, UsageError
-from ._common import add_muscle_arguments, muscles_from_args, parse_float_list, print_json
+from ._common import (
+    add_muscle_arguments,
+    muscles_from_args,
+    parse_float_list,
+    parse_limit_list,
+    print_json,
+)
 
 DESCRIPTION = """\
 Simulate the paper's three-link biped (or a scenario file) under muscle-pair feedback
@@ -85,6 +91,11 @@ def add_experiment_arguments(p: argparse.ArgumentParser) -> None:
                      help="base of support for the fall test: none (the paper; the foot never "
                      "tips), literature (heel −0.063 m, toe 0.188 m: a 1.65 m person) or "
                      "HEEL,TOE [m] relative to the ankle.")
+    src.add_argument("--centre-of-pressure", action="store_true",
+                     help="with --foot, also fall when the centre of pressure leaves the foot "
+                     "(the foot tips), not only the centre of gravity.")
+    src.add_argument("--torque-limits", metavar="ANKLE,KNEE,HIP",
+                     help="largest net muscle moment at each joint [N·m] ('inf' for none).")
     src.add_argument("--max-link-angle", type=float, default=None, metavar="RAD",
                      help="fall when any |θ_i| exceeds this [rad] (default π/3).")
     run = p.add_argument_group("integration")
@@ -119,10 +130,14 @@ def scenario_from_args(args: argparse.Namespace) -> Scenario:
             overrides[name] = value
     if overrides:
         sc = sc.replace(**overrides)
-    if args.max_link_angle is not None or args.foot != "none":
+    if args.max_link_angle is not None or args.foot != "none" or args.centre_of_pressure:
         sc = sc.replace(fall=FallCriteria(
             args.max_link_angle if args.max_link_angle is not None else sc.fall.max_link_angle,
-            _foot(args.foot) if args.foot != "none" else sc.fall.base_of_support))
+            _foot(args.foot) if args.foot != "none" else sc.fall.base_of_support,
+            args.centre_of_pressure or sc.fall.centre_of_pressure))
+    if args.torque_limits:
+        sc = sc.replace(torque_limits=tuple(
+            parse_limit_list(args.torque_limits, "--torque-limits [N·m]", sc.body.n_links)))
     if args.knee != "free":
         sc = sc.replace(knee=KneeModel(args.knee))
     if args.rates_from != "upright":

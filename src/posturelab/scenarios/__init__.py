@@ -46,6 +46,10 @@ Schema (every table optional except where noted; units in brackets)::
     [fall]
     max_link_angle = 1.0471975511965976  # [rad]
     base_of_support = "none"             # none | literature | {heel = -0.06, toe = 0.19} [m]
+    centre_of_pressure = false           # also fall when the CoP leaves the foot (it tips)
+
+    [limits]
+    torque = [120.0, "inf", "inf"]       # largest net moment at ankle, knee, hip [N·m]
 
     [solver]
     rtol = 1e-8
@@ -126,6 +130,9 @@ class Scenario:
         scipy solve_ivp method.
     case : str or None
         The Table I case, when the muscles come from one.
+    torque_limits : tuple of float or None
+        Largest net muscle moment per joint (ankle, knee, hip, …); inf for
+        none. [N·m]
     """
 
     name: str
@@ -144,6 +151,7 @@ class Scenario:
     sample_rate: float = 1000.0
     method: str = "DOP853"
     case: str | None = None
+    torque_limits: tuple[float, ...] | None = None
 
     def run(self, **overrides: Any) -> SimulationResult:
         """Simulate this scenario; keyword ``overrides`` replace fields first."""
@@ -151,7 +159,8 @@ class Scenario:
         return simulate(
             sc.body, sc.muscles, sc.disturbance, sc.duration,
             initial_state=sc.initial_state, rates_from=sc.rates_from, knee=sc.knee,
-            fall=sc.fall, rtol=sc.rtol, atol=sc.atol, sample_rate=sc.sample_rate,
+            fall=sc.fall, torque_limits=sc.torque_limits, rtol=sc.rtol, atol=sc.atol,
+            sample_rate=sc.sample_rate,
             method=sc.method, description=sc.description,
         )
 
@@ -163,7 +172,7 @@ class Scenario:
 
 
 TOP_KEYS = ("name", "description", "source", "duration", "body", "muscles", "disturbance",
-            "initial", "knee", "fall", "solver")
+            "initial", "knee", "fall", "limits", "solver")
 
 
 def load_scenario(path: str | Path) -> Scenario:
@@ -243,7 +252,8 @@ def _parse(data: dict, base_dir: Path, origin: str) -> Scenario:
     kt = _table(data, "knee", ("mode", "stop_angle"), origin)
     knee = KneeModel(kt.get("mode", "free"), kt.get("stop_angle", 0.0))
 
-    ft = _table(data, "fall", ("max_link_angle", "base_of_support"), origin)
+    ft = _table(data, "fall", ("max_link_angle", "base_of_support", "centre_of_pressure"),
+                origin)
     bos_spec = ft.get("base_of_support", "none")
     if bos_spec == "none":
         bos = None
@@ -257,7 +267,16 @@ def _parse(data: dict, base_dir: Path, origin: str) -> Scenario:
     else:
         raise ScenarioError(f"{origin}: fall.base_of_support must be 'none', 'literature' or "
                             f"{{heel = …, toe = …}}, got {bos_spec!r}")
-    fall = FallCriteria(ft.get("max_link_angle", math.pi / 3), bos)
+    fall = FallCriteria(ft.get("max_link_angle", math.pi / 3), bos,
+                        bool(ft.get("centre_of_pressure", False)))
+    lt = _table(data, "limits", ("torque",), origin)
+    torque_limits = None
+    if "torque" in lt:
+        values = [math.inf if v in ("inf", "none") else v for v in lt["torque"]]
+        torque_limits = tuple(finite_or_inf("limits.torque [N·m]", v) for v in values)
+        if len(torque_limits) != body.n_links:
+            raise ScenarioError(f"{origin}: limits.torque needs {body.n_links} values "
+                                f"(one per joint), got {len(torque_limits)}")
 
     st = _table(data, "solver", ("rtol", "atol", "sample_rate", "method"), origin)
     method = st.get("method", "DOP853")
@@ -273,8 +292,19 @@ def _parse(data: dict, base_dir: Path, origin: str) -> Scenario:
         rtol=finite_float("solver.rtol", st.get("rtol", 1e-8)),
         atol=finite_float("solver.atol", st.get("atol", 1e-10)),
         sample_rate=finite_float("solver.sample_rate [Hz]", st.get("sample_rate", 1000.0)),
-        method=method, case=case,
+        method=method, case=case, torque_limits=torque_limits,
     )
+
+
+def finite_or_inf(name: str, value) -> float:
+    """A number > 0, or +inf (no limit)."""
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ScenarioError(f"{name} must be numbers or \"inf\", got {value!r}") from None
+    if math.isnan(v) or v <= 0:
+        raise ScenarioError(f"{name} must be > 0 (or \"inf\"), got {value!r}")
+    return v
 
 
 def _parse_body(bt: dict, origin: str) -> Body:
