@@ -200,6 +200,31 @@ def moments_to_link_torques(moments: np.ndarray) -> np.ndarray:
     return above - moments
 
 
+class _History:
+    """The state at past times: a constant before t = 0, then the dense outputs of the
+    integrated segments (the method of steps for the delayed feedback)."""
+
+    def __init__(self, before: np.ndarray):
+        self.before = np.asarray(before, dtype=float).copy()
+        self.starts: list[float] = []
+        self.ends: list[float] = []
+        self.pieces: list = []
+
+    def add(self, t0: float, t1: float, sol) -> None:
+        if t1 > t0:
+            self.starts.append(t0)
+            self.ends.append(t1)
+            self.pieces.append(sol)
+
+    def __call__(self, t: float) -> np.ndarray:
+        if t < 0.0 or not self.pieces:
+            return self.before
+        import bisect
+
+        k = max(bisect.bisect_right(self.starts, t) - 1, 0)
+        return self.pieces[k](min(t, self.ends[k]))
+
+
 @dataclass
 class _Model:
     body: Body
@@ -207,12 +232,26 @@ class _Model:
     disturbance: Disturbance
     knee_row: np.ndarray | None  # C (N,) for the knee constraint, or None
     limits: np.ndarray | None = None  # (N,) largest |joint moment| [N·m], inf where none
+    delay: float = 0.0  # neural delay of the muscle feedback [s]
+    history: _History | None = None
     E: np.ndarray = field(init=False)
     crossing: np.ndarray = field(init=False)
 
     def __post_init__(self) -> None:
         self.E = self.muscles.selection_matrix
         self.crossing = joint_crossing_matrix(self.muscles)
+
+    def feedback_state(self, t: float, x: np.ndarray) -> np.ndarray:
+        """The state the muscles respond to: x(t − delay) (x itself without delay)."""
+        if self.delay <= 0.0:
+            return x
+        return self.history(t - self.delay)
+
+    def raw_moments_at(self, t, x, active):
+        """Unsaturated joint moments τ = Cᵀ M from the fed-back state. [N·m]"""
+        n = self.body.n_links
+        xf = self.feedback_state(t, x)
+        return self.raw_moments(xf[:n], xf[n:], active)
 
     def raw_moments(self, theta, omega, active):
         """Unsaturated joint moments τ = Cᵀ M. [N·m]"""
@@ -234,7 +273,8 @@ class _Model:
     def free_acceleration(self, t, x, active, saturation=None):
         n = self.body.n_links
         theta, omega = x[:n], x[n:]
-        _, U = self.torques(theta, omega, active, saturation)
+        xf = self.feedback_state(t, x)
+        _, U = self.torques(xf[:n], xf[n:], active, saturation)
         a = self.disturbance.acceleration(t)
         rhs = (U - velocity_terms(self.body, theta, omega)
                + (self.body.gravity + a[1]) * gravity_vector(self.body, theta)
@@ -262,12 +302,13 @@ class _Model:
         n = self.body.n_links
         theta, omega = x[:n], x[n:]
         acc = self.acceleration(t, x, active, locked, saturation)
+        xf = self.feedback_state(t, x)
         if self.limits is None:
-            M = (self.muscles.stiffnesses * (self.E @ theta)
-                 + self.muscles.viscosities * (self.E @ omega)) * active
+            M = (self.muscles.stiffnesses * (self.E @ xf[:n])
+                 + self.muscles.viscosities * (self.E @ xf[n:])) * active
             tau0 = M @ self.crossing[:, 0]
         else:
-            tau0 = self.torques(theta, omega, active, saturation)[0][0]
+            tau0 = self.torques(xf[:n], xf[n:], active, saturation)[0][0]
         a = self.body.gravity_coefficients
         ay = self.disturbance.acceleration(t)[1]
         fy = (self.body.total_mass * (self.body.gravity + ay)
@@ -319,6 +360,7 @@ def simulate(
     knee: KneeModel | None = None,
     fall: FallCriteria | None = None,
     torque_limits: np.ndarray | None = None,
+    feedback_delay: float = 0.0,
     rtol: float = 1e-8,
     atol: float = 1e-10,
     sample_rate: float = 1000.0,
@@ -350,6 +392,10 @@ def simulate(
         Largest net muscle moment at the ankle, knee, hip, … (the sum of the
         pairs crossing each joint); ``inf`` for no limit. A joint saturates and
         lets go at events, never inside the right-hand side. [N·m]
+    feedback_delay : float
+        Neural delay τ of the muscle feedback: pair torques respond to the
+        state at t − τ (before t = 0, to the state before any velocity step).
+        Integrated by the method of steps, in pieces no longer than τ. [s]
     rtol, atol : float
         Integrator tolerances (relative [-], absolute [rad, rad/s]).
     sample_rate : float
@@ -383,6 +429,9 @@ def simulate(
     if knee.mode != "free" and n < 2:
         raise ParameterError("knee mode 'locked' or 'stop' needs a body with at least 2 links")
 
+    delay = float_in_range("feedback_delay [s]", feedback_delay, 0.0, 1.0, unit="s")
+    before = (np.zeros(2 * n) if initial_state is None
+              else finite_array("initial_state [rad, rad/s]", initial_state, (2 * n,)))
     x = initial_state_for(body, disturbance, initial_state, rates_from)
     knee_row = None
     if knee.mode != "free":
@@ -398,7 +447,8 @@ def simulate(
             )
         if np.all(np.isinf(limits)):
             limits = None
-    model = _Model(body, muscles, disturbance, knee_row, limits)
+    history = _History(before) if delay > 0 else None
+    model = _Model(body, muscles, disturbance, knee_row, limits, delay, history)
 
     locked = knee.mode == "locked"
     if knee.mode == "locked":
@@ -425,18 +475,19 @@ def simulate(
             act[p] = 1.0 if (s > 0 or (s == 0 and sd >= 0)) else 0.0
         return act
 
-    active = active_from(x)
+    active = active_from(model.feedback_state(0.0, x))
     limited = [] if limits is None else [j for j in range(n) if np.isfinite(limits[j])]
     saturation = np.zeros(n)
     if limited:
-        tau0 = model.raw_moments(x[:n], x[n:], active)
+        tau0 = model.raw_moments_at(0.0, x, active)
         for j in limited:
             if abs(tau0[j]) > limits[j]:
                 saturation[j] = np.sign(tau0[j])
     locked_flags: list[np.ndarray] = []
     grid = np.arange(0.0, duration + 0.5 / sample_rate, 1.0 / sample_rate)
     grid = grid[grid <= duration + 1e-12]
-    stops = sorted({b for b in disturbance.breakpoints if 0.0 < b < duration} | {duration})
+    stops = sorted({b for b in disturbance.breakpoints if 0.0 < b < duration} | {duration}
+                   | {k * delay for k in (1, 2, 3) if 0.0 < k * delay < duration})
     max_step = min(disturbance.max_step, duration)
     if math.isfinite(disturbance.max_step) and len(disturbance.breakpoints) > 2000:
         stops = [duration]  # a long measured profile: step capped at its sample spacing instead
@@ -465,6 +516,8 @@ def simulate(
     while t < duration:
         t_end = next(s for s in stops if s > t + 1e-12) if any(s > t + 1e-12 for s in stops) \
             else duration
+        if delay > 0:
+            t_end = min(t_end, t + delay)  # the method of steps: the past is already known
 
         sat = saturation.copy() if limited else None
 
@@ -504,14 +557,14 @@ def simulate(
             if saturation[j] == 0:
                 for side in (1.0, -1.0):
                     def ev_sat(tt, xx, _j=j, _side=side, _a=active):
-                        tau = model.raw_moments(xx[:n], xx[n:], _a)[_j]
+                        tau = model.raw_moments_at(tt, xx, _a)[_j]
                         return _side * tau - limits[_j] - _SWITCH_HYSTERESIS
                     ev_sat.terminal, ev_sat.direction = True, 1
                     events.append(ev_sat)
                     kinds.append(("saturate", (j, side)))
             else:
                 def ev_unsat(tt, xx, _j=j, _side=saturation[j], _a=active):
-                    tau = model.raw_moments(xx[:n], xx[n:], _a)[_j]
+                    tau = model.raw_moments_at(tt, xx, _a)[_j]
                     return _side * tau - limits[_j] + _SWITCH_HYSTERESIS
                 ev_unsat.terminal, ev_unsat.direction = True, -1
                 events.append(ev_unsat)
@@ -521,7 +574,7 @@ def simulate(
             # The tiny hysteresis keeps a pair resting at zero stretch from re-firing.
             sign = 1.0 if active[p] else -1.0
             def ev_p(tt, xx, _p=p, _s=sign):
-                return E[_p] @ xx[:n] + _s * _SWITCH_HYSTERESIS
+                return E[_p] @ model.feedback_state(tt, xx)[:n] + _s * _SWITCH_HYSTERESIS
             ev_p.terminal, ev_p.direction = True, (-1 if active[p] else 1)
             events.append(ev_p)
             kinds.append(("pair", int(p)))
@@ -547,6 +600,8 @@ def simulate(
             status, message = "failed", f"integrator error at t = {t:.6g} s: {exc}"
             break
         seg_end = float(sol.t[-1])
+        if history is not None:
+            history.add(t, seg_end, sol.sol)
         last_segment = sol.status == 0 and t_end >= duration
         sel = (grid >= t - 1e-12) & ((grid <= seg_end + 1e-12) if last_segment or sol.status == 1
                                       else (grid < seg_end - 1e-12))
@@ -588,7 +643,7 @@ def simulate(
                 break
             if kind == "pair":
                 # the pair engages if its stretch is now growing, goes slack otherwise
-                sd = E[info] @ x[n:]
+                sd = E[info] @ model.feedback_state(seg_end, x)[n:]
                 active = active.copy()
                 active[info] = 1.0 if sd >= 0 else 0.0
             elif kind == "knee-hit":
@@ -604,10 +659,13 @@ def simulate(
             continue
         t = t_end
 
+    feedback = None
+    if history is not None and times:
+        feedback = np.array([history(tk - delay) for tk in np.concatenate(times)])
     return _assemble(body, muscles, disturbance, times, states, status, message, fell,
                      fall_time, fall_reason, switch_times, description,
                      locked=np.concatenate(locked_flags) if locked_flags else None,
-                     knee_row=knee_row, torque_limits=limits)
+                     knee_row=knee_row, torque_limits=limits, feedback_states=feedback)
 
 
 def _outside_at_start(model, fall, x, active, locked, saturation) -> str | None:
@@ -632,11 +690,12 @@ def _outside_at_start(model, fall, x, active, locked, saturation) -> str | None:
 
 def _assemble(body, muscles, disturbance, times, states, status, message, fell, fall_time,
               fall_reason, switch_times, description, *, locked=None, knee_row=None,
-              torque_limits=None) -> SimulationResult:
+              torque_limits=None, feedback_states=None) -> SimulationResult:
     """Derived series of a run: torques, accelerations, ground reaction, CoG, platform.
 
     ``locked`` (T,) marks samples where the knee constraint held (its row
-    ``knee_row``); ``torque_limits`` (N,) saturates the joint moments. [N·m]
+    ``knee_row``); ``torque_limits`` (N,) saturates the joint moments [N·m];
+    ``feedback_states`` (T, 2N) is what the muscles responded to (delayed feedback).
     """
     n = body.n_links
     if times:
@@ -648,7 +707,8 @@ def _assemble(body, muscles, disturbance, times, states, status, message, fell, 
     theta, omega = state[:, :n], state[:, n:]
     from .muscles import pair_torques as _pair_torques
 
-    M = _pair_torques(muscles, theta, omega)
+    fb = state if feedback_states is None else np.asarray(feedback_states)
+    M = _pair_torques(muscles, fb[:, :n], fb[:, n:])
     moments = M @ joint_crossing_matrix(muscles)
     if torque_limits is not None:
         moments = np.clip(moments, -torque_limits, torque_limits)

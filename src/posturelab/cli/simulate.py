@@ -94,6 +94,8 @@ def add_experiment_arguments(p: argparse.ArgumentParser) -> None:
     src.add_argument("--centre-of-pressure", action="store_true",
                      help="with --foot, also fall when the centre of pressure leaves the foot "
                      "(the foot tips), not only the centre of gravity.")
+    src.add_argument("--feedback-delay", type=float, default=None, metavar="SECONDS",
+                     help="neural delay of the muscle feedback [s] (default 0, the paper).")
     src.add_argument("--torque-limits", metavar="ANKLE,KNEE,HIP",
                      help="largest net muscle moment at each joint [N·m] ('inf' for none).")
     src.add_argument("--max-link-angle", type=float, default=None, metavar="RAD",
@@ -135,6 +137,11 @@ def scenario_from_args(args: argparse.Namespace) -> Scenario:
             args.max_link_angle if args.max_link_angle is not None else sc.fall.max_link_angle,
             _foot(args.foot) if args.foot != "none" else sc.fall.base_of_support,
             args.centre_of_pressure or sc.fall.centre_of_pressure))
+    if args.feedback_delay is not None:
+        if not (math.isfinite(args.feedback_delay) and 0 <= args.feedback_delay <= 1):
+            raise ParameterError(
+                f"--feedback-delay [s] must be in [0, 1], got {args.feedback_delay:g}")
+        sc = sc.replace(feedback_delay=args.feedback_delay)
     if args.torque_limits:
         sc = sc.replace(torque_limits=tuple(
             parse_limit_list(args.torque_limits, "--torque-limits [N·m]", sc.body.n_links)))

@@ -22,6 +22,7 @@ Schema (every table optional except where noted; units in brackets)::
                                          #              viscosity, one_sided}]
     viscosity_ratio = 0.25               # [s]
     gastrocnemius = "two-sided"          # or "one-sided"
+    feedback_delay = 0.0                 # neural delay of the muscle feedback [s]
 
     [disturbance]                        # or [[disturbance]] several, summed
     type = "velocity-step"               # velocity-step | half-sine | ramp-and-hold |
@@ -133,6 +134,8 @@ class Scenario:
     torque_limits : tuple of float or None
         Largest net muscle moment per joint (ankle, knee, hip, …); inf for
         none. [N·m]
+    feedback_delay : float
+        Neural delay of the muscle feedback. [s]
     """
 
     name: str
@@ -152,6 +155,7 @@ class Scenario:
     method: str = "DOP853"
     case: str | None = None
     torque_limits: tuple[float, ...] | None = None
+    feedback_delay: float = 0.0
 
     def run(self, **overrides: Any) -> SimulationResult:
         """Simulate this scenario; keyword ``overrides`` replace fields first."""
@@ -159,7 +163,8 @@ class Scenario:
         return simulate(
             sc.body, sc.muscles, sc.disturbance, sc.duration,
             initial_state=sc.initial_state, rates_from=sc.rates_from, knee=sc.knee,
-            fall=sc.fall, torque_limits=sc.torque_limits, rtol=sc.rtol, atol=sc.atol,
+            fall=sc.fall, torque_limits=sc.torque_limits,
+            feedback_delay=sc.feedback_delay, rtol=sc.rtol, atol=sc.atol,
             sample_rate=sc.sample_rate,
             method=sc.method, description=sc.description,
         )
@@ -233,7 +238,12 @@ def _parse(data: dict, base_dir: Path, origin: str) -> Scenario:
 
     body = _parse_body(_table(data, "body", ("preset", "segments", "gravity"), origin), origin)
     mt = _table(data, "muscles", ("case", "stiffness", "pairs", "viscosity_ratio",
-                                  "gastrocnemius"), origin)
+                                  "gastrocnemius", "feedback_delay"), origin)
+    mt = dict(mt)
+    delay = finite_float("muscles.feedback_delay [s]", mt.pop("feedback_delay", 0.0))
+    if not 0.0 <= delay <= 1.0:
+        raise ScenarioError(f"{origin}: muscles.feedback_delay [s] must be in [0, 1], "
+                            f"got {delay:g}")
     muscles, case = _parse_muscles(mt, body, origin)
     disturbance = _parse_disturbances(data.get("disturbance"), base_dir, origin)
 
@@ -292,7 +302,7 @@ def _parse(data: dict, base_dir: Path, origin: str) -> Scenario:
         rtol=finite_float("solver.rtol", st.get("rtol", 1e-8)),
         atol=finite_float("solver.atol", st.get("atol", 1e-10)),
         sample_rate=finite_float("solver.sample_rate [Hz]", st.get("sample_rate", 1000.0)),
-        method=method, case=case, torque_limits=torque_limits,
+        method=method, case=case, torque_limits=torque_limits, feedback_delay=delay,
     )
 
 
