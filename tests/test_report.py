@@ -160,3 +160,16 @@ def test_cli_prints_path_and_summary(built, monkeypatch, capsys):
     assert lines[0] == str(out / "index.html")
     assert len(lines) == 2 and "51 of 54" in lines[1] and "Errata (7" in lines[1]
     assert "[1/2] Fig. 3" in captured.err
+
+
+def test_beyond_the_paper_findings(built):
+    """Recovery limit (the CoP criterion is stricter than the CoG one) and delay tolerance."""
+    import re
+
+    _, report, _ = built
+    recovery = next(f for f in report.findings if f.startswith("Largest recoverable"))
+    cop_cm, cog_cm = (float(x) for x in re.findall(r"([\d.]+) cm", recovery)[:2])
+    assert 5 < cop_cm < cog_cm < 100
+    delay = next(f for f in report.findings if f.startswith("Neural delay"))
+    survive, fall = (float(x) for x in re.findall(r"τ = (\d+) ms", delay)[:2])
+    assert 2 <= survive < fall <= 30
