@@ -1,0 +1,559 @@
+"""Parameter sweeps of the nonlinear simulation over the paper's pair gains.
+
+A sweep takes a base experiment (a :class:`~posturelab.scenarios.Scenario`
+with the paper's five muscle pairs) and a list of parameters to vary, each
+over N evenly spaced values from LO to HI inclusive
+(:class:`VaryRange`, written ``NAME=LO:HI:N`` on the command line). It
+simulates the full grid (the cartesian product, the first parameter varying
+slowest) with the compiled simulator (:func:`posturelab.fast.simulate_batch`)
+and returns one row per run: the varied values, then the outcomes (fell,
+fall time, peak |θ_i|, settling time).
+
+Parameters that can vary (:data:`SWEEP_PARAMETERS`): the stiffness of the
+paper's pairs ``ankle``, ``knee``, ``hip``, ``quadriceps``, ``gastrocnemius``
+[N·m/rad], and ``viscosity_ratio`` [s]. The viscosity of a pair is the ratio
+times its stiffness: the varied ratio, else the one given, else the base
+experiment's own ratio for that pair (0.25, the paper's, where its stiffness
+is 0).
+
+Work can go to a Dask distributed cluster (:func:`run_sweep` with
+``workers``/``scheduler``/``client``) in chunks; the results are identical to
+the single-process path (each run is the same deterministic computation).
+"""
+
+from __future__ import annotations
+
+import io
+import itertools
+import math
+import re
+import sys
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import IO, Any
+
+import numpy as np
+
+from .errors import ParameterError, PostureLabError
+from .fast import DEFAULT_ATOL, DEFAULT_RTOL, BatchResult, simulate_batch
+from .muscles import DEFAULT_VISCOSITY_RATIO, PAPER_PAIR_NAMES
+from .results import atomic_write_bytes, atomic_write_text
+from .scenarios import Scenario
+
+__all__ = [
+    "SWEEP_PARAMETERS",
+    "PARAMETER_UNITS",
+    "OUTCOME_COLUMNS",
+    "OUTCOME_UNITS",
+    "VaryRange",
+    "parse_vary",
+    "SweepGrid",
+    "sweep_grid",
+    "SweepResult",
+    "run_sweep",
+    "ProgressBar",
+]
+
+#: Names a sweep can vary: the paper's pair stiffnesses and the viscosity ratio.
+SWEEP_PARAMETERS: tuple[str, ...] = (*PAPER_PAIR_NAMES, "viscosity_ratio")
+#: Unit of each sweep parameter.
+PARAMETER_UNITS: dict[str, str] = {**{n: "N·m/rad" for n in PAPER_PAIR_NAMES},
+                                   "viscosity_ratio": "s"}
+#: Outcome columns of a sweep table (after the varied parameters), for 3 links.
+OUTCOME_COLUMNS: tuple[str, ...] = ("fell", "fall_time", "peak_theta1", "peak_theta2",
+                                    "peak_theta3", "settling_time")
+#: Unit of each outcome column ('' for the flag).
+OUTCOME_UNITS: dict[str, str] = {"fell": "", "fall_time": "s", "peak_theta1": "rad",
+                                 "peak_theta2": "rad", "peak_theta3": "rad",
+                                 "settling_time": "s"}
+#: Angle threshold of the settling time. [rad]
+SETTLE_TOLERANCE = 0.01
+
+_NUMBER = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
+_VARY_RE = re.compile(rf"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*=\s*({_NUMBER})\s*:\s*({_NUMBER})"
+                      rf"\s*:\s*([^:\s]+)\s*$")
+
+
+# ---------------------------------------------------------------------------
+# What to vary
+# ---------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class VaryRange:
+    """One swept parameter: ``count`` evenly spaced values from ``low`` to ``high`` inclusive.
+
+    Parameters
+    ----------
+    name : str
+        One of :data:`SWEEP_PARAMETERS`.
+    low, high : float
+        First and last value, low <= high, both >= 0. [N·m/rad] or [s]
+    count : int
+        Number of values, >= 1 (1 needs low = high). [-]
+    """
+
+    name: str
+    low: float
+    high: float
+    count: int
+
+    def __post_init__(self) -> None:
+        if self.name not in SWEEP_PARAMETERS:
+            raise ParameterError(f"unknown sweep parameter {self.name!r}; known: "
+                                 f"{', '.join(SWEEP_PARAMETERS)}")
+        unit = PARAMETER_UNITS[self.name]
+        for label, v in (("LO", self.low), ("HI", self.high)):
+            if not (isinstance(v, int | float | np.floating) and math.isfinite(v)):
+                raise ParameterError(f"{self.name} {label} [{unit}] must be a finite number, "
+                                     f"got {v!r}")
+            if v < 0:
+                raise ParameterError(f"{self.name} {label} [{unit}] must be >= 0, got {v:g}")
+        if self.low > self.high:
+            raise ParameterError(f"{self.name}: LO ({self.low:g}) must be <= HI "
+                                 f"({self.high:g}) [{unit}]")
+        if isinstance(self.count, bool) or not isinstance(self.count, int | np.integer):
+            raise ParameterError(f"{self.name}: N must be an integer >= 1, got {self.count!r}")
+        if self.count < 1:
+            raise ParameterError(f"{self.name}: N must be an integer >= 1, got {self.count}")
+        if self.count == 1 and self.low != self.high:
+            raise ParameterError(f"{self.name}: N = 1 takes a single value, so LO must equal "
+                                 f"HI (got {self.low:g} and {self.high:g})")
+        object.__setattr__(self, "low", float(self.low))
+        object.__setattr__(self, "high", float(self.high))
+        object.__setattr__(self, "count", int(self.count))
+
+    @property
+    def values(self) -> np.ndarray:
+        """The ``count`` values, ``low`` and ``high`` included. [N·m/rad] or [s]"""
+        return np.linspace(self.low, self.high, self.count)
+
+    @property
+    def unit(self) -> str:
+        """Unit of the parameter."""
+        return PARAMETER_UNITS[self.name]
+
+
+def parse_vary(text: str) -> VaryRange:
+    """Parse ``NAME=LO:HI:N`` (N evenly spaced values from LO to HI inclusive).
+
+    Raises
+    ------
+    ParameterError
+        Malformed text, an unknown name (the message lists the known ones),
+        LO > HI, a negative value, or N not an integer >= 1.
+    """
+    m = _VARY_RE.match(str(text))
+    if not m:
+        name = str(text).split("=", 1)[0].strip()
+        if "=" in str(text) and name and name not in SWEEP_PARAMETERS:
+            raise ParameterError(f"unknown sweep parameter {name!r} in --vary {text!r}; known: "
+                                 f"{', '.join(SWEEP_PARAMETERS)}")
+        raise ParameterError(f"--vary must be NAME=LO:HI:N (N evenly spaced values from LO to "
+                             f"HI inclusive), got {text!r}")
+    name, low, high, count = m.groups()
+    if not re.fullmatch(r"\d+", count):
+        raise ParameterError(f"--vary {text!r}: N must be an integer >= 1, got {count!r}")
+    return VaryRange(name, float(low), float(high), int(count))
+
+
+# ---------------------------------------------------------------------------
+# The grid
+# ---------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class SweepGrid:
+    """The runs of a sweep.
+
+    Attributes
+    ----------
+    names : tuple of str
+        The varied parameters, in the order given.
+    values : numpy.ndarray, shape (M, K)
+        Row r holds run r's values of the K varied parameters (the cartesian
+        product, the first parameter varying slowest). [N·m/rad] or [s]
+    stiffness : numpy.ndarray, shape (M, 5)
+        Pair stiffness of each run (ankle, knee, hip, quadriceps, gastrocnemius). [N·m/rad]
+    viscosity : numpy.ndarray, shape (M, 5)
+        Pair viscosity of each run. [N·m·s/rad]
+    """
+
+    names: tuple[str, ...]
+    values: np.ndarray
+    stiffness: np.ndarray
+    viscosity: np.ndarray
+
+    @property
+    def n_runs(self) -> int:
+        """Number of runs M. [-]"""
+        return int(self.values.shape[0])
+
+    @property
+    def shape(self) -> tuple[int, ...]:
+        """Number of values of each varied parameter. [-]"""
+        return tuple(len(np.unique(self.values[:, k])) for k in range(len(self.names)))
+
+
+def _base_ratios(scenario: Scenario, viscosity_ratio: float | None) -> np.ndarray:
+    """Viscosity/stiffness of each pair of the base experiment (or the given ratio). [s]"""
+    if viscosity_ratio is not None:
+        if not (math.isfinite(viscosity_ratio) and viscosity_ratio >= 0):
+            raise ParameterError(f"viscosity ratio [s] must be >= 0, got {viscosity_ratio!r}")
+        return np.full(len(PAPER_PAIR_NAMES), float(viscosity_ratio))
+    k = np.asarray(scenario.muscles.stiffnesses, dtype=float)
+    v = np.asarray(scenario.muscles.viscosities, dtype=float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(k > 0, v / np.where(k > 0, k, 1.0), DEFAULT_VISCOSITY_RATIO)
+
+
+def check_base(scenario: Scenario) -> None:
+    """The base experiment must have the paper's five pairs and nothing the fast simulator
+    does not compile (torque limits, a feedback delay, centre-of-pressure falls)."""
+    names = tuple(scenario.muscles.names)
+    if names != PAPER_PAIR_NAMES or scenario.body.n_links != 3:
+        raise ParameterError(f"a sweep needs the paper's five pairs ({', '.join(PAPER_PAIR_NAMES)})"
+                             f" on 3 links; the base experiment has {', '.join(names)} on "
+                             f"{scenario.body.n_links} links")
+    limits = getattr(scenario, "torque_limits", None)
+    if limits is not None and not np.all(np.isinf(np.asarray(limits, dtype=float))):
+        raise ParameterError("a sweep cannot use torque limits (the fast simulator does not "
+                             "compile them); use posturelab simulate for such runs")
+    if getattr(scenario, "feedback_delay", 0.0):
+        raise ParameterError("a sweep cannot use a feedback delay (the fast simulator does "
+                             "not compile it); use posturelab simulate for such runs")
+    if getattr(scenario.fall, "centre_of_pressure", False):
+        raise ParameterError("a sweep cannot use centre-of-pressure falls (the fast simulator "
+                             "does not compile them); use posturelab simulate for such runs")
+
+
+def sweep_grid(scenario: Scenario, varies: Sequence[VaryRange],
+               viscosity_ratio: float | None = None) -> SweepGrid:
+    """The full grid of a sweep around ``scenario`` (see the module docstring).
+
+    Parameters
+    ----------
+    scenario : Scenario
+        The base experiment (the paper's five pairs).
+    varies : sequence of VaryRange
+        The parameters to vary; each name at most once.
+    viscosity_ratio : float, optional
+        Viscosity/stiffness for every pair when ``viscosity_ratio`` is not
+        varied; default: the base experiment's ratio per pair. [s]
+    """
+    check_base(scenario)
+    varies = list(varies)
+    if not varies:
+        raise ParameterError("give at least one --vary NAME=LO:HI:N")
+    names = [v.name for v in varies]
+    dup = sorted({n for n in names if names.count(n) > 1})
+    if dup:
+        raise ParameterError(f"--vary names a parameter more than once: {', '.join(dup)}")
+    values = np.array(list(itertools.product(*[v.values for v in varies])), dtype=float)
+    values = values.reshape(-1, len(varies))
+    m = values.shape[0]
+    stiffness = np.tile(np.asarray(scenario.muscles.stiffnesses, dtype=float), (m, 1))
+    ratios = np.tile(_base_ratios(scenario, viscosity_ratio), (m, 1))
+    for k, name in enumerate(names):
+        if name == "viscosity_ratio":
+            ratios[:] = values[:, k:k + 1]
+        else:
+            stiffness[:, PAPER_PAIR_NAMES.index(name)] = values[:, k]
+    return SweepGrid(tuple(names), values, stiffness, ratios * stiffness)
+
+
+# ---------------------------------------------------------------------------
+# Results
+# ---------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class SweepResult:
+    """One row per run: the varied values, then the outcomes.
+
+    Attributes
+    ----------
+    grid : SweepGrid
+        The runs.
+    outcomes : BatchResult
+        Their outcomes (row r is run r).
+    """
+
+    grid: SweepGrid
+    outcomes: BatchResult
+
+    def columns(self) -> list[tuple[str, np.ndarray]]:
+        """(name, values) of every column, in table order (units: :data:`PARAMETER_UNITS`,
+        :data:`OUTCOME_UNITS`)."""
+        cols = [(name, self.grid.values[:, k]) for k, name in enumerate(self.grid.names)]
+        o = self.outcomes
+        cols.append(("fell", o.fell))
+        cols.append(("fall_time", o.fall_time))
+        for i in range(o.peak_theta.shape[1]):
+            cols.append((f"peak_theta{i + 1}", o.peak_theta[:, i]))
+        cols.append(("settling_time", o.settling_time))
+        return cols
+
+    def to_csv_text(self) -> str:
+        """CSV: a header row, then one row per run; ``fell`` is true/false, a missing fall or
+        settling time is an empty cell, numbers have 17 significant digits (exact)."""
+        cols = self.columns()
+        buf = io.StringIO()
+        buf.write(",".join(name for name, _ in cols) + "\n")
+        text_cols = []
+        for name, values in cols:
+            if name == "fell":
+                text_cols.append(np.where(values, "true", "false"))
+            else:
+                text_cols.append(np.array([_number(v) for v in values.tolist()], dtype=object))
+        for row in zip(*text_cols, strict=True):
+            buf.write(",".join(row) + "\n")
+        return buf.getvalue()
+
+    def to_parquet_bytes(self) -> bytes:
+        """The table as Parquet (pyarrow): float64 columns (NaN as null), ``fell`` boolean;
+        each field's unit in its metadata."""
+        pa, pq = _pyarrow()
+        fields, arrays = [], []
+        for name, values in self.columns():
+            unit = PARAMETER_UNITS.get(name, OUTCOME_UNITS.get(name, ""))
+            if name == "fell":
+                arr = pa.array(np.asarray(values, dtype=bool))
+                typ = pa.bool_()
+            else:
+                values = np.asarray(values, dtype=float)
+                arr = pa.array(values, mask=np.isnan(values), type=pa.float64())
+                typ = pa.float64()
+            fields.append(pa.field(name, typ, metadata={"unit": unit} if unit else None))
+            arrays.append(arr)
+        table = pa.Table.from_arrays(arrays, schema=pa.schema(fields))
+        sink = io.BytesIO()
+        pq.write_table(table, sink)
+        return sink.getvalue()
+
+    def write(self, path: str | Path) -> None:
+        """Write the table to ``path`` (.csv or .parquet by its suffix), atomically."""
+        kind = table_format(path)
+        if kind == "csv":
+            atomic_write_text(path, self.to_csv_text())
+        else:
+            atomic_write_bytes(path, self.to_parquet_bytes())
+
+
+def _number(v: float) -> str:
+    return "" if math.isnan(v) else repr(float(v))
+
+
+def _pyarrow():
+    try:
+        import pyarrow as pa
+        import pyarrow.parquet as pq
+    except ImportError:
+        raise PostureLabError("writing Parquet needs pyarrow: pip install pyarrow (or "
+                              "'posturelab[parquet]'); or write .csv") from None
+    return pa, pq
+
+
+def table_format(path: str | Path) -> str:
+    """'csv' or 'parquet' from the file suffix; anything else is a ParameterError."""
+    suffix = Path(path).suffix.lower()
+    if suffix == ".csv":
+        return "csv"
+    if suffix in (".parquet", ".pq"):
+        return "parquet"
+    raise ParameterError(f"the output file must end in .csv or .parquet, got {str(path)!r}")
+
+
+# ---------------------------------------------------------------------------
+# Running
+# ---------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class _Task:
+    """What every chunk of a sweep shares (sent once to each Dask worker)."""
+
+    scenario: Scenario
+    rtol: float
+    atol: float
+
+    def run(self, stiffness: np.ndarray, viscosity: np.ndarray, parallel: bool) -> BatchResult:
+        sc = self.scenario
+        return simulate_batch(
+            sc.body, stiffness, viscosity, sc.disturbance, sc.duration, sc.initial_state,
+            muscles=sc.muscles, rates_from=sc.rates_from, knee=sc.knee, fall=sc.fall,
+            rtol=self.rtol, atol=self.atol, sample_rate=sc.sample_rate,
+            settle_tolerance=SETTLE_TOLERANCE, parallel=parallel)
+
+
+def _run_chunk(task: _Task, stiffness: np.ndarray, viscosity: np.ndarray) -> BatchResult:
+    """A chunk on a Dask worker: one thread per task (the worker's threads run tasks)."""
+    return task.run(stiffness, viscosity, parallel=False)
+
+
+def _concatenate(parts: list[BatchResult]) -> BatchResult:
+    if len(parts) == 1:
+        return parts[0]
+    fields = ("fell", "fall_time", "peak_theta", "settling_time", "final_state", "status_code",
+              "n_steps", "n_switches")
+    return BatchResult(**{f: np.concatenate([getattr(p, f) for p in parts]) for f in fields},
+                       settle_tolerance=parts[0].settle_tolerance)
+
+
+class ProgressBar:
+    """A one-line progress bar on a text stream (standard error by default).
+
+    Parameters
+    ----------
+    total : int
+        Number of runs. [-]
+    stream : file-like, optional
+        Where to draw; ``sys.stderr`` by default.
+    width : int
+        Characters of the bar itself. [-]
+    """
+
+    def __init__(self, total: int, stream: IO[str] | None = None, width: int = 30):
+        self.total = max(int(total), 1)
+        self.stream = sys.stderr if stream is None else stream
+        self.width = width
+        self.start = time.perf_counter()
+        self.done = 0
+        self._draw()
+
+    def update(self, done: int) -> None:
+        """Set the number of finished runs and redraw."""
+        self.done = min(int(done), self.total)
+        self._draw()
+
+    def close(self) -> None:
+        """Finish the line."""
+        self._draw()
+        self.stream.write("\n")
+        self.stream.flush()
+
+    def _draw(self) -> None:
+        frac = self.done / self.total
+        filled = int(round(frac * self.width))
+        elapsed = time.perf_counter() - self.start
+        eta = elapsed * (1 - frac) / frac if frac > 0 else math.nan
+        eta_text = f", {eta:.1f} s left" if frac < 1 and math.isfinite(eta) else ""
+        self.stream.write(f"\r[{'#' * filled}{'.' * (self.width - filled)}] {frac:4.0%} "
+                          f"{self.done}/{self.total} runs, {elapsed:.1f} s{eta_text} ")
+        self.stream.flush()
+
+
+def run_sweep(
+    scenario: Scenario,
+    varies: Sequence[VaryRange],
+    *,
+    viscosity_ratio: float | None = None,
+    rtol: float = DEFAULT_RTOL,
+    atol: float = DEFAULT_ATOL,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    client: Any = None,
+    chunk_size: int | None = None,
+    progress: Callable[[int, int], None] | None = None,
+) -> SweepResult:
+    """Simulate every run of the grid and collect the outcomes.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        The base experiment (the paper's five pairs, 3 links).
+    varies : sequence of VaryRange
+        The parameters to vary.
+    viscosity_ratio : float, optional
+        See :func:`sweep_grid`. [s]
+    rtol : float
+        Relative tolerance of the fast simulator. [-]
+    atol : float
+        Absolute tolerance. [rad, rad/s]
+    workers : int, optional
+        Run on a Dask LocalCluster of this many single-threaded worker
+        processes (unless ``scheduler`` or ``client`` is given). [-]
+    scheduler : str, optional
+        Address of a running Dask scheduler (``tcp://host:8786``); its workers
+        need posturelab installed.
+    client : distributed.Client, optional
+        An existing Dask client to use.
+    chunk_size : int, optional
+        Runs per chunk (a progress step, a Dask task). [-]
+    progress : callable, optional
+        ``progress(done, total)`` after each finished chunk.
+
+    Returns
+    -------
+    SweepResult
+        The same numbers whichever way the runs were spread.
+    """
+    grid = sweep_grid(scenario, varies, viscosity_ratio)
+    task = _Task(scenario, rtol, atol)
+    m = grid.n_runs
+    distributed_run = client is not None or scheduler is not None or workers is not None
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int)
+                                or workers < 1):
+        raise ParameterError(f"--workers must be an integer >= 1, got {workers!r}")
+    if chunk_size is None:
+        chunk_size = 2048 if not distributed_run else max(64, min(2048, -(-m // (8 * (
+            workers or 4)))))
+    if chunk_size < 1:
+        raise ParameterError(f"chunk size must be >= 1, got {chunk_size}")
+    bounds = [(lo, min(m, lo + chunk_size)) for lo in range(0, m, chunk_size)]
+    if not distributed_run:
+        parts = []
+        done = 0
+        for lo, hi in bounds:
+            parts.append(task.run(grid.stiffness[lo:hi], grid.viscosity[lo:hi], parallel=True))
+            done += hi - lo
+            if progress is not None:
+                progress(done, m)
+        return SweepResult(grid, _concatenate(parts))
+    parts = _run_on_dask(task, grid, bounds, workers, scheduler, client, progress)
+    return SweepResult(grid, _concatenate(parts))
+
+
+def _run_on_dask(task, grid, bounds, workers, scheduler, client, progress) -> list[BatchResult]:
+    try:
+        import distributed
+    except ImportError:
+        raise PostureLabError("--workers/--scheduler need Dask: pip install 'dask[distributed]' "
+                              "(or 'posturelab[dask]')") from None
+    own_client = own_cluster = None
+    try:
+        if client is None:
+            if scheduler is not None:
+                try:
+                    own_client = client = distributed.Client(scheduler, timeout=20)
+                except (OSError, TimeoutError) as exc:
+                    raise PostureLabError(f"cannot reach the Dask scheduler at {scheduler!r}: "
+                                          f"{exc}") from None
+            else:
+                import logging
+
+                own_cluster = distributed.LocalCluster(
+                    n_workers=workers, threads_per_worker=1, processes=True,
+                    dashboard_address=None, silence_logs=logging.ERROR)
+                own_client = client = distributed.Client(own_cluster)
+        shared = client.scatter(task, broadcast=True)
+        futures = [client.submit(_run_chunk, shared, grid.stiffness[lo:hi],
+                                 grid.viscosity[lo:hi], pure=False) for lo, hi in bounds]
+        index = {f.key: k for k, f in enumerate(futures)}
+        parts: list[BatchResult | None] = [None] * len(futures)
+        done = 0
+        for fut in distributed.as_completed(futures):
+            k = index[fut.key]
+            parts[k] = fut.result()
+            lo, hi = bounds[k]
+            done += hi - lo
+            if progress is not None:
+                progress(done, grid.n_runs)
+        return parts  # type: ignore[return-value]
+    finally:
+        if own_client is not None:
+            own_client.close()
+        if own_cluster is not None:
+            own_cluster.close()

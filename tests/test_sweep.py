@@ -1,0 +1,191 @@
+"""Sweeps (posturelab.sweep) and ``posturelab sweep``: tables, formats, Dask, bad input."""
+
+from __future__ import annotations
+
+import csv
+import math
+import sys
+
+import numpy as np
+import pytest
+
+from posturelab.body import paper_body
+from posturelab.cli import main
+from posturelab.errors import ParameterError
+from posturelab.fast import simulate_batch, simulate_fast
+from posturelab.muscles import paper_muscles
+from posturelab.paper import BACKWARD_INITIAL_STATE
+from posturelab.platform import VelocityStep
+from posturelab.scenarios import builtin_scenario
+from posturelab.sweep import (
+    OUTCOME_COLUMNS,
+    VaryRange,
+    parse_vary,
+    run_sweep,
+    sweep_grid,
+)
+
+POSTURE = list(BACKWARD_INITIAL_STATE[:3]) + [0.0, 0.0, 0.0]
+
+
+def read_csv(path):
+    with open(path, newline="") as fh:
+        rows = list(csv.reader(fh))
+    return rows[0], rows[1:]
+
+
+def cell(text):
+    return math.nan if text == "" else float(text)
+
+
+def test_cli_sweep_csv_equals_batch_and_single_runs(tmp_path, capsys):
+    """The CSV's columns, and its values exactly (17 digits), are simulate_batch's; a run
+    also equals simulate_fast's single run."""
+    out = tmp_path / "sweep.csv"
+    code = main(["sweep", "--case", "1", "--disturbance", "backward", "--duration", "2",
+                 "--vary", "ankle=0:1200:3", "--vary", "gastrocnemius=0:600:2",
+                 "--out", str(out)])
+    assert code == 0
+    assert "wrote" in capsys.readouterr().out
+    header, rows = read_csv(out)
+    assert header == ["ankle", "gastrocnemius", *OUTCOME_COLUMNS]
+    assert len(rows) == 6
+    # the grid: first parameter slowest, LO and HI included
+    values = np.array([[float(r[0]), float(r[1])] for r in rows])
+    np.testing.assert_array_equal(values, [[0, 0], [0, 600], [600, 0], [600, 600],
+                                           [1200, 0], [1200, 600]])
+    k = np.tile(paper_muscles("1").stiffnesses, (6, 1))
+    k[:, 0] = values[:, 0]
+    k[:, 4] = values[:, 1]
+    batch = simulate_batch(paper_body(), k, 0.25 * k, VelocityStep.backward(1.0), 2.0, POSTURE)
+    assert [r[2] for r in rows] == ["true" if f else "false" for f in batch.fell]
+    got = np.array([[cell(x) for x in r[3:]] for r in rows])
+    want = np.column_stack([batch.fall_time, batch.peak_theta, batch.settling_time])
+    np.testing.assert_array_equal(got, want)
+    assert batch.fell[0] and not batch.fell[-1]
+    one = simulate_fast(paper_body(), paper_muscles(stiffness=k[-1], viscosity=0.25 * k[-1]),
+                        VelocityStep.backward(1.0), 2.0, initial_state=POSTURE)
+    np.testing.assert_array_equal(got[-1, 1:4], one.max_abs_theta)
+    settle = one.settling_time(0.01)
+    assert (math.isnan(got[-1, 4]) if settle is None else got[-1, 4] == settle)
+
+
+def test_parquet_round_trip(tmp_path):
+    pq = pytest.importorskip("pyarrow.parquet")
+    sc = builtin_scenario("paper-forward-case2")
+    result = run_sweep(sc.replace(duration=1.5), [parse_vary("ankle=300:900:3"),
+                                                  parse_vary("viscosity_ratio=0.1:0.3:2")])
+    path = tmp_path / "sweep.parquet"
+    result.write(path)
+    table = pq.read_table(path)
+    assert table.column_names == ["ankle", "viscosity_ratio", *OUTCOME_COLUMNS]
+    assert table.schema.field("ankle").metadata[b"unit"] == "N·m/rad".encode()
+    for name, values in result.columns():
+        col = table.column(name).to_numpy(zero_copy_only=False)
+        if name == "fell":
+            np.testing.assert_array_equal(col, values)
+        else:
+            np.testing.assert_array_equal(np.asarray(col, dtype=float), values)
+    assert not list(tmp_path.glob(".*.tmp"))  # no temporary file left behind
+
+
+def test_viscosity_follows_the_ratio():
+    """A varied ratio sets every pair's viscosity; otherwise the base's ratio (0.25) holds."""
+    sc = builtin_scenario("paper-backward-case1")
+    g = sweep_grid(sc, [VaryRange("hip", 0.0, 100.0, 2), VaryRange("viscosity_ratio", 0.1,
+                                                                      0.5, 3)])
+    assert g.n_runs == 6 and g.shape == (2, 3)
+    np.testing.assert_allclose(g.viscosity, g.values[:, 1:2] * g.stiffness)
+    g = sweep_grid(sc, [VaryRange("knee", 50.0, 50.0, 1)])
+    np.testing.assert_allclose(g.viscosity, 0.25 * g.stiffness)
+    g = sweep_grid(sc, [VaryRange("knee", 50.0, 50.0, 1)], viscosity_ratio=0.4)
+    np.testing.assert_allclose(g.viscosity, 0.4 * g.stiffness)
+
+
+def test_dask_path_equals_the_local_path():
+    """Chunks on a Dask LocalCluster (2 workers, threads, started here) give the same numbers."""
+    distributed = pytest.importorskip("distributed")
+    sc = builtin_scenario("paper-backward-case1").replace(duration=1.0)
+    varies = [parse_vary("ankle=200:1400:4"), parse_vary("quadriceps=0:600:3")]
+    local = run_sweep(sc, varies)
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=False,
+                                  dashboard_address=None) as cluster:
+        with distributed.Client(cluster) as client:
+            remote = run_sweep(sc, varies, client=client, chunk_size=5)
+    for (name, a), (_, b) in zip(local.columns(), remote.columns(), strict=True):
+        np.testing.assert_array_equal(a, b, err_msg=name)
+    np.testing.assert_array_equal(local.outcomes.final_state, remote.outcomes.final_state)
+
+
+def test_cli_scenario_base_and_progress_bar(tmp_path, capsys):
+    """--scenario FILE.toml as the base (one-sided gastrocnemius); --progress draws on stderr."""
+    toml = tmp_path / "base.toml"
+    toml.write_text('duration = 1.0\n[muscles]\ncase = "1"\ngastrocnemius = "one-sided"\n'
+                    'viscosity_ratio = 0.3\n[disturbance]\ntype = "velocity-step"\n'
+                    'velocity = -0.5\n[initial]\nposture = [0.1, -0.1, 0.1]\n')
+    out = tmp_path / "s.csv"
+    assert main(["sweep", "--scenario", str(toml), "--vary", "knee=0:300:2", "--out", str(out),
+                 "--progress"]) == 0
+    err = capsys.readouterr().err
+    assert "100%" in err and "2/2 runs" in err
+    header, rows = read_csv(out)
+    assert header[0] == "knee" and len(rows) == 2
+    m = paper_muscles("1", gastrocnemius="one-sided", viscosity_ratio=0.3)
+    one = simulate_fast(paper_body(), m.with_stiffness(knee=300.0), VelocityStep(-0.5), 1.0,
+                        initial_state=POSTURE)
+    np.testing.assert_allclose([cell(x) for x in rows[1][3:6]], one.max_abs_theta, rtol=0,
+                               atol=0)
+
+
+@pytest.mark.parametrize("vary, words", [
+    ("elbow=0:1:2", "unknown sweep parameter 'elbow'"),
+    ("ankle=900:100:3", "LO (900) must be <= HI"),
+    ("ankle=0:100:0", "N must be an integer >= 1"),
+    ("ankle=0:100", "NAME=LO:HI:N"),
+    ("ankle=0:100:2.5", "N must be an integer"),
+    ("ankle=-5:100:3", "must be >= 0"),
+    ("ankle=0:100:1", "LO must equal HI"),
+])
+def test_bad_vary_is_one_line_and_exit_2(tmp_path, capsys, vary, words):
+    code = main(["sweep", "--case", "1", "--disturbance", "backward", "--vary", vary,
+                 "--out", str(tmp_path / "x.csv")])
+    assert code == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and err.startswith("posturelab: error:")
+    assert words in err
+    if "unknown" in words:
+        assert "ankle, knee, hip, quadriceps, gastrocnemius, viscosity_ratio" in err
+    assert not (tmp_path / "x.csv").exists()
+
+
+@pytest.mark.parametrize("extra, words", [
+    (["--vary", "ankle=0:1:2", "--vary", "ankle=0:1:2"], "more than once"),
+    (["--vary", "ankle=0:1:2", "--torque-limits", "50,inf,inf"], "torque limits"),
+    (["--vary", "ankle=0:1:2", "--out-format"], "unrecognized"),
+])
+def test_other_bad_input_exit_2(tmp_path, capsys, extra, words):
+    code = main(["sweep", "--case", "1", "--disturbance", "backward", *extra,
+                 "--out", str(tmp_path / "x.csv")])
+    assert code == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and words in err
+
+
+def test_bad_output_suffix_and_missing_dask(tmp_path, capsys, monkeypatch):
+    assert main(["sweep", "--case", "1", "--vary", "ankle=0:1:2",
+                 "--out", str(tmp_path / "x.xlsx")]) == 2
+    assert ".csv or .parquet" in capsys.readouterr().err
+    monkeypatch.setitem(sys.modules, "distributed", None)  # as if Dask were not installed
+    assert main(["sweep", "--case", "1", "--vary", "ankle=0:1:2", "--workers", "2",
+                 "--out", str(tmp_path / "x.csv")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "need Dask" in err
+
+
+def test_parse_vary_values():
+    v = parse_vary(" ankle = 0 : 2000 : 5 ")
+    np.testing.assert_array_equal(v.values, [0.0, 500.0, 1000.0, 1500.0, 2000.0])
+    assert v.unit == "N·m/rad"
+    assert parse_vary("viscosity_ratio=0.25:0.25:1").values.tolist() == [0.25]
+    with pytest.raises(ParameterError):
+        sweep_grid(builtin_scenario("paper-backward-case1"), [])
