@@ -94,3 +94,18 @@ def print_json(obj) -> None:
     """Print exactly one JSON object on standard output."""
     json.dump(obj, sys.stdout, allow_nan=False)
     sys.stdout.write("\n")
+
+
+def check_writable(paths: list[str]) -> None:
+    """Fail early, before any work, when an output's directory is missing or read-only."""
+    import os
+    from pathlib import Path
+
+    for p in paths:
+        d = Path(p).parent if str(Path(p).parent) else Path(".")
+        if not d.is_dir():
+            raise ParameterError(f"cannot write {p!r}: directory {str(d)!r} does not exist")
+        if not os.access(d, os.W_OK):
+            raise ParameterError(f"cannot write {p!r}: directory {str(d)!r} is not writable")
+        if Path(p).is_dir():
+            raise ParameterError(f"cannot write {p!r}: it is a directory")

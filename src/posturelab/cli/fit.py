@@ -43,7 +43,7 @@ def add_parser(sub, name: str) -> argparse.ArgumentParser:
 def run(args: argparse.Namespace) -> int:
     import json
 
-    sc = scenario_from_args(args)
+    sc = scenario_from_args(args, "fit")
     time, theta = read_trajectory_csv(args.data, sc.body.n_links)
     sc = sc.replace(duration=max(float(time[-1]), 1e-3))
     free = [s.strip() for s in args.free.split(",") if s.strip()]

@@ -17,6 +17,7 @@ from ..simulate import FOOT_FROM_LITERATURE, BaseOfSupport, FallCriteria, KneeMo
 from . import CONVENTIONS_EPILOG, UsageError
 from ._common import (
     add_muscle_arguments,
+    check_writable,
     muscles_from_args,
     parse_float_list,
     parse_limit_list,
@@ -113,18 +114,21 @@ MODEL_OPTIONS = ("case", "stiffness", "disturbance", "platform_profile", "initia
                  "initial_rates")
 
 
-def scenario_from_args(args: argparse.Namespace) -> Scenario:
-    """Build the scenario the arguments describe (a file, a built-in, or the options)."""
+def scenario_from_args(args: argparse.Namespace, command: str = "simulate") -> Scenario:
+    """Build the scenario the arguments describe (a file, a built-in, or the options).
+
+    ``command`` names the subcommand in usage errors.
+    """
     if args.scenario and args.builtin:
-        raise UsageError("simulate: give --scenario or --builtin, not both")
+        raise UsageError(f"{command}: give --scenario or --builtin, not both")
     if args.scenario or args.builtin:
         clash = [o for o in MODEL_OPTIONS if getattr(args, o) is not None]
         if clash:
-            raise UsageError(f"simulate: --{clash[0].replace('_', '-')} cannot be "
+            raise UsageError(f"{command}: --{clash[0].replace('_', '-')} cannot be "
                              "combined with a scenario; edit the scenario instead")
         sc = load_scenario(args.scenario) if args.scenario else builtin_scenario(args.builtin)
     else:
-        sc = _scenario_from_options(args)
+        sc = _scenario_from_options(args, command)
     overrides = {}
     for name in ("duration", "rtol", "atol", "sample_rate"):
         value = getattr(args, name)
@@ -165,12 +169,12 @@ def _foot(text: str) -> BaseOfSupport:
     return BaseOfSupport(heel, toe, source="--foot")
 
 
-def _scenario_from_options(args: argparse.Namespace) -> Scenario:
+def _scenario_from_options(args: argparse.Namespace, command: str) -> Scenario:
     if args.case is None and args.stiffness is None:
-        raise UsageError("simulate: give --case or --stiffness (or --scenario / "
+        raise UsageError(f"{command}: give --case or --stiffness (or --scenario / "
                          "--builtin)")
     if args.disturbance not in (None, "none") and args.platform_profile:
-        raise UsageError("simulate: give --disturbance or --platform-profile, not both")
+        raise UsageError(f"{command}: give --disturbance or --platform-profile, not both")
     body = paper_body()
     muscles = muscles_from_args(args)
     n = body.n_links
@@ -200,7 +204,7 @@ def _scenario_from_options(args: argparse.Namespace) -> Scenario:
 def run(args: argparse.Namespace) -> int:
     sc = scenario_from_args(args)
     outputs = [p for p in (args.out, args.plot, args.animate) if p]
-    _check_writable(outputs)
+    check_writable(outputs)
     result = sc.run()
     if args.out:
         result.to_csv(args.out)
@@ -228,19 +232,3 @@ def run(args: argparse.Namespace) -> int:
         print(f"posturelab: warning: {result.message}", file=sys.stderr)
         return 1
     return 0
-
-
-def _check_writable(paths: list[str]) -> None:
-    """Fail early, before simulating, when an output's directory is missing or read-only."""
-    import os
-    from pathlib import Path
-
-    for p in paths:
-        d = Path(p).parent if str(Path(p).parent) else Path(".")
-        if not d.is_dir():
-            raise ParameterError(f"cannot write {p!r}: directory {str(d)!r} does not exist")
-        if not os.access(d, os.W_OK):
-            raise ParameterError(f"cannot write {p!r}: directory {str(d)!r} is not writable")
-        if Path(p).is_dir():
-            raise ParameterError(f"cannot write {p!r}: it is a directory")
-

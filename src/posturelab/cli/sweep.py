@@ -17,7 +17,8 @@ from ..sweep import (
     table_format,
 )
 from . import CONVENTIONS_EPILOG, UsageError
-from .simulate import _check_writable, add_experiment_arguments, scenario_from_args
+from ._common import check_writable
+from .simulate import add_experiment_arguments, scenario_from_args
 
 DESCRIPTION = f"""\
 Simulate the nonlinear model for every combination of the --vary values (the full grid,
@@ -79,7 +80,7 @@ def run(args: argparse.Namespace) -> int:
                          "'posturelab sweep --help')")
     varies = [parse_vary(v) for v in args.vary]
     table_format(args.out)
-    _check_writable([args.out])
+    check_writable([args.out])
     if not (args.scenario or args.builtin or args.case is not None
             or args.stiffness is not None):
         raise UsageError("sweep: give the base experiment: --case or --stiffness (with "
@@ -91,7 +92,7 @@ def run(args: argparse.Namespace) -> int:
     ratio = args.viscosity_ratio
     if ratio is None and not (args.scenario or args.builtin):
         args.viscosity_ratio = DEFAULT_VISCOSITY_RATIO  # what --case / --stiffness build with
-    scenario = scenario_from_args(args)
+    scenario = scenario_from_args(args, "sweep")
     tolerances = {}
     if args.rtol is not None:
         tolerances["rtol"] = scenario.rtol
