@@ -43,6 +43,7 @@ OMEGA_TOL = 1e-4  # [rad/s]
 TIME_TOL = 1e-6  # [s]
 PAPER_POSTURE = [0.1, -0.1, 0.1, 0.0, 0.0, 0.0]
 REF = {"rtol": 1e-10, "atol": 1e-12}
+METHODS = ["RK45", "RK23"]  # both compiled integrators are held to the same tolerances
 
 
 def assert_same_run(fast, ref, theta_tol=THETA_TOL, omega_tol=OMEGA_TOL):
@@ -59,8 +60,8 @@ def assert_same_run(fast, ref, theta_tol=THETA_TOL, omega_tol=OMEGA_TOL):
     assert fast.pair_names == ref.pair_names
 
 
-def run_both(body, muscles, disturbance, duration, **kwargs):
-    fast = simulate_fast(body, muscles, disturbance, duration, **kwargs)
+def run_both(body, muscles, disturbance, duration, method="RK45", **kwargs):
+    fast = simulate_fast(body, muscles, disturbance, duration, method=method, **kwargs)
     ref = simulate(body, muscles, disturbance, duration, **kwargs, **REF)
     return fast, ref
 
@@ -70,8 +71,9 @@ def run_both(body, muscles, disturbance, duration, **kwargs):
 # ---------------------------------------------------------------------------
 
 
+@pytest.mark.parametrize("method", METHODS)
 @pytest.mark.parametrize("name", builtin_scenario_names())
-def test_every_builtin_scenario_matches_the_reference(name):
+def test_every_builtin_scenario_matches_the_reference(name, method):
     """Status, fall, fall time and trajectory of each shipped scenario (its own tolerances for
     the reference, the fast defaults for the compiled simulator)."""
     sc = builtin_scenario(name)
@@ -80,7 +82,7 @@ def test_every_builtin_scenario_matches_the_reference(name):
         sc.body, sc.muscles, sc.disturbance, sc.duration, initial_state=sc.initial_state,
         rates_from=sc.rates_from, knee=sc.knee, fall=sc.fall,
         torque_limits=sc.torque_limits, feedback_delay=sc.feedback_delay,
-        sample_rate=sc.sample_rate, description=sc.description,
+        sample_rate=sc.sample_rate, description=sc.description, method=method,
     )
     assert_same_run(fast, ref)
     assert fast.message == ref.message
@@ -92,40 +94,45 @@ def test_every_builtin_scenario_matches_the_reference(name):
 # ---------------------------------------------------------------------------
 
 
-def test_half_sine_pulse_from_upright():
+@pytest.mark.parametrize("method", METHODS)
+def test_half_sine_pulse_from_upright(method):
     """A backward half-sine acceleration pulse (breakpoints at its start and end)."""
-    fast, ref = run_both(paper_body(), paper_muscles("1"), HalfSinePulse(-3.0, 0.3, 0.2), 3.0)
+    fast, ref = run_both(paper_body(), paper_muscles("1"), HalfSinePulse(-3.0, 0.3, 0.2), 3.0,
+                         method)
     assert_same_run(fast, ref)
     np.testing.assert_allclose(fast.platform_acceleration, ref.platform_acceleration, atol=1e-12)
     np.testing.assert_allclose(fast.platform_velocity, ref.platform_velocity, atol=1e-12)
 
 
-def test_sum_of_sines_horizontal_and_vertical():
+@pytest.mark.parametrize("method", METHODS)
+def test_sum_of_sines_horizontal_and_vertical(method):
     """Two sums of sines, one horizontal and one vertical, summed (step capped at max_step)."""
     d = combine(SumOfSines((0.8, 0.5), (0.7, 1.9), (0.3, 1.0)),
                 SumOfSines((0.6,), (1.1,), axis="y"))
-    fast, ref = run_both(paper_body(), paper_muscles("1"), d, 3.0)
+    fast, ref = run_both(paper_body(), paper_muscles("1"), d, 3.0, method)
     assert_same_run(fast, ref)
     np.testing.assert_allclose(fast.platform_acceleration, ref.platform_acceleration, atol=1e-12)
 
 
-def test_measured_profile_linear_interpolation():
+@pytest.mark.parametrize("method", METHODS)
+def test_measured_profile_linear_interpolation(method):
     """A measured profile (x and y, 401 samples): every sample is a breakpoint; zero outside."""
     rng = np.random.default_rng(7)
     t = np.linspace(0.1, 1.1, 401)
     ax = np.cumsum(rng.normal(0.0, 0.4, t.size))
     ay = 0.5 * np.sin(2 * np.pi * t)
     d = MeasuredProfile(t, ax, ay, source="synthetic")
-    fast, ref = run_both(paper_body(), paper_muscles("1"), d, 2.0,
+    fast, ref = run_both(paper_body(), paper_muscles("1"), d, 2.0, method,
                          initial_state=PAPER_POSTURE)
     assert_same_run(fast, ref)
     np.testing.assert_allclose(fast.platform_acceleration, ref.platform_acceleration, atol=1e-12)
 
 
-def test_ramp_and_hold_combined_with_a_velocity_step():
+@pytest.mark.parametrize("method", METHODS)
+def test_ramp_and_hold_combined_with_a_velocity_step(method):
     """A combined disturbance: a vertical velocity step (initial rates) plus a ramp-and-hold."""
     d = combine(VelocityStep(0.3, "y"), RampAndHold(-0.08, 0.5, 0.1))
-    fast, ref = run_both(paper_body(), paper_muscles("1"), d, 2.0,
+    fast, ref = run_both(paper_body(), paper_muscles("1"), d, 2.0, method,
                          initial_state=PAPER_POSTURE)
     assert_same_run(fast, ref)
     np.testing.assert_allclose(fast.platform_position, ref.platform_position, atol=1e-9)
@@ -136,12 +143,13 @@ def test_ramp_and_hold_combined_with_a_velocity_step():
 # ---------------------------------------------------------------------------
 
 
-def test_one_sided_gastrocnemius_switch_times():
+@pytest.mark.parametrize("method", METHODS)
+def test_one_sided_gastrocnemius_switch_times(method):
     """The real gastrocnemius (acts while θ2 >= 0): from θ2 = −0.1 it is slack, engages as
     the body sways forward and goes slack again near 3.9 s; the switches are located at the
     same times as in the reference."""
     muscles = paper_muscles("1", gastrocnemius="one-sided")
-    fast, ref = run_both(paper_body(), muscles, VelocityStep.backward(1.0), 4.5,
+    fast, ref = run_both(paper_body(), muscles, VelocityStep.backward(1.0), 4.5, method,
                          initial_state=PAPER_POSTURE)
     assert_same_run(fast, ref)
     assert len(ref.switch_times) >= 2
@@ -152,9 +160,11 @@ def test_one_sided_gastrocnemius_switch_times():
     assert np.all(m_gastro[fast.theta[:, 1] < 0] == 0.0)
 
 
-def test_locked_knee():
+@pytest.mark.parametrize("method", METHODS)
+def test_locked_knee(method):
     """A locked knee (θ2 − θ1 constant, projection form): the constraint holds throughout."""
     fast, ref = run_both(paper_body(), paper_muscles("1"), VelocityStep.backward(0.5), 3.0,
+                         method,
                          initial_state=[0.05, 0.05, 0.1, 0.0, 0.0, 0.0],
                          knee=KneeModel("locked"))
     assert_same_run(fast, ref)
@@ -162,11 +172,13 @@ def test_locked_knee():
     np.testing.assert_allclose(fast.omega[:, 1] - fast.omega[:, 0], 0.0, atol=1e-8)
 
 
-def test_knee_stop_and_base_of_support_fall():
+@pytest.mark.parametrize("method", METHODS)
+def test_knee_stop_and_base_of_support_fall(method):
     """A hyper-extension stop (the knee hits it: plastic impact, then locked) and a fall when
     the centre of gravity passes the toe (the release is in the lab-ramp-and-hold scenario)."""
     fall = FallCriteria(base_of_support=FOOT_FROM_LITERATURE)
     fast, ref = run_both(paper_body(), paper_muscles("2"), VelocityStep.backward(0.5), 3.0,
+                         method,
                          initial_state=[0.05, 0.0, 0.05, 0.0, 0.0, 0.0],
                          knee=KneeModel("stop"), fall=fall)
     assert_same_run(fast, ref)
@@ -177,17 +189,19 @@ def test_knee_stop_and_base_of_support_fall():
     assert fast.time[-1] == pytest.approx(ref.fall_time, abs=TIME_TOL)
 
 
-def test_fall_already_at_the_start():
+@pytest.mark.parametrize("method", METHODS)
+def test_fall_already_at_the_start(method):
     """A posture already beyond the limit is a fall at t = 0 (as the reference)."""
-    fast, ref = run_both(paper_body(), paper_muscles("1"), None, 1.0,
+    fast, ref = run_both(paper_body(), paper_muscles("1"), None, 1.0, method,
                          initial_state=[1.2, 0.0, 0.0, 0.0, 0.0, 0.0])
     assert fast.fell and fast.fall_time == 0.0 and fast.time.size == 1
     assert fast.message == ref.message
     assert_same_run(fast, ref)
 
 
+@pytest.mark.parametrize("method", METHODS)
 @pytest.mark.parametrize("n_links", [2, 4])
-def test_other_chain_lengths_use_the_general_solver(n_links):
+def test_other_chain_lengths_use_the_general_solver(n_links, method):
     """N = 2 and N = 4 (Gaussian elimination instead of the 3×3 closed form)."""
     rng = np.random.default_rng(n_links)
     lengths = rng.uniform(0.3, 0.6, n_links)
@@ -199,7 +213,8 @@ def test_other_chain_lengths_use_the_general_solver(n_links):
     pairs.append(MusclePair("long", 0, n_links, 200.0, 50.0, one_sided=True))
     muscles = MuscleSet(tuple(pairs), n_links)
     x0 = np.concatenate([np.full(n_links, 0.02), np.zeros(n_links)])
-    fast, ref = run_both(body, muscles, VelocityStep.backward(0.4), 2.0, initial_state=x0)
+    fast, ref = run_both(body, muscles, VelocityStep.backward(0.4), 2.0, method,
+                         initial_state=x0)
     assert_same_run(fast, ref)
 
 
@@ -264,8 +279,9 @@ def _gains(rng, m):
     return k
 
 
+@pytest.mark.parametrize("method", METHODS)
 @pytest.mark.parametrize("setting", ["paper", "one-sided, knee stop, foot"])
-def test_batch_equals_single_runs_bit_for_bit(setting):
+def test_batch_equals_single_runs_bit_for_bit(setting, method):
     """Each batch row is simulate_fast's run with those gains: the same numbers exactly."""
     rng = np.random.default_rng(11)
     stiffness = _gains(rng, 6)
@@ -277,6 +293,7 @@ def test_batch_equals_single_runs_bit_for_bit(setting):
         disturbance = RampAndHold(-0.1, 0.4)
         options = dict(knee=KneeModel("stop"),
                        fall=FallCriteria(base_of_support=FOOT_FROM_LITERATURE))
+    options["method"] = method
     batch = simulate_batch(paper_body(), stiffness, viscosity, disturbance, 3.0,
                            PAPER_POSTURE if setting == "paper" else None, muscles=layout,
                            **options)
@@ -374,3 +391,21 @@ def test_sincos_array_is_accurate():
     kern.sincos_array(x, s, c)
     np.testing.assert_allclose(s, np.sin(x), rtol=0, atol=4e-16)
     np.testing.assert_allclose(c, np.cos(x), rtol=0, atol=4e-16)
+
+
+def test_rk23_takes_fewer_evaluations_on_the_stiff_paper_case():
+    """Case 1 is bounded by stability (a pole near −554 1/s): Bogacki–Shampine's three
+    evaluations per step beat Dormand–Prince's six, at the same accuracy (above)."""
+    sc = builtin_scenario("paper-backward-case1")
+    counts = {}
+    for method in METHODS:
+        out = simulate_batch(sc.body, np.asarray(sc.muscles.stiffnesses)[None, :],
+                             np.asarray(sc.muscles.viscosities)[None, :], sc.disturbance,
+                             sc.duration, sc.initial_state, method=method)
+        counts[method] = int(out.n_steps[0])
+    assert counts["RK23"] * 3 < 0.85 * counts["RK45"] * 6
+
+
+def test_unknown_method_is_refused():
+    with pytest.raises(ParameterError, match="method"):
+        simulate_fast(paper_body(), paper_muscles("1"), None, 0.1, method="LSODA")

@@ -125,7 +125,7 @@ def crossings(muscles: MuscleSet) -> np.ndarray:
 def control_arrays(
     body: Body, fall: FallCriteria, knee: KneeModel, *, rtol: float, atol: float,
     max_step: float, duration: float, max_switches: int, locked0: bool,
-    settle_tolerance: float,
+    settle_tolerance: float, method: str = "RK45",
 ) -> tuple[np.ndarray, np.ndarray]:
     """The kernels' scalar parameters ``fpar`` (floats) and ``ipar`` (int64)."""
     fpar = np.zeros(kern.N_FPAR)
@@ -149,4 +149,5 @@ def control_arrays(
                               "stop": kern.KNEE_STOP}[knee.mode]
     ipar[kern.I_MAX_SWITCHES] = max_switches
     ipar[kern.I_LOCKED0] = 1 if locked0 else 0
+    ipar[kern.I_METHOD] = {"RK45": kern.METHOD_RK45, "RK23": kern.METHOD_RK23}[method]
     return fpar, ipar

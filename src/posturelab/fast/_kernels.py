@@ -5,7 +5,12 @@ muscles, disturbances and options into them and unpacks the results. The
 physics is that of :mod:`posturelab.dynamics` and :mod:`posturelab.simulate`
 (DESIGN.md's closed form for N links). The integrator is the Dormand–Prince
 5(4) pair of scipy's ``RK45`` (same tableau, error estimate and free
-4th-order dense output) with Hairer's PI step-size controller.
+4th-order dense output) or, with ``ipar[I_METHOD] = METHOD_RK23``, the
+Bogacki–Shampine 3(2) pair of scipy's ``RK23`` (tableau, error estimate, cubic
+Hermite dense output, stored as a quartic with a zero top coefficient), with
+Hairer's PI step-size controller (exponents from the method's error order;
+the powers err^α by short log/exp approximations, deterministic and far more
+accurate than step-size control needs).
 
 Performance notes (measured; see benchmarks/bench_simulate.py)
 --------------------------------------------------------------
@@ -114,7 +119,11 @@ I_USE_BOS = 0
 I_KNEE_MODE = 1
 I_MAX_SWITCHES = 2
 I_LOCKED0 = 3
-N_IPAR = 4
+I_METHOD = 4
+N_IPAR = 5
+
+METHOD_RK45 = 0
+METHOD_RK23 = 1
 
 # layout of the result vector of _integrate
 R_STATUS = 0
@@ -170,6 +179,51 @@ _SAFE = 0.9
 _FACC1 = 1.0 / 0.2
 _FACC2 = 1.0 / 10.0
 _LOG_ERR_FLOOR = math.log(1e-4)
+
+# ---------------------------------------------------------------------------
+# Bogacki–Shampine 3(2): the tableau of scipy's RK23 (FSAL, three new evaluations per
+# step), its error estimate and its cubic Hermite dense output
+# ---------------------------------------------------------------------------
+
+_BS_C2, _BS_C3 = 1 / 2, 3 / 4
+_BS_A21 = 1 / 2
+_BS_A32 = 3 / 4
+_BS_B1, _BS_B2, _BS_B3 = 2 / 9, 1 / 3, 4 / 9
+_BS_E1, _BS_E2, _BS_E3, _BS_E4 = 5 / 72, -1 / 12, -1 / 9, 1 / 8
+_BS_P = np.array([
+    [1, -4 / 3, 5 / 9],
+    [0, 1, -2 / 3],
+    [0, 4 / 3, -8 / 9],
+    [0, -1, 1],
+])
+# PI control of the 3(2) pair (error order 3): h ← h · 0.9 · err^−α · errold^β
+_BS_BETA = 0.04
+_BS_EXPO1 = 1.0 / 3.0 - _BS_BETA * 0.75
+_LN2 = 0.6931471805599453
+_SQRT_HALF = 0.7071067811865476
+
+
+@njit(cache=True, error_model="numpy", fastmath=_CONTRACT, inline="always")
+def _log_approx(x):
+    """ln x for finite x > 0 to about 1e-6 relative (step-size control needs no more):
+    x = m·2^e, ln m = −ln2/2 + 2 atanh z, z = (m − √½)/(m + √½), |z| <= 0.172."""
+    m, e = math.frexp(x)
+    z = (m - _SQRT_HALF) / (m + _SQRT_HALF)
+    z2 = z * z
+    return (e - 0.5) * _LN2 + 2.0 * z * (1.0 + z2 * (1.0 / 3.0 + z2 * (1.0 / 5.0
+                                                                       + z2 * (1.0 / 7.0))))
+
+
+@njit(cache=True, error_model="numpy", fastmath=_CONTRACT, inline="always")
+def _exp_approx(y):
+    """e^y for −700 < y < 700 to about 1e-7 relative: 2^k e^r, |r| <= ln2/2."""
+    k = math.floor(y * (1.0 / _LN2) + 0.5)
+    r = y - k * _LN2
+    p = 1.0 + r * (1.0 + r * (0.5 + r * (1.0 / 6.0 + r * (1.0 / 24.0 + r * (
+        1.0 / 120.0 + r * (1.0 / 720.0 + r * (1.0 / 5040.0)))))))
+    return math.ldexp(p, int(k))
+
+
 #: steps between fresh libm sines/cosines of the step's start angles (see _rotate)
 _TRIG_REFRESH = 64
 
@@ -647,8 +701,10 @@ def _event_root(kind, par, sgn, t0, t1, g0, g1, y0, Q, h, mp, E, fpar, dp, scrat
 
 
 @njit(cache=True, error_model="numpy", fastmath=_CONTRACT)
-def _initial_step(t0, y0, f0, t_bound, max_step, rtol, atol, locked, mp, dp, work, y1, f1):
-    """scipy's select_initial_step (Hairer, Nørsett & Wanner, Sec. II.4), error order 4.
+def _initial_step(t0, y0, f0, t_bound, max_step, rtol, atol, locked, mp, dp, work, y1, f1,
+                  order):
+    """scipy's select_initial_step (Hairer, Nørsett & Wanner, Sec. II.4) for a method whose
+    error estimate has order ``order`` (4 for RK45, 2 for RK23).
 
     ``f0`` and ``f1`` are (≥1, 2N) arrays whose row 0 holds a derivative.
     """
@@ -680,7 +736,7 @@ def _initial_step(t0, y0, f0, t_bound, max_step, rtol, atol, locked, mp, dp, wor
     if d1 <= 1e-15 and d2 <= 1e-15:
         h1 = max(1e-6, h0 * 1e-3)
     else:
-        h1 = (0.01 / max(d1, d2)) ** 0.2
+        h1 = (0.01 / max(d1, d2)) ** (1.0 / (order + 1.0))
     return min(100.0 * h0, h1, interval, max_step)
 
 
@@ -717,6 +773,155 @@ def _stage_accelerations(t, h, t_new, dp, out):
         ax, ay = platform_acceleration(ts, dp)
         out[2 * s] = ax
         out[2 * s + 1] = ay
+
+
+@njit(cache=True, error_model="numpy", fastmath=_CONTRACT)
+def _bs_stage_accelerations(t, h, t_new, dp, out):
+    """(ẍ_d, ÿ_d) at the three new stage times of a Bogacki–Shampine step into out. [m/s²]"""
+    for s in range(3):
+        if s == 0:
+            ts = t + _BS_C2 * h
+        elif s == 1:
+            ts = t + _BS_C3 * h
+        else:
+            ts = t_new
+        ax, ay = platform_acceleration(ts, dp)
+        out[2 * s] = ax
+        out[2 * s + 1] = ay
+
+
+@njit(cache=True, error_model="numpy", fastmath=_CONTRACT)
+def _bs_step3(h, x, stg, ytmp, locked, mp, acc, base, trig, rtol, atol):
+    """One Bogacki–Shampine 3(2) step of the 3-link chain, in scalars (scipy's RK23).
+
+    As :func:`_dp_step3`: from (t, x) with stg[0] = f(t, x), writes the stages to
+    stg[1:4] (stg[3] = f(t_new, y_new)), y_new to ``ytmp`` and its sines and
+    cosines to ``trig``; returns the mean square of the scaled error estimate.
+    ``acc`` (6,) holds the platform acceleration at the three new stage times.
+    """
+    prm = _model_tuple3(mp)
+    x0 = x[0]
+    x1 = x[1]
+    x2 = x[2]
+    x3 = x[3]
+    x4 = x[4]
+    x5 = x[5]
+    tb1 = base[0]
+    tb2 = base[1]
+    tb3 = base[2]
+    sb1 = base[3]
+    sb2 = base[4]
+    sb3 = base[5]
+    cb1 = base[6]
+    cb2 = base[7]
+    cb3 = base[8]
+    a0 = stg[0, 0]
+    a1 = stg[0, 1]
+    a2 = stg[0, 2]
+    a3 = stg[0, 3]
+    a4 = stg[0, 4]
+    a5 = stg[0, 5]
+    p = h * _BS_A21
+    (b0, b1, b2, b3, b4, b5), _ = _f3(
+        x0 + p * a0, x1 + p * a1, x2 + p * a2, x3 + p * a3, x4 + p * a4,
+        x5 + p * a5, locked, prm, acc[0], acc[1], tb1, tb2, tb3, sb1, sb2, sb3, cb1, cb2, cb3)
+    q = h * _BS_A32
+    (c0, c1, c2, c3, c4, c5), _ = _f3(
+        x0 + q * b0, x1 + q * b1, x2 + q * b2, x3 + q * b3, x4 + q * b4,
+        x5 + q * b5, locked, prm, acc[2], acc[3], tb1, tb2, tb3, sb1, sb2, sb3, cb1, cb2, cb3)
+    p = h * _BS_B1
+    q = h * _BS_B2
+    r = h * _BS_B3
+    y0 = x0 + ((p * a0 + q * b0) + r * c0)
+    y1 = x1 + ((p * a1 + q * b1) + r * c1)
+    y2 = x2 + ((p * a2 + q * b2) + r * c2)
+    y3 = x3 + ((p * a3 + q * b3) + r * c3)
+    y4 = x4 + ((p * a4 + q * b4) + r * c4)
+    y5 = x5 + ((p * a5 + q * b5) + r * c5)
+    (k0, k1, k2, k3, k4, k5), tr = _f3(
+        y0, y1, y2, y3, y4, y5, locked, prm, acc[4], acc[5],
+        tb1, tb2, tb3, sb1, sb2, sb3, cb1, cb2, cb3)
+    ytmp[0] = y0
+    ytmp[1] = y1
+    ytmp[2] = y2
+    ytmp[3] = y3
+    ytmp[4] = y4
+    ytmp[5] = y5
+    for i, val in enumerate((b0, b1, b2, b3, b4, b5)):
+        stg[1, i] = val
+    for i, val in enumerate((c0, c1, c2, c3, c4, c5)):
+        stg[2, i] = val
+    for i, val in enumerate((k0, k1, k2, k3, k4, k5)):
+        stg[3, i] = val
+    for i in range(6):
+        trig[i] = tr[i]
+    err0 = h * ((_BS_E1 * a0 + _BS_E2 * b0) + (_BS_E3 * c0 + _BS_E4 * k0))
+    err1 = h * ((_BS_E1 * a1 + _BS_E2 * b1) + (_BS_E3 * c1 + _BS_E4 * k1))
+    err2 = h * ((_BS_E1 * a2 + _BS_E2 * b2) + (_BS_E3 * c2 + _BS_E4 * k2))
+    err3 = h * ((_BS_E1 * a3 + _BS_E2 * b3) + (_BS_E3 * c3 + _BS_E4 * k3))
+    err4 = h * ((_BS_E1 * a4 + _BS_E2 * b4) + (_BS_E3 * c4 + _BS_E4 * k4))
+    err5 = h * ((_BS_E1 * a5 + _BS_E2 * b5) + (_BS_E3 * c5 + _BS_E4 * k5))
+    err0 /= atol + rtol * max(abs(x0), abs(y0))
+    err1 /= atol + rtol * max(abs(x1), abs(y1))
+    err2 /= atol + rtol * max(abs(x2), abs(y2))
+    err3 /= atol + rtol * max(abs(x3), abs(y3))
+    err4 /= atol + rtol * max(abs(x4), abs(y4))
+    err5 /= atol + rtol * max(abs(x5), abs(y5))
+    return (err0 * err0 + err1 * err1 + err2 * err2 + err3 * err3 + err4 * err4
+            + err5 * err5) / 6.0
+
+
+@njit(cache=True, error_model="numpy", fastmath=_CONTRACT)
+def _bs_stepN(t, t_new, h, x, stg, ytmp, m, locked, mp, dp, work, rtol, atol):
+    """One Bogacki–Shampine step of an N-link chain (arrays; see :func:`_bs_step3`)."""
+    for s in range(1, 4):
+        if s == 1:
+            for i in range(m):
+                ytmp[i] = x[i] + h * (_BS_A21 * stg[0, i])
+            ts = t + _BS_C2 * h
+        elif s == 2:
+            for i in range(m):
+                ytmp[i] = x[i] + h * (_BS_A32 * stg[1, i])
+            ts = t + _BS_C3 * h
+        else:
+            for i in range(m):
+                ytmp[i] = x[i] + h * ((_BS_B1 * stg[0, i] + _BS_B2 * stg[1, i])
+                                      + _BS_B3 * stg[2, i])
+            ts = t_new
+        _derivN(ts, ytmp, stg, s, locked, mp, dp, work)
+    acc = 0.0
+    for i in range(m):
+        e = ((_BS_E1 * stg[0, i] + _BS_E2 * stg[1, i]) + (_BS_E3 * stg[2, i]
+                                                          + _BS_E4 * stg[3, i]))
+        sc = atol + rtol * max(abs(x[i]), abs(ytmp[i]))
+        e = h * e / sc
+        acc += e * e
+    return acc / m
+
+
+@njit(cache=True, error_model="numpy", fastmath=_CONTRACT)
+def _bs_dense_coefficients(Q, stg, h, m):
+    """Q = h Kᵀ P of the Bogacki–Shampine step (cubic Hermite); Q[:, 3] = 0, so that the
+    interpolant y + Q·(σ, σ², σ³, σ⁴) is the cubic exactly."""
+    for i in range(m):
+        for k in range(3):
+            Q[i, k] = h * ((stg[0, i] * _BS_P[0, k] + stg[1, i] * _BS_P[1, k])
+                           + (stg[2, i] * _BS_P[2, k] + stg[3, i] * _BS_P[3, k]))
+        Q[i, 3] = 0.0
+
+
+@njit(cache=True, error_model="numpy", fastmath=_CONTRACT)
+def _bs_dense_coefficients3(Q, stg, h):
+    """As :func:`_bs_dense_coefficients` for the 6 states of 3 links (constant sizes)."""
+    for k in range(3):
+        p0 = h * _BS_P[0, k]
+        p1 = h * _BS_P[1, k]
+        p2 = h * _BS_P[2, k]
+        p3 = h * _BS_P[3, k]
+        for i in range(6):
+            Q[i, k] = (stg[0, i] * p0 + stg[1, i] * p1) + (stg[2, i] * p2 + stg[3, i] * p3)
+    for i in range(6):
+        Q[i, 3] = 0.0
 
 
 @njit(cache=True, error_model="numpy", fastmath=_CONTRACT)
@@ -954,6 +1159,19 @@ def _integrate(x0, grid, mp0, E, kd, ld, one_sided, dp, bps, fpar, ipar, samples
     knee_mode = ipar[I_KNEE_MODE]
     max_switches = ipar[I_MAX_SWITCHES]
     locked = ipar[I_LOCKED0] != 0
+    rk23 = ipar[I_METHOD] == METHOD_RK23
+    if rk23:
+        expo1 = _BS_EXPO1
+        beta = _BS_BETA
+        err_order = 2
+        last_row = 3
+        evals_per_step = 3
+    else:
+        expo1 = _EXPO1
+        beta = _BETA
+        err_order = 4
+        last_row = 6
+        evals_per_step = 6
 
     mp = mp0.copy()
     work = np.empty((n, n + 4))
@@ -1025,7 +1243,7 @@ def _integrate(x0, grid, mp0, E, kd, ld, one_sided, dp, bps, fpar, ipar, samples
                                         dp, scratch, work)
             t_stop = bps[bi] if bi < bps.size else duration
             h = _initial_step(t, x, stg, t_stop, max_step, rtol, atol, locked, mp, dp, work,
-                              ytmp, scratch)
+                              ytmp, scratch, err_order)
             n_evals += 2
             log_errold = _LOG_ERR_FLOOR
             last_rejected = False
@@ -1048,18 +1266,29 @@ def _integrate(x0, grid, mp0, E, kd, ld, one_sided, dp, bps, fpar, ipar, samples
         t_new = t_stop if landing else t + h
 
         if n3:
-            if has_acceleration:
-                _stage_accelerations(t, h, t_new, dp, stage_acc)
-            err2 = _dp_step3(h, x, stg, ytmp, locked, mp, stage_acc, base, trig, rtol, atol)
+            if rk23:
+                if has_acceleration:
+                    _bs_stage_accelerations(t, h, t_new, dp, stage_acc)
+                err2 = _bs_step3(h, x, stg, ytmp, locked, mp, stage_acc, base, trig, rtol,
+                                 atol)
+            else:
+                if has_acceleration:
+                    _stage_accelerations(t, h, t_new, dp, stage_acc)
+                err2 = _dp_step3(h, x, stg, ytmp, locked, mp, stage_acc, base, trig, rtol,
+                                 atol)
+        elif rk23:
+            err2 = _bs_stepN(t, t_new, h, x, stg, ytmp, m, locked, mp, dp, work, rtol, atol)
         else:
             err2 = _dp_stepN(t, t_new, h, x, stg, ytmp, m, locked, mp, dp, work, rtol, atol)
-        n_evals += 6
+        n_evals += evals_per_step
         # err2 is the squared error norm: accept when the norm is <= 1
         if not (err2 <= 1.0):
             # rejected (a NaN error counts as too large)
             n_rejected += 1
-            if err2 == err2:
-                h = h / min(_FACC1, math.exp(0.5 * _EXPO1 * math.log(err2)) / _SAFE)
+            if err2 < 1e300:
+                h = h / min(_FACC1, _exp_approx(0.5 * expo1 * _log_approx(err2)) / _SAFE)
+            elif err2 == err2:
+                h = h / _FACC1
             else:
                 h = 0.1 * h
             last_rejected = True
@@ -1067,14 +1296,19 @@ def _integrate(x0, grid, mp0, E, kd, ld, one_sided, dp, bps, fpar, ipar, samples
 
         # ---- accepted: Hairer's PI controller, fac = err^0.17 / errold^0.04 / 0.9 ----
         n_steps += 1
-        log_err = 0.5 * math.log(err2) if err2 > 0.0 else -745.0
-        fac = max(_FACC2, min(_FACC1, math.exp(_EXPO1 * log_err - _BETA * log_errold) / _SAFE))
+        log_err = 0.5 * _log_approx(err2) if err2 > 1e-300 else -345.0
+        fac = max(_FACC2, min(_FACC1, _exp_approx(expo1 * log_err - beta * log_errold) / _SAFE))
         h_next = h / fac
         if last_rejected:
             h_next = min(h_next, h)
         last_rejected = False
         log_errold = max(log_err, _LOG_ERR_FLOOR)
-        if n3:
+        if rk23:
+            if n3:
+                _bs_dense_coefficients3(Q, stg, h)
+            else:
+                _bs_dense_coefficients(Q, stg, h, m)
+        elif n3:
             _dense_coefficients3(Q, stg, h)
         else:
             _dense_coefficients(Q, stg, h, m)
@@ -1128,41 +1362,94 @@ def _integrate(x0, grid, mp0, E, kd, ld, one_sided, dp, bps, fpar, ipar, samples
                              or (inclusive and grid[g_end] <= t_end + 1e-12)):
             g_end += 1
         inv_h = 1.0 / h
-        if store:
-            # component by component: contiguous writes that vectorise
-            for i in range(m):
-                q0 = Q[i, 0]
-                q1 = Q[i, 1]
-                q2 = Q[i, 2]
-                q3 = Q[i, 3]
-                xi = x[i]
-                row = samples[i]
-                for g in range(gi, g_end):
-                    sg = (grid[g] - t) * inv_h
-                    row[g] = xi + sg * (q0 + sg * (q1 + sg * (q2 + sg * q3)))
+        if n3:
+            # one pass per sample, the six components written out (the same expression
+            # for a stored run and a batch row, so that they agree bit for bit)
+            q00 = Q[0, 0]
+            q01 = Q[0, 1]
+            q02 = Q[0, 2]
+            q03 = Q[0, 3]
+            q10 = Q[1, 0]
+            q11 = Q[1, 1]
+            q12 = Q[1, 2]
+            q13 = Q[1, 3]
+            q20 = Q[2, 0]
+            q21 = Q[2, 1]
+            q22 = Q[2, 2]
+            q23 = Q[2, 3]
+            xa = x[0]
+            xb = x[1]
+            xc = x[2]
+            pk0 = peak[0]
+            pk1 = peak[1]
+            pk2 = peak[2]
             for g in range(gi, g_end):
-                sample_locked[g] = locked
-        for g in range(gi, g_end):
-            outside = False
-            if store:
-                for i in range(n):
-                    v = abs(samples[i, g])
-                    if v > peak[i]:
-                        peak[i] = v
-                    if v > settle_tol:
-                        outside = True
-            else:
                 sg = (grid[g] - t) * inv_h
-                for i in range(n):
-                    v = abs(x[i] + sg * (Q[i, 0] + sg * (Q[i, 1] + sg * (Q[i, 2] + sg * Q[i, 3]))))
-                    if v > peak[i]:
-                        peak[i] = v
-                    if v > settle_tol:
-                        outside = True
-            if outside:
-                last_outside = grid[g]
-                any_outside = True
-            final_outside = outside
+                v0 = xa + sg * (q00 + sg * (q01 + sg * (q02 + sg * q03)))
+                v1 = xb + sg * (q10 + sg * (q11 + sg * (q12 + sg * q13)))
+                v2 = xc + sg * (q20 + sg * (q21 + sg * (q22 + sg * q23)))
+                if store:
+                    samples[0, g] = v0
+                    samples[1, g] = v1
+                    samples[2, g] = v2
+                    samples[3, g] = x[3] + sg * (Q[3, 0] + sg * (Q[3, 1] + sg * (
+                        Q[3, 2] + sg * Q[3, 3])))
+                    samples[4, g] = x[4] + sg * (Q[4, 0] + sg * (Q[4, 1] + sg * (
+                        Q[4, 2] + sg * Q[4, 3])))
+                    samples[5, g] = x[5] + sg * (Q[5, 0] + sg * (Q[5, 1] + sg * (
+                        Q[5, 2] + sg * Q[5, 3])))
+                    sample_locked[g] = locked
+                v0 = abs(v0)
+                v1 = abs(v1)
+                v2 = abs(v2)
+                pk0 = max(pk0, v0)
+                pk1 = max(pk1, v1)
+                pk2 = max(pk2, v2)
+                outside = v0 > settle_tol or v1 > settle_tol or v2 > settle_tol
+                if outside:
+                    last_outside = grid[g]
+                    any_outside = True
+                final_outside = outside
+            peak[0] = pk0
+            peak[1] = pk1
+            peak[2] = pk2
+        else:
+            if store:
+                # component by component: contiguous writes that vectorise
+                for i in range(m):
+                    q0 = Q[i, 0]
+                    q1 = Q[i, 1]
+                    q2 = Q[i, 2]
+                    q3 = Q[i, 3]
+                    xi = x[i]
+                    row = samples[i]
+                    for g in range(gi, g_end):
+                        sg = (grid[g] - t) * inv_h
+                        row[g] = xi + sg * (q0 + sg * (q1 + sg * (q2 + sg * q3)))
+                for g in range(gi, g_end):
+                    sample_locked[g] = locked
+            for g in range(gi, g_end):
+                outside = False
+                if store:
+                    for i in range(n):
+                        v = abs(samples[i, g])
+                        if v > peak[i]:
+                            peak[i] = v
+                        if v > settle_tol:
+                            outside = True
+                else:
+                    sg = (grid[g] - t) * inv_h
+                    for i in range(n):
+                        v = abs(x[i] + sg * (Q[i, 0] + sg * (Q[i, 1] + sg * (
+                            Q[i, 2] + sg * Q[i, 3]))))
+                        if v > peak[i]:
+                            peak[i] = v
+                        if v > settle_tol:
+                            outside = True
+                if outside:
+                    last_outside = grid[g]
+                    any_outside = True
+                final_outside = outside
         gi = g_end
         if gi > first_gi:
             sg = (grid[gi - 1] - t) * inv_h
@@ -1243,7 +1530,7 @@ def _integrate(x0, grid, mp0, E, kd, ld, one_sided, dp, bps, fpar, ipar, samples
         t = t_new
         for i in range(m):
             x[i] = ytmp[i]
-            stg[0, i] = stg[6, i]
+            stg[0, i] = stg[last_row, i]
         for e in range(n_ev):
             g_old[e] = g_new[e]
         if n3:
@@ -1489,10 +1776,14 @@ def derived_fields(samples, count, locked, E, kd, ld, one_sided, crosses, mp0, t
             y1 = m12 - m11
             y2 = m22 - m12
             y3 = m23 - m13
-            lam = (b2 - b1) / (y2 - y1) if locked[k] else 0.0
-            alpha[0, k] = b1 - y1 * lam
-            alpha[1, k] = b2 - y2 * lam
-            alpha[2, k] = b3 - y3 * lam
+            if locked[k]:
+                lam = (b2 - b1) / (y2 - y1)
+                b1 -= y1 * lam
+                b2 -= y2 * lam
+                b3 -= y3 * lam
+            alpha[0, k] = b1
+            alpha[1, k] = b2
+            alpha[2, k] = b3
     else:
         work = np.empty((n, n + 4))
         x = np.empty(2 * n)
@@ -1542,19 +1833,37 @@ def derived_fields(samples, count, locked, E, kd, ld, one_sided, crosses, mp0, t
         cop[k] = mom[0, k] / gy if gy > 0.0 else np.nan
     vel = np.empty(T2)
     pos = np.empty(T2)
-    if T > 0:
-        vel[0, 0] = vx0
-        vel[1, 0] = vy0
-        pos[0, 0] = 0.0
-        pos[1, 0] = 0.0
-    for c in range(2):
-        ac = acc[c]
-        vc = vel[c]
-        pc = pos[c]
-        for k in range(1, T):
-            dt = time[k] - time[k - 1]
-            vc[k] = vc[k - 1] + 0.5 * (ac[k] + ac[k - 1]) * dt
-            pc[k] = pc[k - 1] + 0.5 * (vc[k] + vc[k - 1]) * dt
+    if dp[0] > 0.0:
+        # trapezoidal integration, both axes in one pass (independent chains overlap)
+        if T > 0:
+            vx = vx0
+            vy = vy0
+            px = 0.0
+            py = 0.0
+            vel[0, 0] = vx
+            vel[1, 0] = vy
+            pos[0, 0] = 0.0
+            pos[1, 0] = 0.0
+            for k in range(1, T):
+                dt = time[k] - time[k - 1]
+                vxn = vx + 0.5 * (acc[0, k] + acc[0, k - 1]) * dt
+                vyn = vy + 0.5 * (acc[1, k] + acc[1, k - 1]) * dt
+                px = px + 0.5 * (vxn + vx) * dt
+                py = py + 0.5 * (vyn + vy) * dt
+                vx = vxn
+                vy = vyn
+                vel[0, k] = vx
+                vel[1, k] = vy
+                pos[0, k] = px
+                pos[1, k] = py
+    else:
+        # no acceleration: the velocity stays that of the step, the trapezoids sum to v·t
+        t0 = time[0] if T > 0 else 0.0
+        for k in range(T):
+            vel[0, k] = vx0
+            vel[1, k] = vy0
+            pos[0, k] = vx0 * (time[k] - t0)
+            pos[1, k] = vy0 * (time[k] - t0)
     return M, U, mom, alpha, cog, cogv, ground, cop, acc, vel, pos
 
 
