@@ -43,7 +43,7 @@ OMEGA_TOL = 1e-4  # [rad/s]
 TIME_TOL = 1e-6  # [s]
 PAPER_POSTURE = [0.1, -0.1, 0.1, 0.0, 0.0, 0.0]
 REF = {"rtol": 1e-10, "atol": 1e-12}
-METHODS = ["RK45", "RK23"]  # both compiled integrators are held to the same tolerances
+METHODS = ["RK45", "RK23", "Radau"]  # every compiled integrator is held to the same tolerances
 
 
 def assert_same_run(fast, ref, theta_tol=THETA_TOL, omega_tol=OMEGA_TOL):

@@ -105,7 +105,7 @@ DEFAULT_RTOL = 1e-6
 #: reference (measured by benchmarks/bench_simulate.py; tested in tests/test_fast.py).
 DEFAULT_ATOL = 1e-9
 
-_METHODS = ("RK45", "RK23")
+_METHODS = ("RK45", "RK23", "Radau")
 
 _STATUS_NAMES = ("completed", "fell", "failed", "failed", "failed")
 

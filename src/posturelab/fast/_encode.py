@@ -149,5 +149,6 @@ def control_arrays(
                               "stop": kern.KNEE_STOP}[knee.mode]
     ipar[kern.I_MAX_SWITCHES] = max_switches
     ipar[kern.I_LOCKED0] = 1 if locked0 else 0
-    ipar[kern.I_METHOD] = {"RK45": kern.METHOD_RK45, "RK23": kern.METHOD_RK23}[method]
+    ipar[kern.I_METHOD] = {"RK45": kern.METHOD_RK45, "RK23": kern.METHOD_RK23,
+                           "Radau": kern.METHOD_RADAU}[method]
     return fpar, ipar

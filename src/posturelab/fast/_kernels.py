@@ -124,6 +124,7 @@ N_IPAR = 5
 
 METHOD_RK45 = 0
 METHOD_RK23 = 1
+METHOD_RADAU = 2
 
 # layout of the result vector of _integrate
 R_STATUS = 0
@@ -1114,6 +1115,240 @@ def _dense_coefficients(Q, stg, h, m):
 
 
 # ---------------------------------------------------------------------------
+# Radau IIA of order 5: scipy's Radau (Hairer & Wanner's RADAU5), compiled, with the
+# Newton systems reduced from 2N×2N to N×N by the structure of the Jacobian
+# ---------------------------------------------------------------------------
+
+_S6 = 6.0 ** 0.5
+_RC1 = (4.0 - _S6) / 10.0  # collocation nodes c1, c2 (c3 = 1)
+_RC2 = (4.0 + _S6) / 10.0
+_RE1 = (-13.0 - 7.0 * _S6) / 3.0  # error estimate weights
+_RE2 = (-13.0 + 7.0 * _S6) / 3.0
+_RE3 = -1.0 / 3.0
+# eigenvalues of the inverse of the Radau matrix: one real, a complex pair
+_MU_REAL = 3.0 + 3.0 ** (2.0 / 3.0) - 3.0 ** (1.0 / 3.0)
+_MU_CRE = 3.0 + 0.5 * (3.0 ** (1.0 / 3.0) - 3.0 ** (2.0 / 3.0))
+_MU_CIM = -0.5 * (3.0 ** (5.0 / 6.0) + 3.0 ** (7.0 / 6.0))
+# the transformation that diagonalises it (T, T⁻¹), to the digits scipy prints
+_T00, _T01, _T02 = 0.09443876248897524, -0.14125529502095421, 0.03002919410514742
+_T10, _T11, _T12 = 0.25021312296533332, 0.20412935229379994, -0.38294211275726192
+_T20, _T21, _T22 = 1.0, 1.0, 0.0
+_TI00, _TI01, _TI02 = 4.17871859155190428, 0.32768282076106237, 0.52337644549944951
+_TI10, _TI11, _TI12 = -4.17871859155190428, -0.32768282076106237, 0.47662355450055044
+_TI20, _TI21, _TI22 = 0.50287263494578682, -2.57192694985560522, 0.59603920482822492
+# the collocation polynomial (dense output): y_old + Σ_k (Σ_s Z_s P_sk) σ^(k+1)
+_RP = np.array([
+    [13.0 / 3.0 + 7.0 * _S6 / 3.0, -23.0 / 3.0 - 22.0 * _S6 / 3.0, 10.0 / 3.0 + 5.0 * _S6],
+    [13.0 / 3.0 - 7.0 * _S6 / 3.0, -23.0 / 3.0 + 22.0 * _S6 / 3.0, 10.0 / 3.0 - 5.0 * _S6],
+    [1.0 / 3.0, -8.0 / 3.0, 10.0 / 3.0],
+])
+_NEWTON_MAXITER = 6
+_SQRT_EPS = 1.4901161193847656e-08
+
+
+@njit(cache=True, error_model="numpy", fastmath=_CONTRACT)
+def _lu_factor(A, piv, n):
+    """LU factorisation with partial pivoting of A[:n, :n] in place (real or complex);
+    whole rows are swapped, as LAPACK's getrf does."""
+    for k in range(n):
+        p = k
+        big = abs(A[k, k])
+        for i in range(k + 1, n):
+            v = abs(A[i, k])
+            if v > big:
+                big = v
+                p = i
+        piv[k] = p
+        if p != k:
+            for j in range(n):
+                tmp = A[k, j]
+                A[k, j] = A[p, j]
+                A[p, j] = tmp
+        inv = 1.0 / A[k, k]
+        for i in range(k + 1, n):
+            A[i, k] *= inv
+            f = A[i, k]
+            for j in range(k + 1, n):
+                A[i, j] -= f * A[k, j]
+
+
+@njit(cache=True, error_model="numpy", fastmath=_CONTRACT)
+def _lu_solve(A, piv, b, n):
+    """Solve with the factors of :func:`_lu_factor`, b[:n] in place."""
+    for k in range(n):
+        p = piv[k]
+        if p != k:
+            tmp = b[k]
+            b[k] = b[p]
+            b[p] = tmp
+    for i in range(n):
+        s = b[i]
+        for j in range(i):
+            s -= A[i, j] * b[j]
+        b[i] = s
+    for i in range(n - 1, -1, -1):
+        s = b[i]
+        for j in range(i + 1, n):
+            s -= A[i, j] * b[j]
+        b[i] = s / A[i, i]
+
+
+@njit(cache=True, error_model="numpy", fastmath=_CONTRACT)
+def _radau_jacobian(t, x, f0, jac, n, locked, mp, dp, work, xt, ft):
+    """The acceleration rows [∂Θ̈/∂Θ, ∂Θ̈/∂Θ̇] (N, 2N) of the Jacobian by forward differences
+    (the velocity rows are [0, I] exactly); ``f0`` = f(t, x). Returns the evaluations used."""
+    m = 2 * n
+    for j in range(m):
+        xt[j] = x[j]
+    for j in range(m):
+        d = _SQRT_EPS * max(abs(x[j]), 1e-2)
+        d = (x[j] + d) - x[j]
+        xt[j] = x[j] + d
+        _deriv(t, xt, ft, 0, locked, mp, dp, work)
+        xt[j] = x[j]
+        for i in range(n):
+            jac[i, j] = (ft[0, n + i] - f0[n + i]) / d
+    return m
+
+
+@njit(cache=True, error_model="numpy", fastmath=_CONTRACT)
+def _radau_factor(h, jac, lur, pivr, luc, pivc, n):
+    """Factor the Newton matrices μ/h·I − Jacobian, reduced to S(c) = c²I − c·∂Θ̈/∂Θ̇ −
+    ∂Θ̈/∂Θ (N×N) for c = μ_real/h (real) and μ_complex/h (complex)."""
+    cr = _MU_REAL / h
+    cc = complex(_MU_CRE, _MU_CIM) / h
+    for i in range(n):
+        for j in range(n):
+            p = jac[i, j]
+            q = jac[i, n + j]
+            lur[i, j] = -(cr * q) - p
+            luc[i, j] = -(cc * q) - p
+        lur[i, i] += cr * cr
+        luc[i, i] += cc * cc
+    _lu_factor(lur, pivr, n)
+    _lu_factor(luc, pivc, n)
+
+
+@njit(cache=True, error_model="numpy", fastmath=_CONTRACT)
+def _block_solve(c, jac, lu, piv, r, n, tmp):
+    """Solve (c·I − Jacobian) v = r in place (r of length 2N, real or complex).
+
+    With the Jacobian [[0, I], [P, Q]]: the angle part a solves S(c) a = r₂ + (c·I − Q) r₁
+    (S factored by :func:`_radau_factor`), the rate part is c·a − r₁.
+    """
+    for i in range(n):
+        s = r[n + i] + c * r[i]
+        for j in range(n):
+            s -= jac[i, n + j] * r[j]
+        tmp[i] = s
+    _lu_solve(lu, piv, tmp, n)
+    for i in range(n):
+        r[n + i] = c * tmp[i] - r[i]
+        r[i] = tmp[i]
+
+
+@njit(cache=True, error_model="numpy", fastmath=_CONTRACT)
+def _radau_newton(t, h, x, Z, W, F, scale, tol, jac, lur, pivr, luc, pivc, n, locked, mp,
+                  dp, work, ys, fr, fc, tmpr, tmpc):
+    """Solve the collocation system for Z (3, 2N) (the stage states minus x), starting from
+    the guess in Z: scipy's solve_collocation_system. Returns (converged, iterations,
+    rate of convergence; −1 when not measured)."""
+    m = 2 * n
+    cr = _MU_REAL / h
+    cc = complex(_MU_CRE, _MU_CIM) / h
+    for i in range(m):
+        z0 = Z[0, i]
+        z1 = Z[1, i]
+        z2 = Z[2, i]
+        W[0, i] = _TI00 * z0 + _TI01 * z1 + _TI02 * z2
+        W[1, i] = _TI10 * z0 + _TI11 * z1 + _TI12 * z2
+        W[2, i] = _TI20 * z0 + _TI21 * z1 + _TI22 * z2
+    norm_old = -1.0
+    rate = -1.0
+    converged = False
+    iters = 0
+    for k in range(_NEWTON_MAXITER):
+        iters = k + 1
+        for s in range(3):
+            cs = _RC1 if s == 0 else (_RC2 if s == 1 else 1.0)
+            for i in range(m):
+                ys[i] = x[i] + Z[s, i]
+            _deriv(t + cs * h, ys, F, s, locked, mp, dp, work)
+        finite = True
+        for s in range(3):
+            for i in range(m):
+                if not np.isfinite(F[s, i]):
+                    finite = False
+        if not finite:
+            break
+        for i in range(m):
+            f0 = F[0, i]
+            f1 = F[1, i]
+            f2 = F[2, i]
+            fr[i] = (_TI00 * f0 + _TI01 * f1 + _TI02 * f2) - cr * W[0, i]
+            fc[i] = (complex(_TI10 * f0 + _TI11 * f1 + _TI12 * f2,
+                             _TI20 * f0 + _TI21 * f1 + _TI22 * f2)
+                     - cc * complex(W[1, i], W[2, i]))
+        _block_solve(cr, jac, lur, pivr, fr, n, tmpr)
+        _block_solve(cc, jac, luc, pivc, fc, n, tmpc)
+        acc = 0.0
+        for i in range(m):
+            a = fr[i] / scale[i]
+            b = fc[i].real / scale[i]
+            c = fc[i].imag / scale[i]
+            acc += a * a + b * b + c * c
+        norm = math.sqrt(acc / (3 * m))
+        if norm_old >= 0.0:
+            rate = norm / norm_old
+        if rate >= 0.0 and (rate >= 1.0 or rate ** (_NEWTON_MAXITER - k) / (1.0 - rate) * norm
+                            > tol):
+            break
+        for i in range(m):
+            W[0, i] += fr[i]
+            W[1, i] += fc[i].real
+            W[2, i] += fc[i].imag
+            w0 = W[0, i]
+            w1 = W[1, i]
+            w2 = W[2, i]
+            Z[0, i] = _T00 * w0 + _T01 * w1 + _T02 * w2
+            Z[1, i] = _T10 * w0 + _T11 * w1 + _T12 * w2
+            Z[2, i] = _T20 * w0 + _T21 * w1 + _T22 * w2
+        if norm == 0.0 or (rate >= 0.0 and rate / (1.0 - rate) * norm < tol):
+            converged = True
+            break
+        norm_old = norm
+    return converged, iters, rate
+
+
+@njit(cache=True, error_model="numpy", fastmath=_CONTRACT)
+def _radau_error(h, x, y, f0, Z, jac, lur, pivr, n, rtol, atol, err, tmpr):
+    """Radau's embedded error estimate (μ_real/h·I − Jacobian)⁻¹ (f0 + Σ e_s Z_s / h) into
+    ``err``; returns its RMS scaled norm."""
+    m = 2 * n
+    for i in range(m):
+        err[i] = f0[i] + (_RE1 * Z[0, i] + _RE2 * Z[1, i] + _RE3 * Z[2, i]) / h
+    _block_solve(_MU_REAL / h, jac, lur, pivr, err, n, tmpr)
+    acc = 0.0
+    for i in range(m):
+        v = err[i] / (atol + rtol * max(abs(x[i]), abs(y[i])))
+        acc += v * v
+    return math.sqrt(acc / m)
+
+
+@njit(cache=True, error_model="numpy", fastmath=_CONTRACT)
+def _radau_predict(h, h_old, err, err_old):
+    """scipy's predict_factor (Gustafsson's predictive control, exponent 1/4)."""
+    if err_old < 0.0 or h_old <= 0.0 or err == 0.0:
+        mult = 1.0
+    else:
+        mult = h / h_old * (err_old / err) ** 0.25
+    if err == 0.0:
+        return np.inf
+    return min(1.0, mult) * err ** -0.25
+
+
+
+# ---------------------------------------------------------------------------
 # One run
 # ---------------------------------------------------------------------------
 
@@ -1160,12 +1395,19 @@ def _integrate(x0, grid, mp0, E, kd, ld, one_sided, dp, bps, fpar, ipar, samples
     max_switches = ipar[I_MAX_SWITCHES]
     locked = ipar[I_LOCKED0] != 0
     rk23 = ipar[I_METHOD] == METHOD_RK23
+    radau = ipar[I_METHOD] == METHOD_RADAU
     if rk23:
         expo1 = _BS_EXPO1
         beta = _BS_BETA
         err_order = 2
         last_row = 3
         evals_per_step = 3
+    elif radau:
+        expo1 = 0.0
+        beta = 0.0
+        err_order = 3  # as scipy's Radau selects its first step
+        last_row = 1
+        evals_per_step = 0  # counted as they happen
     else:
         expo1 = _EXPO1
         beta = _BETA
@@ -1193,6 +1435,35 @@ def _integrate(x0, grid, mp0, E, kd, ld, one_sided, dp, bps, fpar, ipar, samples
     ev_dir = np.empty(n_ev_max, np.int64)
     g_old = np.empty(n_ev_max)
     g_new = np.empty(n_ev_max)
+    # Radau: stage increments Z, their transform W, stage derivatives, the Jacobian's
+    # acceleration rows, the two factored Newton matrices, and the previous step's state
+    rm = m if radau else 0
+    rn = n if radau else 0
+    rZ = np.zeros((3, rm))
+    rZ0 = np.zeros((3, rm))
+    rW = np.empty((3, rm))
+    rF = np.empty((3, rm))
+    jac = np.zeros((rn, rm))
+    lur = np.empty((rn, rn))
+    pivr = np.zeros(rn, np.int64)
+    luc = np.empty((rn, rn), np.complex128)
+    pivc = np.zeros(rn, np.int64)
+    rscale = np.empty(rm)
+    rfr = np.empty(rm)
+    rfc = np.empty(rm, np.complex128)
+    rtmpr = np.empty(rn)
+    rtmpc = np.empty(rn, np.complex128)
+    rerr = np.empty(rm)
+    rxt = np.empty(rm)
+    xold = np.empty(rm)
+    have_sol = False
+    current_jac = False
+    h_lu = -1.0
+    h_old = -1.0
+    err_old = -1.0
+    h_start = 0.0
+    t_prev = 0.0
+    h_prev = 1.0
 
     for i in range(n):
         peak[i] = 0.0
@@ -1245,6 +1516,14 @@ def _integrate(x0, grid, mp0, E, kd, ld, one_sided, dp, bps, fpar, ipar, samples
             h = _initial_step(t, x, stg, t_stop, max_step, rtol, atol, locked, mp, dp, work,
                               ytmp, scratch, err_order)
             n_evals += 2
+            if radau:
+                n_evals += _radau_jacobian(t, x, stg[0], jac, n, locked, mp, dp, work, rxt,
+                                           scratch)
+                current_jac = True
+                have_sol = False
+                h_lu = -1.0
+                h_old = -1.0
+                err_old = -1.0
             log_errold = _LOG_ERR_FLOOR
             last_rejected = False
             restart = False
@@ -1255,6 +1534,9 @@ def _integrate(x0, grid, mp0, E, kd, ld, one_sided, dp, bps, fpar, ipar, samples
                     base[6 + i] = math.cos(x[i])
 
         t_stop = bps[bi] if bi < bps.size else duration
+        if radau and h > max_step:
+            h_old = -1.0
+            err_old = -1.0
         h = min(h, max_step)
         landing = False
         if t + 1.01 * h >= t_stop:
@@ -1265,53 +1547,148 @@ def _integrate(x0, grid, mp0, E, kd, ld, one_sided, dp, bps, fpar, ipar, samples
             break
         t_new = t_stop if landing else t + h
 
-        if n3:
-            if rk23:
-                if has_acceleration:
-                    _bs_stage_accelerations(t, h, t_new, dp, stage_acc)
-                err2 = _bs_step3(h, x, stg, ytmp, locked, mp, stage_acc, base, trig, rtol,
-                                 atol)
+        if radau:
+            if not last_rejected:
+                h_start = h
+            if h != h_lu:
+                _radau_factor(h, jac, lur, pivr, luc, pivc, n)
+                h_lu = h
+            # the first guess: the previous step's collocation polynomial, extrapolated
+            for s_ in range(3):
+                cs = _RC1 if s_ == 0 else (_RC2 if s_ == 1 else 1.0)
+                if have_sol:
+                    sg = (t + cs * h - t_prev) / h_prev
+                    for i in range(m):
+                        rZ0[s_, i] = (xold[i] + sg * (Q[i, 0] + sg * (Q[i, 1] + sg * Q[i, 2]))
+                                      - x[i])
+                else:
+                    for i in range(m):
+                        rZ0[s_, i] = 0.0
+            for i in range(m):
+                rscale[i] = atol + abs(x[i]) * rtol
+            newton_tol = max(10.0 * _EPS / rtol, min(0.03, math.sqrt(rtol)))
+            converged = False
+            n_iter = 0
+            rate = -1.0
+            while True:
+                for s_ in range(3):
+                    for i in range(m):
+                        rZ[s_, i] = rZ0[s_, i]
+                converged, n_iter, rate = _radau_newton(
+                    t, h, x, rZ, rW, rF, rscale, newton_tol, jac, lur, pivr, luc, pivc, n,
+                    locked, mp, dp, work, ys, rfr, rfc, rtmpr, rtmpc)
+                n_evals += 3 * n_iter
+                if converged or current_jac:
+                    break
+                n_evals += _radau_jacobian(t, x, stg[0], jac, n, locked, mp, dp, work, rxt,
+                                           scratch)
+                current_jac = True
+                _radau_factor(h, jac, lur, pivr, luc, pivc, n)
+                h_lu = h
+            if not converged:
+                h = 0.5 * h
+                n_rejected += 1
+                last_rejected = True
+                continue
+            for i in range(m):
+                ytmp[i] = x[i] + rZ[2, i]
+            err_norm = _radau_error(h, x, ytmp, stg[0], rZ, jac, lur, pivr, n, rtol, atol,
+                                    rerr, rtmpr)
+            safety = 0.9 * (2 * _NEWTON_MAXITER + 1) / (2 * _NEWTON_MAXITER + n_iter)
+            if last_rejected and err_norm > 1.0:
+                # after a rejection, one more smoothing of the estimate (scipy, Hairer)
+                for i in range(m):
+                    rxt[i] = x[i] + rerr[i]
+                _deriv(t, rxt, scratch, 0, locked, mp, dp, work)
+                n_evals += 1
+                err_norm = _radau_error(h, x, ytmp, scratch[0], rZ, jac, lur, pivr, n, rtol,
+                                        atol, rerr, rtmpr)
+            if not (err_norm <= 1.0):
+                n_rejected += 1
+                if err_norm == err_norm:
+                    h = h * max(0.2, safety * _radau_predict(h, h_old, err_norm, err_old))
+                else:
+                    h = 0.2 * h
+                last_rejected = True
+                continue
+            # ---- accepted ----
+            n_steps += 1
+            recompute_jac = n_iter > 2 and rate > 1e-3
+            fac = min(10.0, safety * _radau_predict(h, h_old, err_norm, err_old))
+            if not recompute_jac and fac < 1.2:
+                fac = 1.0
+            _deriv(t_new, ytmp, stg, 1, locked, mp, dp, work)
+            n_evals += 1
+            if recompute_jac:
+                n_evals += _radau_jacobian(t_new, ytmp, stg[1], jac, n, locked, mp, dp, work,
+                                           rxt, scratch)
+                current_jac = True
+                h_lu = -1.0
             else:
-                if has_acceleration:
-                    _stage_accelerations(t, h, t_new, dp, stage_acc)
-                err2 = _dp_step3(h, x, stg, ytmp, locked, mp, stage_acc, base, trig, rtol,
-                                 atol)
-        elif rk23:
-            err2 = _bs_stepN(t, t_new, h, x, stg, ytmp, m, locked, mp, dp, work, rtol, atol)
+                current_jac = False
+            h_old = h_start
+            err_old = err_norm
+            h_next = h * fac
+            last_rejected = False
+            for i in range(m):
+                z0 = rZ[0, i]
+                z1 = rZ[1, i]
+                z2 = rZ[2, i]
+                for k in range(3):
+                    Q[i, k] = (z0 * _RP[0, k] + z1 * _RP[1, k]) + z2 * _RP[2, k]
+                Q[i, 3] = 0.0
+                xold[i] = x[i]
+            have_sol = True
+            t_prev = t
+            h_prev = h
         else:
-            err2 = _dp_stepN(t, t_new, h, x, stg, ytmp, m, locked, mp, dp, work, rtol, atol)
-        n_evals += evals_per_step
-        # err2 is the squared error norm: accept when the norm is <= 1
-        if not (err2 <= 1.0):
-            # rejected (a NaN error counts as too large)
-            n_rejected += 1
-            if err2 < 1e300:
-                h = h / min(_FACC1, _exp_approx(0.5 * expo1 * _log_approx(err2)) / _SAFE)
-            elif err2 == err2:
-                h = h / _FACC1
-            else:
-                h = 0.1 * h
-            last_rejected = True
-            continue
-
-        # ---- accepted: Hairer's PI controller, fac = err^0.17 / errold^0.04 / 0.9 ----
-        n_steps += 1
-        log_err = 0.5 * _log_approx(err2) if err2 > 1e-300 else -345.0
-        fac = max(_FACC2, min(_FACC1, _exp_approx(expo1 * log_err - beta * log_errold) / _SAFE))
-        h_next = h / fac
-        if last_rejected:
-            h_next = min(h_next, h)
-        last_rejected = False
-        log_errold = max(log_err, _LOG_ERR_FLOOR)
-        if rk23:
             if n3:
-                _bs_dense_coefficients3(Q, stg, h)
+                if rk23:
+                    if has_acceleration:
+                        _bs_stage_accelerations(t, h, t_new, dp, stage_acc)
+                    err2 = _bs_step3(h, x, stg, ytmp, locked, mp, stage_acc, base, trig, rtol,
+                                     atol)
+                else:
+                    if has_acceleration:
+                        _stage_accelerations(t, h, t_new, dp, stage_acc)
+                    err2 = _dp_step3(h, x, stg, ytmp, locked, mp, stage_acc, base, trig, rtol,
+                                     atol)
+            elif rk23:
+                err2 = _bs_stepN(t, t_new, h, x, stg, ytmp, m, locked, mp, dp, work, rtol, atol)
             else:
-                _bs_dense_coefficients(Q, stg, h, m)
-        elif n3:
-            _dense_coefficients3(Q, stg, h)
-        else:
-            _dense_coefficients(Q, stg, h, m)
+                err2 = _dp_stepN(t, t_new, h, x, stg, ytmp, m, locked, mp, dp, work, rtol, atol)
+            n_evals += evals_per_step
+            # err2 is the squared error norm: accept when the norm is <= 1
+            if not (err2 <= 1.0):
+                # rejected (a NaN error counts as too large)
+                n_rejected += 1
+                if err2 < 1e300:
+                    h = h / min(_FACC1, _exp_approx(0.5 * expo1 * _log_approx(err2)) / _SAFE)
+                elif err2 == err2:
+                    h = h / _FACC1
+                else:
+                    h = 0.1 * h
+                last_rejected = True
+                continue
+
+            # ---- accepted: Hairer's PI controller, fac = err^0.17 / errold^0.04 / 0.9 ----
+            n_steps += 1
+            log_err = 0.5 * _log_approx(err2) if err2 > 1e-300 else -345.0
+            fac = max(_FACC2, min(_FACC1, _exp_approx(expo1 * log_err - beta * log_errold) / _SAFE))
+            h_next = h / fac
+            if last_rejected:
+                h_next = min(h_next, h)
+            last_rejected = False
+            log_errold = max(log_err, _LOG_ERR_FLOOR)
+            if rk23:
+                if n3:
+                    _bs_dense_coefficients3(Q, stg, h)
+                else:
+                    _bs_dense_coefficients(Q, stg, h, m)
+            elif n3:
+                _dense_coefficients3(Q, stg, h)
+            else:
+                _dense_coefficients(Q, stg, h, m)
 
         # events that fired in (t, t_new]: the earliest root on the interpolant
         ev_hit = -1
@@ -1533,7 +1910,7 @@ def _integrate(x0, grid, mp0, E, kd, ld, one_sided, dp, bps, fpar, ipar, samples
             stg[0, i] = stg[last_row, i]
         for e in range(n_ev):
             g_old[e] = g_new[e]
-        if n3:
+        if n3 and not radau:
             if n_steps % _TRIG_REFRESH == 0:
                 # fresh libm values now and then keep rounding from building up
                 for i in range(3):
