@@ -393,9 +393,11 @@ def test_sincos_array_is_accurate():
     np.testing.assert_allclose(c, np.cos(x), rtol=0, atol=4e-16)
 
 
-def test_rk23_takes_fewer_evaluations_on_the_stiff_paper_case():
-    """Case 1 is bounded by stability (a pole near −554 1/s): Bogacki–Shampine's three
-    evaluations per step beat Dormand–Prince's six, at the same accuracy (above)."""
+def test_step_counts_on_the_stiff_paper_case():
+    """Case 1 is stiff (a pole near −554 1/s): the explicit methods are bounded by stability,
+    where Bogacki–Shampine's three evaluations per step beat Dormand–Prince's six; Radau's
+    steps are set by accuracy and are several times fewer (same accuracy: the scenario
+    test above)."""
     sc = builtin_scenario("paper-backward-case1")
     counts = {}
     for method in METHODS:
@@ -404,6 +406,37 @@ def test_rk23_takes_fewer_evaluations_on_the_stiff_paper_case():
                              sc.duration, sc.initial_state, method=method)
         counts[method] = int(out.n_steps[0])
     assert counts["RK23"] * 3 < 0.85 * counts["RK45"] * 6
+    # the stability bound of RK45: h <= 3.3/554 s, so at least 5 s / 6 ms = 830 steps
+    assert counts["RK45"] > 830
+    assert counts["Radau"] < counts["RK45"] / 4
+
+
+def test_radau_follows_the_exact_solution_of_a_very_stiff_pendulum():
+    """One link, pair gains putting the poles at −1e5 and −2 1/s (J s² + L s + K − mgh = 0)
+    and an initial lean of 1e-6 rad, so that sin θ = θ to 2e-19 rad: the linear solution
+    exp(A t) x0 is exact. An explicit method would need about 1e5·5/3.3 = 150,000 steps;
+    Radau follows the slow mode in a few hundred, to the tolerance asked for."""
+    from scipy.linalg import expm
+
+    from posturelab import get_body
+
+    body = get_body("paper-1link")
+    J = float(body.inertia_diagonal[0])
+    mgh = float(body.gravity * body.gravity_coefficients[0])
+    fast_pole, slow_pole = 1e5, 2.0
+    viscosity = J * (fast_pole + slow_pole)
+    stiffness = mgh + J * fast_pole * slow_pole
+    muscles = MuscleSet((MusclePair("ankle", 0, 1, stiffness, viscosity),), 1)
+    x0 = np.array([1e-6, 0.0])
+    res = simulate_fast(body, muscles, None, 5.0, initial_state=x0, rtol=1e-6, atol=1e-14,
+                        method="Radau")
+    assert res.status == "completed"
+    A = np.array([[0.0, 1.0], [-(stiffness - mgh) / J, -viscosity / J]])
+    exact = np.array([(expm(A * t) @ x0)[0] for t in res.time[::50]])
+    np.testing.assert_allclose(res.theta[::50, 0], exact, rtol=0, atol=1e-11)
+    out = simulate_batch(body, [[stiffness]], [[viscosity]], None, 5.0, x0, muscles=muscles,
+                         rtol=1e-6, atol=1e-14, method="Radau")
+    assert out.n_steps[0] < 1000
 
 
 def test_unknown_method_is_refused():

@@ -40,22 +40,29 @@ pressure (``FallCriteria(centre_of_pressure=True)``).
 
 What differs
 ------------
-The integrator: by default (``method="RK45"``) the Dormand–Prince 5(4) pair of
-scipy's ``RK45`` (tableau, error estimate, free 4th-order dense output); with
-``method="RK23"`` the Bogacki–Shampine 3(2) pair of scipy's ``RK23`` (FSAL,
-three new evaluations per step, its error estimate and cubic Hermite dense
-output). Both use a PI step-size controller (Hairer's, with the exponents of
-the method's error order), compiled with numba. After a switch the integration restarts
-with a fresh initial step, as the reference does; at a profile breakpoint it
-lands on it and continues. The paper's model is mildly stiff (a pole near
-−550 1/s for case 1, −1200 1/s for the stiffest gains of a typical sweep):
-an explicit method's step is bounded by stability there, not accuracy, so
-the angle error at rtol = 1e-6 is far below 1e-6 rad. In that regime RK23
-needs about a quarter fewer derivative evaluations than RK45 (case 1: 3860
-against 5216) and is the faster choice for the paper's gains at rtol = 1e-6
-(benchmarks/bench_simulate.py); RK45 remains the default and is the better
-one for tight tolerances. Both are tested against the
-reference on every built-in scenario.
+The integrator. The paper's model is stiff: case 1 has a real pole at
+−554 1/s (the viscous knee–hip mode; −1200 1/s for the stiffest gains of a
+typical sweep) beside poles of a few 1/s that carry the motion. An explicit
+method's step is then bounded by stability, not accuracy (RK45 takes 868
+steps on case 1 at rtol 1e-6 and is accurate to 2e-9 rad, far more than
+asked). The default, ``method="Radau"``, is scipy's ``Radau`` (Radau IIA of
+order 5, Hairer & Wanner's RADAU5: simplified Newton iterations, its error
+estimate and step-size prediction, the Jacobian re-evaluated only when
+Newton converges slowly, the cubic collocation polynomial as dense output),
+compiled, so its steps are set by accuracy (case 1: 166 steps, angle error
+2.4e-8 rad at rtol 1e-6). Its Jacobian is [[0, I], [∂Θ̈/∂Θ, ∂Θ̈/∂Θ̇]]
+(forward differences for the lower half), which reduces each Newton system
+from 2N×2N to N×N: S(c) a = r₂ + (cI − ∂Θ̈/∂Θ̇) r₁, b = c a − r₁ with
+S(c) = c²I − c ∂Θ̈/∂Θ̇ − ∂Θ̈/∂Θ (closed-form inverses for N = 3, LU with
+pivoting otherwise). ``method="RK45"`` is the Dormand–Prince 5(4) pair of
+scipy's ``RK45`` (tableau, error estimate, free 4th-order dense output) and
+``method="RK23"`` the Bogacki–Shampine 3(2) pair of scipy's ``RK23``, both
+with Hairer's PI step-size controller; they remain for comparison and for
+non-stiff gain sets. After a switch the integration restarts with a fresh
+initial step (and, for Radau, a fresh Jacobian), as the reference does; at a
+profile breakpoint it lands on it and continues. All three are tested
+against the reference on every built-in scenario; measured speeds are in
+benchmarks/bench_simulate.py.
 
 Compilation: every kernel is ``@njit(cache=True)``. The first call in a
 fresh environment compiles them (about 45 s on 2 cores for simulate_fast and
@@ -294,7 +301,7 @@ def simulate_fast(
     sample_rate: float = 1000.0,
     max_switches: int = 10_000,
     description: str = "",
-    method: str = "RK45",
+    method: str = "Radau",
 ) -> SimulationResult:
     """Simulate the nonlinear chain with the compiled integrator.
 
@@ -338,11 +345,11 @@ def simulate_fast(
         More switches than this fail the run (chattering guard). [-]
     description : str
         Words stored in the result.
-    method : {"RK45", "RK23"}
-        The compiled integrator: Dormand–Prince 5(4) (default) or Bogacki–Shampine
-        3(2), which is cheaper where the step is bounded by stability (the paper's
-        gains at rtol ~1e-6; see the module docstring). Ignored by the reference
-        fallback (DOP853).
+    method : {"Radau", "RK45", "RK23"}
+        The compiled integrator: Radau IIA of order 5 (default; implicit, for the
+        model's stiff viscous modes), Dormand–Prince 5(4) or Bogacki–Shampine 3(2)
+        (explicit; see the module docstring). Ignored by the reference fallback
+        (DOP853).
 
     Returns
     -------
@@ -503,7 +510,7 @@ def simulate_batch(
     max_switches: int = 10_000,
     parallel: bool = True,
     chunk: int = 8,
-    method: str = "RK45",
+    method: str = "Radau",
 ) -> BatchResult:
     """Simulate M gain sets on one body and disturbance; keep only the outcomes.
 
@@ -545,7 +552,7 @@ def simulate_batch(
         GIL (for callers that bring their own threads, such as Dask workers).
     chunk : int
         Runs per parallel work item. [-]
-    method : {"RK45", "RK23"}
+    method : {"Radau", "RK45", "RK23"}
         The compiled integrator, as for :func:`simulate_fast`.
 
     Returns

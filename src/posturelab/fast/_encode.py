@@ -125,7 +125,7 @@ def crossings(muscles: MuscleSet) -> np.ndarray:
 def control_arrays(
     body: Body, fall: FallCriteria, knee: KneeModel, *, rtol: float, atol: float,
     max_step: float, duration: float, max_switches: int, locked0: bool,
-    settle_tolerance: float, method: str = "RK45",
+    settle_tolerance: float, method: str = "Radau",
 ) -> tuple[np.ndarray, np.ndarray]:
     """The kernels' scalar parameters ``fpar`` (floats) and ``ipar`` (int64)."""
     fpar = np.zeros(kern.N_FPAR)

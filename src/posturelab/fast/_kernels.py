@@ -3,20 +3,27 @@
 Everything here works on plain arrays; :mod:`posturelab.fast` packs bodies,
 muscles, disturbances and options into them and unpacks the results. The
 physics is that of :mod:`posturelab.dynamics` and :mod:`posturelab.simulate`
-(DESIGN.md's closed form for N links). The integrator is the Dormand–Prince
+(DESIGN.md's closed form for N links). The integrators: Radau IIA of order 5
+(``ipar[I_METHOD] = METHOD_RADAU``, the default of :mod:`posturelab.fast`;
+scipy's ``Radau`` step by step, with the Newton systems reduced to N×N by the
+structure of the Jacobian, see :func:`_block_solve`), the Dormand–Prince
 5(4) pair of scipy's ``RK45`` (same tableau, error estimate and free
-4th-order dense output) or, with ``ipar[I_METHOD] = METHOD_RK23``, the
-Bogacki–Shampine 3(2) pair of scipy's ``RK23`` (tableau, error estimate, cubic
-Hermite dense output, stored as a quartic with a zero top coefficient), with
-Hairer's PI step-size controller (exponents from the method's error order;
-the powers err^α by short log/exp approximations, deterministic and far more
-accurate than step-size control needs).
+4th-order dense output) and the Bogacki–Shampine 3(2) pair of scipy's
+``RK23`` (tableau, error estimate, cubic Hermite dense output, stored as a
+quartic with a zero top coefficient). The explicit pairs use Hairer's PI
+step-size controller (exponents from the method's error order; the powers
+err^α by short log/exp approximations, deterministic and far more accurate
+than step-size control needs).
 
 Performance notes (measured; see benchmarks/bench_simulate.py)
 --------------------------------------------------------------
-* The paper's model is mildly stiff (a real pole near −550 1/s for case 1):
-  the explicit step is bounded by stability, so a run is ~900 steps of ~6
-  derivative evaluations and the cost per evaluation is what matters.
+* The paper's model is stiff (a real pole near −550 1/s for case 1): an
+  explicit step is bounded by stability (RK45: 868 steps of 6 evaluations),
+  Radau's by accuracy (166 steps of about 7 evaluations and two 3×3 solves,
+  one real and one complex, per Newton iteration). For N = 3 the Newton
+  iteration (:func:`_radau_newton3`) is straight-line scalar code around
+  :func:`_f3`, with the reduced matrices inverted in closed form once per
+  step size.
 * For N = 3 a step is straight-line scalar code (:func:`_dp_step3`): no
   array round trips between stages, the 3×3 solve in closed form, and the
   sines and cosines of the stage angles rotated from those at the step's
@@ -1348,6 +1355,234 @@ def _radau_predict(h, h_old, err, err_old):
 
 
 
+@njit(cache=True, error_model="numpy", fastmath=_CONTRACT)
+def _radau_factor3(h, jac, S):
+    """For 3 links: the inverses of S(c) (see :func:`_radau_factor`) in closed form, real
+    c = μ_real/h into S[0:3], complex c = μ_complex/h into S[3:6] (real part) and S[6:9]
+    (imaginary part); S is (9, 3)."""
+    cr = _MU_REAL / h
+    cc = complex(_MU_CRE, _MU_CIM) / h
+    for which in range(2):
+        c = complex(cr, 0.0) if which == 0 else cc
+        c2 = c * c
+        a00 = c2 - c * jac[0, 3] - jac[0, 0]
+        a01 = -(c * jac[0, 4]) - jac[0, 1]
+        a02 = -(c * jac[0, 5]) - jac[0, 2]
+        a10 = -(c * jac[1, 3]) - jac[1, 0]
+        a11 = c2 - c * jac[1, 4] - jac[1, 1]
+        a12 = -(c * jac[1, 5]) - jac[1, 2]
+        a20 = -(c * jac[2, 3]) - jac[2, 0]
+        a21 = -(c * jac[2, 4]) - jac[2, 1]
+        a22 = c2 - c * jac[2, 5] - jac[2, 2]
+        m00 = a11 * a22 - a12 * a21
+        m01 = a02 * a21 - a01 * a22
+        m02 = a01 * a12 - a02 * a11
+        m10 = a12 * a20 - a10 * a22
+        m11 = a00 * a22 - a02 * a20
+        m12 = a02 * a10 - a00 * a12
+        m20 = a10 * a21 - a11 * a20
+        m21 = a01 * a20 - a00 * a21
+        m22 = a00 * a11 - a01 * a10
+        inv = 1.0 / (a00 * m00 + a01 * m10 + a02 * m20)
+        vals = (m00 * inv, m01 * inv, m02 * inv, m10 * inv, m11 * inv, m12 * inv,
+                m20 * inv, m21 * inv, m22 * inv)
+        for k in range(9):
+            i = k // 3
+            j = k % 3
+            if which == 0:
+                S[i, j] = vals[k].real
+            else:
+                S[3 + i, j] = vals[k].real
+                S[6 + i, j] = vals[k].imag
+
+
+@njit(cache=True, error_model="numpy", fastmath=_CONTRACT)
+def _radau_newton3(h, x, Z, W, F, inv_scale, tol, jac, S, prm, locked, acc, base, fr, fi,
+                   fc):
+    """:func:`_radau_newton` for 3 links: the stage derivatives by :func:`_f3` (sines and
+    cosines rotated from ``base``, platform accelerations at the three nodes in ``acc``),
+    the reduced systems solved with the closed-form inverses of :func:`_radau_factor3`."""
+    cr = _MU_REAL / h
+    ccr = _MU_CRE / h
+    cci = _MU_CIM / h
+    tb1 = base[0]
+    tb2 = base[1]
+    tb3 = base[2]
+    sb1 = base[3]
+    sb2 = base[4]
+    sb3 = base[5]
+    cb1 = base[6]
+    cb2 = base[7]
+    cb3 = base[8]
+    x0 = x[0]
+    x1 = x[1]
+    x2 = x[2]
+    x3 = x[3]
+    x4 = x[4]
+    x5 = x[5]
+    for i in range(6):
+        z0 = Z[0, i]
+        z1 = Z[1, i]
+        z2 = Z[2, i]
+        W[0, i] = _TI00 * z0 + _TI01 * z1 + _TI02 * z2
+        W[1, i] = _TI10 * z0 + _TI11 * z1 + _TI12 * z2
+        W[2, i] = _TI20 * z0 + _TI21 * z1 + _TI22 * z2
+    norm_old = -1.0
+    rate = -1.0
+    converged = False
+    iters = 0
+    for k in range(_NEWTON_MAXITER):
+        iters = k + 1
+        for s in range(3):
+            d, _ = _f3(x0 + Z[s, 0], x1 + Z[s, 1], x2 + Z[s, 2], x3 + Z[s, 3], x4 + Z[s, 4],
+                       x5 + Z[s, 5], locked, prm, acc[2 * s], acc[2 * s + 1],
+                       tb1, tb2, tb3, sb1, sb2, sb3, cb1, cb2, cb3)
+            for i in range(6):
+                F[s, i] = d[i]
+        total = 0.0
+        for i in range(6):
+            f0 = F[0, i]
+            f1 = F[1, i]
+            f2 = F[2, i]
+            total += f0 + f1 + f2
+            w1 = W[1, i]
+            w2 = W[2, i]
+            fr[i] = (_TI00 * f0 + _TI01 * f1 + _TI02 * f2) - cr * W[0, i]
+            fc[i] = (_TI10 * f0 + _TI11 * f1 + _TI12 * f2) - (ccr * w1 - cci * w2)
+            fi[i] = (_TI20 * f0 + _TI21 * f1 + _TI22 * f2) - (ccr * w2 + cci * w1)
+        if not np.isfinite(total):
+            break
+        # real system: a = S_r⁻¹ (r₂ + c r₁ − Q r₁), b = c a − r₁
+        acc2 = 0.0
+        for part in range(2):
+            if part == 0:
+                q0 = fr[0]
+                q1 = fr[1]
+                q2 = fr[2]
+                u0 = fr[3] + cr * q0 - (jac[0, 3] * q0 + jac[0, 4] * q1 + jac[0, 5] * q2)
+                u1 = fr[4] + cr * q1 - (jac[1, 3] * q0 + jac[1, 4] * q1 + jac[1, 5] * q2)
+                u2 = fr[5] + cr * q2 - (jac[2, 3] * q0 + jac[2, 4] * q1 + jac[2, 5] * q2)
+                a0 = S[0, 0] * u0 + S[0, 1] * u1 + S[0, 2] * u2
+                a1 = S[1, 0] * u0 + S[1, 1] * u1 + S[1, 2] * u2
+                a2 = S[2, 0] * u0 + S[2, 1] * u1 + S[2, 2] * u2
+                fr[3] = cr * a0 - q0
+                fr[4] = cr * a1 - q1
+                fr[5] = cr * a2 - q2
+                fr[0] = a0
+                fr[1] = a1
+                fr[2] = a2
+            else:
+                # complex system, (real, imaginary) parts written out
+                p0 = fc[0]
+                p1 = fc[1]
+                p2 = fc[2]
+                q0 = fi[0]
+                q1 = fi[1]
+                q2 = fi[2]
+                ur0 = fc[3] + (ccr * p0 - cci * q0) - (jac[0, 3] * p0 + jac[0, 4] * p1
+                                                       + jac[0, 5] * p2)
+                ur1 = fc[4] + (ccr * p1 - cci * q1) - (jac[1, 3] * p0 + jac[1, 4] * p1
+                                                       + jac[1, 5] * p2)
+                ur2 = fc[5] + (ccr * p2 - cci * q2) - (jac[2, 3] * p0 + jac[2, 4] * p1
+                                                       + jac[2, 5] * p2)
+                ui0 = fi[3] + (ccr * q0 + cci * p0) - (jac[0, 3] * q0 + jac[0, 4] * q1
+                                                       + jac[0, 5] * q2)
+                ui1 = fi[4] + (ccr * q1 + cci * p1) - (jac[1, 3] * q0 + jac[1, 4] * q1
+                                                       + jac[1, 5] * q2)
+                ui2 = fi[5] + (ccr * q2 + cci * p2) - (jac[2, 3] * q0 + jac[2, 4] * q1
+                                                       + jac[2, 5] * q2)
+                ar0 = (S[3, 0] * ur0 + S[3, 1] * ur1 + S[3, 2] * ur2) - (
+                    S[6, 0] * ui0 + S[6, 1] * ui1 + S[6, 2] * ui2)
+                ar1 = (S[4, 0] * ur0 + S[4, 1] * ur1 + S[4, 2] * ur2) - (
+                    S[7, 0] * ui0 + S[7, 1] * ui1 + S[7, 2] * ui2)
+                ar2 = (S[5, 0] * ur0 + S[5, 1] * ur1 + S[5, 2] * ur2) - (
+                    S[8, 0] * ui0 + S[8, 1] * ui1 + S[8, 2] * ui2)
+                ai0 = (S[3, 0] * ui0 + S[3, 1] * ui1 + S[3, 2] * ui2) + (
+                    S[6, 0] * ur0 + S[6, 1] * ur1 + S[6, 2] * ur2)
+                ai1 = (S[4, 0] * ui0 + S[4, 1] * ui1 + S[4, 2] * ui2) + (
+                    S[7, 0] * ur0 + S[7, 1] * ur1 + S[7, 2] * ur2)
+                ai2 = (S[5, 0] * ui0 + S[5, 1] * ui1 + S[5, 2] * ui2) + (
+                    S[8, 0] * ur0 + S[8, 1] * ur1 + S[8, 2] * ur2)
+                fc[3] = (ccr * ar0 - cci * ai0) - p0
+                fc[4] = (ccr * ar1 - cci * ai1) - p1
+                fc[5] = (ccr * ar2 - cci * ai2) - p2
+                fi[3] = (ccr * ai0 + cci * ar0) - q0
+                fi[4] = (ccr * ai1 + cci * ar1) - q1
+                fi[5] = (ccr * ai2 + cci * ar2) - q2
+                fc[0] = ar0
+                fc[1] = ar1
+                fc[2] = ar2
+                fi[0] = ai0
+                fi[1] = ai1
+                fi[2] = ai2
+        for i in range(6):
+            a = fr[i] * inv_scale[i]
+            b = fc[i] * inv_scale[i]
+            c = fi[i] * inv_scale[i]
+            acc2 += a * a + b * b + c * c
+        norm = math.sqrt(acc2 / 18.0)
+        if norm_old >= 0.0:
+            rate = norm / norm_old
+        if rate >= 0.0 and (rate >= 1.0 or rate ** (_NEWTON_MAXITER - k) / (1.0 - rate) * norm
+                            > tol):
+            break
+        for i in range(6):
+            w0 = W[0, i] + fr[i]
+            w1 = W[1, i] + fc[i]
+            w2 = W[2, i] + fi[i]
+            W[0, i] = w0
+            W[1, i] = w1
+            W[2, i] = w2
+            Z[0, i] = _T00 * w0 + _T01 * w1 + _T02 * w2
+            Z[1, i] = _T10 * w0 + _T11 * w1 + _T12 * w2
+            Z[2, i] = _T20 * w0 + _T21 * w1
+        if norm == 0.0 or (rate >= 0.0 and rate / (1.0 - rate) * norm < tol):
+            converged = True
+            break
+        norm_old = norm
+    return converged, iters, rate
+
+
+@njit(cache=True, error_model="numpy", fastmath=_CONTRACT)
+def _radau_error3(h, x, y, f0, Z, jac, S, rtol, atol, err):
+    """:func:`_radau_error` for 3 links with the closed-form inverse of S(μ_real/h)."""
+    cr = _MU_REAL / h
+    inv_h = 1.0 / h
+    for i in range(6):
+        err[i] = f0[i] + (_RE1 * Z[0, i] + _RE2 * Z[1, i] + _RE3 * Z[2, i]) * inv_h
+    q0 = err[0]
+    q1 = err[1]
+    q2 = err[2]
+    u0 = err[3] + cr * q0 - (jac[0, 3] * q0 + jac[0, 4] * q1 + jac[0, 5] * q2)
+    u1 = err[4] + cr * q1 - (jac[1, 3] * q0 + jac[1, 4] * q1 + jac[1, 5] * q2)
+    u2 = err[5] + cr * q2 - (jac[2, 3] * q0 + jac[2, 4] * q1 + jac[2, 5] * q2)
+    a0 = S[0, 0] * u0 + S[0, 1] * u1 + S[0, 2] * u2
+    a1 = S[1, 0] * u0 + S[1, 1] * u1 + S[1, 2] * u2
+    a2 = S[2, 0] * u0 + S[2, 1] * u1 + S[2, 2] * u2
+    err[3] = cr * a0 - q0
+    err[4] = cr * a1 - q1
+    err[5] = cr * a2 - q2
+    err[0] = a0
+    err[1] = a1
+    err[2] = a2
+    acc = 0.0
+    for i in range(6):
+        v = err[i] / (atol + rtol * max(abs(x[i]), abs(y[i])))
+        acc += v * v
+    return math.sqrt(acc / 6.0)
+
+
+@njit(cache=True, error_model="numpy", fastmath=_CONTRACT)
+def _radau_stage_accelerations(t, h, dp, out):
+    """(ẍ_d, ÿ_d) at the three collocation nodes of a Radau step into out (6,). [m/s²]"""
+    for s in range(3):
+        cs = _RC1 if s == 0 else (_RC2 if s == 1 else 1.0)
+        ax, ay = platform_acceleration(t + cs * h, dp)
+        out[2 * s] = ax
+        out[2 * s + 1] = ay
+
+
+
 # ---------------------------------------------------------------------------
 # One run
 # ---------------------------------------------------------------------------
@@ -1456,6 +1691,11 @@ def _integrate(x0, grid, mp0, E, kd, ld, one_sided, dp, bps, fpar, ipar, samples
     rerr = np.empty(rm)
     rxt = np.empty(rm)
     xold = np.empty(rm)
+    S3 = np.zeros((9, 3))  # 3 links: closed-form inverses of the reduced Newton matrices
+    rfi = np.empty(rm)
+    rfc3 = np.empty(rm)
+    racc = np.zeros(6)
+    prm = _model_tuple3(mp if n3 else np.zeros(34))
     have_sol = False
     current_jac = False
     h_lu = -1.0
@@ -1517,6 +1757,8 @@ def _integrate(x0, grid, mp0, E, kd, ld, one_sided, dp, bps, fpar, ipar, samples
                               ytmp, scratch, err_order)
             n_evals += 2
             if radau:
+                if n3:
+                    prm = _model_tuple3(mp)  # the gains change at a switch
                 n_evals += _radau_jacobian(t, x, stg[0], jac, n, locked, mp, dp, work, rxt,
                                            scratch)
                 current_jac = True
@@ -1551,8 +1793,13 @@ def _integrate(x0, grid, mp0, E, kd, ld, one_sided, dp, bps, fpar, ipar, samples
             if not last_rejected:
                 h_start = h
             if h != h_lu:
-                _radau_factor(h, jac, lur, pivr, luc, pivc, n)
+                if n3:
+                    _radau_factor3(h, jac, S3)
+                else:
+                    _radau_factor(h, jac, lur, pivr, luc, pivc, n)
                 h_lu = h
+            if n3 and has_acceleration:
+                _radau_stage_accelerations(t, h, dp, racc)
             # the first guess: the previous step's collocation polynomial, extrapolated
             for s_ in range(3):
                 cs = _RC1 if s_ == 0 else (_RC2 if s_ == 1 else 1.0)
@@ -1566,6 +1813,8 @@ def _integrate(x0, grid, mp0, E, kd, ld, one_sided, dp, bps, fpar, ipar, samples
                         rZ0[s_, i] = 0.0
             for i in range(m):
                 rscale[i] = atol + abs(x[i]) * rtol
+                if n3:
+                    rscale[i] = 1.0 / rscale[i]
             newton_tol = max(10.0 * _EPS / rtol, min(0.03, math.sqrt(rtol)))
             converged = False
             n_iter = 0
@@ -1574,16 +1823,24 @@ def _integrate(x0, grid, mp0, E, kd, ld, one_sided, dp, bps, fpar, ipar, samples
                 for s_ in range(3):
                     for i in range(m):
                         rZ[s_, i] = rZ0[s_, i]
-                converged, n_iter, rate = _radau_newton(
-                    t, h, x, rZ, rW, rF, rscale, newton_tol, jac, lur, pivr, luc, pivc, n,
-                    locked, mp, dp, work, ys, rfr, rfc, rtmpr, rtmpc)
+                if n3:
+                    converged, n_iter, rate = _radau_newton3(
+                        h, x, rZ, rW, rF, rscale, newton_tol, jac, S3, prm, locked, racc, base,
+                        rfr, rfi, rfc3)
+                else:
+                    converged, n_iter, rate = _radau_newton(
+                        t, h, x, rZ, rW, rF, rscale, newton_tol, jac, lur, pivr, luc, pivc, n,
+                        locked, mp, dp, work, ys, rfr, rfc, rtmpr, rtmpc)
                 n_evals += 3 * n_iter
                 if converged or current_jac:
                     break
                 n_evals += _radau_jacobian(t, x, stg[0], jac, n, locked, mp, dp, work, rxt,
                                            scratch)
                 current_jac = True
-                _radau_factor(h, jac, lur, pivr, luc, pivc, n)
+                if n3:
+                    _radau_factor3(h, jac, S3)
+                else:
+                    _radau_factor(h, jac, lur, pivr, luc, pivc, n)
                 h_lu = h
             if not converged:
                 h = 0.5 * h
@@ -1592,8 +1849,11 @@ def _integrate(x0, grid, mp0, E, kd, ld, one_sided, dp, bps, fpar, ipar, samples
                 continue
             for i in range(m):
                 ytmp[i] = x[i] + rZ[2, i]
-            err_norm = _radau_error(h, x, ytmp, stg[0], rZ, jac, lur, pivr, n, rtol, atol,
-                                    rerr, rtmpr)
+            if n3:
+                err_norm = _radau_error3(h, x, ytmp, stg[0], rZ, jac, S3, rtol, atol, rerr)
+            else:
+                err_norm = _radau_error(h, x, ytmp, stg[0], rZ, jac, lur, pivr, n, rtol, atol,
+                                        rerr, rtmpr)
             safety = 0.9 * (2 * _NEWTON_MAXITER + 1) / (2 * _NEWTON_MAXITER + n_iter)
             if last_rejected and err_norm > 1.0:
                 # after a rejection, one more smoothing of the estimate (scipy, Hairer)
@@ -1601,8 +1861,12 @@ def _integrate(x0, grid, mp0, E, kd, ld, one_sided, dp, bps, fpar, ipar, samples
                     rxt[i] = x[i] + rerr[i]
                 _deriv(t, rxt, scratch, 0, locked, mp, dp, work)
                 n_evals += 1
-                err_norm = _radau_error(h, x, ytmp, scratch[0], rZ, jac, lur, pivr, n, rtol,
-                                        atol, rerr, rtmpr)
+                if n3:
+                    err_norm = _radau_error3(h, x, ytmp, scratch[0], rZ, jac, S3, rtol, atol,
+                                             rerr)
+                else:
+                    err_norm = _radau_error(h, x, ytmp, scratch[0], rZ, jac, lur, pivr, n,
+                                            rtol, atol, rerr, rtmpr)
             if not (err_norm <= 1.0):
                 n_rejected += 1
                 if err_norm == err_norm:
@@ -1617,7 +1881,20 @@ def _integrate(x0, grid, mp0, E, kd, ld, one_sided, dp, bps, fpar, ipar, samples
             fac = min(10.0, safety * _radau_predict(h, h_old, err_norm, err_old))
             if not recompute_jac and fac < 1.2:
                 fac = 1.0
-            _deriv(t_new, ytmp, stg, 1, locked, mp, dp, work)
+            if n3:
+                if has_acceleration:
+                    ax_new, ay_new = platform_acceleration(t_new, dp)
+                else:
+                    ax_new = 0.0
+                    ay_new = 0.0
+                fnew, tr = _f3(ytmp[0], ytmp[1], ytmp[2], ytmp[3], ytmp[4], ytmp[5], locked,
+                               prm, ax_new, ay_new, base[0], base[1], base[2], base[3],
+                               base[4], base[5], base[6], base[7], base[8])
+                for i in range(6):
+                    stg[1, i] = fnew[i]
+                    trig[i] = tr[i]
+            else:
+                _deriv(t_new, ytmp, stg, 1, locked, mp, dp, work)
             n_evals += 1
             if recompute_jac:
                 n_evals += _radau_jacobian(t_new, ytmp, stg[1], jac, n, locked, mp, dp, work,
@@ -1910,7 +2187,7 @@ def _integrate(x0, grid, mp0, E, kd, ld, one_sided, dp, bps, fpar, ipar, samples
             stg[0, i] = stg[last_row, i]
         for e in range(n_ev):
             g_old[e] = g_new[e]
-        if n3 and not radau:
+        if n3:
             if n_steps % _TRIG_REFRESH == 0:
                 # fresh libm values now and then keep rounding from building up
                 for i in range(3):
