@@ -238,6 +238,38 @@ def test_derived_fields_equal_the_references_assembly():
         np.testing.assert_allclose(a, b, rtol=1e-10, atol=1e-10, err_msg=name)
 
 
+def test_derived_series_are_computed_on_first_access_and_kept():
+    """simulate_fast defers the derived series: nothing is computed until one is read, then
+    all are computed once and the same arrays come back on every access."""
+    fast = simulate_fast(paper_body(), paper_muscles("1"), VelocityStep.backward(0.5), 0.5,
+                         initial_state=PAPER_POSTURE)
+    assert "_series" not in vars(fast)
+    torques = fast.pair_torques
+    assert "_series" in vars(fast)
+    assert fast.pair_torques is torques
+    assert fast.joint_torques.shape == (fast.time.size, 3)
+    # U = −EᵀM, from the series just computed
+    E = paper_muscles("1").selection_matrix
+    np.testing.assert_allclose(fast.joint_torques, -torques @ E, rtol=1e-12, atol=1e-9)
+
+
+def test_a_result_without_its_derived_series_says_so():
+    from posturelab.errors import PostureLabError
+    from posturelab.results import SimulationResult
+
+    bare = SimulationResult(time=np.zeros(1), theta=np.zeros((1, 3)), omega=np.zeros((1, 3)),
+                            pair_names=("ankle",), status="completed", message="",
+                            fell=False, fall_time=None, fall_reason=None)
+    with pytest.raises(PostureLabError, match="derived series"):
+        _ = bare.pair_torques
+    wrong = SimulationResult(time=np.zeros(1), theta=np.zeros((1, 3)), omega=np.zeros((1, 3)),
+                             pair_names=("ankle",), status="completed", message="",
+                             fell=False, fall_time=None, fall_reason=None,
+                             derived=lambda: 42)
+    with pytest.raises(PostureLabError, match="DerivedSeries"):
+        _ = wrong.cog_position
+
+
 def test_options_not_compiled_run_the_reference():
     """Torque limits (and a feedback delay, centre-of-pressure falls) go to simulate()."""
     kwargs = dict(initial_state=PAPER_POSTURE, torque_limits=[60.0, np.inf, np.inf])

@@ -52,7 +52,7 @@ from .platform import (
     VelocityStep,
     read_profile_csv,
 )
-from .results import SimulationResult
+from .results import DerivedSeries, SimulationResult
 from .scenarios import Scenario, builtin_scenario, builtin_scenario_names, load_scenario
 from .simulate import (
     FOOT_FROM_LITERATURE,
@@ -78,7 +78,8 @@ __all__ = [
     "centre_of_gravity", "centre_of_gravity_velocity", "physiological_state",
     "CombinedDisturbance", "HalfSinePulse", "MeasuredProfile", "NoDisturbance", "RampAndHold",
     "SumOfSines", "VelocityStep", "read_profile_csv",
-    "SimulationResult", "Scenario", "builtin_scenario", "builtin_scenario_names", "load_scenario",
+    "SimulationResult", "DerivedSeries", "Scenario", "builtin_scenario",
+    "builtin_scenario_names", "load_scenario",
     "FOOT_FROM_LITERATURE", "BaseOfSupport", "FallCriteria", "KneeModel",
     "base_of_support_for_height", "simulate",
 ]

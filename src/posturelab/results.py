@@ -3,22 +3,84 @@
 from __future__ import annotations
 
 import csv
+import functools
 import io
 import os
 import tempfile
-from dataclasses import dataclass
+from collections.abc import Callable
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from .errors import PostureLabError
 
-__all__ = ["SimulationResult", "atomic_write_text", "atomic_write_bytes", "new_file_mode"]
+__all__ = ["SimulationResult", "DerivedSeries", "atomic_write_text", "atomic_write_bytes",
+           "new_file_mode"]
 
 
 @dataclass(frozen=True)
+class DerivedSeries:
+    """The series a :class:`SimulationResult` derives from its states (time first).
+
+    Attributes
+    ----------
+    pair_torques : numpy.ndarray, shape (T, P)
+        Muscle-pair torques M. [N·m]
+    joint_torques : numpy.ndarray, shape (T, N)
+        Generalised torques U = −EᵀM. [N·m]
+    joint_moments : numpy.ndarray, shape (T, N)
+        Net muscle moment per joint. [N·m]
+    cog_position : numpy.ndarray, shape (T, 2)
+        Centre of gravity relative to the ankle. [m]
+    cog_velocity : numpy.ndarray, shape (T, 2)
+        Its velocity. [m/s]
+    platform_acceleration : numpy.ndarray, shape (T, 2)
+        (ẍ_d, ÿ_d). [m/s²]
+    platform_velocity : numpy.ndarray, shape (T, 2)
+        (ẋ_d, ẏ_d). [m/s]
+    platform_position : numpy.ndarray, shape (T, 2)
+        (x_d, y_d). [m]
+    angular_acceleration : numpy.ndarray, shape (T, N), optional
+        Link angular accelerations. [rad/s²]
+    ground_reaction : numpy.ndarray, shape (T, 2), optional
+        Force of the platform on the foot. [N]
+    centre_of_pressure : numpy.ndarray, shape (T,), optional
+        Centre of pressure relative to the ankle. [m]
+    """
+
+    pair_torques: np.ndarray
+    joint_torques: np.ndarray
+    joint_moments: np.ndarray
+    cog_position: np.ndarray
+    cog_velocity: np.ndarray
+    platform_acceleration: np.ndarray
+    platform_velocity: np.ndarray
+    platform_position: np.ndarray
+    angular_acceleration: np.ndarray | None = None
+    ground_reaction: np.ndarray | None = None
+    centre_of_pressure: np.ndarray | None = None
+
+
+def _derived(name: str, doc: str) -> property:
+    def get(self: SimulationResult):
+        return getattr(self._series, name)
+
+    get.__name__ = name
+    return property(get, doc=doc)
+
+
+@dataclass(frozen=True, eq=False)
 class SimulationResult:
     """The outcome of one nonlinear simulation; arrays have time as the first axis.
+
+    The states (``time``, ``theta``, ``omega``) and the outcome are stored; the
+    series derived from them (``pair_torques`` to ``platform_position``,
+    ``angular_acceleration``, ``ground_reaction``, ``centre_of_pressure``) come
+    from ``derived``: a :class:`DerivedSeries`, or a function that computes one,
+    called on the first access of any of them and then kept. The compiled
+    simulator defers them this way, so that a run whose angles are all that is
+    read (a sweep, a fit, a bisection) does not pay for them.
 
     Attributes
     ----------
@@ -69,19 +131,13 @@ class SimulationResult:
     centre_of_pressure : numpy.ndarray, shape (T,), optional
         Centre of pressure under the massless foot, x_p = τ_ankle / F_y,
         relative to the ankle. [m]
+    derived : DerivedSeries or callable returning one
+        Where the derived series come from (see above).
     """
 
     time: np.ndarray
     theta: np.ndarray
     omega: np.ndarray
-    pair_torques: np.ndarray
-    joint_torques: np.ndarray
-    joint_moments: np.ndarray
-    cog_position: np.ndarray
-    cog_velocity: np.ndarray
-    platform_acceleration: np.ndarray
-    platform_velocity: np.ndarray
-    platform_position: np.ndarray
     pair_names: tuple[str, ...]
     status: str
     message: str
@@ -90,9 +146,37 @@ class SimulationResult:
     fall_reason: str | None
     switch_times: tuple[float, ...] = ()
     description: str = ""
-    angular_acceleration: np.ndarray | None = None
-    ground_reaction: np.ndarray | None = None
-    centre_of_pressure: np.ndarray | None = None
+    derived: DerivedSeries | Callable[[], DerivedSeries] | None = field(
+        default=None, repr=False)
+
+    @functools.cached_property
+    def _series(self) -> DerivedSeries:
+        source = self.derived
+        if source is None:
+            raise PostureLabError("this result was built without its derived series")
+        series = source() if callable(source) else source
+        if not isinstance(series, DerivedSeries):
+            raise PostureLabError(f"derived series must be a DerivedSeries, got "
+                                  f"{type(series).__name__}")
+        return series
+
+    pair_torques = _derived("pair_torques", "Muscle-pair torques M, shape (T, P). [N·m]")
+    joint_torques = _derived("joint_torques", "Generalised torques U = −EᵀM, (T, N). [N·m]")
+    joint_moments = _derived("joint_moments", "Net muscle moment per joint, (T, N). [N·m]")
+    cog_position = _derived("cog_position", "Centre of gravity (x_c, y_c), (T, 2). [m]")
+    cog_velocity = _derived("cog_velocity", "Its velocity (ẋ_c, ẏ_c), (T, 2). [m/s]")
+    platform_acceleration = _derived("platform_acceleration",
+                                     "Platform acceleration (ẍ_d, ÿ_d), (T, 2). [m/s²]")
+    platform_velocity = _derived("platform_velocity",
+                                 "Platform velocity (ẋ_d, ẏ_d), (T, 2). [m/s]")
+    platform_position = _derived("platform_position",
+                                 "Platform position (x_d, y_d), (T, 2). [m]")
+    angular_acceleration = _derived("angular_acceleration",
+                                    "Link angular accelerations, (T, N). [rad/s²]")
+    ground_reaction = _derived("ground_reaction",
+                               "Force of the platform on the foot (F_x, F_y), (T, 2). [N]")
+    centre_of_pressure = _derived("centre_of_pressure",
+                                  "Centre of pressure relative to the ankle, (T,). [m]")
 
     @property
     def n_links(self) -> int:

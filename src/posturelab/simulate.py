@@ -36,7 +36,7 @@ from .dynamics import (
 from .errors import ParameterError
 from .muscles import MuscleSet
 from .platform import Disturbance, NoDisturbance
-from .results import SimulationResult
+from .results import DerivedSeries, SimulationResult
 
 __all__ = [
     "BaseOfSupport",
@@ -746,14 +746,16 @@ def _assemble(body, muscles, disturbance, times, states, status, message, fell, 
         vel[:] = disturbance.velocity_change
     for arr in (time, theta, omega, alpha):
         arr.setflags(write=False)
-    return SimulationResult(
-        time=time, theta=theta, omega=omega, pair_torques=M, joint_torques=U,
-        joint_moments=moments,
+    derived = DerivedSeries(
+        pair_torques=M, joint_torques=U, joint_moments=moments,
         cog_position=centre_of_gravity(body, theta),
         cog_velocity=centre_of_gravity_velocity(body, theta, omega),
         platform_acceleration=acc, platform_velocity=vel, platform_position=pos,
+        angular_acceleration=alpha, ground_reaction=ground, centre_of_pressure=cop,
+    )
+    return SimulationResult(
+        time=time, theta=theta, omega=omega,
         pair_names=tuple(muscles.names), status=status, message=message, fell=fell,
         fall_time=fall_time, fall_reason=fall_reason, switch_times=tuple(switch_times),
-        description=description or disturbance.describe(),
-        angular_acceleration=alpha, ground_reaction=ground, centre_of_pressure=cop,
+        description=description or disturbance.describe(), derived=derived,
     )

@@ -84,7 +84,7 @@ from ..body import Body
 from ..errors import ParameterError
 from ..muscles import MuscleSet, paper_muscles
 from ..platform import Disturbance, NoDisturbance
-from ..results import SimulationResult
+from ..results import DerivedSeries, SimulationResult
 from ..simulate import FallCriteria, KneeModel, initial_state_for, simulate
 from . import _kernels as kern
 from ._encode import (
@@ -399,24 +399,36 @@ def simulate_fast(
         else:
             fall_time, fall_reason = None, None
             message = _message(status, t_reached, s.duration, s.max_switches)
-    (M, U, moments, alpha, cog, cogv, ground, cop, acc, vel, pos) = kern.derived_fields(
-        samples, count, locked, s.E, kd, ld, s.one_sided, s.crosses, s.mp0,
-        body.total_mass, np.array(time, dtype=float), s.dist.packed, *s.dist.velocity_change)
     # the kernels keep time last; the result holds time-first views of the same memory
     theta = samples[:n, :count].T
     omega = samples[n:, :count].T
-    alpha = alpha.T
-    for arr in (time, theta, omega, alpha):
+    for arr in (time, theta, omega):
         arr.setflags(write=False)
+    derive = functools.partial(_derived_series, samples, count, locked, s, kd, ld,
+                               body.total_mass, time)
     return SimulationResult(
-        time=time, theta=theta, omega=omega, pair_torques=M.T, joint_torques=U.T,
-        joint_moments=moments.T, cog_position=cog.T, cog_velocity=cogv.T,
-        platform_acceleration=acc.T, platform_velocity=vel.T, platform_position=pos.T,
+        time=time, theta=theta, omega=omega,
         pair_names=tuple(muscles.names), status=_STATUS_NAMES[status], message=message,
         fell=status == kern.STATUS_FELL, fall_time=fall_time, fall_reason=fall_reason,
         switch_times=tuple(float(v) for v in switches),
-        description=description or disturbance.describe(),
-        angular_acceleration=alpha, ground_reaction=ground.T, centre_of_pressure=cop,
+        description=description or disturbance.describe(), derived=derive,
+    )
+
+
+def _derived_series(samples: np.ndarray, count: int, locked: np.ndarray, s: _Setup,
+                    kd: np.ndarray, ld: np.ndarray, total_mass: float,
+                    time: np.ndarray) -> DerivedSeries:
+    """The derived series of a run (computed when the result is first asked for one)."""
+    (M, U, moments, alpha, cog, cogv, ground, cop, acc, vel, pos) = kern.derived_fields(
+        samples, count, locked, s.E, kd, ld, s.one_sided, s.crosses, s.mp0, total_mass,
+        np.array(time, dtype=float), s.dist.packed, *s.dist.velocity_change)
+    alpha = alpha.T
+    alpha.setflags(write=False)
+    return DerivedSeries(
+        pair_torques=M.T, joint_torques=U.T, joint_moments=moments.T, cog_position=cog.T,
+        cog_velocity=cogv.T, platform_acceleration=acc.T, platform_velocity=vel.T,
+        platform_position=pos.T, angular_acceleration=alpha, ground_reaction=ground.T,
+        centre_of_pressure=cop,
     )
 
 
