@@ -8,8 +8,10 @@ Run it as a script (not a test): ``python benchmarks/bench_simulate.py``. In one
      ``paper-backward-case1``), 5 s sampled at 1 kHz;
    * a second baseline: the same solve_ivp call with a right-hand side built from
      posturelab's public numpy functions (``state_derivative`` of ``joint_torques``);
-   * ``simulate_fast`` on the same case (a full SimulationResult), with its default
-     integrator (RK45) and with ``method="RK23"``; speed-ups against both baselines;
+   * ``simulate_fast`` on the same case (a SimulationResult), with its default
+     integrator (``method="Radau"``), once more reading every derived series (torques,
+     accelerations, centre of gravity, ...; computed on first access), and with the
+     explicit ``method="RK45"`` and ``"RK23"``; speed-ups against both baselines;
    * ``simulate_batch``: 10,000 runs of 5 s with random gains (ankle 400–1500,
      the other four pairs 0–600 N·m/rad, viscosity 0.25 × stiffness), the
      paper's body, a 1 m/s backward step from the paper's initial posture;
@@ -180,13 +182,18 @@ def main() -> int:
         return solve_ivp(rhs_public, (0.0, duration), x0, method="RK45", rtol=RTOL,
                          atol=DEFAULT_ATOL, t_eval=grid)
 
-    def fast():
+    def fast(method="Radau"):
         return simulate_fast(body, muscles, dist, duration, initial_state=sc.initial_state,
-                             rtol=RTOL)
+                             rtol=RTOL, method=method)
 
-    def fast23():
-        return simulate_fast(body, muscles, dist, duration, initial_state=sc.initial_state,
-                             rtol=RTOL, method="RK23")
+    def fast_all_series():
+        res = fast()
+        for name in ("pair_torques", "joint_torques", "joint_moments", "cog_position",
+                     "cog_velocity", "platform_acceleration", "platform_velocity",
+                     "platform_position", "angular_acceleration", "ground_reaction",
+                     "centre_of_pressure"):
+            getattr(res, name)
+        return res
 
     t_base = median_time(baseline, REPEATS_BASELINE)
     err_base = float(np.max(np.abs(baseline().y[: body.n_links].T - ref.theta)))
@@ -194,9 +201,11 @@ def main() -> int:
     err_pub = float(np.max(np.abs(baseline_public().y[: body.n_links].T - ref.theta)))
     t_fast = median_time(fast, REPEATS_FAST)
     err_fast = float(np.max(np.abs(fast().theta - ref.theta)))
-    t_fast23 = median_time(fast23, REPEATS_FAST)
-    err_fast23 = float(np.max(np.abs(fast23().theta - ref.theta)))
-    t_best = min(t_fast, t_fast23)
+    t_all = median_time(fast_all_series, REPEATS_FAST)
+    t_fast45 = median_time(lambda: fast("RK45"), REPEATS_FAST)
+    err_fast45 = float(np.max(np.abs(fast("RK45").theta - ref.theta)))
+    t_fast23 = median_time(lambda: fast("RK23"), REPEATS_FAST)
+    err_fast23 = float(np.max(np.abs(fast("RK23").theta - ref.theta)))
 
     # ---- the batch -----------------------------------------------------------------------
     rng = np.random.default_rng(SEED)
@@ -231,7 +240,9 @@ def main() -> int:
     rows = [
         ("scipy RK45 + numpy RHS (baseline)", t_base, 1.0, err_base),
         ("scipy RK45 + posturelab's public numpy functions", t_pub, t_base / t_pub, err_pub),
-        ("simulate_fast (one run)", t_fast, t_base / t_fast, err_fast),
+        ("simulate_fast (one run, default method='Radau')", t_fast, t_base / t_fast, err_fast),
+        ("  the same, then reading every derived series", t_all, t_base / t_all, err_fast),
+        ("simulate_fast (one run, method='RK45')", t_fast45, t_base / t_fast45, err_fast45),
         ("simulate_fast (one run, method='RK23')", t_fast23, t_base / t_fast23, err_fast23),
         (f"simulate_batch ({N_BATCH} runs)", t_batch, t_base * N_BATCH / t_batch, err_batch),
     ]
@@ -257,13 +268,13 @@ def main() -> int:
           f"{cached['first_batch']:.2f} s = {cached['total']:.2f} s")
     print()
     print("targets: simulate_fast >= 500× baseline: "
-          f"{'met' if t_base / t_best >= 500 else 'NOT met'} ({t_base / t_best:.0f}× with "
-          f"{'RK23' if t_fast23 <= t_fast else 'RK45'}; {t_pub / t_best:.0f}× the public-"
-          "function baseline); "
+          f"{'met' if t_base / t_fast >= 500 else 'NOT met'} ({t_base / t_fast:.0f}×; "
+          f"{t_pub / t_fast:.0f}× the public-function baseline; {t_base / t_all:.0f}× reading "
+          "every derived series too); "
           f"batch <= 1.5 s: {'met' if t_batch <= 1.5 else 'NOT met'} ({t_batch:.2f} s"
           f"{', scaled from ' + str(N_BATCH) + ' runs' if QUICK else ''}); "
           f"errors <= 1e-6 rad: "
-          f"{'met' if max(err_fast, err_fast23, err_batch) <= 1e-6 else 'NOT met'}; "
+          f"{'met' if max(err_fast, err_fast45, err_fast23, err_batch) <= 1e-6 else 'NOT met'}; "
           f"cached first call < 2 s: {'met' if cached['total'] < 2 else 'NOT met'}")
     return 0
 

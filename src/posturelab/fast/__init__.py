@@ -65,7 +65,7 @@ against the reference on every built-in scenario; measured speeds are in
 benchmarks/bench_simulate.py.
 
 Compilation: every kernel is ``@njit(cache=True)``. The first call in a
-fresh environment compiles them (about 45 s on 2 cores for simulate_fast and
+fresh environment compiles them (about 70 s on 2 cores for simulate_fast and
 both batch paths); later processes load the machine code from numba's cache
 (``__pycache__`` beside the sources, or ``NUMBA_CACHE_DIR``) in well under a
 second. :func:`warm_up` compiles or loads everything at once.
