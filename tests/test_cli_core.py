@@ -305,3 +305,22 @@ def test_help_mentions_units_and_sign_convention(capsys, command, units):
         assert unit in out, unit
     assert SIGN.search(out), "help must state that angles are positive leaning forward"
     assert "vertical" in out
+
+
+def test_load_compiled_is_quiet_when_fast_and_says_so_when_slow():
+    """The notice appears only when loading takes longer than the threshold."""
+    import io
+    import time
+
+    from posturelab.cli._common import load_compiled
+
+    quiet = io.StringIO()
+    load_compiled(lambda: None, "nothing", stream=quiet, notice_after=5.0)
+    assert quiet.getvalue() == ""
+    loud = io.StringIO()
+    seconds = load_compiled(lambda: time.sleep(0.3), "the simulator", stream=loud,
+                            notice_after=0.05)
+    lines = loud.getvalue().splitlines()
+    assert lines[0].startswith("posturelab: compiling the simulator")
+    assert lines[1].startswith("posturelab: compiled the simulator in")
+    assert seconds >= 0.3

@@ -109,3 +109,37 @@ def check_writable(paths: list[str]) -> None:
             raise ParameterError(f"cannot write {p!r}: directory {str(d)!r} is not writable")
         if Path(p).is_dir():
             raise ParameterError(f"cannot write {p!r}: it is a directory")
+
+
+def load_compiled(load, what: str, stream=None, notice_after: float = 2.0) -> float:
+    """Run ``load()`` (which compiles or loads numba kernels) and say so if it takes long.
+
+    Loading from numba's cache takes well under a second and prints nothing;
+    when ``load()`` is still running after ``notice_after`` seconds (the first
+    use after installing, which compiles), one line on ``stream`` (standard
+    error by default) says what is happening, and a second when it is done.
+    Returns the seconds ``load()`` took. [s]
+    """
+    import threading
+    import time
+
+    stream = sys.stderr if stream is None else stream
+    said = threading.Event()
+
+    def notice() -> None:
+        said.set()
+        print(f"posturelab: compiling {what} (once after installing; cached for later runs)…",
+              file=stream, flush=True)
+
+    timer = threading.Timer(notice_after, notice)
+    timer.daemon = True
+    t0 = time.perf_counter()
+    timer.start()
+    try:
+        load()
+    finally:
+        timer.cancel()
+    seconds = time.perf_counter() - t0
+    if said.is_set():
+        print(f"posturelab: compiled {what} in {seconds:.0f} s", file=stream, flush=True)
+    return seconds

@@ -13,6 +13,7 @@ from typing import IO
 from ..errors import ParameterError, UnknownNameError
 from ..muscles import PAPER_PAIR_NAMES
 from . import CONVENTIONS_EPILOG
+from ._common import load_compiled
 
 #: Axis names: the paper's five pairs (stiffness [N·m/rad]) and the viscosity ratio [s]
 #: (the same as posturelab.batch_linear.GRID_PARAMETERS, which imports numba).
@@ -292,6 +293,8 @@ def run(args: argparse.Namespace) -> int:
     from ..batch_linear import parameter_grid, stability_map
 
     parameter_grid(x, y, resolution, case=args.case, viscosity_ratio=ratio)  # validates --case
+    load_compiled(lambda: stability_map(x, y, 2, case=args.case, viscosity_ratio=ratio),
+                  "the stability evaluator")
 
     temporaries: list[Path] = []
     try:

@@ -17,7 +17,7 @@ from ..sweep import (
     table_format,
 )
 from . import CONVENTIONS_EPILOG, UsageError
-from ._common import check_writable
+from ._common import check_writable, load_compiled
 from .simulate import add_experiment_arguments, scenario_from_args
 
 DESCRIPTION = f"""\
@@ -99,6 +99,9 @@ def run(args: argparse.Namespace) -> int:
     if args.atol is not None:
         tolerances["atol"] = scenario.atol
 
+    from ..fast import warm_up
+
+    load_compiled(warm_up, "the simulator")  # before the clock and the bar start
     bar = None
     if args.progress or sys.stderr.isatty():
         total = 1
