@@ -26,6 +26,22 @@ def test_noise_free_data_recovers_gains_exactly(experiment):
     assert fit.residual_rms < 1e-7
 
 
+def test_fast_and_reference_engines_give_the_same_fit(experiment):
+    """The compiled simulator (default) and scipy's inside the same fit: the same estimates
+    and standard errors, to far below their own uncertainty."""
+    sc, truth = experiment
+    rng = np.random.default_rng(7)
+    noisy = truth.theta + rng.normal(0.0, 0.001, truth.theta.shape)
+    start = sc.replace(muscles=pl.paper_muscles(stiffness=[800, 300, 300, 300, 100]))
+    fits = {engine: fit_stiffness(start, truth.time, noisy, ["ankle", "gastrocnemius"],
+                                  engine=engine) for engine in ("fast", "reference")}
+    np.testing.assert_allclose(fits["fast"].estimates, fits["reference"].estimates, rtol=1e-5)
+    np.testing.assert_allclose(fits["fast"].standard_errors,
+                               fits["reference"].standard_errors, rtol=1e-3)
+    with pytest.raises(pl.PostureLabError, match="engine"):
+        fit_stiffness(start, truth.time, noisy, ["ankle"], engine="turbo")
+
+
 def test_noisy_data_true_values_inside_confidence_intervals(experiment):
     """Seeded 2 mrad noise: each true value lies within its 95 % interval, which is narrow."""
     sc, truth = experiment

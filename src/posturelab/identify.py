@@ -10,6 +10,12 @@ from the Gauss–Newton covariance s² (JᵀJ)⁻¹.
 
 The model of viscosity: every pair's viscosity is ``viscosity_ratio`` times
 its stiffness (the paper's L_d = 0.25 K_d); the ratio is fixed or fitted.
+
+The simulations run on the compiled simulator (:func:`posturelab.fast.simulate_fast`,
+at the scenario's tolerances) by default, or on the reference
+:func:`posturelab.simulate.simulate` with ``engine="reference"``; runs with
+features the compiled simulator does not cover (torque limits, a feedback
+delay, centre-of-pressure falls) go to the reference either way.
 """
 
 from __future__ import annotations
@@ -33,6 +39,8 @@ from .scenarios import Scenario
 __all__ = ["FitResult", "fit_stiffness", "read_trajectory_csv"]
 
 VISCOSITY_RATIO = "viscosity_ratio"
+#: The simulators ``fit_stiffness`` can run the model on.
+ENGINES = ("fast", "reference")
 
 
 @dataclass(frozen=True)
@@ -119,6 +127,7 @@ def fit_stiffness(
     initial_guess: Sequence[float] | None = None,
     upper_bound: float = 1e5,
     max_simulations: int = 400,
+    engine: str = "fast",
 ) -> FitResult:
     """Fit pair stiffnesses (and optionally the viscosity ratio) to measured angles.
 
@@ -144,11 +153,17 @@ def fit_stiffness(
         Largest stiffness allowed. [N·m/rad]
     max_simulations : int
         Budget of simulations for the optimiser.
+    engine : {"fast", "reference"}
+        Which simulator runs the model: the compiled one (default; the first use
+        after installing compiles it, about a minute) or scipy's (the scenario's
+        ``solver.method``).
 
     Returns
     -------
     FitResult
     """
+    if engine not in ENGINES:
+        raise ParameterError(f"engine must be one of {', '.join(ENGINES)}, got {engine!r}")
     names = list(free)
     if not names:
         raise ParameterError("free must name at least one pair or 'viscosity_ratio'")
@@ -187,7 +202,16 @@ def fit_stiffness(
         stiff = {nm: v for nm, v in zip(names, params, strict=True) if nm != VISCOSITY_RATIO}
         ratio = (params[names.index(VISCOSITY_RATIO)] if VISCOSITY_RATIO in names
                  else viscosity_ratio)
-        return sc.run(muscles=_muscles_with(scenario.muscles, stiff, ratio))
+        muscles = _muscles_with(scenario.muscles, stiff, ratio)
+        if engine == "reference":
+            return sc.run(muscles=muscles)
+        from .fast import simulate_fast
+
+        return simulate_fast(
+            sc.body, muscles, sc.disturbance, sc.duration, initial_state=sc.initial_state,
+            rates_from=sc.rates_from, knee=sc.knee, fall=sc.fall,
+            torque_limits=sc.torque_limits, feedback_delay=sc.feedback_delay, rtol=sc.rtol,
+            atol=sc.atol, sample_rate=sc.sample_rate, description=sc.description)
 
     def residuals(params: np.ndarray) -> np.ndarray:
         r = run(params)
