@@ -474,3 +474,26 @@ def test_radau_follows_the_exact_solution_of_a_very_stiff_pendulum():
 def test_unknown_method_is_refused():
     with pytest.raises(ParameterError, match="method"):
         simulate_fast(paper_body(), paper_muscles("1"), None, 0.1, method="LSODA")
+
+
+@pytest.mark.parametrize("disturbance", [
+    VelocityStep.backward(1.0),
+    MeasuredProfile(np.linspace(0.0, 0.4, 41), 3.0 * np.sin(np.linspace(0.0, np.pi, 41))),
+])
+def test_batch_disturbance_scale_equals_single_runs_bit_for_bit(disturbance):
+    """Run r of a batch with disturbance_scale is the single run with disturbance.scaled(s_r)
+    (a hashable step and an unhashable measured profile; repeated and zero factors)."""
+    k = np.tile(np.asarray(paper_muscles("1").stiffnesses), (5, 1))
+    k[:, 0] = [400.0, 400.0, 900.0, 900.0, 600.0]
+    scale = np.array([0.5, 3.0, 0.5, 3.0, 0.0])
+    out = simulate_batch(paper_body(), k, 0.25 * k, disturbance, 1.5, PAPER_POSTURE,
+                         disturbance_scale=scale)
+    for r in range(k.shape[0]):
+        one = simulate_fast(paper_body(), paper_muscles(stiffness=k[r], viscosity=0.25 * k[r]),
+                            disturbance.scaled(scale[r]), 1.5, initial_state=PAPER_POSTURE)
+        assert one.fell == out.fell[r]
+        np.testing.assert_array_equal(one.max_abs_theta, out.peak_theta[r])
+        np.testing.assert_array_equal(one.final_state, out.final_state[r])
+    with pytest.raises(ParameterError, match="disturbance_scale"):
+        simulate_batch(paper_body(), k, 0.25 * k, disturbance, 1.5, PAPER_POSTURE,
+                       disturbance_scale=[1.0, 2.0])

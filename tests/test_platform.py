@@ -8,6 +8,7 @@ from posturelab.errors import DataFileError, ParameterError
 from posturelab.platform import (
     HalfSinePulse,
     MeasuredProfile,
+    NoDisturbance,
     RampAndHold,
     SumOfSines,
     VelocityStep,
@@ -99,3 +100,31 @@ def test_read_profile_missing_file(tmp_path):
 def test_bad_disturbance_parameters(factory, needle):
     with pytest.raises(ParameterError, match=needle):
         factory()
+
+
+@pytest.mark.parametrize("disturbance", [
+    VelocityStep.backward(0.8),
+    HalfSinePulse(2.0, 0.3, 0.1),
+    RampAndHold(0.12, 0.5, 0.05, axis="y"),
+    SumOfSines((1.0, 0.5), (1.0, 2.5), (0.0, 0.3)),
+    MeasuredProfile([0.0, 0.1, 0.2, 0.4], [0.0, 1.0, -0.5, 0.0], [0.0, 0.2, 0.0, 0.0]),
+    combine(HalfSinePulse(2.0, 0.3), VelocityStep.forward(0.5)),
+])
+@pytest.mark.parametrize("factor", [2.5, -1.0, 0.0])
+def test_scaled_multiplies_every_amplitude_and_keeps_the_timing(disturbance, factor):
+    """a(t) and the velocity step scale by the factor; breakpoints and max step do not."""
+    t = np.linspace(0.0, 0.6, 61)
+    scaled = disturbance.scaled(factor)
+    np.testing.assert_allclose(scaled.acceleration(t), factor * disturbance.acceleration(t),
+                               rtol=1e-15, atol=1e-15)
+    np.testing.assert_allclose(scaled.velocity_change,
+                               factor * np.asarray(disturbance.velocity_change), atol=1e-15)
+    assert scaled.breakpoints == disturbance.breakpoints
+    assert scaled.max_step == disturbance.max_step
+
+
+def test_scaled_rejects_a_non_finite_factor():
+    with pytest.raises(ParameterError, match="factor"):
+        VelocityStep.backward(1.0).scaled(float("nan"))
+    with pytest.raises(ParameterError, match="factor"):
+        NoDisturbance().scaled(float("inf"))

@@ -102,11 +102,34 @@ def test_viscosity_follows_the_ratio():
     np.testing.assert_allclose(g.viscosity, 0.4 * g.stiffness)
 
 
+def test_disturbance_scale_sweeps_the_perturbation_size():
+    """disturbance_scale multiplies the base step's speed: each row equals a single run with
+    the scaled step; a weak ankle that recovers from a small step falls from a large one."""
+    sc = builtin_scenario("paper-backward-case1").replace(duration=3.0)
+    varies = [parse_vary("ankle=300:900:2"), parse_vary("disturbance_scale=0.5:4:3")]
+    result = run_sweep(sc, varies)
+    assert result.grid.disturbance_scale.tolist() == [0.5, 2.25, 4.0] * 2
+    o = result.outcomes
+    for r in range(result.grid.n_runs):
+        k = result.grid.stiffness[r]
+        one = simulate_fast(sc.body, paper_muscles(stiffness=k, viscosity=0.25 * k),
+                            sc.disturbance.scaled(result.grid.disturbance_scale[r]),
+                            sc.duration, initial_state=sc.initial_state)
+        assert one.fell == o.fell[r]
+        np.testing.assert_array_equal(one.max_abs_theta, o.peak_theta[r])
+    weak = o.fell[:3]
+    assert not weak[0] and weak[-1]
+    # the peak lean grows with the perturbation for the runs that do not fall
+    strong = o.peak_theta[3:, 0]
+    assert np.all(np.diff(strong) > 0)
+
+
 def test_dask_path_equals_the_local_path():
     """Chunks on a Dask LocalCluster (2 workers, threads, started here) give the same numbers."""
     distributed = pytest.importorskip("distributed")
     sc = builtin_scenario("paper-backward-case1").replace(duration=1.0)
-    varies = [parse_vary("ankle=200:1400:4"), parse_vary("quadriceps=0:600:3")]
+    varies = [parse_vary("ankle=200:1400:4"), parse_vary("quadriceps=0:600:3"),
+              parse_vary("disturbance_scale=0.5:2:2")]
     local = run_sweep(sc, varies)
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=False,
                                   dashboard_address=None) as cluster:

@@ -19,7 +19,7 @@ from __future__ import annotations
 import csv
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Literal
 
@@ -75,6 +75,17 @@ class Disturbance:
         """One-line human description with units."""
         return "no platform motion"
 
+    def scaled(self, factor: float) -> Disturbance:
+        """The same motion with every amplitude multiplied by ``factor`` [-].
+
+        The velocity step's speed, a pulse's peak, a ramp's displacement, the
+        sines' amplitudes and a measured profile's accelerations scale; times,
+        durations and frequencies (and so the breakpoints) do not. A negative
+        factor reverses the motion; 0 leaves the platform still.
+        """
+        finite_float("factor [-]", factor)
+        return self
+
 
 @dataclass(frozen=True)
 class NoDisturbance(Disturbance):
@@ -114,6 +125,9 @@ class VelocityStep(Disturbance):
     def forward(cls, speed: float = 1.0) -> VelocityStep:
         """Platform jerked forward at ``speed`` [m/s] (> 0): the body sways backward."""
         return cls(positive_float("speed [m/s]", speed))
+
+    def scaled(self, factor: float) -> VelocityStep:
+        return replace(self, velocity=self.velocity * finite_float("factor [-]", factor))
 
     def describe(self) -> str:
         word = {"x": ("forward", "backward"), "y": ("up", "down")}[self.axis]
@@ -184,6 +198,10 @@ class HalfSinePulse(_SinePulse):
     def peak_acceleration_value(self) -> float:
         return self.peak_acceleration
 
+    def scaled(self, factor: float) -> HalfSinePulse:
+        return replace(self, peak_acceleration=self.peak_acceleration
+                       * finite_float("factor [-]", factor))
+
     @property
     def velocity_gain(self) -> float:
         """Velocity reached at the end of the pulse, 2·peak·duration/π. [m/s]"""
@@ -223,6 +241,9 @@ class RampAndHold(_SinePulse):
         object.__setattr__(self, "displacement",
                            finite_float("displacement [m]", self.displacement))
         self._validate_window()
+
+    def scaled(self, factor: float) -> RampAndHold:
+        return replace(self, displacement=self.displacement * finite_float("factor [-]", factor))
 
     @property
     def peak_acceleration(self) -> float:
@@ -278,6 +299,10 @@ class SumOfSines(Disturbance):
     @property
     def max_step(self) -> float:
         return 0.05 / max(self.frequencies)
+
+    def scaled(self, factor: float) -> SumOfSines:
+        f = finite_float("factor [-]", factor)
+        return replace(self, amplitudes=tuple(a * f for a in self.amplitudes))
 
     def acceleration(self, t):
         t = np.asarray(t, dtype=float)
@@ -340,6 +365,13 @@ class MeasuredProfile(Disturbance):
     def breakpoints(self) -> tuple[float, ...]:
         return tuple(self.time.tolist())
 
+    def scaled(self, factor: float) -> MeasuredProfile:
+        f = finite_float("factor [-]", factor)
+        if f == 1.0:
+            return self
+        return MeasuredProfile(self.time, self.acceleration_x * f, self.acceleration_y * f,
+                               source=f"{self.source} × {f:g}" if self.source else "")
+
     @property
     def max_step(self) -> float:
         return self._max_step
@@ -378,6 +410,10 @@ class CombinedDisturbance(Disturbance):
 
     def acceleration(self, t):
         return sum(p.acceleration(t) for p in self.parts)
+
+    def scaled(self, factor: float) -> CombinedDisturbance:
+        f = finite_float("factor [-]", factor)
+        return CombinedDisturbance(tuple(p.scaled(f) for p in self.parts))
 
     def describe(self) -> str:
         return " + ".join(p.describe() for p in self.parts)

@@ -11,10 +11,14 @@ fall time, peak |θ_i|, settling time).
 
 Parameters that can vary (:data:`SWEEP_PARAMETERS`): the stiffness of the
 paper's pairs ``ankle``, ``knee``, ``hip``, ``quadriceps``, ``gastrocnemius``
-[N·m/rad], and ``viscosity_ratio`` [s]. The viscosity of a pair is the ratio
-times its stiffness: the varied ratio, else the one given, else the base
-experiment's own ratio for that pair (0.25, the paper's, where its stiffness
-is 0).
+[N·m/rad], ``viscosity_ratio`` [s], and ``disturbance_scale`` [-], which
+multiplies the base experiment's platform motion (the velocity step's speed,
+a pulse's peak, a ramp's displacement, the sines' amplitudes, a measured
+profile's accelerations; see :meth:`posturelab.platform.Disturbance.scaled`),
+so that a sweep over it finds how large a perturbation each gain set
+absorbs. The viscosity of a pair is the ratio times its stiffness: the
+varied ratio, else the one given, else the base experiment's own ratio for
+that pair (0.25, the paper's, where its stiffness is 0).
 
 Work can go to a Dask distributed cluster (:func:`run_sweep` with
 ``workers``/``scheduler``/``client``) in chunks; the results are identical to
@@ -56,11 +60,12 @@ __all__ = [
     "ProgressBar",
 ]
 
-#: Names a sweep can vary: the paper's pair stiffnesses and the viscosity ratio.
-SWEEP_PARAMETERS: tuple[str, ...] = (*PAPER_PAIR_NAMES, "viscosity_ratio")
+#: Names a sweep can vary: the paper's pair stiffnesses, the viscosity ratio and the scale
+#: of the platform motion.
+SWEEP_PARAMETERS: tuple[str, ...] = (*PAPER_PAIR_NAMES, "viscosity_ratio", "disturbance_scale")
 #: Unit of each sweep parameter.
 PARAMETER_UNITS: dict[str, str] = {**{n: "N·m/rad" for n in PAPER_PAIR_NAMES},
-                                   "viscosity_ratio": "s"}
+                                   "viscosity_ratio": "s", "disturbance_scale": "-"}
 #: Outcome columns of a sweep table (after the varied parameters), for 3 links.
 OUTCOME_COLUMNS: tuple[str, ...] = ("fell", "fall_time", "peak_theta1", "peak_theta2",
                                     "peak_theta3", "settling_time")
@@ -90,7 +95,7 @@ class VaryRange:
     name : str
         One of :data:`SWEEP_PARAMETERS`.
     low, high : float
-        First and last value, low <= high, both >= 0. [N·m/rad] or [s]
+        First and last value, low <= high, both >= 0. [N·m/rad], [s] or [-]
     count : int
         Number of values, >= 1 (1 needs low = high). [-]
     """
@@ -127,7 +132,7 @@ class VaryRange:
 
     @property
     def values(self) -> np.ndarray:
-        """The ``count`` values, ``low`` and ``high`` included. [N·m/rad] or [s]"""
+        """The ``count`` values, ``low`` and ``high`` included. [N·m/rad], [s] or [-]"""
         return np.linspace(self.low, self.high, self.count)
 
     @property
@@ -174,17 +179,21 @@ class SweepGrid:
         The varied parameters, in the order given.
     values : numpy.ndarray, shape (M, K)
         Row r holds run r's values of the K varied parameters (the cartesian
-        product, the first parameter varying slowest). [N·m/rad] or [s]
+        product, the first parameter varying slowest). [N·m/rad], [s] or [-]
     stiffness : numpy.ndarray, shape (M, 5)
         Pair stiffness of each run (ankle, knee, hip, quadriceps, gastrocnemius). [N·m/rad]
     viscosity : numpy.ndarray, shape (M, 5)
         Pair viscosity of each run. [N·m·s/rad]
+    disturbance_scale : numpy.ndarray, shape (M,), optional
+        Factor on the base experiment's platform motion per run; None when not
+        varied (every run has the base motion). [-]
     """
 
     names: tuple[str, ...]
     values: np.ndarray
     stiffness: np.ndarray
     viscosity: np.ndarray
+    disturbance_scale: np.ndarray | None = None
 
     @property
     def n_runs(self) -> int:
@@ -256,12 +265,15 @@ def sweep_grid(scenario: Scenario, varies: Sequence[VaryRange],
     m = values.shape[0]
     stiffness = np.tile(np.asarray(scenario.muscles.stiffnesses, dtype=float), (m, 1))
     ratios = np.tile(_base_ratios(scenario, viscosity_ratio), (m, 1))
+    scale = None
     for k, name in enumerate(names):
         if name == "viscosity_ratio":
             ratios[:] = values[:, k:k + 1]
+        elif name == "disturbance_scale":
+            scale = np.ascontiguousarray(values[:, k])
         else:
             stiffness[:, PAPER_PAIR_NAMES.index(name)] = values[:, k]
-    return SweepGrid(tuple(names), values, stiffness, ratios * stiffness)
+    return SweepGrid(tuple(names), values, stiffness, ratios * stiffness, scale)
 
 
 # ---------------------------------------------------------------------------
@@ -379,18 +391,24 @@ class _Task:
     rtol: float
     atol: float
 
-    def run(self, stiffness: np.ndarray, viscosity: np.ndarray, parallel: bool) -> BatchResult:
+    def run(self, stiffness: np.ndarray, viscosity: np.ndarray, scale: np.ndarray | None,
+            parallel: bool) -> BatchResult:
         sc = self.scenario
         return simulate_batch(
             sc.body, stiffness, viscosity, sc.disturbance, sc.duration, sc.initial_state,
             muscles=sc.muscles, rates_from=sc.rates_from, knee=sc.knee, fall=sc.fall,
             rtol=self.rtol, atol=self.atol, sample_rate=sc.sample_rate,
-            settle_tolerance=SETTLE_TOLERANCE, parallel=parallel)
+            settle_tolerance=SETTLE_TOLERANCE, parallel=parallel, disturbance_scale=scale)
 
 
-def _run_chunk(task: _Task, stiffness: np.ndarray, viscosity: np.ndarray) -> BatchResult:
+def _run_chunk(task: _Task, stiffness: np.ndarray, viscosity: np.ndarray,
+               scale: np.ndarray | None) -> BatchResult:
     """A chunk on a Dask worker: one thread per task (the worker's threads run tasks)."""
-    return task.run(stiffness, viscosity, parallel=False)
+    return task.run(stiffness, viscosity, scale, parallel=False)
+
+
+def _rows(values: np.ndarray | None, lo: int, hi: int) -> np.ndarray | None:
+    return None if values is None else values[lo:hi]
 
 
 def _concatenate(parts: list[BatchResult]) -> BatchResult:
@@ -507,7 +525,8 @@ def run_sweep(
         parts = []
         done = 0
         for lo, hi in bounds:
-            parts.append(task.run(grid.stiffness[lo:hi], grid.viscosity[lo:hi], parallel=True))
+            parts.append(task.run(grid.stiffness[lo:hi], grid.viscosity[lo:hi],
+                                  _rows(grid.disturbance_scale, lo, hi), parallel=True))
             done += hi - lo
             if progress is not None:
                 progress(done, m)
@@ -540,7 +559,8 @@ def _run_on_dask(task, grid, bounds, workers, scheduler, client, progress) -> li
                 own_client = client = distributed.Client(own_cluster)
         shared = client.scatter(task, broadcast=True)
         futures = [client.submit(_run_chunk, shared, grid.stiffness[lo:hi],
-                                 grid.viscosity[lo:hi], pure=False) for lo, hi in bounds]
+                                 grid.viscosity[lo:hi], _rows(grid.disturbance_scale, lo, hi),
+                                 pure=False) for lo, hi in bounds]
         index = {f.key: k for k, f in enumerate(futures)}
         parts: list[BatchResult | None] = [None] * len(futures)
         done = 0

@@ -25,8 +25,11 @@ Simulate the nonlinear model for every combination of the --vary values (the ful
 the first --vary varying slowest) with the compiled simulator, and write one row per run.
 
 --vary NAME=LO:HI:N takes N evenly spaced values from LO to HI inclusive (N >= 1; N = 1
-needs LO = HI). NAME is a pair stiffness [N·m/rad] ({", ".join(SWEEP_PARAMETERS[:-1])})
-or viscosity_ratio [s]; repeat --vary for each parameter. Every other gain comes from the
+needs LO = HI). NAME is a pair stiffness [N·m/rad] ({", ".join(SWEEP_PARAMETERS[:-2])}),
+viscosity_ratio [s], or disturbance_scale [-], a factor on the base experiment's platform
+motion (velocity-step speed, pulse peak, ramp displacement, sine amplitudes, measured
+accelerations: --vary disturbance_scale=0.5:3:26 with a 1 m/s step sweeps 0.5-3 m/s);
+repeat --vary for each parameter. Every other gain comes from the
 base experiment: --case/--stiffness with --disturbance (as in posturelab simulate),
 --scenario FILE.toml or --builtin NAME. A pair's viscosity is the ratio times its
 stiffness: the varied viscosity_ratio, else --viscosity-ratio, else the base experiment's
@@ -50,7 +53,8 @@ and centre-of-pressure falls are not compiled: use posturelab simulate for those
 
 def add_parser(sub, name: str) -> argparse.ArgumentParser:
     p = sub.add_parser(
-        name, help="simulate a grid of pair gains; outcomes to CSV or Parquet",
+        name, help="simulate a grid of pair gains and perturbation sizes; outcomes to CSV "
+        "or Parquet",
         description=DESCRIPTION, epilog=CONVENTIONS_EPILOG,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )

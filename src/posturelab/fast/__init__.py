@@ -523,6 +523,7 @@ def simulate_batch(
     parallel: bool = True,
     chunk: int = 8,
     method: str = "Radau",
+    disturbance_scale: np.ndarray | None = None,
 ) -> BatchResult:
     """Simulate M gain sets on one body and disturbance; keep only the outcomes.
 
@@ -566,6 +567,11 @@ def simulate_batch(
         Runs per parallel work item. [-]
     method : {"Radau", "RK45", "RK23"}
         The compiled integrator, as for :func:`simulate_fast`.
+    disturbance_scale : array_like, shape (M,), optional
+        Run r's disturbance is ``disturbance.scaled(disturbance_scale[r])``
+        (:meth:`posturelab.platform.Disturbance.scaled`: the step speed, pulse
+        peak, ramp displacement, sine amplitudes or measured accelerations times
+        the factor); by default every run has ``disturbance`` as it is. [-]
 
     Returns
     -------
@@ -598,22 +604,43 @@ def simulate_batch(
                rtol, atol, sample_rate, max_switches, settle_tolerance, method)
     M = kd_all.shape[0]
     n = body.n_links
+    if disturbance_scale is None:
+        levels = [s]
+        which = np.zeros(M, dtype=np.int64)
+    else:
+        scale = finite_array("disturbance_scale [-]", disturbance_scale, (M,))
+        values, which = np.unique(scale, return_inverse=True)
+        # one set-up per distinct scale: its initial state (a scaled velocity step) and
+        # its packed disturbance; the breakpoints do not depend on the scale
+        levels = [_setup(body, muscles, disturbance.scaled(float(v)), duration, initial_state,
+                         rates_from, knee, fall, rtol, atol, sample_rate, max_switches,
+                         settle_tolerance, method) for v in values]
+        which = np.ascontiguousarray(which.ravel(), dtype=np.int64)
+    # read-only like the single-run arrays, so that the kernels share one compiled form
+    x0_all = np.stack([lv.x0 for lv in levels])
+    dp_all = np.stack([lv.dist.packed for lv in levels])
+    x0_all.setflags(write=False)
+    dp_all.setflags(write=False)
+    which.setflags(write=False)
     results = np.zeros((M, kern.N_RESULT))
     peaks = np.zeros((M, n))
     finals = np.zeros((M, 2 * n))
-    if s.fall_at_start is not None:
-        # every run falls at t = 0 whatever its gains (the reference's check at the start)
-        results[:, kern.R_STATUS] = kern.STATUS_FELL
-        results[:, kern.R_FALL_TIME] = 0.0
-        peaks[:] = np.abs(s.x0[:n])
-        finals[:] = s.x0
-    elif M:
-        args = (s.x0, s.grid, s.mp0, s.E, kd_all, ld_all, s.one_sided, s.dist.packed, s.bps,
+    at_start = np.array([lv.fall_at_start is not None for lv in levels])
+    if M and not at_start.all():
+        args = (x0_all, which, s.grid, s.mp0, s.E, kd_all, ld_all, s.one_sided, dp_all, s.bps,
                 s.fpar, s.ipar, results, peaks, finals)
         if parallel:
             kern.run_batch_parallel(*args, int(chunk))
         else:
             kern.run_batch_serial(*args)
+    if at_start.any():
+        # these runs fall at t = 0 whatever their gains (the reference's check at the start)
+        rows = at_start[which]
+        results[rows] = 0.0
+        results[rows, kern.R_STATUS] = kern.STATUS_FELL
+        results[rows, kern.R_FALL_TIME] = 0.0
+        peaks[rows] = np.abs(x0_all[which[rows], :n])
+        finals[rows] = x0_all[which[rows]]
     status = results[:, kern.R_STATUS].astype(np.int8)
     fell = status == kern.STATUS_FELL
     fall_time = np.where(fell, results[:, kern.R_FALL_TIME], np.nan)

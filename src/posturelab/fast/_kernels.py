@@ -2240,32 +2240,38 @@ def run_one(x0, grid, mp0, E, kd, ld, one_sided, dp, bps, fpar, ipar):
 
 
 @njit(cache=True, error_model="numpy", fastmath=_CONTRACT, nogil=True)
-def run_batch_serial(x0, grid, mp0, E, kd_all, ld_all, one_sided, dp, bps, fpar, ipar,
-                     results, peaks, finals):
-    """Runs one after another in the calling thread, without the GIL (outcomes only)."""
-    dummy = np.empty((x0.size, 0))
+def run_batch_serial(x0_all, which, grid, mp0, E, kd_all, ld_all, one_sided, dp_all, bps, fpar,
+                     ipar, results, peaks, finals):
+    """Runs one after another in the calling thread, without the GIL (outcomes only).
+
+    Run r starts from ``x0_all[which[r]]`` under the disturbance ``dp_all[which[r]]``
+    (one row per distinct disturbance scale; a single row when nothing is scaled)."""
+    dummy = np.empty((x0_all.shape[1], 0))
     dummy_locked = np.empty(0, np.bool_)
     switch_times = np.empty(1)
     for r in range(kd_all.shape[0]):
-        results[r] = _integrate(x0, grid, mp0, E, kd_all[r], ld_all[r], one_sided, dp, bps,
-                                fpar, ipar, dummy, dummy_locked, switch_times, peaks[r],
-                                finals[r])
+        w = which[r]
+        results[r] = _integrate(x0_all[w], grid, mp0, E, kd_all[r], ld_all[r], one_sided,
+                                dp_all[w], bps, fpar, ipar, dummy, dummy_locked, switch_times,
+                                peaks[r], finals[r])
 
 
 @njit(cache=True, parallel=True, error_model="numpy", fastmath=_CONTRACT)
-def run_batch_parallel(x0, grid, mp0, E, kd_all, ld_all, one_sided, dp, bps, fpar, ipar,
-                       results, peaks, finals, chunk):
-    """Runs spread over numba's threads, ``chunk`` runs per work item (outcomes only)."""
+def run_batch_parallel(x0_all, which, grid, mp0, E, kd_all, ld_all, one_sided, dp_all, bps,
+                       fpar, ipar, results, peaks, finals, chunk):
+    """Runs spread over numba's threads, ``chunk`` runs per work item (outcomes only; the
+    arguments as for :func:`run_batch_serial`)."""
     M = kd_all.shape[0]
     n_chunks = (M + chunk - 1) // chunk
     for c in prange(n_chunks):
-        dummy = np.empty((x0.size, 0))
+        dummy = np.empty((x0_all.shape[1], 0))
         dummy_locked = np.empty(0, np.bool_)
         switch_times = np.empty(1)
         for r in range(c * chunk, min(M, c * chunk + chunk)):
-            results[r] = _integrate(x0, grid, mp0, E, kd_all[r], ld_all[r], one_sided, dp, bps,
-                                    fpar, ipar, dummy, dummy_locked, switch_times, peaks[r],
-                                    finals[r])
+            w = which[r]
+            results[r] = _integrate(x0_all[w], grid, mp0, E, kd_all[r], ld_all[r], one_sided,
+                                    dp_all[w], bps, fpar, ipar, dummy, dummy_locked,
+                                    switch_times, peaks[r], finals[r])
 
 
 # ---------------------------------------------------------------------------
