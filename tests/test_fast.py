@@ -251,6 +251,13 @@ def test_derived_series_are_computed_on_first_access_and_kept():
     # U = −EᵀM, from the series just computed
     E = paper_muscles("1").selection_matrix
     np.testing.assert_allclose(fast.joint_torques, -torques @ E, rtol=1e-12, atol=1e-9)
+    # a deferred result pickles (for process pools) and computes the same series after
+    import pickle
+
+    fresh = simulate_fast(paper_body(), paper_muscles("1"), VelocityStep.backward(0.5), 0.5,
+                          initial_state=PAPER_POSTURE)
+    again = pickle.loads(pickle.dumps(fresh))
+    np.testing.assert_array_equal(again.cog_position, fast.cog_position)
 
 
 def test_a_result_without_its_derived_series_says_so():
