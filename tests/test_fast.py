@@ -504,3 +504,22 @@ def test_batch_disturbance_scale_equals_single_runs_bit_for_bit(disturbance):
     with pytest.raises(ParameterError, match="disturbance_scale"):
         simulate_batch(paper_body(), k, 0.25 * k, disturbance, 1.5, PAPER_POSTURE,
                        disturbance_scale=[1.0, 2.0])
+
+
+def test_batch_disturbance_scale_with_a_knee_stop_starts_each_level_as_its_single_run():
+    """Whether the knee starts locked at its stop depends on the knee rate after the step,
+    which the scale changes (here even its sign): each level starts as its own single run."""
+    knee = KneeModel("stop")
+    step = VelocityStep.backward(0.3)
+    k = np.tile(np.asarray(paper_muscles("1").stiffnesses), (4, 1))
+    scale = np.array([-1.0, 1.0, -1.0, 0.5])
+    out = simulate_batch(paper_body(), k, 0.25 * k, step, 1.0, None, knee=knee,
+                         disturbance_scale=scale)
+    for r in range(4):
+        one = simulate_fast(paper_body(), paper_muscles("1"), step.scaled(scale[r]), 1.0,
+                            knee=knee)
+        np.testing.assert_array_equal(one.final_state, out.final_state[r])
+        np.testing.assert_array_equal(one.max_abs_theta, out.peak_theta[r])
+    empty = simulate_batch(paper_body(), np.zeros((0, 5)), np.zeros((0, 5)), step, 1.0,
+                           disturbance_scale=np.zeros(0))
+    assert empty.n_runs == 0

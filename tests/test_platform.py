@@ -128,3 +128,14 @@ def test_scaled_rejects_a_non_finite_factor():
         VelocityStep.backward(1.0).scaled(float("nan"))
     with pytest.raises(ParameterError, match="factor"):
         NoDisturbance().scaled(float("inf"))
+
+
+def test_a_disturbance_that_does_not_define_scaling_is_refused():
+    from posturelab.platform import Disturbance
+
+    class Custom(Disturbance):
+        pass
+
+    with pytest.raises(ParameterError, match="Custom does not define how to scale"):
+        Custom().scaled(2.0)
+    assert NoDisturbance().scaled(3.0) == NoDisturbance()

@@ -15,7 +15,7 @@ from posturelab.errors import ParameterError
 from posturelab.fast import simulate_batch, simulate_fast
 from posturelab.muscles import paper_muscles
 from posturelab.paper import BACKWARD_INITIAL_STATE
-from posturelab.platform import VelocityStep
+from posturelab.platform import NoDisturbance, VelocityStep
 from posturelab.scenarios import builtin_scenario
 from posturelab.sweep import (
     OUTCOME_COLUMNS,
@@ -122,6 +122,12 @@ def test_disturbance_scale_sweeps_the_perturbation_size():
     # the peak lean grows with the perturbation for the runs that do not fall
     strong = o.peak_theta[3:, 0]
     assert np.all(np.diff(strong) > 0)
+
+
+def test_disturbance_scale_needs_a_platform_motion():
+    sc = builtin_scenario("paper-backward-case1").replace(disturbance=NoDisturbance())
+    with pytest.raises(ParameterError, match="has none"):
+        run_sweep(sc, [parse_vary("disturbance_scale=0.5:1:2")])
 
 
 def test_dask_path_equals_the_local_path():

@@ -81,15 +81,20 @@ class Disturbance:
         The velocity step's speed, a pulse's peak, a ramp's displacement, the
         sines' amplitudes and a measured profile's accelerations scale; times,
         durations and frequencies (and so the breakpoints) do not. A negative
-        factor reverses the motion; 0 leaves the platform still.
+        factor reverses the motion; 0 leaves the platform still. A subclass
+        that does not define how it scales is refused.
         """
-        finite_float("factor [-]", factor)
-        return self
+        raise ParameterError(f"{type(self).__name__} does not define how to scale itself "
+                             "(a scaled() method)")
 
 
 @dataclass(frozen=True)
 class NoDisturbance(Disturbance):
     """The platform stays still."""
+
+    def scaled(self, factor: float) -> NoDisturbance:
+        finite_float("factor [-]", factor)
+        return self
 
 
 @dataclass(frozen=True)

@@ -43,6 +43,7 @@ import numpy as np
 from .errors import ParameterError, PostureLabError
 from .fast import DEFAULT_ATOL, DEFAULT_RTOL, BatchResult, simulate_batch
 from .muscles import DEFAULT_VISCOSITY_RATIO, PAPER_PAIR_NAMES
+from .platform import NoDisturbance
 from .results import atomic_write_bytes, atomic_write_text
 from .scenarios import Scenario
 
@@ -265,6 +266,10 @@ def sweep_grid(scenario: Scenario, varies: Sequence[VaryRange],
     m = values.shape[0]
     stiffness = np.tile(np.asarray(scenario.muscles.stiffnesses, dtype=float), (m, 1))
     ratios = np.tile(_base_ratios(scenario, viscosity_ratio), (m, 1))
+    if "disturbance_scale" in names and isinstance(scenario.disturbance, NoDisturbance):
+        raise ParameterError("disturbance_scale multiplies the base experiment's platform "
+                             "motion, and it has none: give --disturbance, a profile or a "
+                             "scenario with a disturbance")
     scale = None
     for k, name in enumerate(names):
         if name == "viscosity_ratio":

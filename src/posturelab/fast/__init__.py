@@ -604,11 +604,12 @@ def simulate_batch(
                rtol, atol, sample_rate, max_switches, settle_tolerance, method)
     M = kd_all.shape[0]
     n = body.n_links
-    if disturbance_scale is None:
+    if disturbance_scale is not None:
+        scale = finite_array("disturbance_scale [-]", disturbance_scale, (M,))
+    if disturbance_scale is None or M == 0:
         levels = [s]
         which = np.zeros(M, dtype=np.int64)
     else:
-        scale = finite_array("disturbance_scale [-]", disturbance_scale, (M,))
         values, which = np.unique(scale, return_inverse=True)
         # one set-up per distinct scale: its initial state (a scaled velocity step) and
         # its packed disturbance; the breakpoints do not depend on the scale
@@ -617,18 +618,19 @@ def simulate_batch(
                          settle_tolerance, method) for v in values]
         which = np.ascontiguousarray(which.ravel(), dtype=np.int64)
     # read-only like the single-run arrays, so that the kernels share one compiled form
+    # (whether the knee starts locked, in ipar, depends on the scaled initial state too)
     x0_all = np.stack([lv.x0 for lv in levels])
     dp_all = np.stack([lv.dist.packed for lv in levels])
-    x0_all.setflags(write=False)
-    dp_all.setflags(write=False)
-    which.setflags(write=False)
+    ipar_all = np.stack([lv.ipar for lv in levels])
+    for arr in (x0_all, dp_all, ipar_all, which):
+        arr.setflags(write=False)
     results = np.zeros((M, kern.N_RESULT))
     peaks = np.zeros((M, n))
     finals = np.zeros((M, 2 * n))
     at_start = np.array([lv.fall_at_start is not None for lv in levels])
     if M and not at_start.all():
         args = (x0_all, which, s.grid, s.mp0, s.E, kd_all, ld_all, s.one_sided, dp_all, s.bps,
-                s.fpar, s.ipar, results, peaks, finals)
+                s.fpar, ipar_all, results, peaks, finals)
         if parallel:
             kern.run_batch_parallel(*args, int(chunk))
         else:

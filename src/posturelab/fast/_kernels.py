@@ -1344,8 +1344,10 @@ def _radau_error(h, x, y, f0, Z, jac, lur, pivr, n, rtol, atol, err, tmpr):
 
 @njit(cache=True, error_model="numpy", fastmath=_CONTRACT)
 def _radau_predict(h, h_old, err, err_old):
-    """scipy's predict_factor (Gustafsson's predictive control, exponent 1/4)."""
-    if err_old < 0.0 or h_old <= 0.0 or err == 0.0:
+    """scipy's predict_factor (Gustafsson's predictive control, exponent 1/4), except that
+    a previous error of exactly 0 (a step from rest before any motion) counts as no
+    history: scipy's formula would make the factor 0."""
+    if err_old <= 0.0 or h_old <= 0.0 or err == 0.0:
         mult = 1.0
     else:
         mult = h / h_old * (err_old / err) ** 0.25
@@ -1702,6 +1704,7 @@ def _integrate(x0, grid, mp0, E, kd, ld, one_sided, dp, bps, fpar, ipar, samples
     h_old = -1.0
     err_old = -1.0
     h_start = 0.0
+    err_rejected = False  # an error-norm rejection in this step (scipy's `rejected`)
     t_prev = 0.0
     h_prev = 1.0
 
@@ -1763,6 +1766,7 @@ def _integrate(x0, grid, mp0, E, kd, ld, one_sided, dp, bps, fpar, ipar, samples
                                            scratch)
                 current_jac = True
                 have_sol = False
+                err_rejected = False
                 h_lu = -1.0
                 h_old = -1.0
                 err_old = -1.0
@@ -1845,7 +1849,7 @@ def _integrate(x0, grid, mp0, E, kd, ld, one_sided, dp, bps, fpar, ipar, samples
             if not converged:
                 h = 0.5 * h
                 n_rejected += 1
-                last_rejected = True
+                last_rejected = True  # a retry of the same step (keeps h_start)
                 continue
             for i in range(m):
                 ytmp[i] = x[i] + rZ[2, i]
@@ -1855,7 +1859,7 @@ def _integrate(x0, grid, mp0, E, kd, ld, one_sided, dp, bps, fpar, ipar, samples
                 err_norm = _radau_error(h, x, ytmp, stg[0], rZ, jac, lur, pivr, n, rtol, atol,
                                         rerr, rtmpr)
             safety = 0.9 * (2 * _NEWTON_MAXITER + 1) / (2 * _NEWTON_MAXITER + n_iter)
-            if last_rejected and err_norm > 1.0:
+            if err_rejected and err_norm > 1.0:
                 # after a rejection, one more smoothing of the estimate (scipy, Hairer)
                 for i in range(m):
                     rxt[i] = x[i] + rerr[i]
@@ -1874,6 +1878,7 @@ def _integrate(x0, grid, mp0, E, kd, ld, one_sided, dp, bps, fpar, ipar, samples
                 else:
                     h = 0.2 * h
                 last_rejected = True
+                err_rejected = True
                 continue
             # ---- accepted ----
             n_steps += 1
@@ -1907,6 +1912,7 @@ def _integrate(x0, grid, mp0, E, kd, ld, one_sided, dp, bps, fpar, ipar, samples
             err_old = err_norm
             h_next = h * fac
             last_rejected = False
+            err_rejected = False
             for i in range(m):
                 z0 = rZ[0, i]
                 z1 = rZ[1, i]
@@ -2241,24 +2247,26 @@ def run_one(x0, grid, mp0, E, kd, ld, one_sided, dp, bps, fpar, ipar):
 
 @njit(cache=True, error_model="numpy", fastmath=_CONTRACT, nogil=True)
 def run_batch_serial(x0_all, which, grid, mp0, E, kd_all, ld_all, one_sided, dp_all, bps, fpar,
-                     ipar, results, peaks, finals):
+                     ipar_all, results, peaks, finals):
     """Runs one after another in the calling thread, without the GIL (outcomes only).
 
     Run r starts from ``x0_all[which[r]]`` under the disturbance ``dp_all[which[r]]``
-    (one row per distinct disturbance scale; a single row when nothing is scaled)."""
+    with the integer options ``ipar_all[which[r]]`` (whether the knee starts locked
+    depends on the initial state): one row per distinct disturbance scale, a single
+    row when nothing is scaled."""
     dummy = np.empty((x0_all.shape[1], 0))
     dummy_locked = np.empty(0, np.bool_)
     switch_times = np.empty(1)
     for r in range(kd_all.shape[0]):
         w = which[r]
         results[r] = _integrate(x0_all[w], grid, mp0, E, kd_all[r], ld_all[r], one_sided,
-                                dp_all[w], bps, fpar, ipar, dummy, dummy_locked, switch_times,
-                                peaks[r], finals[r])
+                                dp_all[w], bps, fpar, ipar_all[w], dummy, dummy_locked,
+                                switch_times, peaks[r], finals[r])
 
 
 @njit(cache=True, parallel=True, error_model="numpy", fastmath=_CONTRACT)
 def run_batch_parallel(x0_all, which, grid, mp0, E, kd_all, ld_all, one_sided, dp_all, bps,
-                       fpar, ipar, results, peaks, finals, chunk):
+                       fpar, ipar_all, results, peaks, finals, chunk):
     """Runs spread over numba's threads, ``chunk`` runs per work item (outcomes only; the
     arguments as for :func:`run_batch_serial`)."""
     M = kd_all.shape[0]
@@ -2270,7 +2278,7 @@ def run_batch_parallel(x0_all, which, grid, mp0, E, kd_all, ld_all, one_sided, d
         for r in range(c * chunk, min(M, c * chunk + chunk)):
             w = which[r]
             results[r] = _integrate(x0_all[w], grid, mp0, E, kd_all[r], ld_all[r], one_sided,
-                                    dp_all[w], bps, fpar, ipar, dummy, dummy_locked,
+                                    dp_all[w], bps, fpar, ipar_all[w], dummy, dummy_locked,
                                     switch_times, peaks[r], finals[r])
 
 
