@@ -1,0 +1,50 @@
+"""The example scripts that compute something beyond the paper, checked independently."""
+
+from __future__ import annotations
+
+import importlib.util
+from pathlib import Path
+
+import numpy as np
+
+from posturelab.body import paper_body
+from posturelab.muscles import paper_muscles
+from posturelab.platform import VelocityStep
+from posturelab.recovery import largest_recoverable
+from posturelab.simulate import FOOT_FROM_LITERATURE, FallCriteria, simulate
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+
+
+def _load(name: str):
+    spec = importlib.util.spec_from_file_location(name, EXAMPLES / f"{name}.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_largest_step_grid_brackets_the_reference_bisection(tmp_path):
+    """The batch grid's boundary (largest speed recovered, smallest that fell) must bracket
+    the boundary that bisection finds with the reference simulator (scipy DOP853), run by
+    run; the example also writes its figure."""
+    example = _load("largest_step_vs_ankle")
+    ankle = np.array([400.0, 900.0])
+    speed = np.linspace(0.1, 3.0, 30)
+    recovered, first_fall = example.largest_recovered(ankle, speed, duration=3.0)
+    assert np.all(np.isfinite(recovered)) and np.all(np.isfinite(first_fall))
+    assert recovered[1] > recovered[0]  # a stiffer ankle absorbs a larger step
+    fall = FallCriteria(base_of_support=FOOT_FROM_LITERATURE)
+    base = np.asarray(paper_muscles("1").stiffnesses, dtype=float)
+    for a, lo, hi in zip(ankle, recovered, first_fall, strict=True):
+        k = base.copy()
+        k[0] = a
+        muscles = paper_muscles(stiffness=k, viscosity=0.25 * k)
+
+        def run(v, muscles=muscles):
+            return simulate(paper_body(), muscles, VelocityStep.backward(v), 3.0, fall=fall)
+
+        # raises if the reference disagrees at either end of the grid's bracket
+        boundary = largest_recoverable(run, lo, hi, tolerance=0.02)
+        assert lo <= boundary.estimate <= hi
+    figure = example.main(tmp_path)
+    assert figure.exists() and figure.stat().st_size > 10_000
