@@ -153,3 +153,32 @@ def test_cli_torque_limits(capsys):
     code = main(["simulate", "--case", "1", "--torque-limits", "90,x,inf"])
     err = capsys.readouterr().err
     assert code == 2 and "--torque-limits" in err and len(err.strip().splitlines()) == 1
+
+
+def test_batch_bisection_equals_one_bisection_per_gain_set():
+    """largest_recoverable_batch brackets each gain set exactly where largest_recoverable
+    brackets it with simulate_fast and the scaled step (same engine, same midpoints); a set
+    that falls at low or recovers at high is reported, not bisected."""
+    from posturelab.fast import simulate_fast
+    from posturelab.recovery import largest_recoverable_batch
+
+    body = pl.paper_body()
+    fall = pl.FallCriteria(base_of_support=pl.FOOT_FROM_LITERATURE)
+    step = pl.VelocityStep.backward(1.0)
+    base = np.asarray(pl.paper_muscles("1").stiffnesses, dtype=float)
+    k = np.tile(base, (4, 1))
+    k[:, 0] = [400.0, 900.0, 60.0, 3000.0]
+    out = largest_recoverable_batch(body, k, 0.25 * k, step, 3.0, 0.1, 1.6, tolerance=0.01,
+                                    fall=fall)
+    assert out.bracketed.tolist() == [True, True, False, False]
+    assert math.isnan(out.recovered[2]) and out.fell[2] == 0.1  # falls even at 0.1
+    assert out.recovered[3] == 1.6 and math.isnan(out.fell[3])  # recovers even at 1.6
+    for r in (0, 1):
+        muscles = pl.paper_muscles(stiffness=k[r], viscosity=0.25 * k[r])
+
+        def run(s, muscles=muscles):
+            return simulate_fast(body, muscles, step.scaled(s), 3.0, fall=fall)
+
+        one = largest_recoverable(run, 0.1, 1.6, tolerance=0.01)
+        assert (out.recovered[r], out.fell[r]) == (one.recovered, one.fell)
+    assert out.recovered[1] > out.recovered[0]

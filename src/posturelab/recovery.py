@@ -11,11 +11,14 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 
+import numpy as np
+
 from ._validation import positive_float
 from .errors import ParameterError
 from .results import SimulationResult
 
-__all__ = ["RecoveryBoundary", "largest_recoverable"]
+__all__ = ["RecoveryBoundary", "largest_recoverable", "BatchRecoveryBoundaries",
+           "largest_recoverable_batch"]
 
 
 @dataclass(frozen=True)
@@ -88,3 +91,119 @@ def largest_recoverable(
         else:
             low = mid
     return RecoveryBoundary(low, high, reason, count)
+
+
+@dataclass(frozen=True)
+class BatchRecoveryBoundaries:
+    """Brackets of the largest recoverable disturbance scale of many gain sets (row r is
+    gain set r).
+
+    Attributes
+    ----------
+    recovered : numpy.ndarray, shape (M,)
+        Largest scale tried that did not fall (``high`` where even that recovered);
+        NaN where ``low`` already fell. [-]
+    fell : numpy.ndarray, shape (M,)
+        Smallest scale tried that fell (``low`` where even that fell); NaN where
+        ``high`` still recovered. [-]
+    n_simulations : int
+        Simulations run in all. [-]
+    """
+
+    recovered: np.ndarray
+    fell: np.ndarray
+    n_simulations: int
+
+    @property
+    def estimate(self) -> np.ndarray:
+        """Midpoint of each bracket (NaN where there is none). [-]"""
+        return 0.5 * (self.recovered + self.fell)
+
+    @property
+    def bracketed(self) -> np.ndarray:
+        """True where ``low`` recovered and ``high`` fell. [-]"""
+        return np.isfinite(self.recovered) & np.isfinite(self.fell)
+
+
+def largest_recoverable_batch(
+    body,
+    stiffness: np.ndarray,
+    viscosity: np.ndarray,
+    disturbance,
+    duration: float,
+    low: float,
+    high: float,
+    *,
+    tolerance: float = 1e-3,
+    max_rounds: int = 60,
+    **batch_options,
+) -> BatchRecoveryBoundaries:
+    """Bisect, for every gain set at once, for the largest factor on ``disturbance`` that
+    does not fall (the compiled simulator, :func:`posturelab.fast.simulate_batch`).
+
+    Each round runs every still-open gain set at the midpoint of its own bracket
+    (``disturbance_scale``), so M gain sets cost about log2((high − low)/tolerance)
+    batches. Row r's bracket is the one :func:`largest_recoverable` finds with
+    ``run(s) = simulate_fast(..., disturbance.scaled(s))`` for gain set r.
+
+    Parameters
+    ----------
+    body : Body
+        The chain.
+    stiffness, viscosity : array_like, shape (M, P)
+        Pair gains per gain set. [N·m/rad], [N·m·s/rad]
+    disturbance : Disturbance
+        The motion at factor 1 (e.g. a 1 m/s velocity step, so that the factor
+        reads as a speed in m/s).
+    duration : float
+        Simulated time of each run. [s]
+    low, high : float
+        Factors assumed to recover and to fall (checked per gain set). [-]
+    tolerance : float
+        Width of the final brackets. [-]
+    max_rounds : int
+        Most bisection rounds. [-]
+    **batch_options
+        Passed to :func:`posturelab.fast.simulate_batch` (``initial_state``,
+        ``muscles``, ``knee``, ``fall``, ``rtol``, …).
+
+    Returns
+    -------
+    BatchRecoveryBoundaries
+    """
+    from .fast import simulate_batch
+
+    positive_float("tolerance", tolerance)
+    if not low < high:
+        raise ParameterError(f"low must be < high, got {low:g} and {high:g}")
+    if "disturbance_scale" in batch_options:
+        raise ParameterError("largest_recoverable_batch sets disturbance_scale itself")
+    stiffness = np.asarray(stiffness, dtype=float)
+    viscosity = np.asarray(viscosity, dtype=float)
+    m = stiffness.shape[0] if stiffness.ndim == 2 else 1
+    stiffness = stiffness.reshape(m, -1)
+    viscosity = viscosity.reshape(m, -1)
+
+    def falls(rows: np.ndarray, scale: np.ndarray) -> np.ndarray:
+        out = simulate_batch(body, stiffness[rows], viscosity[rows], disturbance, duration,
+                             disturbance_scale=scale, **batch_options)
+        return out.fell
+
+    every = np.arange(m)
+    fell_low = falls(every, np.full(m, float(low)))
+    fell_high = falls(every, np.full(m, float(high)))
+    count = 2 * m
+    open_ = ~fell_low & fell_high
+    # outside a bracket: the largest factor tried that recovered, the smallest that fell
+    lo = np.where(fell_low, np.nan, np.where(fell_high, float(low), float(high)))
+    hi = np.where(fell_low, float(low), np.where(fell_high, float(high), np.nan))
+    for _ in range(max_rounds):
+        rows = np.nonzero(open_ & (hi - lo > tolerance))[0]
+        if rows.size == 0:
+            break
+        mid = 0.5 * (lo[rows] + hi[rows])
+        f = falls(rows, mid)
+        count += rows.size
+        hi[rows[f]] = mid[f]
+        lo[rows[~f]] = mid[~f]
+    return BatchRecoveryBoundaries(lo, hi, count)
