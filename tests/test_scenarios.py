@@ -113,3 +113,19 @@ def test_unknown_replace_field():
 
     with pytest.raises(ParameterError, match="durration"):
         builtin_scenario("paper-forward-case1").replace(durration=2)
+
+
+def test_scenario_run_on_either_engine():
+    """Scenario.run(engine="fast") is the compiled simulator at the scenario's tolerances;
+    it agrees with the reference run to 1e-6 rad; an unknown engine is refused."""
+    import numpy as np
+
+    from posturelab.errors import ParameterError
+    from posturelab.scenarios import builtin_scenario
+
+    sc = builtin_scenario("paper-forward-case2")
+    ref, fast = sc.run(), sc.run(engine="fast")
+    assert fast.fell == ref.fell and abs(fast.fall_time - ref.fall_time) < 1e-6
+    np.testing.assert_allclose(fast.theta, ref.theta, rtol=0, atol=1e-6)
+    with pytest.raises(ParameterError, match="engine"):
+        sc.run(engine="turbo")

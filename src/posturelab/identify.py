@@ -202,16 +202,7 @@ def fit_stiffness(
         stiff = {nm: v for nm, v in zip(names, params, strict=True) if nm != VISCOSITY_RATIO}
         ratio = (params[names.index(VISCOSITY_RATIO)] if VISCOSITY_RATIO in names
                  else viscosity_ratio)
-        muscles = _muscles_with(scenario.muscles, stiff, ratio)
-        if engine == "reference":
-            return sc.run(muscles=muscles)
-        from .fast import simulate_fast
-
-        return simulate_fast(
-            sc.body, muscles, sc.disturbance, sc.duration, initial_state=sc.initial_state,
-            rates_from=sc.rates_from, knee=sc.knee, fall=sc.fall,
-            torque_limits=sc.torque_limits, feedback_delay=sc.feedback_delay, rtol=sc.rtol,
-            atol=sc.atol, sample_rate=sc.sample_rate, description=sc.description)
+        return sc.run(engine=engine, muscles=_muscles_with(scenario.muscles, stiff, ratio))
 
     def residuals(params: np.ndarray) -> np.ndarray:
         r = run(params)

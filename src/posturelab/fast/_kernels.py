@@ -1705,6 +1705,7 @@ def _integrate(x0, grid, mp0, E, kd, ld, one_sided, dp, bps, fpar, ipar, samples
     err_old = -1.0
     h_start = 0.0
     err_rejected = False  # an error-norm rejection in this step (scipy's `rejected`)
+    newton_tol = max(10.0 * _EPS / rtol, min(0.03, math.sqrt(rtol)))  # scipy's
     t_prev = 0.0
     h_prev = 1.0
 
@@ -1819,7 +1820,6 @@ def _integrate(x0, grid, mp0, E, kd, ld, one_sided, dp, bps, fpar, ipar, samples
                 rscale[i] = atol + abs(x[i]) * rtol
                 if n3:
                     rscale[i] = 1.0 / rscale[i]
-            newton_tol = max(10.0 * _EPS / rtol, min(0.03, math.sqrt(rtol)))
             converged = False
             n_iter = 0
             rate = -1.0

@@ -157,16 +157,29 @@ class Scenario:
     torque_limits: tuple[float, ...] | None = None
     feedback_delay: float = 0.0
 
-    def run(self, **overrides: Any) -> SimulationResult:
-        """Simulate this scenario; keyword ``overrides`` replace fields first."""
+    def run(self, *, engine: str = "reference", **overrides: Any) -> SimulationResult:
+        """Simulate this scenario; keyword ``overrides`` replace fields first.
+
+        ``engine="reference"`` (default) runs :func:`posturelab.simulate.simulate`
+        with the scenario's ``solver.method``; ``engine="fast"`` runs the compiled
+        :func:`posturelab.fast.simulate_fast` (its default integrator) at the
+        scenario's tolerances.
+        """
+        if engine not in ("reference", "fast"):
+            raise ParameterError(f"engine must be 'reference' or 'fast', got {engine!r}")
         sc = self.replace(**overrides) if overrides else self
-        return simulate(
+        if engine == "fast":
+            from ..fast import simulate_fast as run
+            options = {}
+        else:
+            run = simulate
+            options = {"method": sc.method}
+        return run(
             sc.body, sc.muscles, sc.disturbance, sc.duration,
             initial_state=sc.initial_state, rates_from=sc.rates_from, knee=sc.knee,
             fall=sc.fall, torque_limits=sc.torque_limits,
             feedback_delay=sc.feedback_delay, rtol=sc.rtol, atol=sc.atol,
-            sample_rate=sc.sample_rate,
-            method=sc.method, description=sc.description,
+            sample_rate=sc.sample_rate, description=sc.description, **options,
         )
 
     def replace(self, **changes: Any) -> Scenario:
