@@ -33,12 +33,12 @@ import tempfile
 import time
 
 import numpy as np
-
-from posturelab import batch_linear
 from posturelab.body import paper_body
 from posturelab.dynamics import mass_matrix
-from posturelab.linear import sorted_poles
 from posturelab.muscles import paper_muscles
+
+from posturelab import batch_linear
+from posturelab.linear import sorted_poles
 
 FIRST_CALL = (
     "import time; t0 = time.perf_counter(); import numpy as np; "

@@ -142,12 +142,12 @@ def _cpu_name() -> str:
 
 def main() -> int:
     import numba
-
     from posturelab.fast import DEFAULT_ATOL, simulate_batch, simulate_fast, warm_up
     from posturelab.muscles import paper_muscles
     from posturelab.platform import VelocityStep
-    from posturelab.scenarios import builtin_scenario
     from posturelab.simulate import initial_state_for, simulate
+
+    from posturelab.scenarios import builtin_scenario
 
     print("posturelab simulation benchmark" + (" (BENCH_QUICK)" if QUICK else ""))
     warm_up()  # also makes sure the default cache is populated for the cached-load measurement

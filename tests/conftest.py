@@ -1,6 +1,5 @@
 import numpy as np
 import pytest
-
 from posturelab.body import paper_body
 
 

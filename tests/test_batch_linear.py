@@ -11,7 +11,6 @@ coefficient; stable flags identical.
 
 import numpy as np
 import pytest
-
 from posturelab.batch_linear import (
     GRID_PARAMETERS,
     STABILITY_MARGIN,
@@ -24,8 +23,6 @@ from posturelab.batch_linear import (
     stability_map,
 )
 from posturelab.body import Body
-from posturelab.errors import ParameterError, UnknownNameError
-from posturelab.linear import analyse, sorted_poles
 from posturelab.muscles import (
     PAPER_PAIR_NAMES,
     STIFFNESS_CASES,
@@ -33,6 +30,9 @@ from posturelab.muscles import (
     MuscleSet,
     paper_muscles,
 )
+
+from posturelab.errors import ParameterError, UnknownNameError
+from posturelab.linear import analyse, sorted_poles
 
 POLE_RTOL = 1e-8
 CASES = list(STIFFNESS_CASES)

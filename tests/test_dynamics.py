@@ -8,9 +8,6 @@ short, strong platform pulse, the gravity coefficients from Appendix A.
 
 import numpy as np
 import pytest
-from scipy.integrate import solve_ivp
-
-from _bodies import random_body
 from posturelab.body import Body, paper_body
 from posturelab.dynamics import (
     angular_acceleration,
@@ -23,6 +20,9 @@ from posturelab.dynamics import (
     velocity_step_response,
     velocity_terms,
 )
+from scipy.integrate import solve_ivp
+
+from _bodies import random_body
 
 SEED = 12345
 

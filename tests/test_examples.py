@@ -6,7 +6,6 @@ import importlib.util
 from pathlib import Path
 
 import numpy as np
-
 from posturelab.body import paper_body
 from posturelab.muscles import paper_muscles
 from posturelab.platform import VelocityStep

@@ -14,9 +14,7 @@ import math
 
 import numpy as np
 import pytest
-
 from posturelab.body import Body, paper_body
-from posturelab.errors import ParameterError
 from posturelab.fast import BatchResult, simulate_batch, simulate_fast
 from posturelab.fast import _kernels as kern
 from posturelab.muscles import MusclePair, MuscleSet, paper_muscles
@@ -29,14 +27,16 @@ from posturelab.platform import (
     VelocityStep,
     combine,
 )
-from posturelab.scenarios import builtin_scenario, builtin_scenario_names
 from posturelab.simulate import (
     FOOT_FROM_LITERATURE,
     FallCriteria,
     KneeModel,
-    _assemble,
     simulate,
 )
+
+from posturelab.errors import ParameterError
+from posturelab.scenarios import builtin_scenario, builtin_scenario_names
+from posturelab.simulation.reference import _assemble
 
 THETA_TOL = 1e-6  # [rad]
 OMEGA_TOL = 1e-4  # [rad/s]
@@ -261,8 +261,9 @@ def test_derived_series_are_computed_on_first_access_and_kept():
 
 
 def test_a_result_without_its_derived_series_says_so():
-    from posturelab.errors import PostureLabError
     from posturelab.results import SimulationResult
+
+    from posturelab.errors import PostureLabError
 
     bare = SimulationResult(time=np.zeros(1), theta=np.zeros((1, 3)), omega=np.zeros((1, 3)),
                             pair_names=("ankle",), status="completed", message="",

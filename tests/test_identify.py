@@ -4,10 +4,10 @@ import json
 
 import numpy as np
 import pytest
+from posturelab.identify import fit_stiffness, read_trajectory_csv
 
 import posturelab as pl
 from posturelab.cli import main
-from posturelab.identify import fit_stiffness, read_trajectory_csv
 
 
 @pytest.fixture(scope="module")

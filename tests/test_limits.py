@@ -4,11 +4,11 @@ import math
 
 import numpy as np
 import pytest
-
-import posturelab as pl
 from posturelab.muscles import MusclePair, MuscleSet
 from posturelab.recovery import largest_recoverable
 from posturelab.simulate import moments_to_link_torques
+
+import posturelab as pl
 
 FOOT = pl.FOOT_FROM_LITERATURE
 

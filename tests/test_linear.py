@@ -8,22 +8,22 @@ of Appendix C, and invariances that any correct linearisation must respect.
 
 import numpy as np
 import pytest
-
-from _bodies import random_body
 from posturelab.body import Body, paper_body
 from posturelab.dynamics import state_derivative
-from posturelab.linear import (
-    analyse,
-    analyse_both_sides,
-    finite_difference_state_matrix,
-    state_matrix,
-)
 from posturelab.muscles import (
     STIFFNESS_CASES,
     MusclePair,
     MuscleSet,
     joint_torques,
     paper_muscles,
+)
+
+from _bodies import random_body
+from posturelab.linear import (
+    analyse,
+    analyse_both_sides,
+    finite_difference_state_matrix,
+    state_matrix,
 )
 
 SEED = 12345

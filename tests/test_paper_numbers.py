@@ -7,10 +7,10 @@ value shown to be outside its own printed precision.
 
 import numpy as np
 import pytest
-
 from posturelab.compare import table2_comparison
-from posturelab.linear import analyse, disturbance_sensitivity
 from posturelab.muscles import STIFFNESS_CASES, paper_muscles
+
+from posturelab.linear import analyse, disturbance_sensitivity
 from posturelab.paper import (
     SENSITIVITY_PRINTED,
     TABLE_II_PRINTED,

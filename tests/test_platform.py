@@ -2,9 +2,6 @@
 
 import numpy as np
 import pytest
-from scipy.integrate import cumulative_trapezoid
-
-from posturelab.errors import DataFileError, ParameterError
 from posturelab.platform import (
     HalfSinePulse,
     MeasuredProfile,
@@ -15,6 +12,9 @@ from posturelab.platform import (
     combine,
     read_profile_csv,
 )
+from scipy.integrate import cumulative_trapezoid
+
+from posturelab.errors import DataFileError, ParameterError
 
 
 def test_velocity_step_directions():

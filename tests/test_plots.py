@@ -14,8 +14,6 @@ import numpy as np
 import pytest
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
-
-from posturelab.errors import ParameterError, PostureLabError, UnknownNameError
 from posturelab.plots import (
     new_figure,
     plot_angle_angle,
@@ -25,8 +23,10 @@ from posturelab.plots import (
     plot_time_histories,
     save_figure,
 )
-from posturelab.scenarios import builtin_scenario
 from posturelab.simulate import FOOT_FROM_LITERATURE
+
+from posturelab.errors import ParameterError, PostureLabError, UnknownNameError
+from posturelab.scenarios import builtin_scenario
 
 
 @pytest.fixture(scope="module")
@@ -163,7 +163,6 @@ def test_run_overview(backward, tmp_path):
 
 def test_animate_writes_gif(tmp_path):
     from PIL import Image
-
     from posturelab.animation import animate
 
     sc = builtin_scenario("paper-forward-case2")

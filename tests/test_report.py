@@ -13,11 +13,11 @@ import subprocess
 import sys
 
 import pytest
+from posturelab.report import reproduce_paper
 
 from posturelab.cli import main
 from posturelab.errors import PostureLabError
 from posturelab.paper import TABLE_II_PRINTED
-from posturelab.report import reproduce_paper
 
 FIGS = [f"fig{n:02d}" for n in range(3, 11)]
 

@@ -4,11 +4,8 @@ import math
 
 import numpy as np
 import pytest
-
-import posturelab as pl
 from posturelab.muscles import MusclePair, MuscleSet
 from posturelab.platform import HalfSinePulse, MeasuredProfile, RampAndHold, VelocityStep
-from posturelab.scenarios import builtin_scenario
 from posturelab.simulate import (
     FOOT_FROM_LITERATURE,
     BaseOfSupport,
@@ -17,6 +14,9 @@ from posturelab.simulate import (
     initial_state_for,
     simulate,
 )
+
+import posturelab as pl
+from posturelab.scenarios import builtin_scenario
 
 PAPER_POSTURE = [0.1, -0.1, 0.1]
 

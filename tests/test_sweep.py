@@ -8,15 +8,10 @@ import sys
 
 import numpy as np
 import pytest
-
 from posturelab.body import paper_body
-from posturelab.cli import main
-from posturelab.errors import ParameterError
 from posturelab.fast import simulate_batch, simulate_fast
 from posturelab.muscles import paper_muscles
-from posturelab.paper import BACKWARD_INITIAL_STATE
 from posturelab.platform import NoDisturbance, VelocityStep
-from posturelab.scenarios import builtin_scenario
 from posturelab.sweep import (
     OUTCOME_COLUMNS,
     VaryRange,
@@ -24,6 +19,11 @@ from posturelab.sweep import (
     run_sweep,
     sweep_grid,
 )
+
+from posturelab.cli import main
+from posturelab.errors import ParameterError
+from posturelab.paper import BACKWARD_INITIAL_STATE
+from posturelab.scenarios import builtin_scenario
 
 POSTURE = list(BACKWARD_INITIAL_STATE[:3]) + [0.0, 0.0, 0.0]
 

@@ -6,10 +6,7 @@ import re
 
 import numpy as np
 import pytest
-
 from posturelab.body import BODY_PRESETS, Body, Segment, get_body, paper_body
-from posturelab.errors import ParameterError, PostureLabError, UnknownNameError
-from posturelab.linear import analyse, disturbance_sensitivity, state_matrix
 from posturelab.muscles import (
     PAPER_PAIR_NAMES,
     STIFFNESS_CASES,
@@ -18,6 +15,9 @@ from posturelab.muscles import (
     get_stiffness_case,
     paper_muscles,
 )
+
+from posturelab.errors import ParameterError, PostureLabError, UnknownNameError
+from posturelab.linear import analyse, disturbance_sensitivity, state_matrix
 
 GOOD = {
     "masses": [5.0, 20.0, 40.0],

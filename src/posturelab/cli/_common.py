@@ -8,7 +8,7 @@ import math
 import sys
 
 from ..errors import ParameterError
-from ..muscles import PAPER_PAIR_NAMES, STIFFNESS_CASES
+from ..model.muscles import PAPER_PAIR_NAMES, STIFFNESS_CASES
 
 GASTROCNEMIUS_HELP = (
     "two-sided (default) adds the paper's artificial antagonist so the gastrocnemius pair "
@@ -77,7 +77,7 @@ def add_muscle_arguments(p: argparse.ArgumentParser, *, require: bool = False) -
 
 def muscles_from_args(args: argparse.Namespace):
     """Build the paper's MuscleSet from --case / --stiffness arguments."""
-    from ..muscles import paper_muscles
+    from ..model.muscles import paper_muscles
 
     if args.case is None and args.stiffness is None:
         raise ParameterError("give --case (Table I) or --stiffness K1,K2,K3,K4,K5")

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import argparse
 
-from ..identify import ENGINES, VISCOSITY_RATIO, fit_stiffness, read_trajectory_csv
-from ..muscles import PAPER_PAIR_NAMES
-from ..results import atomic_write_text
+from ..model.muscles import PAPER_PAIR_NAMES
+from ..simulation.results import atomic_write_text
+from ..studies.identification import ENGINES, VISCOSITY_RATIO, fit_stiffness, read_trajectory_csv
 from . import CONVENTIONS_EPILOG
 from ._common import load_compiled, print_json
 from .simulate import add_experiment_arguments, scenario_from_args
@@ -51,7 +51,7 @@ def run(args: argparse.Namespace) -> int:
     sc = sc.replace(duration=max(float(time[-1]), 1e-3))
     free = [s.strip() for s in args.free.split(",") if s.strip()]
     if args.engine == "fast":
-        from ..fast import warm_up
+        from ..simulation.compiled import warm_up
 
         load_compiled(warm_up, "the simulator")
     fit = fit_stiffness(sc, time, theta, free, viscosity_ratio=args.viscosity_ratio,

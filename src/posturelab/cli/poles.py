@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import argparse
 
-from ..body import paper_body
-from ..compare import erratum, table2_comparison
-from ..linear import analyse_both_sides
+from ..linear.analysis import analyse_both_sides
+from ..model.body import paper_body
+from ..paper.compare import erratum, table2_comparison
 from . import CONVENTIONS_EPILOG
 from ._common import add_muscle_arguments, muscles_from_args, print_json
 

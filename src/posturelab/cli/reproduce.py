@@ -40,7 +40,7 @@ def _progress(step: int, total: int, message: str) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..report import reproduce_paper
+    from ..paper.report import reproduce_paper
 
     report = reproduce_paper(args.out, progress=None if args.quiet else _progress)
     if not args.quiet:

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import argparse
 
-from ..body import paper_body
-from ..linear import disturbance_sensitivity
+from ..linear.analysis import disturbance_sensitivity
+from ..model.body import paper_body
 from . import CONVENTIONS_EPILOG
 from ._common import parse_float_list, print_json
 

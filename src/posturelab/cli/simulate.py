@@ -8,12 +8,12 @@ import sys
 
 import numpy as np
 
-from ..body import paper_body
 from ..errors import ParameterError
-from ..paper import BACKWARD_INITIAL_STATE
-from ..platform import NoDisturbance, VelocityStep, read_profile_csv
+from ..model.body import paper_body
+from ..model.platform import NoDisturbance, VelocityStep, read_profile_csv
+from ..paper.printed import BACKWARD_INITIAL_STATE
 from ..scenarios import Scenario, builtin_scenario, builtin_scenario_names, load_scenario
-from ..simulate import FOOT_FROM_LITERATURE, BaseOfSupport, FallCriteria, KneeModel
+from ..simulation.reference import FOOT_FROM_LITERATURE, BaseOfSupport, FallCriteria, KneeModel
 from . import CONVENTIONS_EPILOG, UsageError
 from ._common import (
     add_muscle_arguments,
@@ -209,13 +209,13 @@ def run(args: argparse.Namespace) -> int:
     if args.out:
         result.to_csv(args.out)
     if args.plot:
-        from ..plots import plot_run_overview, save_figure
+        from ..viz.plots import plot_run_overview, save_figure
 
         fig = plot_run_overview(result, link_names=[s.name for s in sc.body.segments],
                                 base_of_support=sc.fall.base_of_support)
         save_figure(fig, args.plot)
     if args.animate:
-        from ..animation import animate
+        from ..viz.animation import animate
 
         animate(result, sc.body, args.animate)
     if args.json:

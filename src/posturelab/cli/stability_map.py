@@ -11,7 +11,7 @@ from pathlib import Path
 from typing import IO
 
 from ..errors import ParameterError, UnknownNameError
-from ..muscles import PAPER_PAIR_NAMES
+from ..model.muscles import PAPER_PAIR_NAMES
 from . import CONVENTIONS_EPILOG
 from ._common import load_compiled
 
@@ -69,7 +69,7 @@ def add_parser(sub, name: str) -> argparse.ArgumentParser:
 
 def parse_axis(text: str, flag: str):
     """Parse ``NAME:LO:HI`` into a :class:`posturelab.batch_linear.ParameterRange`."""
-    from ..batch_linear import ParameterRange
+    from ..linear.batch import ParameterRange
 
     parts = str(text).split(":")
     if len(parts) != 3:
@@ -290,7 +290,7 @@ def run(args: argparse.Namespace) -> int:
         )
     figure_path, csv_path, fmt = output_paths(args.out)
 
-    from ..batch_linear import parameter_grid, stability_map
+    from ..linear.batch import parameter_grid, stability_map
 
     parameter_grid(x, y, resolution, case=args.case, viscosity_ratio=ratio)  # validates --case
     load_compiled(lambda: stability_map(x, y, 2, case=args.case, viscosity_ratio=ratio),

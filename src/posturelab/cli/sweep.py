@@ -7,8 +7,8 @@ import sys
 import time
 
 from ..errors import ParameterError
-from ..muscles import DEFAULT_VISCOSITY_RATIO
-from ..sweep import (
+from ..model.muscles import DEFAULT_VISCOSITY_RATIO
+from ..studies.sweep import (
     OUTCOME_COLUMNS,
     SWEEP_PARAMETERS,
     ProgressBar,
@@ -103,7 +103,7 @@ def run(args: argparse.Namespace) -> int:
     if args.atol is not None:
         tolerances["atol"] = scenario.atol
 
-    from ..fast import warm_up
+    from ..simulation.compiled import warm_up
 
     load_compiled(warm_up, "the simulator")  # before the clock and the bar start
     bar = None

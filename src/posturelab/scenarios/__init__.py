@@ -71,10 +71,10 @@ from typing import Any
 import numpy as np
 
 from .._validation import finite_array, finite_float, reject_unknown_keys
-from ..body import Body, Segment, get_body
 from ..errors import ParameterError, PostureLabError, ScenarioError
-from ..muscles import MusclePair, MuscleSet, paper_muscles
-from ..platform import (
+from ..model.body import Body, Segment, get_body
+from ..model.muscles import MusclePair, MuscleSet, paper_muscles
+from ..model.platform import (
     Disturbance,
     HalfSinePulse,
     NoDisturbance,
@@ -84,14 +84,14 @@ from ..platform import (
     combine,
     read_profile_csv,
 )
-from ..results import SimulationResult
-from ..simulate import (
+from ..simulation.reference import (
     FOOT_FROM_LITERATURE,
     BaseOfSupport,
     FallCriteria,
     KneeModel,
     simulate,
 )
+from ..simulation.results import SimulationResult
 
 __all__ = [
     "Scenario",
@@ -169,7 +169,7 @@ class Scenario:
             raise ParameterError(f"engine must be 'reference' or 'fast', got {engine!r}")
         sc = self.replace(**overrides) if overrides else self
         if engine == "fast":
-            from ..fast import simulate_fast as run
+            from ..simulation.compiled import simulate_fast as run
             options = {}
         else:
             run = simulate

@@ -40,12 +40,12 @@ from typing import IO, Any
 
 import numpy as np
 
-from .errors import ParameterError, PostureLabError
-from .fast import DEFAULT_ATOL, DEFAULT_RTOL, BatchResult, simulate_batch
-from .muscles import DEFAULT_VISCOSITY_RATIO, PAPER_PAIR_NAMES
-from .platform import NoDisturbance
-from .results import atomic_write_bytes, atomic_write_text
-from .scenarios import Scenario
+from ..errors import ParameterError, PostureLabError
+from ..model.muscles import DEFAULT_VISCOSITY_RATIO, PAPER_PAIR_NAMES
+from ..model.platform import NoDisturbance
+from ..scenarios import Scenario
+from ..simulation.compiled import DEFAULT_ATOL, DEFAULT_RTOL, BatchResult, simulate_batch
+from ..simulation.results import atomic_write_bytes, atomic_write_text
 
 __all__ = [
     "SWEEP_PARAMETERS",

@@ -27,11 +27,11 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from PIL import Image
 
-from ._validation import float_in_range, positive_float
-from .body import Body
-from .errors import ParameterError, PostureLabError
-from .results import SimulationResult, new_file_mode
-from .simulate import BaseOfSupport, base_of_support_for_height
+from .._validation import float_in_range, positive_float
+from ..errors import ParameterError, PostureLabError
+from ..model.body import Body
+from ..simulation.reference import BaseOfSupport, base_of_support_for_height
+from ..simulation.results import SimulationResult, new_file_mode
 
 _FALL_RED = "#c00000"
 _COG_YELLOW = "#f2a900"

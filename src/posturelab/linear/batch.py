@@ -69,11 +69,10 @@ from typing import IO
 import numba
 import numpy as np
 
-from ._validation import finite_array, nonnegative_float
-from .body import Body, paper_body
-from .errors import ParameterError, UnknownNameError
-from .linear import sorted_poles
-from .muscles import (
+from .._validation import finite_array, nonnegative_float
+from ..errors import ParameterError, UnknownNameError
+from ..model.body import Body, paper_body
+from ..model.muscles import (
     DEFAULT_VISCOSITY_RATIO,
     PAPER_PAIR_NAMES,
     STIFFNESS_CASES,
@@ -81,6 +80,7 @@ from .muscles import (
     get_stiffness_case,
     paper_muscles,
 )
+from .analysis import sorted_poles
 
 __all__ = [
     "STABILITY_MARGIN",

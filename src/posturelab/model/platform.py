@@ -25,8 +25,8 @@ from typing import Literal
 
 import numpy as np
 
-from ._validation import finite_array, finite_float, nonnegative_float, positive_float
-from .errors import DataFileError, ParameterError
+from .._validation import finite_array, finite_float, nonnegative_float, positive_float
+from ..errors import DataFileError, ParameterError
 
 __all__ = [
     "Disturbance",

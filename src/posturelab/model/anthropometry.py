@@ -24,9 +24,9 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ._validation import float_in_range
+from .._validation import float_in_range
+from ..errors import ParameterError, UnknownNameError
 from .body import Body, BodyPreset, paper_body, register_body_preset
-from .errors import ParameterError, UnknownNameError
 
 __all__ = ["WINTER_TABLE", "body_from_anthropometry", "lump", "ANTHROPOMETRIC_TABLES"]
 

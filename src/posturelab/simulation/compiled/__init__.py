@@ -79,13 +79,13 @@ from typing import Literal
 
 import numpy as np
 
-from .._validation import finite_array, float_in_range, positive_float
-from ..body import Body
-from ..errors import ParameterError
-from ..muscles import MuscleSet, paper_muscles
-from ..platform import Disturbance, NoDisturbance
+from ..._validation import finite_array, float_in_range, positive_float
+from ...errors import ParameterError
+from ...model.body import Body
+from ...model.muscles import MuscleSet, paper_muscles
+from ...model.platform import Disturbance, NoDisturbance
+from ..reference import FallCriteria, KneeModel, initial_state_for, simulate
 from ..results import DerivedSeries, SimulationResult
-from ..simulate import FallCriteria, KneeModel, initial_state_for, simulate
 from . import _kernels as kern
 from ._encode import (
     EncodedDisturbance,
@@ -661,8 +661,8 @@ def simulate_batch(
 
 def warm_up() -> None:
     """Compile (or load from numba's cache) the kernels with a tiny run of each entry point."""
-    from ..body import paper_body
-    from ..platform import VelocityStep
+    from ...model.body import paper_body
+    from ...model.platform import VelocityStep
 
     body = paper_body()
     muscles = paper_muscles("1")

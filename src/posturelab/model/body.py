@@ -21,9 +21,9 @@ from functools import cached_property
 
 import numpy as np
 
-from ._validation import finite_float, positive_float
-from .conventions import STANDARD_GRAVITY
-from .errors import ParameterError, UnknownNameError
+from .._validation import finite_float, positive_float
+from ..conventions import STANDARD_GRAVITY
+from ..errors import ParameterError, UnknownNameError
 
 __all__ = ["Segment", "Body", "BodyPreset", "BODY_PRESETS", "get_body", "paper_body"]
 

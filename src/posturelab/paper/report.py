@@ -39,20 +39,25 @@ from pathlib import Path
 
 import numpy as np
 
-from .body import Body, paper_body
+from ..errors import PostureLabError
+from ..linear.analysis import analyse, analyse_both_sides, disturbance_sensitivity
+from ..model.body import Body, paper_body
+from ..model.muscles import PAPER_PAIR_NAMES, STIFFNESS_CASES, TABLE_I_CITATION, paper_muscles
+from ..simulation.reference import FOOT_FROM_LITERATURE, BaseOfSupport, FallCriteria
+from ..simulation.results import (
+    SimulationResult,
+    atomic_write_bytes,
+    atomic_write_text,
+    new_file_mode,
+)
 from .compare import Table2Row, erratum, sensitivity_comparison, table2_comparison
-from .errors import PostureLabError
-from .linear import analyse, analyse_both_sides, disturbance_sensitivity
-from .muscles import PAPER_PAIR_NAMES, STIFFNESS_CASES, TABLE_I_CITATION, paper_muscles
-from .paper import (
+from .printed import (
     BACKWARD_INITIAL_STATE,
     ERRATA,
     SENSITIVITY_PRINTED,
     TABLE_II_SOURCE,
     Erratum,
 )
-from .results import SimulationResult, atomic_write_bytes, atomic_write_text, new_file_mode
-from .simulate import FOOT_FROM_LITERATURE, BaseOfSupport, FallCriteria
 
 __all__ = [
     "FIGURE_CAPTIONS",
@@ -266,7 +271,7 @@ def _outcome(r: SimulationResult) -> str:
 
 
 def _figure_bytes(fig) -> tuple[bytes, bytes]:
-    from .plots import figure_bytes
+    from ..viz.plots import figure_bytes
 
     return figure_bytes(fig, "png", DPI), figure_bytes(fig, "svg", DPI)
 
@@ -519,14 +524,14 @@ def reproduce_paper(out_dir: str | Path, progress: ProgressCallback | None = Non
 
 
 def _build(tmp: Path, progress: ProgressCallback | None) -> tuple[dict, list[str]]:
-    from .plots import (
+    from ..scenarios import builtin_scenario
+    from ..viz.plots import (
         new_figure,
         plot_angle_angle,
         plot_cog_phase,
         plot_pair_torques,
         plot_time_histories,
     )
-    from .scenarios import builtin_scenario
 
     total = 19
     step = 0
@@ -755,10 +760,10 @@ DELAY_BRACKET = (0.002, 0.03)
 
 def _recovery_finding(body: Body, foot: BaseOfSupport) -> str:
     """Largest backward ramp-and-hold case 1 recovers from, by the CoP and the CoG criteria."""
-    from .muscles import paper_muscles
-    from .platform import RampAndHold
-    from .recovery import largest_recoverable
-    from .simulate import FallCriteria, simulate
+    from ..model.muscles import paper_muscles
+    from ..model.platform import RampAndHold
+    from ..simulation.reference import FallCriteria, simulate
+    from ..studies.recovery import largest_recoverable
 
     muscles = paper_muscles("1")
 
@@ -832,7 +837,7 @@ def _verdict_class(v: str) -> str:
 
 def _html(body: Body, rows: list[Table2Row], sens, sens_flexed, flexed, checks,
           images, findings, t2_total, t2_agree, f2, f3, long3) -> str:
-    from . import __version__
+    from .. import __version__
 
     h: list[str] = []
     a = h.append

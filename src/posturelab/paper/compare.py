@@ -6,10 +6,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .body import Body, paper_body
-from .linear import analyse, disturbance_sensitivity
-from .muscles import STIFFNESS_CASES, paper_muscles
-from .paper import (
+from ..linear.analysis import analyse, disturbance_sensitivity
+from ..model.body import Body, paper_body
+from ..model.muscles import STIFFNESS_CASES, paper_muscles
+from .printed import (
     ERRATA,
     SENSITIVITY_PRINTED,
     TABLE_II_PRINTED,

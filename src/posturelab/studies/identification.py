@@ -30,11 +30,11 @@ import numpy as np
 from scipy import stats
 from scipy.optimize import least_squares
 
-from ._validation import finite_array
-from .errors import DataFileError, ParameterError, UnknownNameError
-from .muscles import MusclePair, MuscleSet
-from .results import SimulationResult
-from .scenarios import Scenario
+from .._validation import finite_array
+from ..errors import DataFileError, ParameterError, UnknownNameError
+from ..model.muscles import MusclePair, MuscleSet
+from ..scenarios import Scenario
+from ..simulation.results import SimulationResult
 
 __all__ = ["FitResult", "fit_stiffness", "read_trajectory_csv"]
 

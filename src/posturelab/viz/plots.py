@@ -32,9 +32,9 @@ import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
-from .errors import ParameterError, UnknownNameError
-from .results import SimulationResult, atomic_write_bytes
-from .simulate import BaseOfSupport
+from ..errors import ParameterError, UnknownNameError
+from ..simulation.reference import BaseOfSupport
+from ..simulation.results import SimulationResult, atomic_write_bytes
 
 __all__ = [
     "new_figure",

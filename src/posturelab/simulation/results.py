@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import PostureLabError
+from ..errors import PostureLabError
 
 __all__ = ["SimulationResult", "DerivedSeries", "atomic_write_text", "atomic_write_bytes",
            "new_file_mode"]

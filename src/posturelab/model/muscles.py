@@ -25,8 +25,8 @@ from typing import Literal
 
 import numpy as np
 
-from ._validation import finite_array, nonnegative_float
-from .errors import ParameterError, UnknownNameError
+from .._validation import finite_array, nonnegative_float
+from ..errors import ParameterError, UnknownNameError
 
 __all__ = [
     "MusclePair",

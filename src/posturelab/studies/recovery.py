@@ -13,9 +13,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._validation import positive_float
-from .errors import ParameterError
-from .results import SimulationResult
+from .._validation import positive_float
+from ..errors import ParameterError
+from ..simulation.results import SimulationResult
 
 __all__ = ["RecoveryBoundary", "largest_recoverable", "BatchRecoveryBoundaries",
            "largest_recoverable_batch"]
@@ -171,7 +171,7 @@ def largest_recoverable_batch(
     -------
     BatchRecoveryBoundaries
     """
-    from .fast import simulate_batch
+    from ..simulation.compiled import simulate_batch
 
     positive_float("tolerance", tolerance)
     if not low < high:

@@ -22,20 +22,19 @@ from dataclasses import dataclass, field
 from typing import Literal
 
 import numpy as np
-from scipy.integrate import solve_ivp
 
-from ._validation import finite_array, float_in_range, positive_float
-from .body import Body
-from .com import centre_of_gravity, centre_of_gravity_velocity
-from .dynamics import (
+from .._validation import finite_array, float_in_range, positive_float
+from ..errors import ParameterError
+from ..model.body import Body
+from ..model.dynamics import (
     gravity_vector,
     mass_matrix,
     platform_vector,
     velocity_terms,
 )
-from .errors import ParameterError
-from .muscles import MuscleSet
-from .platform import Disturbance, NoDisturbance
+from ..model.kinematics import centre_of_gravity, centre_of_gravity_velocity
+from ..model.muscles import MuscleSet
+from ..model.platform import Disturbance, NoDisturbance
 from .results import DerivedSeries, SimulationResult
 
 __all__ = [
@@ -414,6 +413,8 @@ def simulate(
         state at the fall is the last sample (off the regular grid); a failed
         integration in ``status == "failed"`` with a ``message``.
     """
+    from scipy.integrate import solve_ivp
+
     disturbance = NoDisturbance() if disturbance is None else disturbance
     knee = KneeModel() if knee is None else knee
     fall = FallCriteria() if fall is None else fall
@@ -705,7 +706,7 @@ def _assemble(body, muscles, disturbance, times, states, status, message, fell, 
         time = np.zeros(0)
         state = np.zeros((0, 2 * n))
     theta, omega = state[:, :n], state[:, n:]
-    from .muscles import pair_torques as _pair_torques
+    from ..model.muscles import pair_torques as _pair_torques
 
     fb = state if feedback_states is None else np.asarray(feedback_states)
     M = _pair_torques(muscles, fb[:, :n], fb[:, n:])

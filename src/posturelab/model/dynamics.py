@@ -193,7 +193,7 @@ def velocity_step_response(
     numpy.ndarray, shape (N,)
         ΔΘ̇. [rad/s]
     """
-    from ._validation import finite_array, finite_float
+    from .._validation import finite_array, finite_float
 
     dv = finite_float("platform_velocity_change [m/s]", platform_velocity_change)
     theta = (np.zeros(body.n_links) if theta is None

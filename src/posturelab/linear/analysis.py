@@ -22,11 +22,11 @@ from typing import Literal
 
 import numpy as np
 
-from ._validation import finite_array
-from .body import Body
-from .dynamics import mass_matrix, platform_vector, state_derivative
-from .errors import ParameterError
-from .muscles import MuscleSet, joint_torques
+from .._validation import finite_array
+from ..errors import ParameterError
+from ..model.body import Body
+from ..model.dynamics import mass_matrix, platform_vector, state_derivative
+from ..model.muscles import MuscleSet, joint_torques
 
 __all__ = [
     "LinearAnalysis",

@@ -7,10 +7,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..body import Body
-from ..errors import ParameterError
-from ..muscles import MuscleSet
-from ..platform import (
+from ...errors import ParameterError
+from ...model.body import Body
+from ...model.muscles import MuscleSet
+from ...model.platform import (
     CombinedDisturbance,
     Disturbance,
     HalfSinePulse,
@@ -20,7 +20,7 @@ from ..platform import (
     SumOfSines,
     VelocityStep,
 )
-from ..simulate import _RELEASE_HYSTERESIS, _SWITCH_HYSTERESIS, FallCriteria, KneeModel
+from ..reference import _RELEASE_HYSTERESIS, _SWITCH_HYSTERESIS, FallCriteria, KneeModel
 from . import _kernels as kern
 
 _AXIS = {"x": 0, "y": 1}

@@ -1,0 +1,17 @@
+"""The ankle-strategy paper: its printed numbers and errata (:mod:`.printed`), the
+comparison of printed and computed values (:mod:`.compare`) and the reproduction
+report (:mod:`.report`, imported on first use)."""
+
+from .printed import (
+    BACKWARD_INITIAL_STATE,
+    BACKWARD_INITIAL_STATE_SOURCE,
+    ERRATA,
+    SENSITIVITY_PRINTED,
+    SENSITIVITY_SOURCE,
+    TABLE_II_PRINTED,
+    TABLE_II_SOURCE,
+    Erratum,
+    match_printed_poles,
+    printed_decimals,
+    printed_tolerance,
+)
