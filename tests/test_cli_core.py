@@ -1,7 +1,8 @@
 """The ``poles`` and ``sensitivity`` subcommands, in-process and as a real subprocess.
 
 Expected numbers are the paper's printed values (Table II, Section VI) at their
-printed precision, or the errata values of DESIGN.md; errors must be one line
+printed precision, or the derived values of the errata (docs/design.md,
+``posturelab.paper.ERRATA``); errors must be one line
 on standard error with exit code 2 and never a traceback.
 """
 
@@ -16,7 +17,8 @@ import pytest
 from posturelab.cli import main
 from posturelab.paper import TABLE_II_PRINTED, printed_tolerance
 
-# Table II entries the paper gets wrong (DESIGN.md errata), as derived: (case, column) -> value
+# Table II entries the paper gets wrong (errata 1, 2, 7 of docs/design.md), as derived:
+# (case, column) -> value
 ERRATA = {("3", 0): -575.405, ("3", 2): -0.092, ("6b", 2): -3.752}
 SENSITIVITY = (2.5580, -0.0654, 0.0027)  # Section VI, printed to 4 decimals [rad/m]
 

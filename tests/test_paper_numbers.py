@@ -1,8 +1,9 @@
 """Every number the paper prints about the linear model, as a fixture with its source.
 
 Tolerance: half a unit of the last printed digit (pvlib's test_shading.py style).
-The errata (DESIGN.md) are asserted at *our* derived values, with the printed
-value shown to be outside its own printed precision.
+The errata (docs/design.md; ``posturelab.paper.ERRATA``) are asserted at *our*
+derived values, with the printed value shown to be outside its own printed
+precision.
 """
 
 import numpy as np
@@ -20,7 +21,7 @@ from posturelab.paper import (
 
 # (case, column) pairs the printed paper gets wrong, with the value the linearised
 # model gives (computed independently with numpy eigvals on the 6x6 matrix of
-# Appendix B/C during review; DESIGN.md "errata").
+# Appendix B/C during review; the errata of docs/design.md).
 ERRATA_VALUES = {
     ("3", 2): (-0.092, 0.0005, "erratum 1: Table II case 3 prints -0.90"),
     ("6b", 2): (-3.752, 0.0005, "erratum 2: Table II case 6b repeats -3.26"),

@@ -1,4 +1,4 @@
-"""Independent check of posturelab.dynamics against a symbolic derivation.
+"""Independent check of posturelab.model.dynamics against a symbolic derivation.
 
 The equations of motion of a planar chain of N links hinged at their ends,
 standing on a platform that translates by (x_d(t), y_d(t)), are derived here
@@ -8,7 +8,7 @@ result, M(Θ) Θ̈ = F(Θ, Θ̇, U, ẍ_d, ÿ_d, ẋ_d, ẏ_d), is compared nume
 
     J(Θ) Θ̈ + B(Θ, Θ̇) Θ̇ − (g + ÿ_d) G(Θ) + ẍ_d H(Θ) = U
 
-(posturelab's model, DESIGN.md), so that M = J and F = U − BΘ̇ + (g + ÿ_d)G − ẍ_d H.
+(posturelab's model, docs/design.md), so that M = J and F = U − BΘ̇ + (g + ÿ_d)G − ẍ_d H.
 
 Geometry (conventions.py): x forward, y up; link i is rotated by −θ_i about z,
 so its axis is (sin θ_i, cos θ_i) and θ_i > 0 leans it forward. A generalised
@@ -142,7 +142,7 @@ def close(actual, expected, rtol=RTOL):
 
 
 # ---------------------------------------------------------------------------
-# Symbolic derivation vs posturelab.dynamics, N = 1..4
+# Symbolic derivation vs posturelab.model.dynamics, N = 1..4
 # ---------------------------------------------------------------------------
 
 

@@ -1,5 +1,5 @@
 """Bad input raises ParameterError / UnknownNameError naming the field, the value and
-the allowed range (DESIGN.md, quality bar)."""
+the allowed range (docs/design.md, quality bar)."""
 
 import math
 import re

@@ -3,7 +3,7 @@
 A :class:`Body` is a chain of N >= 1 rigid links hinged at their ends, standing
 on a foot that stays flat on the platform (see :mod:`posturelab.conventions`).
 Link 1 is the lowest. Bodies only hold parameters; the physics lives in
-:mod:`posturelab.dynamics` as pure functions.
+:mod:`posturelab.model.dynamics` as pure functions.
 
 Presets
 -------
@@ -85,8 +85,8 @@ class Body:
 
     Notes
     -----
-    The derived arrays follow DESIGN.md's closed form (see
-    :mod:`posturelab.dynamics`): ``a_i = m_i k_i + (Σ_{j>i} m_j) l_i`` [kg·m],
+    The derived arrays follow the N-link closed form of docs/design.md (see
+    :mod:`posturelab.model.dynamics`): ``a_i = m_i k_i + (Σ_{j>i} m_j) l_i`` [kg·m],
     the diagonal of J(0) ``I_i + m_i k_i² + (Σ_{j>i} m_j) l_i²`` [kg·m²] and the
     coupling ``c_ij = l_i a_j`` (i < j) [kg·m²].
     """
@@ -307,7 +307,7 @@ BODY_PRESETS: dict[str, BodyPreset] = {
 
 
 def register_body_preset(preset: BodyPreset) -> None:
-    """Add a preset to :data:`BODY_PRESETS` (used by :mod:`posturelab.anthropometry`)."""
+    """Add a preset to :data:`BODY_PRESETS` (used by :mod:`posturelab.model.anthropometry`)."""
     BODY_PRESETS[preset.name] = preset
 
 

@@ -3,7 +3,7 @@
 Pure functions over arrays. Angles may carry leading batch axes: ``theta`` of
 shape ``(..., N)`` gives results of shape ``(..., N)`` or ``(..., N, N)``.
 
-The model (DESIGN.md; paper eq. 1 with y up, erratum 3)::
+The model (docs/design.md, N links; paper eq. 1 with y up, erratum 3)::
 
     J(Θ) Θ̈ + B(Θ, Θ̇) Θ̇ − (g + ÿ_d) G(Θ) + ẍ_d H(Θ) = U
 

@@ -240,7 +240,7 @@ def joint_torques(muscles: MuscleSet, theta: np.ndarray, omega: np.ndarray) -> n
 # The paper's five pairs and Table I
 # ---------------------------------------------------------------------------
 
-#: The paper's five pairs (Appendix C, eq. 4; DESIGN.md): name -> (lo, hi, description).
+#: The paper's five pairs (Appendix C, eq. 4; docs/design.md): name -> (lo, hi, description).
 PAPER_PAIRS: dict[str, tuple[int, int, str]] = {
     "ankle": (0, 1, "tibialis anterior – soleus; crosses the ankle"),
     "knee": (1, 2, "vasti – short head of hamstring; crosses the knee"),
