@@ -36,7 +36,8 @@ from posturelab.simulate import (
 
 from posturelab.errors import ParameterError
 from posturelab.scenarios import builtin_scenario, builtin_scenario_names
-from posturelab.simulation.reference import _assemble
+from posturelab.simulation.derived import derived_series
+from posturelab.simulation.setup import prepare_run
 
 THETA_TOL = 1e-6  # [rad]
 OMEGA_TOL = 1e-4  # [rad/s]
@@ -220,16 +221,15 @@ def test_other_chain_lengths_use_the_general_solver(n_links, method):
 
 def test_derived_fields_equal_the_references_assembly():
     """Torques, moments, accelerations, centre of gravity, ground reaction, centre of pressure
-    and platform motion: the reference's _assemble applied to the fast samples."""
+    and platform motion: the reference's derived series applied to the fast samples."""
     muscles = paper_muscles("1", gastrocnemius="one-sided")
     d = combine(HalfSinePulse(2.0, 0.4, 0.1), SumOfSines((0.3,), (1.5,), axis="y"))
     fast = simulate_fast(paper_body(), muscles, d, 1.5, initial_state=PAPER_POSTURE,
                          knee=KneeModel("locked"))
     locked = np.ones(fast.time.size, dtype=bool)
-    knee_row = np.array([-1.0, 1.0, 0.0])
-    again = _assemble(paper_body(), muscles, d, [np.asarray(fast.time)], [fast.state],
-                      fast.status, fast.message, fast.fell, fast.fall_time, fast.fall_reason,
-                      list(fast.switch_times), "", locked=locked, knee_row=knee_row)
+    setup = prepare_run(paper_body(), muscles, d, 1.5, initial_state=PAPER_POSTURE,
+                        knee=KneeModel("locked"))
+    again = derived_series(setup, np.asarray(fast.time), fast.state, locked=locked)
     for name in ("pair_torques", "joint_torques", "joint_moments", "angular_acceleration",
                  "cog_position", "cog_velocity", "ground_reaction", "centre_of_pressure",
                  "platform_acceleration", "platform_velocity", "platform_position"):

@@ -10,10 +10,10 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..model.body import paper_body
+from ..model.options import FOOT_FROM_LITERATURE, BaseOfSupport, FallCriteria, KneeModel
 from ..model.platform import NoDisturbance, VelocityStep, read_profile_csv
 from ..paper.printed import BACKWARD_INITIAL_STATE
 from ..scenarios import Scenario, builtin_scenario, builtin_scenario_names, load_scenario
-from ..simulation.reference import FOOT_FROM_LITERATURE, BaseOfSupport, FallCriteria, KneeModel
 from . import CONVENTIONS_EPILOG, UsageError
 from ._common import (
     add_muscle_arguments,

@@ -31,6 +31,9 @@ __all__ = [
     "kinetic_energy",
     "potential_energy",
     "velocity_step_response",
+    "knee_constraint_row",
+    "constrained_acceleration",
+    "constrained_velocity",
 ]
 
 
@@ -200,3 +203,44 @@ def velocity_step_response(
              else finite_array("theta [rad]", theta, (body.n_links,)))
     J = mass_matrix(body, theta)
     return -np.linalg.solve(J, platform_vector(body, theta)) * dv
+
+
+def knee_constraint_row(n_links: int) -> np.ndarray:
+    """The row C of the knee constraint C·Θ̈ = 0 (the knee angle θ2 − θ1 held), (−1, 1, 0, …). [-]"""
+    row = np.zeros(n_links)
+    row[0], row[1] = -1.0, 1.0
+    return row
+
+
+def constrained_acceleration(body: Body, theta: np.ndarray, acceleration: np.ndarray,
+                             row: np.ndarray) -> np.ndarray:
+    """Accelerations with the constraint C·Θ̈ = 0: Θ̈ − J⁻¹C (C·Θ̈)/(C·J⁻¹C).
+
+    The constraint force acts along C (a torque pair at the joint), so the
+    free accelerations ``acceleration`` [rad/s²] lose their component along J⁻¹C.
+
+    Parameters
+    ----------
+    theta : array_like, shape (N,)
+        Link angles. [rad]
+    acceleration : array_like, shape (N,)
+        Accelerations without the constraint. [rad/s²]
+    row : array_like, shape (N,)
+        C, e.g. :func:`knee_constraint_row`. [-]
+
+    Returns
+    -------
+    numpy.ndarray, shape (N,)
+        Constrained accelerations. [rad/s²]
+    """
+    J = mass_matrix(body, theta)
+    JiC = np.linalg.solve(J, row)
+    acc = np.asarray(acceleration, dtype=float)
+    return acc - JiC * (row @ acc) / (row @ JiC)
+
+
+def constrained_velocity(body: Body, theta: np.ndarray, omega: np.ndarray,
+                         row: np.ndarray) -> np.ndarray:
+    """Rates after a plastic impact onto C·Θ̇ = 0 (momentum conserved along the constraint):
+    Θ̇ − J⁻¹C (C·Θ̇)/(C·J⁻¹C). [rad/s]"""
+    return constrained_acceleration(body, theta, omega, row)

@@ -1,7 +1,10 @@
-"""Centre of gravity (paper eqs. 2–3) and the physiological space of Nashner and McCollum.
+"""Centre of gravity (paper eqs. 2–3), ground reaction, centre of pressure, and the
+physiological space of Nashner and McCollum.
 
 Positions are relative to the ankle (the base of the chain, on the platform),
-x forward and y up.
+x forward and y up. The foot is massless and flat on the platform, so the ground
+reaction is the rate of change of the chain's momentum plus its weight, and the
+centre of pressure is where that force must act to balance the ankle moment.
 """
 
 from __future__ import annotations
@@ -15,6 +18,9 @@ __all__ = [
     "centre_of_gravity",
     "centre_of_gravity_velocity",
     "physiological_state",
+    "centre_of_gravity_acceleration",
+    "ground_reaction",
+    "centre_of_pressure",
 ]
 
 
@@ -86,3 +92,73 @@ def physiological_state(body: Body, state: np.ndarray) -> np.ndarray:
     return np.stack(
         [theta[..., 0], theta[..., -1], r, omega[..., 0], omega[..., -1], rdot], axis=-1
     )
+
+
+def centre_of_gravity_acceleration(body: Body, theta: np.ndarray, omega: np.ndarray,
+                                   alpha: np.ndarray) -> np.ndarray:
+    """Acceleration of the centre of gravity relative to the ankle.
+
+    ẍ_c = (Σ a_i θ̈_i cos θ_i − Σ a_i θ̇_i² sin θ_i)/Σm,
+    ÿ_c = (−Σ a_i θ̈_i sin θ_i − Σ a_i θ̇_i² cos θ_i)/Σm.
+
+    Parameters
+    ----------
+    theta, omega, alpha : array_like, shape (..., N)
+        Link angles [rad], rates [rad/s] and accelerations [rad/s²].
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 2)
+        ``[ẍ_c, ÿ_c]``. [m/s²]
+    """
+    theta = np.asarray(theta, dtype=float)
+    omega = np.asarray(omega, dtype=float)
+    alpha = np.asarray(alpha, dtype=float)
+    a = body.gravity_coefficients
+    s, c = np.sin(theta), np.cos(theta)
+    ax = np.sum(a * (alpha * c - omega**2 * s), axis=-1) / body.total_mass
+    ay = -np.sum(a * (alpha * s + omega**2 * c), axis=-1) / body.total_mass
+    return np.stack([ax, ay], axis=-1)
+
+
+def ground_reaction(body: Body, theta: np.ndarray, omega: np.ndarray, alpha: np.ndarray,
+                    platform_acceleration: np.ndarray) -> np.ndarray:
+    """Force of the platform on the (massless) foot: F = Σm (a_platform + a_cog + g ŷ).
+
+    Parameters
+    ----------
+    theta, omega, alpha : array_like, shape (..., N)
+        Link angles [rad], rates [rad/s] and accelerations [rad/s²].
+    platform_acceleration : array_like, shape (..., 2)
+        (ẍ_d, ÿ_d). [m/s²]
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 2)
+        ``[F_x, F_y]``. [N]
+    """
+    acc = np.asarray(platform_acceleration, dtype=float)
+    cog = centre_of_gravity_acceleration(body, theta, omega, alpha)
+    gravity = np.array([0.0, body.gravity])
+    return body.total_mass * (acc + cog + gravity)
+
+
+def centre_of_pressure(ankle_moment: np.ndarray, vertical_force: np.ndarray) -> np.ndarray:
+    """Centre of pressure under the massless foot, x_p = τ_ankle / F_y, from the ankle. [m]
+
+    Parameters
+    ----------
+    ankle_moment : array_like, shape (...)
+        Net muscle moment at the ankle τ_ankle. [N·m]
+    vertical_force : array_like, shape (...)
+        Vertical ground reaction F_y. [N]
+
+    Returns
+    -------
+    numpy.ndarray, shape (...)
+        x_p [m]; NaN where F_y <= 0 (the foot is not pressed on the platform).
+    """
+    tau = np.asarray(ankle_moment, dtype=float)
+    fy = np.asarray(vertical_force, dtype=float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(fy > 0.0, tau / np.where(fy > 0.0, fy, 1.0), np.nan)

@@ -40,6 +40,9 @@ __all__ = [
     "get_stiffness_case",
     "pair_torques",
     "joint_torques",
+    "joint_crossing_matrix",
+    "joint_moments",
+    "moments_to_link_torques",
 ]
 
 #: Viscosity as a fraction of stiffness used throughout the paper (Appendix C). [s]
@@ -143,6 +146,19 @@ class MuscleSet:
         return E
 
     @cached_property
+    def crossing_matrix(self) -> np.ndarray:
+        """C, shape (P, N): C[p, j] = 1 when pair p crosses joint j (0 = ankle, 1 = knee, …). [-]
+
+        Joint j lies between link j (0 = the foot) and link j + 1; the net muscle
+        moment at the joints is τ = Cᵀ M.
+        """
+        crosses = np.zeros((len(self.pairs), self.n_links))
+        for r, p in enumerate(self.pairs):
+            crosses[r, p.lo:p.hi] = 1.0
+        crosses.setflags(write=False)
+        return crosses
+
+    @cached_property
     def stiffnesses(self) -> np.ndarray:
         """Diagonal of K_d. [N·m/rad]"""
         return np.array([p.stiffness for p in self.pairs])
@@ -209,13 +225,17 @@ class MuscleSet:
         return MuscleSet(tuple(p for p in self.pairs if not p.one_sided), self.n_links)
 
 
-def pair_torques(muscles: MuscleSet, theta: np.ndarray, omega: np.ndarray) -> np.ndarray:
+def pair_torques(muscles: MuscleSet, theta: np.ndarray, omega: np.ndarray,
+                 active: np.ndarray | None = None) -> np.ndarray:
     """Pair torques M = K_d E Θ + L_d E Θ̇, zero for an inactive one-sided pair.
 
     Parameters
     ----------
     theta, omega : array_like, shape (..., N)
         Link angles [rad] and rates [rad/s].
+    active : array_like, shape (P,), optional
+        Which pairs act (1) or are slack (0), as a simulation tracks them by events;
+        by default a one-sided pair acts while its stretch is >= 0. [-]
 
     Returns
     -------
@@ -226,6 +246,8 @@ def pair_torques(muscles: MuscleSet, theta: np.ndarray, omega: np.ndarray) -> np
     stretch = np.asarray(theta, dtype=float) @ E.T
     rate = np.asarray(omega, dtype=float) @ E.T
     M = muscles.stiffnesses * stretch + muscles.viscosities * rate
+    if active is not None:
+        return M * np.asarray(active, dtype=float)
     if muscles.one_sided_mask.any():
         M = np.where(muscles.one_sided_mask & (stretch < 0.0), 0.0, M)
     return M
@@ -234,6 +256,40 @@ def pair_torques(muscles: MuscleSet, theta: np.ndarray, omega: np.ndarray) -> np
 def joint_torques(muscles: MuscleSet, theta: np.ndarray, omega: np.ndarray) -> np.ndarray:
     """Generalised torques U = −Eᵀ M on the link-angle coordinates, shape (..., N). [N·m]"""
     return -pair_torques(muscles, theta, omega) @ muscles.selection_matrix
+
+
+def joint_crossing_matrix(muscles: MuscleSet) -> np.ndarray:
+    """C (P, N): C[p, j] = 1 when pair p crosses joint j (:attr:`MuscleSet.crossing_matrix`). [-]"""
+    return muscles.crossing_matrix
+
+
+def joint_moments(muscles: MuscleSet, theta: np.ndarray, omega: np.ndarray,
+                  active: np.ndarray | None = None) -> np.ndarray:
+    """Net muscle moment at each joint, τ = Cᵀ M: the sum of the pairs crossing it.
+
+    Parameters
+    ----------
+    theta, omega : array_like, shape (..., N)
+        Link angles [rad] and rates [rad/s].
+    active : array_like, shape (P,), optional
+        As for :func:`pair_torques`. [-]
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., N)
+        Ankle, knee, hip, … moments. [N·m]
+    """
+    return pair_torques(muscles, theta, omega, active) @ muscles.crossing_matrix
+
+
+def moments_to_link_torques(moments: np.ndarray) -> np.ndarray:
+    """Generalised torques on the link angles from joint moments: U_i = −τ_i + τ_{i+1}. [N·m]
+
+    Equal to −EᵀM when τ = CᵀM (see :func:`joint_crossing_matrix`).
+    """
+    moments = np.asarray(moments, dtype=float)
+    above = np.concatenate([moments[..., 1:], np.zeros(moments.shape[:-1] + (1,))], axis=-1)
+    return above - moments
 
 
 # ---------------------------------------------------------------------------

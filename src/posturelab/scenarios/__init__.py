@@ -74,6 +74,7 @@ from .._validation import finite_array, finite_float, reject_unknown_keys
 from ..errors import ParameterError, PostureLabError, ScenarioError
 from ..model.body import Body, Segment, get_body
 from ..model.muscles import MusclePair, MuscleSet, paper_muscles
+from ..model.options import FOOT_FROM_LITERATURE, BaseOfSupport, FallCriteria, KneeModel
 from ..model.platform import (
     Disturbance,
     HalfSinePulse,
@@ -84,13 +85,7 @@ from ..model.platform import (
     combine,
     read_profile_csv,
 )
-from ..simulation.reference import (
-    FOOT_FROM_LITERATURE,
-    BaseOfSupport,
-    FallCriteria,
-    KneeModel,
-    simulate,
-)
+from ..simulation.engines import engine_name, simulate
 from ..simulation.results import SimulationResult
 
 __all__ = [
@@ -160,26 +155,20 @@ class Scenario:
     def run(self, *, engine: str = "reference", **overrides: Any) -> SimulationResult:
         """Simulate this scenario; keyword ``overrides`` replace fields first.
 
-        ``engine="reference"`` (default) runs :func:`posturelab.simulate.simulate`
-        with the scenario's ``solver.method``; ``engine="fast"`` runs the compiled
-        :func:`posturelab.fast.simulate_fast` (its default integrator) at the
-        scenario's tolerances.
+        ``engine="reference"`` (default) runs the reference engine with the
+        scenario's ``solver.method``; ``engine="compiled"`` (or its former name
+        ``"fast"``) runs the compiled engine (its default integrator); both at the
+        scenario's tolerances (:func:`posturelab.simulate`).
         """
-        if engine not in ("reference", "fast"):
-            raise ParameterError(f"engine must be 'reference' or 'fast', got {engine!r}")
+        name = engine_name(engine)
         sc = self.replace(**overrides) if overrides else self
-        if engine == "fast":
-            from ..simulation.compiled import simulate_fast as run
-            options = {}
-        else:
-            run = simulate
-            options = {"method": sc.method}
-        return run(
+        return simulate(
             sc.body, sc.muscles, sc.disturbance, sc.duration,
             initial_state=sc.initial_state, rates_from=sc.rates_from, knee=sc.knee,
             fall=sc.fall, torque_limits=sc.torque_limits,
             feedback_delay=sc.feedback_delay, rtol=sc.rtol, atol=sc.atol,
-            sample_rate=sc.sample_rate, description=sc.description, **options,
+            sample_rate=sc.sample_rate, description=sc.description,
+            method=sc.method if name == "reference" else None, engine=name,
         )
 
     def replace(self, **changes: Any) -> Scenario:

@@ -1,12 +1,15 @@
 """Simulation of the nonlinear chain: one set-up, two engines, one result.
 
-:func:`simulate` is the entry point. The reference engine (:mod:`.reference`,
-scipy's ``solve_ivp``) and the compiled engine (:mod:`.compiled`, numba,
-imported on first use) integrate the same model with the same events and
-return the same :class:`~.results.SimulationResult`.
+:func:`simulate` is the entry point (:mod:`.engines`). :mod:`.setup` validates a
+run and works out what both engines share; the reference engine
+(:mod:`.reference`, the numpy model integrated by scipy) and the compiled engine
+(:mod:`.compiled`, numba, imported on first use) integrate it with the events of
+:mod:`posturelab.model.events` and return a :class:`~.results.SimulationResult`,
+whose derived series come from :mod:`.derived`.
 """
 
-from .reference import (
+from ..model.muscles import joint_crossing_matrix, moments_to_link_torques
+from ..model.options import (
     FOOT_FROM_LITERATURE,
     FOOT_LENGTH_FRACTION_OF_HEIGHT,
     HEEL_FRACTION_OF_FOOT,
@@ -15,9 +18,7 @@ from .reference import (
     KneeMode,
     KneeModel,
     base_of_support_for_height,
-    initial_state_for,
-    joint_crossing_matrix,
-    moments_to_link_torques,
-    simulate,
 )
+from .engines import ENGINES, simulate
 from .results import DerivedSeries, SimulationResult
+from .setup import RunSetup, initial_state_for, prepare_run

@@ -30,7 +30,7 @@ from PIL import Image
 from .._validation import float_in_range, positive_float
 from ..errors import ParameterError, PostureLabError
 from ..model.body import Body
-from ..simulation.reference import BaseOfSupport, base_of_support_for_height
+from ..model.options import BaseOfSupport, base_of_support_for_height
 from ..simulation.results import SimulationResult, new_file_mode
 
 _FALL_RED = "#c00000"

@@ -33,7 +33,7 @@ from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
 from ..errors import ParameterError, UnknownNameError
-from ..simulation.reference import BaseOfSupport
+from ..model.options import BaseOfSupport
 from ..simulation.results import SimulationResult, atomic_write_bytes
 
 __all__ = [

@@ -83,9 +83,11 @@ from ..._validation import finite_array, float_in_range, positive_float
 from ...errors import ParameterError
 from ...model.body import Body
 from ...model.muscles import MuscleSet, paper_muscles
+from ...model.options import FallCriteria, KneeModel
 from ...model.platform import Disturbance, NoDisturbance
-from ..reference import FallCriteria, KneeModel, initial_state_for, simulate
+from ..engines import simulate
 from ..results import DerivedSeries, SimulationResult
+from ..setup import initial_state_for
 from . import _kernels as kern
 from ._encode import (
     EncodedDisturbance,
@@ -657,6 +659,17 @@ def simulate_batch(
         n_switches=results[:, kern.R_N_SWITCHES].astype(np.int64),
         settle_tolerance=settle_tolerance,
     )
+
+
+def integrate_compiled(setup, method: str = "Radau") -> SimulationResult:
+    """Run a :class:`~posturelab.simulation.setup.RunSetup` on the compiled engine."""
+    return simulate_fast(
+        setup.body, setup.muscles, setup.disturbance, setup.duration,
+        initial_state=setup.before, rates_from=setup.rates_from, knee=setup.knee,
+        fall=setup.fall, torque_limits=setup.torque_limits,
+        feedback_delay=setup.feedback_delay, rtol=setup.rtol, atol=setup.atol,
+        sample_rate=setup.sample_rate, max_switches=setup.max_switches,
+        description=setup.description, method=method)
 
 
 def warm_up() -> None:

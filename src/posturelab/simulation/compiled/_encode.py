@@ -9,7 +9,10 @@ import numpy as np
 
 from ...errors import ParameterError
 from ...model.body import Body
+from ...model.events import RELEASE_HYSTERESIS as _RELEASE_HYSTERESIS
+from ...model.events import SWITCH_HYSTERESIS as _SWITCH_HYSTERESIS
 from ...model.muscles import MuscleSet
+from ...model.options import FallCriteria, KneeModel
 from ...model.platform import (
     CombinedDisturbance,
     Disturbance,
@@ -20,7 +23,6 @@ from ...model.platform import (
     SumOfSines,
     VelocityStep,
 )
-from ..reference import _RELEASE_HYSTERESIS, _SWITCH_HYSTERESIS, FallCriteria, KneeModel
 from . import _kernels as kern
 
 _AXIS = {"x": 0, "y": 1}

@@ -1,0 +1,90 @@
+"""The series a run derives from its states: torques, moments, accelerations, centre of
+gravity, ground reaction, centre of pressure, platform motion.
+
+One numpy computation from the model functions serves both engines (the compiled
+engine calls it when a result's derived series are first read).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..model.dynamics import angular_acceleration, mass_matrix
+from ..model.kinematics import (
+    centre_of_gravity,
+    centre_of_gravity_velocity,
+    centre_of_pressure,
+    ground_reaction,
+)
+from ..model.muscles import moments_to_link_torques, pair_torques
+from .results import DerivedSeries
+from .setup import RunSetup
+
+__all__ = ["derived_series"]
+
+
+def derived_series(setup: RunSetup, time: np.ndarray, state: np.ndarray,
+                   feedback_state: np.ndarray | None = None,
+                   locked: np.ndarray | None = None) -> DerivedSeries:
+    """The derived series of a run.
+
+    Parameters
+    ----------
+    setup : RunSetup
+        The run.
+    time : numpy.ndarray, shape (T,)
+        Sample times. [s]
+    state : numpy.ndarray, shape (T, 2N)
+        ``[Θ, Θ̇]`` at the samples. [rad], [rad/s]
+    feedback_state : numpy.ndarray, shape (T, 2N), optional
+        The state the muscles responded to at each sample (x(t − τ) with a delay);
+        ``state`` by default. [rad], [rad/s]
+    locked : numpy.ndarray of bool, shape (T,), optional
+        Samples at which the knee constraint held.
+
+    Returns
+    -------
+    DerivedSeries
+        Pair torques are zero while a one-sided pair's fed-back stretch is negative;
+        joint moments are clipped to the torque limits.
+    """
+    body, muscles, disturbance = setup.body, setup.muscles, setup.disturbance
+    n = body.n_links
+    time = np.asarray(time, dtype=float)
+    state = np.asarray(state, dtype=float).reshape(-1, 2 * n)
+    theta, omega = state[:, :n], state[:, n:]
+    fb = state if feedback_state is None else np.asarray(feedback_state, dtype=float)
+    M = pair_torques(muscles, fb[:, :n], fb[:, n:])
+    moments = M @ muscles.crossing_matrix
+    if setup.torque_limits is not None:
+        moments = np.clip(moments, -setup.torque_limits, setup.torque_limits)
+        U = moments_to_link_torques(moments)
+    else:
+        U = -M @ muscles.selection_matrix
+    acc = disturbance.acceleration(time)
+    alpha = (angular_acceleration(body, theta, omega, U, acc[:, 0], acc[:, 1]) if time.size
+             else np.zeros((0, n)))
+    if locked is not None and setup.knee_row is not None and np.any(locked):
+        row = setup.knee_row
+        J = mass_matrix(body, theta[locked])
+        JiC = np.linalg.solve(J, np.broadcast_to(row, (int(locked.sum()), n))[..., None])[..., 0]
+        alpha[locked] -= JiC * ((alpha[locked] @ row) / (JiC @ row))[:, None]
+    ground = ground_reaction(body, theta, omega, alpha, acc)
+    cop = centre_of_pressure(moments[:, 0], ground[:, 1])
+    vel = np.zeros_like(acc)
+    pos = np.zeros_like(acc)
+    if time.size > 1:
+        dt = np.diff(time)[:, None]
+        vel[1:] = np.cumsum(0.5 * (acc[1:] + acc[:-1]) * dt, axis=0)
+        vel += np.array(disturbance.velocity_change)
+        pos[1:] = np.cumsum(0.5 * (vel[1:] + vel[:-1]) * dt, axis=0)
+    elif time.size == 1:
+        vel[:] = disturbance.velocity_change
+    alpha.setflags(write=False)
+    return DerivedSeries(
+        pair_torques=M, joint_torques=U, joint_moments=moments,
+        cog_position=centre_of_gravity(body, theta),
+        cog_velocity=centre_of_gravity_velocity(body, theta, omega),
+        platform_acceleration=acc, platform_velocity=vel, platform_position=pos,
+        angular_acceleration=alpha, ground_reaction=ground, centre_of_pressure=cop,
+    )

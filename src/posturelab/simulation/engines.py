@@ -1,0 +1,131 @@
+"""The one entry point of a simulation, :func:`simulate`, and which engine runs it.
+
+Both engines take the same :class:`~posturelab.simulation.setup.RunSetup` and return
+the same :class:`~posturelab.simulation.results.SimulationResult`; they differ only in
+how they integrate (``docs/simulators.md`` has the table of what each does).
+"""
+
+from __future__ import annotations
+
+from typing import Literal
+
+import numpy as np
+
+from ..errors import ParameterError
+from ..model.body import Body
+from ..model.muscles import MuscleSet
+from ..model.options import FallCriteria, KneeModel
+from ..model.platform import Disturbance
+from .results import SimulationResult
+from .setup import prepare_run
+
+__all__ = ["simulate", "ENGINES", "engine_name", "ENGINE_DEFAULTS"]
+
+#: Engine names; "fast" is a former name of "compiled".
+ENGINES = ("reference", "compiled")
+
+#: Default (rtol [-], atol [rad, rad/s], method) of each engine.
+ENGINE_DEFAULTS: dict[str, tuple[float, float, str]] = {
+    "reference": (1e-8, 1e-10, "DOP853"),
+    "compiled": (1e-6, 1e-9, "Radau"),
+}
+
+
+def engine_name(engine: str) -> str:
+    """The canonical engine name ("fast" → "compiled"); an unknown name lists the known ones."""
+    name = "compiled" if engine == "fast" else engine
+    if name not in ENGINES:
+        raise ParameterError(f"engine must be one of {', '.join(map(repr, ENGINES))}, got "
+                             f"{engine!r}")
+    return name
+
+
+def simulate(
+    body: Body,
+    muscles: MuscleSet,
+    disturbance: Disturbance | None = None,
+    duration: float = 5.0,
+    *,
+    initial_state: np.ndarray | None = None,
+    rates_from: Literal["upright", "posture"] = "upright",
+    knee: KneeModel | None = None,
+    fall: FallCriteria | None = None,
+    torque_limits: np.ndarray | None = None,
+    feedback_delay: float = 0.0,
+    rtol: float | None = None,
+    atol: float | None = None,
+    sample_rate: float = 1000.0,
+    method: str | None = None,
+    max_switches: int = 10_000,
+    description: str = "",
+    engine: str = "reference",
+) -> SimulationResult:
+    """Simulate the nonlinear chain.
+
+    Parameters
+    ----------
+    body : Body
+        The chain.
+    muscles : MuscleSet
+        Muscle pairs (one-sided pairs switch exactly where their stretch crosses 0).
+    disturbance : Disturbance, optional
+        Platform motion; none by default.
+    duration : float
+        Simulated time. [s]
+    initial_state : array_like, shape (2N,), optional
+        ``[Θ, Θ̇]`` before any velocity step; upright at rest by default. [rad], [rad/s]
+    rates_from : {"upright", "posture"}
+        Where J⁻¹H is evaluated for a velocity step (see
+        :func:`~posturelab.simulation.setup.initial_state_for`).
+    knee : KneeModel, optional
+        Free (default), locked, or with a hyper-extension stop. Needs N >= 2.
+    fall : FallCriteria, optional
+        Fall criteria; default: any |θ_i| > π/3, no foot limit (the paper's model).
+    torque_limits : array_like, shape (N,), optional
+        Largest net muscle moment at the ankle, knee, hip, … (the sum of the
+        pairs crossing each joint); ``inf`` for no limit. A joint saturates and
+        lets go at events, never inside the right-hand side. [N·m]
+    feedback_delay : float
+        Neural delay τ of the muscle feedback: every pair's torque responds to the
+        state at t − τ (before t = 0, to the state before any velocity step). [s]
+    rtol, atol : float, optional
+        Integrator tolerances (relative [-], absolute [rad, rad/s]); by default
+        1e-8 and 1e-10 for the reference engine, 1e-6 and 1e-9 for the compiled one.
+    sample_rate : float
+        Output samples per second. [Hz]
+    method : str, optional
+        The integrator: for the reference engine a scipy ``solve_ivp`` method
+        ("DOP853", the default, "RK45", "Radau", …); for the compiled engine
+        "Radau" (default), "RK45" or "RK23".
+    max_switches : int
+        Guard against chattering: more switches than this fail the run.
+    description : str
+        Words stored in the result.
+    engine : {"reference", "compiled"}
+        ``reference``: the numpy model integrated by scipy (slow, obvious, the check);
+        ``compiled``: the numba engine (hundreds of times faster; the first call
+        after installing compiles it). Same model, events and result.
+
+    Returns
+    -------
+    SimulationResult
+        A fall is reported in ``fell``/``fall_time``/``status`` and the
+        state at the fall is the last sample (off the regular grid); a failed
+        integration in ``status == "failed"`` with a ``message``.
+    """
+    name = engine_name(engine)
+    d_rtol, d_atol, d_method = ENGINE_DEFAULTS[name]
+    setup = prepare_run(
+        body, muscles, disturbance, duration, initial_state=initial_state,
+        rates_from=rates_from, knee=knee, fall=fall, torque_limits=torque_limits,
+        feedback_delay=feedback_delay, rtol=d_rtol if rtol is None else rtol,
+        atol=d_atol if atol is None else atol, sample_rate=sample_rate,
+        max_switches=max_switches, description=description)
+    method = d_method if method is None else method
+    if name == "reference":
+        from .reference import integrate_reference
+
+        return integrate_reference(setup, method)
+    from .compiled import integrate_compiled
+
+    return integrate_compiled(setup, method)

@@ -1,0 +1,406 @@
+"""The set-up of a run, shared by both engines: validation, the initial state, the knee at
+its stop, which pairs act and which joints saturate at the start, a fall at the start, the
+output grid and the breakpoints; and the words of each outcome.
+
+:func:`prepare_run` turns the arguments of :func:`posturelab.simulate` into a frozen
+:class:`RunSetup`; the reference and the compiled engines take that object and
+differ only in how they integrate. :func:`model_response` evaluates the model
+(numpy, :mod:`posturelab.model.dynamics`) with the switches of a run applied; the
+reference engine's right-hand side is this function.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+
+from .._validation import finite_array, float_in_range, positive_float
+from ..errors import ParameterError
+from ..model.body import Body
+from ..model.dynamics import (
+    angular_acceleration,
+    constrained_acceleration,
+    constrained_velocity,
+    gravity_vector,
+    knee_constraint_row,
+    mass_matrix,
+    platform_vector,
+)
+from ..model.kinematics import centre_of_pressure, ground_reaction
+from ..model.muscles import MuscleSet, joint_moments, moments_to_link_torques
+from ..model.options import FallCriteria, KneeModel, torque_limit_array
+from ..model.platform import Disturbance, NoDisturbance
+
+__all__ = [
+    "RunSetup",
+    "prepare_run",
+    "initial_state_for",
+    "model_response",
+    "output_grid",
+    "outcome_message",
+    "DELAY_BREAKPOINT_MULTIPLES",
+    "MAX_FEEDBACK_DELAY",
+]
+
+#: With a feedback delay τ the motion is not smooth at t = kτ (the step at t = 0 reaches
+#: the muscles at τ, its derivative at 2τ, …); every engine ends a step exactly at kτ for
+#: k = 1 … this many (the order of the default integrators). [-]
+DELAY_BREAKPOINT_MULTIPLES = 5
+#: Largest neural feedback delay a run accepts. [s]
+MAX_FEEDBACK_DELAY = 1.0
+
+Status = Literal["completed", "fell", "failed"]
+
+
+@dataclass(frozen=True, eq=False)
+class RunSetup:
+    """Everything both engines share about one run (built by :func:`prepare_run`).
+
+    Attributes
+    ----------
+    body : Body
+    muscles : MuscleSet
+    disturbance : Disturbance
+    duration : float
+        Simulated time. [s]
+    knee : KneeModel
+    fall : FallCriteria
+    torque_limits : numpy.ndarray, shape (N,), or None
+        Largest net muscle moment per joint, ``inf`` where none; None if none limit. [N·m]
+    feedback_delay : float
+        Neural delay τ of the muscle feedback; 0 for none. [s]
+    rtol, atol : float
+        Integrator tolerances [-], [rad, rad/s].
+    sample_rate : float
+        Output samples per second. [Hz]
+    max_switches : int
+        More switches than this fail the run (chattering). [-]
+    description : str
+        The run in words.
+    before : numpy.ndarray, shape (2N,)
+        ``[Θ, Θ̇]`` before any velocity step: what delayed feedback sees for t < 0.
+        [rad], [rad/s]
+    x0 : numpy.ndarray, shape (2N,)
+        The state the integration starts from (after the step, on the knee constraint
+        if the knee starts locked). [rad], [rad/s]
+    locked0 : bool
+        The knee starts locked (mode ``locked``, or at its stop and not flexing).
+    active0 : numpy.ndarray, shape (P,)
+        1 for each pair that acts at the start, 0 for a slack one-sided pair. [-]
+    saturation0 : numpy.ndarray, shape (N,)
+        ±1 for a joint whose moment starts beyond its limit, else 0. [-]
+    grid : numpy.ndarray, shape (T,)
+        Output sample times. [s]
+    breakpoints : numpy.ndarray
+        Corners of the platform profile inside (0, duration), sorted. [s]
+    delay_breakpoints : numpy.ndarray
+        kτ inside (0, duration) for k = 1 … :data:`DELAY_BREAKPOINT_MULTIPLES`. [s]
+    max_step : float
+        Largest integrator step: what resolves the profile, and τ with a delay (the
+        past the feedback needs is then always computed). [s]
+    fall_at_start : str or None
+        Why the run falls at t = 0 (a fall criterion already violated), else None.
+    knee_row : numpy.ndarray, shape (N,), or None
+        The row C of the knee constraint when the knee can lock. [-]
+    rates_from : {"upright", "posture"}
+        Where J⁻¹H was evaluated for a velocity step.
+    """
+
+    body: Body
+    muscles: MuscleSet
+    disturbance: Disturbance
+    duration: float
+    knee: KneeModel
+    fall: FallCriteria
+    torque_limits: np.ndarray | None
+    feedback_delay: float
+    rtol: float
+    atol: float
+    sample_rate: float
+    max_switches: int
+    description: str
+    before: np.ndarray
+    x0: np.ndarray
+    locked0: bool
+    active0: np.ndarray
+    saturation0: np.ndarray
+    grid: np.ndarray
+    breakpoints: np.ndarray
+    delay_breakpoints: np.ndarray
+    max_step: float
+    fall_at_start: str | None
+    knee_row: np.ndarray | None
+    rates_from: str = "upright"
+
+    @property
+    def n_links(self) -> int:
+        """N. [-]"""
+        return self.body.n_links
+
+    @property
+    def stops(self) -> list[float]:
+        """Every time a step must end on: breakpoints, kτ, and the end. [s]"""
+        return sorted({*self.breakpoints.tolist(), *self.delay_breakpoints.tolist(),
+                       self.duration})
+
+
+@functools.lru_cache(maxsize=32)
+def output_grid(duration: float, sample_rate: float) -> np.ndarray:
+    """Output sample times 0, 1/rate, … up to ``duration`` (read-only, shared). [s]"""
+    grid = np.arange(0.0, duration + 0.5 / sample_rate, 1.0 / sample_rate)
+    grid = grid[grid <= duration + 1e-12]
+    grid.setflags(write=False)
+    return grid
+
+
+def initial_state_for(
+    body: Body,
+    disturbance: Disturbance,
+    initial_state: np.ndarray | None = None,
+    rates_from: Literal["upright", "posture"] = "upright",
+) -> np.ndarray:
+    """Initial state after the disturbance's velocity step at t = 0.
+
+    The step changes the rates by ΔΘ̇ = J⁻¹(−H Δẋ_d + G Δẏ_d), with J, H, G
+    evaluated at upright (the paper's choice, ``rates_from="upright"``) or at
+    the initial posture (``"posture"``, exact; erratum 5).
+
+    Parameters
+    ----------
+    initial_state : array_like, shape (2N,), optional
+        ``[Θ, Θ̇]`` before the step; upright at rest by default. [rad], [rad/s]
+    """
+    n = body.n_links
+    x0 = (np.zeros(2 * n) if initial_state is None
+          else finite_array("initial_state [rad, rad/s]", initial_state, (2 * n,)).copy())
+    dv = disturbance.velocity_change
+    if dv != (0.0, 0.0):
+        if rates_from not in ("upright", "posture"):
+            raise ParameterError(
+                f"rates_from must be 'upright' or 'posture', got {rates_from!r}"
+            )
+        ref = np.zeros(n) if rates_from == "upright" else x0[:n]
+        J = mass_matrix(body, ref)
+        gen = -platform_vector(body, ref) * dv[0] + gravity_vector(body, ref) * dv[1]
+        x0[n:] += np.linalg.solve(J, gen)
+    return x0
+
+
+def _expect(name: str, value, kind: type) -> None:
+    if not isinstance(value, kind):
+        raise ParameterError(f"{name} must be a {kind.__name__}, got {type(value).__name__} "
+                             f"{value!r:.60}")
+
+
+def prepare_run(
+    body: Body,
+    muscles: MuscleSet,
+    disturbance: Disturbance | None = None,
+    duration: float = 5.0,
+    *,
+    initial_state: np.ndarray | None = None,
+    rates_from: Literal["upright", "posture"] = "upright",
+    knee: KneeModel | None = None,
+    fall: FallCriteria | None = None,
+    torque_limits: np.ndarray | None = None,
+    feedback_delay: float = 0.0,
+    rtol: float = 1e-8,
+    atol: float = 1e-10,
+    sample_rate: float = 1000.0,
+    max_switches: int = 10_000,
+    description: str = "",
+) -> RunSetup:
+    """Validate the arguments of a run and work out everything both engines share.
+
+    Parameters are those of :func:`posturelab.simulate` (units there).
+
+    Raises
+    ------
+    ParameterError
+        An argument of the wrong type or outside its range, the knee beyond its stop, a
+        muscle set for another number of links.
+    """
+    _expect("body", body, Body)
+    _expect("muscles", muscles, MuscleSet)
+    disturbance = NoDisturbance() if disturbance is None else disturbance
+    _expect("disturbance", disturbance, Disturbance)
+    knee = KneeModel() if knee is None else knee
+    _expect("knee", knee, KneeModel)
+    fall = FallCriteria() if fall is None else fall
+    _expect("fall", fall, FallCriteria)
+    if muscles.n_links != body.n_links:
+        raise ParameterError(
+            f"muscle set is for {muscles.n_links} links but the body has {body.n_links}"
+        )
+    duration = positive_float("duration [s]", duration)
+    rtol = float_in_range("rtol", rtol, 1e-14, 1e-1)
+    atol = float_in_range("atol", atol, 1e-16, 1e-1)
+    sample_rate = float_in_range("sample_rate [Hz]", sample_rate, 1.0, 1e6, unit="Hz")
+    if isinstance(max_switches, bool) or not isinstance(max_switches, int | np.integer) \
+            or max_switches < 0:
+        raise ParameterError(f"max_switches must be an integer >= 0, got {max_switches!r}")
+    n = body.n_links
+    if knee.mode != "free" and n < 2:
+        raise ParameterError("knee mode 'locked' or 'stop' needs a body with at least 2 links")
+    delay = float_in_range("feedback_delay [s]", feedback_delay, 0.0, MAX_FEEDBACK_DELAY,
+                           unit="s")
+    limits = torque_limit_array(torque_limits, n)
+    before = (np.zeros(2 * n) if initial_state is None
+              else finite_array("initial_state [rad, rad/s]", initial_state, (2 * n,)).copy())
+    x0 = initial_state_for(body, disturbance, initial_state, rates_from)
+    knee_row = knee_constraint_row(n) if knee.mode != "free" else None
+    locked0 = knee.mode == "locked"
+    if knee.mode == "stop":
+        kappa = x0[1] - x0[0]
+        if kappa > knee.stop_angle + 1e-12:
+            raise ParameterError(
+                f"initial knee angle θ2 − θ1 = {kappa:g} rad is beyond the hyper-extension "
+                f"stop ({knee.stop_angle:g} rad)"
+            )
+        locked0 = abs(kappa - knee.stop_angle) <= 1e-12 and (x0[n + 1] - x0[n]) >= 0
+    if locked0:
+        x0[n:] = constrained_velocity(body, x0[:n], x0[n:], knee_row)
+    feedback0 = before if delay > 0 else x0
+    active0 = _active_from(muscles, feedback0)
+    saturation0 = np.zeros(n)
+    if limits is not None:
+        tau0 = joint_moments(muscles, feedback0[:n], feedback0[n:], active0)
+        over = np.isfinite(limits) & (np.abs(tau0) > limits)
+        saturation0[over] = np.sign(tau0[over])
+    breakpoints = np.array(sorted({b for b in disturbance.breakpoints if 0.0 < b < duration}),
+                           dtype=float)
+    delay_bps = np.array([k * delay for k in range(1, DELAY_BREAKPOINT_MULTIPLES + 1)
+                          if delay > 0 and k * delay < duration])
+    max_step = min(disturbance.max_step, duration, delay if delay > 0 else math.inf)
+    for arr in (before, x0, active0, saturation0, breakpoints, delay_bps):
+        arr.setflags(write=False)
+    setup = RunSetup(
+        body=body, muscles=muscles, disturbance=disturbance, duration=duration, knee=knee,
+        fall=fall, torque_limits=limits, feedback_delay=delay, rtol=rtol, atol=atol,
+        sample_rate=sample_rate, max_switches=int(max_switches),
+        description=description or disturbance.describe(), before=before, x0=x0,
+        locked0=bool(locked0), active0=active0, saturation0=saturation0,
+        grid=output_grid(duration, sample_rate), breakpoints=breakpoints,
+        delay_breakpoints=delay_bps, max_step=max_step, fall_at_start=None, knee_row=knee_row,
+        rates_from=rates_from,
+    )
+    object.__setattr__(setup, "fall_at_start", _fall_at_start(setup))
+    return setup
+
+
+def _active_from(muscles: MuscleSet, state: np.ndarray) -> np.ndarray:
+    """One-sided pairs act at the start if stretched, or at zero stretch and stretching."""
+    n = muscles.n_links
+    E = muscles.selection_matrix
+    s, sd = E @ state[:n], E @ state[n:]
+    act = np.where(muscles.one_sided_mask, (s > 0) | ((s == 0) & (sd >= 0)), True)
+    return act.astype(float)
+
+
+def model_response(setup: RunSetup, t: float, x: np.ndarray, feedback: np.ndarray,
+                   active: np.ndarray, locked: bool, saturation: np.ndarray | None
+                   ) -> tuple[np.ndarray, np.ndarray]:
+    """The model at one state with the run's switches applied (numpy).
+
+    Parameters
+    ----------
+    t : float
+        Time. [s]
+    x : numpy.ndarray, shape (2N,)
+        The state. [rad], [rad/s]
+    feedback : numpy.ndarray, shape (2N,)
+        The state the muscles respond to (x itself, or x(t − τ)). [rad], [rad/s]
+    active : numpy.ndarray, shape (P,)
+        Which pairs act. [-]
+    locked : bool
+        The knee constraint holds.
+    saturation : numpy.ndarray, shape (N,), or None
+        ±1 for a saturated joint (its moment is ±limit), 0 for a free one. [-]
+
+    Returns
+    -------
+    moments : numpy.ndarray, shape (N,)
+        Net muscle moment per joint, after saturation. [N·m]
+    acceleration : numpy.ndarray, shape (N,)
+        Θ̈ (on the knee constraint if locked). [rad/s²]
+    """
+    n = setup.n_links
+    tau = joint_moments(setup.muscles, feedback[:n], feedback[n:], active)
+    if saturation is not None and setup.torque_limits is not None:
+        bound = np.where(np.isfinite(setup.torque_limits), setup.torque_limits, 0.0)
+        tau = np.where(saturation != 0, saturation * bound, tau)
+    a = setup.disturbance.acceleration(t)
+    acc = angular_acceleration(setup.body, x[:n], x[n:], moments_to_link_torques(tau),
+                               a[0], a[1])
+    if locked:
+        acc = constrained_acceleration(setup.body, x[:n], acc, setup.knee_row)
+    return tau, acc
+
+
+def raw_moments(setup: RunSetup, feedback: np.ndarray, active: np.ndarray) -> np.ndarray:
+    """Unsaturated net muscle moment per joint from the fed-back state. [N·m]"""
+    n = setup.n_links
+    return joint_moments(setup.muscles, feedback[:n], feedback[n:], active)
+
+
+def cop_at(setup: RunSetup, t: float, x: np.ndarray, feedback: np.ndarray, active, locked,
+           saturation) -> float:
+    """Centre of pressure x_p at one state, relative to the ankle. [m]"""
+    n = setup.n_links
+    tau, acc = model_response(setup, t, x, feedback, active, locked, saturation)
+    fy = ground_reaction(setup.body, x[:n], x[n:], acc, setup.disturbance.acceleration(t))[1]
+    return float(centre_of_pressure(tau[0], fy))
+
+
+def _fall_at_start(setup: RunSetup) -> str | None:
+    """A fall criterion already violated at t = 0 (events only see crossings)."""
+    n = setup.n_links
+    x = setup.x0
+    fall = setup.fall
+    over = np.nonzero(np.abs(x[:n]) > fall.max_link_angle)[0]
+    if over.size:
+        return f"link {over[0] + 1} angle beyond ±{fall.max_link_angle:.3g} rad at the start"
+    bos = fall.base_of_support
+    if bos is None:
+        return None
+    xc = setup.body.gravity_coefficients @ np.sin(x[:n]) / setup.body.total_mass
+    if not bos.heel <= xc <= bos.toe:
+        return f"centre of gravity ({xc:.3f} m) outside the foot at the start"
+    if fall.centre_of_pressure:
+        feedback = setup.before if setup.feedback_delay > 0 else x
+        sat = setup.saturation0 if setup.torque_limits is not None else None
+        xp = cop_at(setup, 0.0, x, feedback, setup.active0, setup.locked0, sat)
+        if not bos.heel <= xp <= bos.toe:
+            return (f"centre of pressure ({xp:.3f} m) outside the foot at the start: "
+                    "the foot tips")
+    return None
+
+
+def outcome_message(status: str, t: float, setup: RunSetup, *, fall_reason: str = "",
+                    detail: str = "") -> str:
+    """The words of a run's outcome.
+
+    Parameters
+    ----------
+    status : {"completed", "fell", "step-too-small", "non-finite", "chattering", "failed"}
+        What happened ("failed" takes its words from ``detail``).
+    t : float
+        When it happened (the fall, the failure). [s]
+    """
+    if status == "completed":
+        return f"ran to {setup.duration:g} s"
+    if status == "fell":
+        when = "0 s" if t == 0.0 else f"{t:.4f} s"
+        return f"fell at t = {when}: {fall_reason}"
+    if status == "step-too-small":
+        return (f"integrator failed at t = {t:.6g} s: required step size is less than "
+                "spacing between numbers")
+    if status == "non-finite":
+        return f"state diverged (non-finite) at t = {t:.6g} s"
+    if status == "chattering":
+        return f"more than {setup.max_switches} switches by t = {t:.6g} s (chattering)"
+    return detail
