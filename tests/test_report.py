@@ -1,6 +1,6 @@
 """``reproduce_paper`` and ``posturelab reproduce``: the regenerated paper.
 
-The report is built once per module (about 6 s) and inspected by several
+The report is built once per module (about 20 s) and inspected by several
 tests. The Table II numbers themselves are tested in test_paper_numbers.py;
 here we check that the report carries them, flags the errata, and never
 leaves a half-written output behind.
@@ -111,10 +111,12 @@ def test_failure_leaves_nothing(tmp_path, monkeypatch):
     """A failure half-way removes the temporary files and the directory it created."""
     import posturelab.report as rep
 
+    import posturelab.paper.checks as checks
+
     def boom(*args, **kwargs):
         raise PostureLabError("simulated failure")
 
-    monkeypatch.setattr(rep, "_check_fig9", boom)
+    monkeypatch.setattr(checks, "check_fig9", boom)
     out = tmp_path / "a" / "b"
     with pytest.raises(PostureLabError, match="simulated failure"):
         rep.reproduce_paper(out)
@@ -173,3 +175,37 @@ def test_beyond_the_paper_findings(built):
     delay = next(f for f in report.findings if f.startswith("Neural delay"))
     survive, fall = (float(x) for x in re.findall(r"τ = (\d+) ms", delay)[:2])
     assert 2 <= survive < fall <= 30
+
+
+def test_searches_take_their_runner():
+    """The two searches run on whatever runner they are given (the engine is one argument)."""
+    from types import SimpleNamespace
+
+    from posturelab.body import paper_body
+
+    from posturelab.paper.checks import delay_finding, recovery_finding
+    from posturelab.simulation import FOOT_FROM_LITERATURE
+
+    calls = []
+
+    def ramp(body, muscles, distance, fall):
+        calls.append(distance)
+        return SimpleNamespace(fell=distance > (0.08 if fall.centre_of_pressure else 0.2),
+                               fall_reason="x")
+
+    rec = recovery_finding(paper_body(), FOOT_FROM_LITERATURE, run=ramp)
+    assert rec.by_cop == pytest.approx(0.08, abs=1e-3)
+    assert rec.by_cog == pytest.approx(0.2, abs=1e-3) and len(calls) > 10
+    assert "beyond a 8.0 cm move" in rec.text and "only beyond 20.0 cm" in rec.text
+
+    class Scenario:
+        def replace(self, **changes):
+            assert changes == {"duration": 1.5, "sample_rate": 100.0}
+            return self
+
+    delay = delay_finding(Scenario(), run=lambda sc, tau: SimpleNamespace(fell=tau > 0.0123))
+    assert delay.survives < 0.0123 < delay.falls and delay.falls - delay.survives <= 1e-3
+    assert (f"survives τ = {delay.survives * 1000:.0f} ms but falls at "
+            f"τ = {delay.falls * 1000:.0f} ms") in delay.text
+    never = delay_finding(Scenario(), run=lambda sc, tau: SimpleNamespace(fell=False))
+    assert never.text == "Neural delay: the bracket of delays searched did not bracket a fall."

@@ -1,4 +1,4 @@
-"""The numbers the paper prints, with their sources, and our errata.
+"""The numbers (and figure captions) the paper prints, with their sources, and our errata.
 
 These are *data*, transcribed from ``paper/ankle-strategy-paper.txt``; the
 tests compare our computations against them, and the report shows both side
@@ -20,6 +20,7 @@ __all__ = [
     "BACKWARD_INITIAL_STATE_SOURCE",
     "Erratum",
     "ERRATA",
+    "FIGURE_CAPTIONS",
     "printed_decimals",
     "match_printed_poles",
 ]
@@ -134,3 +135,30 @@ ERRATA: tuple[Erratum, ...] = (
         "the fifth significant digit (2e-5 relative); the other poles of the row agree.",
     ),
 )
+
+#: The paper's figure captions (Section V), transcribed from paper/ankle-strategy-paper.txt.
+FIGURE_CAPTIONS: dict[int, str] = {
+    3: "The trajectories of motion: the three angles and the three angular velocities as "
+       "functions of time in a backward platform motion.",
+    4: "The spatial trajectories of motion: the angles θ2 and θ3 as functions of θ1 in a "
+       "backward platform motion - a forward subject sway. All angles seem to linearly depend "
+       "on one another, and the knee gets locked at the point of maximum excursion forward.",
+    5: "The torque activity at the three joints and the gastrocnemius as functions of time - "
+       "all torques are in Newton-meters",
+    6: "The quadriceps two-jointed muscle activity as a function of time",
+    7: "The phase plane portrait of the horizontal motion of the center of gravity - velocity "
+       "versus position - in a backward platform motion, i.e., in a forward sway.",
+    8: "The phase plane portrait of the horizontal motion of the center of gravity - velocity "
+       "versus position in forward platform disturbance. Artificial antagonistic "
+       "gastrocnemius is assumed. In reality, the tibialis anterior would compensate for the "
+       "artificial gastrocnemius muscle introduced here, because the knees are locked and θ1 "
+       "and θ2 are equal.",
+    9: "The phase plane portrait of the horizontal motion of the center of gravity - velocity "
+       "versus position - in forward platform disturbance. The system is unstable, and fall "
+       "is inevitable. It is possible that a much larger tibialis anterior force would have "
+       "prevented the fall.",
+    10: "The phase plane portrait of the horizontal motion of the center of gravity - velocity "
+        "versus position in forward platform disturbance with no gastrocnemius, but larger "
+        "ankle stiffness. The system is recovering from the disturbance but more slowly. A "
+        "larger tibialis anterior - soleus force pair would implement this case.",
+}
