@@ -9,12 +9,14 @@ leaves a half-written output behind.
 from __future__ import annotations
 
 import csv
+import dataclasses
 import subprocess
 import sys
 
 import pytest
 from posturelab.report import reproduce_paper
 
+import posturelab
 from posturelab.cli import main
 from posturelab.errors import PostureLabError
 from posturelab.paper import TABLE_II_PRINTED
@@ -175,6 +177,30 @@ def test_beyond_the_paper_findings(built):
     delay = next(f for f in report.findings if f.startswith("Neural delay"))
     survive, fall = (float(x) for x in re.findall(r"τ = (\d+) ms", delay)[:2])
     assert 2 <= survive < fall <= 30
+
+
+@dataclasses.dataclass(frozen=True)
+class _Finding:
+    text: str
+
+
+def test_template_autoescapes(built):
+    """index.html comes from the template with autoescape on: markup in a finding is text."""
+    from posturelab.paper.report import render_index
+
+    out, report, _ = built
+    page = (out / "index.html").read_text(encoding="utf-8")
+    assert "(θ2 &lt; 0)" in page and "(θ2 < 0)" not in page  # the one-sided finding
+    paper = report.details
+    odd = _Finding("x < 1 & <script>alert('x')</script>")
+    images = {p.stem: p.read_bytes() for p in out.glob("*.png")}
+    page = render_index(dataclasses.replace(paper, findings=paper.findings + (odd,)), images,
+                        version="<v>")
+    assert "<p>x &lt; 1 &amp; &lt;script&gt;alert(&#39;x&#39;)&lt;/script&gt;</p>" in page
+    assert "<script>" not in page and "posturelab &lt;v&gt;." in page
+    assert page == (out / "index.html").read_text(encoding="utf-8").replace(
+        "</body>", "<p>x &lt; 1 &amp; &lt;script&gt;alert(&#39;x&#39;)&lt;/script&gt;</p>\n"
+        "</body>").replace(f"posturelab {posturelab.__version__}.", "posturelab &lt;v&gt;.")
 
 
 def test_searches_take_their_runner():
