@@ -125,6 +125,40 @@ def test_failure_leaves_nothing(tmp_path, monkeypatch):
     assert list(tmp_path.iterdir()) == []
 
 
+def test_interrupt_leaves_nothing(tmp_path, monkeypatch):
+    """KeyboardInterrupt at the first step: the temporary files and new directories go."""
+    import posturelab.report as rep
+
+    import posturelab.paper.checks as checks
+
+    def interrupt(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(checks, "table2_check", interrupt)
+    with pytest.raises(KeyboardInterrupt):
+        rep.reproduce_paper(tmp_path / "a" / "b")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_sigterm_leaves_nothing(tmp_path):
+    """SIGTERM while `posturelab reproduce` runs: exit status 143, nothing left behind."""
+    import signal
+    import time
+
+    out = tmp_path / "a" / "b"
+    proc = subprocess.Popen([sys.executable, "-m", "posturelab", "reproduce", "--quiet",
+                             "--out", str(out)], stdout=subprocess.DEVNULL,
+                            stderr=subprocess.PIPE)
+    deadline = time.monotonic() + 60
+    while not (out.is_dir() and any(out.iterdir())) and proc.poll() is None:
+        assert time.monotonic() < deadline
+        time.sleep(0.05)
+    proc.send_signal(signal.SIGTERM)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 143, err
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_cli_unwritable_location(tmp_path, capsys):
     blocker = tmp_path / "regular-file"
     blocker.write_text("")

@@ -29,9 +29,12 @@ import csv
 import io
 import os
 import shutil
+import signal
 import tempfile
+import threading
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterator, Mapping
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from functools import lru_cache
 from pathlib import Path
@@ -266,6 +269,26 @@ def _remove_dirs(created: list[Path]) -> None:
             pass
 
 
+@contextmanager
+def _terminate_raises() -> Iterator[None]:
+    """While inside, SIGTERM raises ``SystemExit(143)`` instead of ending the process at once,
+    so that the temporary files are removed; only in the main thread, and only where
+    SIGTERM still has its default action."""
+    if threading.current_thread() is not threading.main_thread() or \
+            signal.getsignal(signal.SIGTERM) is not signal.SIG_DFL:
+        yield
+        return
+
+    def terminate(signum, frame):
+        raise SystemExit(128 + signum)
+
+    signal.signal(signal.SIGTERM, terminate)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, signal.SIG_DFL)
+
+
 # ---------------------------------------------------------------------------
 # The report
 # ---------------------------------------------------------------------------
@@ -293,9 +316,18 @@ def reproduce_paper(out_dir: str | Path, progress: ProgressCallback | None = Non
     PostureLabError
         ``out_dir`` is a file, or cannot be created or written; nothing is
         left behind.
+
+    Notes
+    -----
+    An interrupt (KeyboardInterrupt, or SIGTERM, which raises ``SystemExit(143)``
+    while the call runs in the main thread) also leaves nothing behind.
     """
+    with _terminate_raises():
+        return _reproduce(Path(out_dir), progress)
+
+
+def _reproduce(out: Path, progress: ProgressCallback | None) -> ReproduceReport:
     t_start = time.perf_counter()
-    out = Path(out_dir)
     created = _prepare_out_dir(out)
     try:
         tmp = Path(tempfile.mkdtemp(prefix=".posturelab-reproduce-", dir=out))
