@@ -13,6 +13,7 @@ from .printed import (
     ERRATA,
     SENSITIVITY_PRINTED,
     TABLE_II_PRINTED,
+    Erratum,
     match_printed_poles,
     printed_tolerance,
 )
@@ -99,6 +100,6 @@ def sensitivity_comparison(body: Body | None = None) -> SensitivityComparison:
     return SensitivityComparison(SENSITIVITY_PRINTED, value, ok)
 
 
-def erratum(number: int):
+def erratum(number: int) -> Erratum:
     """The :class:`posturelab.paper.Erratum` with this number."""
     return next(e for e in ERRATA if e.number == number)
