@@ -47,8 +47,9 @@ __all__ = [
     "EVENT_DIRECTION",
     "EVENT_OFFSET",
     "EVENT_ENDS_RUN",
+    "EventSlots",
+    "event_slots",
     "segment_events",
-    "max_segment_events",
     "fall_message",
     "JOINT_NAMES",
 ]
@@ -141,17 +142,54 @@ for _a in (EVENT_DIRECTION, EVENT_OFFSET, EVENT_ENDS_RUN):
 JOINT_NAMES = ("ankle", "knee", "hip")
 
 
-def max_segment_events(n_links: int, n_pairs: int) -> int:
-    """Largest number of events a segment can list. [-]"""
-    return n_links + 4 + 2 * n_links + n_pairs + 1
+# Conditions under which an event slot is part of a segment (codes shared with the kernels)
+ALWAYS = 0
+JOINT_FREE = 1
+JOINT_SATURATED = 2
+PAIR_ACTIVE = 3
+PAIR_SLACK = 4
+KNEE_FREE = 5
+KNEE_LOCKED = 6
 
 
-def segment_events(n_links, base_of_support, centre_of_pressure, limited, saturation,
-                   one_sided, active, knee_stop, locked, kind, index, side):
-    """List the events of a smooth segment, in the order that breaks ties; return how many.
+@dataclass(frozen=True)
+class EventSlots:
+    """Every event a run can have, in the order that breaks ties, with when each applies.
 
-    Written for numpy arrays in plain loops, so that the compiled engine runs this very
-    function (compiled) and the reference engine runs it as Python.
+    A smooth segment's events are the slots whose condition holds at its start
+    (:func:`segment_events`). Arrays of equal length S.
+
+    Attributes
+    ----------
+    kind : numpy.ndarray of int64
+        Event code. [-]
+    index : numpy.ndarray of int64
+        The link, joint or pair it concerns. [-]
+    side : numpy.ndarray
+        +1 or −1 for a joint saturating at +limit or −limit, else 0 (a joint letting go
+        takes the side it is saturated at). [-]
+    condition : numpy.ndarray of int64
+        ALWAYS, JOINT_FREE or JOINT_SATURATED (joint ``index``), PAIR_ACTIVE or PAIR_SLACK
+        (pair ``index``), KNEE_FREE or KNEE_LOCKED. [-]
+    """
+
+    kind: np.ndarray
+    index: np.ndarray
+    side: np.ndarray
+    condition: np.ndarray
+
+    def __len__(self) -> int:
+        return int(self.kind.size)
+
+
+def event_slots(n_links: int, base_of_support: bool, centre_of_pressure: bool,
+                limited: np.ndarray, one_sided: np.ndarray, knee_stop: bool) -> EventSlots:
+    """The event slots of a run, in tie-breaking order.
+
+    Falls first (every link angle, then the centre of gravity past the toe and the heel,
+    then the centre of pressure), then each limited joint (saturating either way while
+    free, letting go while saturated), then each one-sided pair (going slack while acting,
+    engaging while slack), then the knee stop (reached while free, left while locked).
 
     Parameters
     ----------
@@ -159,70 +197,49 @@ def segment_events(n_links, base_of_support, centre_of_pressure, limited, satura
         N. [-]
     base_of_support, centre_of_pressure : bool
         Whether the centre of gravity, and the centre of pressure, may leave a foot.
-    limited : numpy.ndarray of int, shape (N,)
-        1 for a joint with a finite torque limit. [-]
-    saturation : numpy.ndarray, shape (N,)
-        0 for a free joint, ±1 for one saturated at +limit or −limit. [-]
-    one_sided : numpy.ndarray of int, shape (P,)
-        1 for a one-sided pair. [-]
-    active : numpy.ndarray, shape (P,)
-        1 for a pair that acts, 0 for a slack one. [-]
+    limited : array_like of bool, shape (N,)
+        Joints with a finite torque limit.
+    one_sided : array_like of bool, shape (P,)
+        One-sided pairs.
     knee_stop : bool
         The knee has a hyper-extension stop.
-    locked : bool
-        The knee is at its stop (locked) now.
-    kind, index, side : numpy.ndarray of int64, int64, float64
-        Filled with each event's code, its link / joint / pair index and its side (±1
-        for a saturation, else 0); at least :func:`max_segment_events` long.
-
-    Returns
-    -------
-    int
-        The number of events listed.
     """
-    m = 0
-    for i in range(n_links):  # falls: every link angle, then the foot
-        kind[m] = LINK_ANGLE
-        index[m] = i
-        side[m] = 0.0
-        m += 1
+    rows: list[tuple[int, int, float, int]] = [(LINK_ANGLE, i, 0.0, ALWAYS)
+                                               for i in range(n_links)]
     if base_of_support:
-        for code in (COG_TOE, COG_HEEL):
-            kind[m] = code
-            index[m] = 0
-            side[m] = 0.0
-            m += 1
+        rows += [(COG_TOE, 0, 0.0, ALWAYS), (COG_HEEL, 0, 0.0, ALWAYS)]
         if centre_of_pressure:
-            for code in (COP_TOE, COP_HEEL):
-                kind[m] = code
-                index[m] = 0
-                side[m] = 0.0
-                m += 1
-    for j in range(n_links):  # a free limited joint saturates either way; a saturated one lets go
-        if limited[j]:
-            if saturation[j] == 0.0:
-                for s in (1.0, -1.0):
-                    kind[m] = SATURATES
-                    index[m] = j
-                    side[m] = s
-                    m += 1
-            else:
-                kind[m] = LETS_GO
-                index[m] = j
-                side[m] = saturation[j]
-                m += 1
-    for p in range(one_sided.size):
-        if one_sided[p]:
-            kind[m] = PAIR_SLACKENS if active[p] > 0.0 else PAIR_ENGAGES
-            index[m] = p
-            side[m] = 0.0
-            m += 1
+            rows += [(COP_TOE, 0, 0.0, ALWAYS), (COP_HEEL, 0, 0.0, ALWAYS)]
+    for j in np.nonzero(np.asarray(limited, dtype=bool))[0]:
+        rows += [(SATURATES, int(j), 1.0, JOINT_FREE), (SATURATES, int(j), -1.0, JOINT_FREE),
+                 (LETS_GO, int(j), 0.0, JOINT_SATURATED)]
+    for p in np.nonzero(np.asarray(one_sided, dtype=bool))[0]:
+        rows += [(PAIR_SLACKENS, int(p), 0.0, PAIR_ACTIVE),
+                 (PAIR_ENGAGES, int(p), 0.0, PAIR_SLACK)]
     if knee_stop:
-        kind[m] = KNEE_LEAVES_STOP if locked else KNEE_HITS_STOP
-        index[m] = 1
-        side[m] = 0.0
-        m += 1
-    return m
+        rows += [(KNEE_HITS_STOP, 1, 0.0, KNEE_FREE), (KNEE_LEAVES_STOP, 1, 0.0, KNEE_LOCKED)]
+    kind, index, side, cond = zip(*rows, strict=True)
+    slots = EventSlots(np.array(kind, np.int64), np.array(index, np.int64),
+                       np.array(side, float), np.array(cond, np.int64))
+    for arr in (slots.kind, slots.index, slots.side, slots.condition):
+        arr.setflags(write=False)
+    return slots
+
+
+def segment_events(slots: EventSlots, saturation: np.ndarray, active: np.ndarray,
+                   locked: bool) -> list[tuple[int, int, float]]:
+    """The (kind, index, side) of each event of a smooth segment that starts with joint
+    saturation ``saturation`` (N,), pairs ``active`` (P,) and the knee ``locked``."""
+    on = {ALWAYS: lambda i: True, JOINT_FREE: lambda i: saturation[i] == 0.0,
+          JOINT_SATURATED: lambda i: saturation[i] != 0.0,
+          PAIR_ACTIVE: lambda i: active[i] > 0.0, PAIR_SLACK: lambda i: not active[i] > 0.0,
+          KNEE_FREE: lambda i: not locked, KNEE_LOCKED: lambda i: bool(locked)}
+    out = []
+    for k, i, sd, c in zip(slots.kind.tolist(), slots.index.tolist(), slots.side.tolist(),
+                           slots.condition.tolist(), strict=True):
+        if on[c](i):
+            out.append((k, i, float(saturation[i]) if k == LETS_GO else sd))
+    return out
 
 
 def fall_message(code: int, index: int, *, max_link_angle: float, toe: float = 0.0,

@@ -8,7 +8,11 @@ Every disturbance is an immutable object with
 * ``acceleration(t)`` — (ẍ_d, ÿ_d) at times ``t`` [m/s²], shape (..., 2);
 * ``breakpoints`` — the times where the acceleration or its slope jumps; the
   simulator stops and restarts its integrator exactly there so it never
-  steps blindly over a corner.
+  steps blindly over a corner;
+* ``primitives()`` — the acceleration as a sum of a few kinds of terms
+  (:class:`Primitive`: a windowed sine, a sine, a sampled profile), which the
+  compiled engine evaluates. A new kind of disturbance that is such a sum needs
+  ``acceleration``, ``breakpoints``, ``scaled`` and ``primitives`` and nothing else.
 
 Sign conventions: x forward, y up. A *backward* platform motion has
 ẋ_d < 0 and makes the body sway forward.
@@ -29,6 +33,7 @@ from .._validation import finite_array, finite_float, nonnegative_float, positiv
 from ..errors import DataFileError, ParameterError
 
 __all__ = [
+    "Primitive",
     "Disturbance",
     "NoDisturbance",
     "VelocityStep",
@@ -48,6 +53,44 @@ def _axis(axis: str) -> int:
     if axis not in ("x", "y"):
         raise ParameterError(f"axis must be 'x' (horizontal) or 'y' (vertical), got {axis!r}")
     return 0 if axis == "x" else 1
+
+
+@dataclass(frozen=True)
+class Primitive:
+    """One term of a platform acceleration, in the form the compiled engine evaluates.
+
+    Attributes
+    ----------
+    kind : {"windowed-sine", "sine", "samples"}
+        ``windowed-sine``: a(t) = amplitude · sin(2π · cycles · s) for
+        s = (t − start)/duration in [0, 1], zero elsewhere; ``sine``:
+        a(t) = amplitude · sin(2π · frequency · t + phase); ``samples``: linear
+        interpolation of (time, x, y), zero outside.
+    axis : int
+        0 horizontal (x), 1 vertical (y); unused for samples (both axes). [-]
+    amplitude : float
+        [m/s²]
+    duration, start : float
+        The window of a windowed sine. [s]
+    cycles : float
+        Sine cycles within the window (½ a half-sine, 1 a ramp-and-hold). [-]
+    frequency : float
+        [Hz]
+    phase : float
+        [rad]
+    samples : tuple of numpy.ndarray, optional
+        (time [s], x acceleration [m/s²], y acceleration [m/s²]).
+    """
+
+    kind: str
+    axis: int = 0
+    amplitude: float = 0.0
+    duration: float = 0.0
+    start: float = 0.0
+    cycles: float = 0.0
+    frequency: float = 0.0
+    phase: float = 0.0
+    samples: tuple | None = None
 
 
 class Disturbance:
@@ -75,6 +118,14 @@ class Disturbance:
         """One-line human description with units."""
         return "no platform motion"
 
+    def primitives(self) -> tuple[Primitive, ...]:
+        """The acceleration as a sum of :class:`Primitive` terms (none for the base class,
+        which does not move; a subclass that moves and does not define this cannot run on
+        the compiled engine)."""
+        if type(self) is Disturbance:
+            return ()
+        raise NotImplementedError(type(self).__name__)
+
     def scaled(self, factor: float) -> Disturbance:
         """The same motion with every amplitude multiplied by ``factor`` [-].
 
@@ -95,6 +146,9 @@ class NoDisturbance(Disturbance):
     def scaled(self, factor: float) -> NoDisturbance:
         finite_float("factor [-]", factor)
         return self
+
+    def primitives(self) -> tuple[Primitive, ...]:
+        return ()
 
 
 @dataclass(frozen=True)
@@ -134,6 +188,9 @@ class VelocityStep(Disturbance):
     def scaled(self, factor: float) -> VelocityStep:
         return replace(self, velocity=self.velocity * finite_float("factor [-]", factor))
 
+    def primitives(self) -> tuple[Primitive, ...]:
+        return ()  # no acceleration: the step only sets the initial rates
+
     def describe(self) -> str:
         word = {"x": ("forward", "backward"), "y": ("up", "down")}[self.axis]
         return (f"platform velocity step of {abs(self.velocity):g} m/s "
@@ -162,6 +219,10 @@ class _SinePulse(Disturbance):
     def peak_acceleration_value(self) -> float:
         """Amplitude of the sine. [m/s²]"""
         raise NotImplementedError
+
+    def primitives(self) -> tuple[Primitive, ...]:
+        return (Primitive("windowed-sine", _axis(self.axis), self.peak_acceleration_value,
+                          duration=self.duration, start=self.start, cycles=self._cycles),)
 
     def acceleration(self, t):
         t = np.asarray(t, dtype=float)
@@ -309,6 +370,11 @@ class SumOfSines(Disturbance):
         f = finite_float("factor [-]", factor)
         return replace(self, amplitudes=tuple(a * f for a in self.amplitudes))
 
+    def primitives(self) -> tuple[Primitive, ...]:
+        return tuple(Primitive("sine", _axis(self.axis), a, frequency=f, phase=ph)
+                     for a, f, ph in zip(self.amplitudes, self.frequencies, self.phases,
+                                         strict=True))
+
     def acceleration(self, t):
         t = np.asarray(t, dtype=float)
         a = np.zeros(t.shape)
@@ -381,6 +447,10 @@ class MeasuredProfile(Disturbance):
     def max_step(self) -> float:
         return self._max_step
 
+    def primitives(self) -> tuple[Primitive, ...]:
+        return (Primitive("samples", samples=(self.time, self.acceleration_x,
+                                              self.acceleration_y)),)
+
     def acceleration(self, t):
         t = np.asarray(t, dtype=float)
         out = np.zeros(t.shape + (2,))
@@ -419,6 +489,9 @@ class CombinedDisturbance(Disturbance):
     def scaled(self, factor: float) -> CombinedDisturbance:
         f = finite_float("factor [-]", factor)
         return CombinedDisturbance(tuple(p.scaled(f) for p in self.parts))
+
+    def primitives(self) -> tuple[Primitive, ...]:
+        return tuple(q for p in self.parts for q in p.primitives())
 
     def describe(self) -> str:
         return " + ".join(p.describe() for p in self.parts)

@@ -24,10 +24,11 @@ __all__ = ["simulate", "ENGINES", "engine_name", "ENGINE_DEFAULTS"]
 #: Engine names; "fast" is a former name of "compiled".
 ENGINES = ("reference", "compiled")
 
-#: Default (rtol [-], atol [rad, rad/s], method) of each engine.
-ENGINE_DEFAULTS: dict[str, tuple[float, float, str]] = {
+#: Default (rtol [-], atol [rad, rad/s], method) of each engine; the compiled engine's
+#: method depends on the run (posturelab.simulation.compiled.default_method).
+ENGINE_DEFAULTS: dict[str, tuple[float, float, str | None]] = {
     "reference": (1e-8, 1e-10, "DOP853"),
-    "compiled": (1e-6, 1e-9, "Radau"),
+    "compiled": (1e-6, 1e-9, None),
 }
 
 
@@ -96,7 +97,8 @@ def simulate(
     method : str, optional
         The integrator: for the reference engine a scipy ``solve_ivp`` method
         ("DOP853", the default, "RK45", "Radau", …); for the compiled engine
-        "Radau" (default), "RK45" or "RK23".
+        "Radau", "RK45" or "RK23" (by default Radau, or RK45 when the feedback is
+        delayed: :func:`posturelab.simulation.compiled.default_method`).
     max_switches : int
         Guard against chattering: more switches than this fail the run.
     description : str

@@ -37,11 +37,6 @@ from .setup import RunSetup, cop_at, model_response, outcome_message, raw_moment
 
 __all__ = ["integrate_reference", "REFERENCE_METHODS"]
 
-# Names paper/report.py imported from here before the options moved to model/options.py;
-# removed once it imports them from there.
-from ..model.options import FOOT_FROM_LITERATURE, BaseOfSupport, FallCriteria  # noqa: E402, F401
-from .engines import simulate  # noqa: E402, F401
-
 #: scipy ``solve_ivp`` methods the reference engine accepts.
 REFERENCE_METHODS = ("DOP853", "RK45", "RK23", "Radau", "BDF", "LSODA")
 
@@ -107,10 +102,8 @@ def integrate_reference(setup: RunSetup, method: str = "DOP853") -> SimulationRe
     a_coef = body.gravity_coefficients
     mtot = body.total_mass
     E = muscles.selection_matrix
-    cap = ev.max_segment_events(n, len(muscles.pairs))
-    kinds = np.zeros(cap, np.int64)
-    index = np.zeros(cap, np.int64)
-    side = np.zeros(cap)
+    slots = ev.event_slots(n, bos is not None, fall.centre_of_pressure, limited,
+                           muscles.one_sided_mask, knee.mode == "stop")
 
     def event_function(k: int, j: int, sd: float, _active, _locked, _sat):
         """The event function g(t, x) of event kind k (index j, side sd) in this segment."""
@@ -174,16 +167,12 @@ def integrate_reference(setup: RunSetup, method: str = "DOP853") -> SimulationRe
             acc = model_response(setup, tt, xx, feedback(tt, xx), _active, _locked, _sat)[1]
             return np.concatenate([xx[n:], acc])
 
-        count = ev.segment_events(
-            n, bos is not None, fall.centre_of_pressure, limited, saturation,
-            muscles.one_sided_mask.astype(np.int64), active, knee.mode == "stop", locked,
-            kinds, index, side)
+        listed = ev.segment_events(slots, saturation, active, locked)
         events = []
-        for e in range(count):
-            g = event_function(int(kinds[e]), int(index[e]), float(side[e]), active, locked,
-                               sat)
+        for k, j, sd in listed:
+            g = event_function(k, j, sd, active, locked, sat)
             g.terminal = True
-            g.direction = int(ev.EVENT_DIRECTION[kinds[e]])
+            g.direction = int(ev.EVENT_DIRECTION[k])
             events.append(g)
 
         try:
@@ -226,7 +215,7 @@ def integrate_reference(setup: RunSetup, method: str = "DOP853") -> SimulationRe
         if not fired:
             fired = [k for k, te in enumerate(sol.t_events) if len(te)]
         e = fired[0]
-        kind, j = int(kinds[e]), int(index[e])
+        kind, j, sd = listed[e]
         x = sol.y_events[e][-1].copy()
         t = seg_end
         if ev.EVENT_ENDS_RUN[kind]:
@@ -261,7 +250,7 @@ def integrate_reference(setup: RunSetup, method: str = "DOP853") -> SimulationRe
             locked = False
         else:  # SATURATES / LETS_GO
             saturation = saturation.copy()
-            saturation[j] = side[e] if kind == ev.SATURATES else 0.0
+            saturation[j] = sd if kind == ev.SATURATES else 0.0
 
     time = np.concatenate(times)
     state = np.concatenate(states, axis=0)

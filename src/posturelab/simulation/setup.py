@@ -141,6 +141,14 @@ class RunSetup:
         """N. [-]"""
         return self.body.n_links
 
+    def with_fall_criteria(self, **changes) -> RunSetup:
+        """The same set-up with some fall criteria changed (fall_at_start recomputed)."""
+        from dataclasses import replace
+
+        new = replace(self, fall=replace(self.fall, **changes), fall_at_start=None)
+        object.__setattr__(new, "fall_at_start", _fall_at_start(new))
+        return new
+
     @property
     def stops(self) -> list[float]:
         """Every time a step must end on: breakpoints, kτ, and the end. [s]"""
@@ -265,12 +273,10 @@ def prepare_run(
     if locked0:
         x0[n:] = constrained_velocity(body, x0[:n], x0[n:], knee_row)
     feedback0 = before if delay > 0 else x0
-    active0 = _active_from(muscles, feedback0)
-    saturation0 = np.zeros(n)
-    if limits is not None:
-        tau0 = joint_moments(muscles, feedback0[:n], feedback0[n:], active0)
-        over = np.isfinite(limits) & (np.abs(tau0) > limits)
-        saturation0[over] = np.sign(tau0[over])
+    active0 = start_activity(muscles, feedback0)
+    saturation0 = start_saturation(
+        start_moments(muscles, feedback0, active0, muscles.stiffnesses, muscles.viscosities),
+        limits)
     breakpoints = np.array(sorted({b for b in disturbance.breakpoints if 0.0 < b < duration}),
                            dtype=float)
     delay_bps = np.array([k * delay for k in range(1, DELAY_BREAKPOINT_MULTIPLES + 1)
@@ -292,13 +298,62 @@ def prepare_run(
     return setup
 
 
-def _active_from(muscles: MuscleSet, state: np.ndarray) -> np.ndarray:
-    """One-sided pairs act at the start if stretched, or at zero stretch and stretching."""
+def start_activity(muscles: MuscleSet, state: np.ndarray) -> np.ndarray:
+    """Which pairs act at the start: one-sided pairs if stretched, or at zero stretch and
+    stretching, in the state the muscles respond to, ``state`` (..., 2N). Returns (..., P)."""
     n = muscles.n_links
     E = muscles.selection_matrix
-    s, sd = E @ state[:n], E @ state[n:]
+    state = np.asarray(state, dtype=float)
+    s, sd = state[..., :n] @ E.T, state[..., n:] @ E.T
     act = np.where(muscles.one_sided_mask, (s > 0) | ((s == 0) & (sd >= 0)), True)
     return act.astype(float)
+
+
+def start_moments(muscles: MuscleSet, state: np.ndarray, active: np.ndarray,
+                  stiffness: np.ndarray, viscosity: np.ndarray) -> np.ndarray:
+    """Unsaturated joint moments τ = Cᵀ diag(active)(k_d E Θ + l_d E Θ̇) for gains that may
+    differ per run: state (..., 2N), active and gains (..., P). Returns (..., N). [N·m]"""
+    n = muscles.n_links
+    E = muscles.selection_matrix
+    state = np.asarray(state, dtype=float)
+    pair = (np.asarray(stiffness) * (state[..., :n] @ E.T)
+            + np.asarray(viscosity) * (state[..., n:] @ E.T)) * active
+    return pair @ muscles.crossing_matrix
+
+
+def start_saturation(moments: np.ndarray, limits: np.ndarray | None) -> np.ndarray:
+    """±1 for each joint whose moment starts beyond its limit, else 0 (shape of moments)."""
+    moments = np.asarray(moments, dtype=float)
+    sat = np.zeros(moments.shape)
+    if limits is not None:
+        limits = np.broadcast_to(np.asarray(limits, dtype=float), moments.shape)
+        over = np.isfinite(limits) & (np.abs(moments) > limits)
+        sat[over] = np.sign(moments[over])
+    return sat
+
+
+def start_centre_of_pressure(setup: RunSetup, moments: np.ndarray, limits, saturation
+                             ) -> np.ndarray:
+    """Centre of pressure at t = 0 for runs that differ in their moments (..., N) [N·m],
+    limits (..., N) [N·m] and saturation (..., N): x_p (...). [m]"""
+    n = setup.n_links
+    x = setup.x0
+    tau = np.asarray(moments, dtype=float)
+    if limits is not None:
+        bound = np.where(np.isfinite(limits), limits, 0.0)
+        tau = np.where(saturation != 0, saturation * bound, tau)
+    a = setup.disturbance.acceleration(0.0)
+    theta = np.broadcast_to(x[:n], tau.shape)
+    omega = np.broadcast_to(x[n:], tau.shape)
+    acc = angular_acceleration(setup.body, theta, omega, moments_to_link_torques(tau), a[0],
+                               a[1])
+    if setup.locked0:
+        acc = np.apply_along_axis(
+            lambda row: constrained_acceleration(setup.body, x[:n], row, setup.knee_row),
+            -1, acc)
+    fy = ground_reaction(setup.body, theta, omega, acc, np.broadcast_to(a, tau.shape[:-1] + (2,))
+                         )[..., 1]
+    return centre_of_pressure(tau[..., 0], fy)
 
 
 def model_response(setup: RunSetup, t: float, x: np.ndarray, feedback: np.ndarray,
@@ -374,10 +429,23 @@ def _fall_at_start(setup: RunSetup) -> str | None:
         feedback = setup.before if setup.feedback_delay > 0 else x
         sat = setup.saturation0 if setup.torque_limits is not None else None
         xp = cop_at(setup, 0.0, x, feedback, setup.active0, setup.locked0, sat)
-        if not bos.heel <= xp <= bos.toe:
-            return (f"centre of pressure ({xp:.3f} m) outside the foot at the start: "
-                    "the foot tips")
+        return cop_fall_at_start(xp, bos)
     return None
+
+
+def cop_fall_at_start(xp: float, bos) -> str | None:
+    """Why a centre of pressure x_p [m] at t = 0 is a fall (outside the foot), else None."""
+    if not bos.heel <= xp <= bos.toe:
+        return f"centre of pressure ({xp:.3f} m) outside the foot at the start: the foot tips"
+    return None
+
+
+def fall_at_start_by_posture(setup: RunSetup) -> str | None:
+    """The part of :attr:`RunSetup.fall_at_start` that does not depend on the gains (the link
+    angles and the centre of gravity)."""
+    if setup.fall.centre_of_pressure:
+        return _fall_at_start(setup.with_fall_criteria(centre_of_pressure=False))
+    return setup.fall_at_start
 
 
 def outcome_message(status: str, t: float, setup: RunSetup, *, fall_reason: str = "",
@@ -386,7 +454,8 @@ def outcome_message(status: str, t: float, setup: RunSetup, *, fall_reason: str 
 
     Parameters
     ----------
-    status : {"completed", "fell", "step-too-small", "non-finite", "chattering", "failed"}
+    status : {"completed", "fell", "step-too-small", "non-finite", "chattering", "no-memory",
+              "failed"}
         What happened ("failed" takes its words from ``detail``).
     t : float
         When it happened (the fall, the failure). [s]
@@ -403,4 +472,6 @@ def outcome_message(status: str, t: float, setup: RunSetup, *, fall_reason: str 
         return f"state diverged (non-finite) at t = {t:.6g} s"
     if status == "chattering":
         return f"more than {setup.max_switches} switches by t = {t:.6g} s (chattering)"
+    if status == "no-memory":
+        return f"ran out of memory at t = {t:.6g} s"
     return detail

@@ -1,289 +1,280 @@
-"""A compiled simulator: the physics and events of :func:`posturelab.simulate.simulate`, fast.
+"""The compiled engine: the model of :mod:`posturelab.model` in C.
 
-:func:`simulate_fast` returns the same :class:`~posturelab.results.SimulationResult`
-as :func:`posturelab.simulate.simulate` (the reference, scipy's DOP853);
-:func:`simulate_batch` runs many gain sets and keeps only their outcomes
-(:class:`BatchResult`), never the trajectories, spread over the CPU cores.
+:func:`integrate_compiled` runs a :class:`~posturelab.simulation.setup.RunSetup` and
+returns the same :class:`~posturelab.simulation.results.SimulationResult` as the
+reference engine (``posturelab.simulate(..., engine="compiled")``);
+:func:`simulate_batch` runs many parameter sets (gains, torque limits, feedback
+delays, perturbation sizes) and keeps only their outcomes (:class:`BatchResult`),
+spread over the CPU cores. Everything the reference engine does, this one does:
+one-sided pairs, the knee free, locked or against its stop, joint torque
+saturation, falls by link angle, centre of gravity and centre of pressure, and
+neural feedback delay as a delay differential equation (``docs/simulators.md``).
 
-What is the same as the reference
----------------------------------
-* The model: DESIGN.md's closed form for any N-link chain (a_i, J_ii, c_ij),
-  muscle pairs U = −Eᵀ(K_d EΘ + L_d EΘ̇), one-sided pairs acting only while
-  their stretch is >= 0, horizontal and vertical platform acceleration.
-* Disturbances: a velocity step sets the initial rates through
-  :func:`posturelab.simulate.initial_state_for`; half-sine pulses,
-  ramp-and-hold moves, sums of sines and measured profiles (linear
-  interpolation, zero outside) are compiled as a code and a parameter row
-  each; combinations are summed. Every breakpoint of the profile is a step
-  end: a step is clipped to land on it, never steps over it; the step is also
-  capped at the disturbance's ``max_step``, as in the reference.
-* Events, located on the dense-output interpolant of the step in which they
-  occur (Illinois regula falsi to 4 machine epsilons, like scipy's brentq),
-  with the reference's direction rules and order: a fall when any |θ_i|
-  passes ``max_link_angle`` or the centre of gravity x_c = Σ a_i sin θ_i / Σm
-  leaves [heel, toe]; a one-sided pair switching (the same hysteresis,
-  ``posturelab.simulate._SWITCH_HYSTERESIS``); the knee reaching its
-  hyper-extension stop (plastic impact, then locked) and letting go. A state
-  already beyond a fall criterion at t = 0 is a fall at t = 0.
-* Knee modes ``free``, ``locked`` and ``stop``, all compiled (the locked knee
-  in the projection form of ``simulate._Model.acceleration``).
-* Output: the same sample grid, the same rule for which samples a fall or a
-  switch keeps (and the state at the fall closing the series), the same
-  derived fields (torques, moments, accelerations, centre of gravity, ground
-  reaction, centre of pressure, platform motion) and messages.
+The C sources (``csrc/``, built by ``setup.py`` when the package is installed):
+``pl_rhs.c`` (the equation of motion, general N) and ``pl_rhs_small.c`` (generated for
+N = 1, 2, 3 by :mod:`._codegen`); ``pl_explicit.c`` (one step routine for every explicit
+pair, whose tableau comes from :mod:`._tableaux` as data); ``pl_radau.c`` (Radau IIA of
+order 5, the default: the model is stiff); ``pl_history.c`` (the past of a delayed run);
+``pl_events.c`` (event functions and roots); ``pl_driver.c`` (the integration loop,
+written once); ``pl_module.c`` (the entry points). In Python: :mod:`._encode` (set-up →
+arrays), :mod:`._binding` (the structs and the library), :mod:`._layout` (shared codes).
 
-Not compiled (``simulate_fast`` hands these runs to the reference
-:func:`posturelab.simulate.simulate` with the same arguments;
-``simulate_batch`` refuses them): joint torque limits (``torque_limits``), a
-neural feedback delay (``feedback_delay > 0``) and falls by the centre of
-pressure (``FallCriteria(centre_of_pressure=True)``).
-
-What differs
-------------
-The integrator. The paper's model is stiff: case 1 has a real pole at
-−554 1/s (the viscous knee–hip mode; −1200 1/s for the stiffest gains of a
-typical sweep) beside poles of a few 1/s that carry the motion. An explicit
-method's step is then bounded by stability, not accuracy (RK45 takes 868
-steps on case 1 at rtol 1e-6 and is accurate to 2e-9 rad, far more than
-asked). The default, ``method="Radau"``, is scipy's ``Radau`` (Radau IIA of
-order 5, Hairer & Wanner's RADAU5: simplified Newton iterations, its error
-estimate and step-size prediction, the Jacobian re-evaluated only when
-Newton converges slowly, the cubic collocation polynomial as dense output),
-compiled, so its steps are set by accuracy (case 1: 166 steps, angle error
-2.4e-8 rad at rtol 1e-6). Its Jacobian is [[0, I], [∂Θ̈/∂Θ, ∂Θ̈/∂Θ̇]]
-(forward differences for the lower half), which reduces each Newton system
-from 2N×2N to N×N: S(c) a = r₂ + (cI − ∂Θ̈/∂Θ̇) r₁, b = c a − r₁ with
-S(c) = c²I − c ∂Θ̈/∂Θ̇ − ∂Θ̈/∂Θ (closed-form inverses for N = 3, LU with
-pivoting otherwise). ``method="RK45"`` is the Dormand–Prince 5(4) pair of
-scipy's ``RK45`` (tableau, error estimate, free 4th-order dense output) and
-``method="RK23"`` the Bogacki–Shampine 3(2) pair of scipy's ``RK23``, both
-with Hairer's PI step-size controller; they remain for comparison and for
-non-stiff gain sets. After a switch the integration restarts with a fresh
-initial step (and, for Radau, a fresh Jacobian), as the reference does; at a
-profile breakpoint it lands on it and continues. All three are tested
-against the reference on every built-in scenario; measured speeds are in
-benchmarks/bench_simulate.py.
-
-Compilation: every kernel is ``@njit(cache=True)``. The first call in a
-fresh environment compiles them (about 70 s on 2 cores for simulate_fast and
-both batch paths); later processes load the machine code from numba's cache
-(``__pycache__`` beside the sources, or ``NUMBA_CACHE_DIR``) in well under a
-second. :func:`warm_up` compiles or loads everything at once.
+Nothing is compiled at run time: the extension is built at install (a C compiler, a few
+seconds). A batch runs in chunks on Python threads; each C call releases the GIL.
 """
 
 from __future__ import annotations
 
+import ctypes
 import functools
+import math
+import os
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
 
-from ..._validation import finite_array, float_in_range, positive_float
+from ..._validation import finite_array, positive_float
 from ...errors import ParameterError
 from ...model.body import Body
+from ...model.events import fall_message
 from ...model.muscles import MuscleSet, paper_muscles
 from ...model.options import FallCriteria, KneeModel
-from ...model.platform import Disturbance, NoDisturbance
+from ...model.platform import Disturbance
+from ..derived import derived_series
 from ..engines import simulate
-from ..results import DerivedSeries, SimulationResult
-from ..setup import initial_state_for
-from . import _kernels as kern
-from ._encode import (
-    EncodedDisturbance,
-    control_arrays,
-    crossings,
-    encode_disturbance,
-    model_array,
-    pair_layout,
+from ..results import SimulationResult
+from ..setup import (
+    RunSetup,
+    cop_fall_at_start,
+    fall_at_start_by_posture,
+    outcome_message,
+    prepare_run,
+    start_activity,
+    start_centre_of_pressure,
+    start_moments,
+    start_saturation,
 )
+from . import _encode as enc
+from ._binding import Batch, Out, Run, library, pointer
+from ._layout import (
+    METHOD_EXPLICIT,
+    METHOD_RADAU,
+    N_RESULT,
+    R_ANY_OUTSIDE,
+    R_FALL_INDEX,
+    R_FALL_KIND,
+    R_FALL_SAMPLE,
+    R_FALL_TIME,
+    R_FINAL_OUTSIDE,
+    R_LAST_OUTSIDE,
+    R_N_SAMPLES,
+    R_N_STEPS,
+    R_N_SWITCHES,
+    R_STATUS,
+    R_T_REACHED,
+    STATUS_FELL,
+    STATUS_NAMES,
+    STATUS_OUTCOMES,
+)
+from ._tableaux import BOGACKI_SHAMPINE_32, DORMAND_PRINCE_54
+
+ctypes_int64 = ctypes.POINTER(ctypes.c_int64)
+ctypes_uint8 = ctypes.POINTER(ctypes.c_uint8)
 
 __all__ = [
     "DEFAULT_RTOL",
     "DEFAULT_ATOL",
+    "METHODS",
     "BatchResult",
+    "integrate_compiled",
     "simulate_fast",
     "simulate_batch",
+    "default_method",
     "warm_up",
 ]
 
-#: Default relative tolerance of the fast simulator. [-]
+#: Default relative tolerance of the compiled engine. [-]
 DEFAULT_RTOL = 1e-6
 #: Default absolute tolerance [rad, rad/s]. With rtol = 1e-6 the angle error of the paper's
 #: scenarios and of random-gain sweeps stays below 1e-6 rad against a DOP853 rtol = 1e-10
 #: reference (measured by benchmarks/bench_simulate.py; tested in tests/test_fast.py).
 DEFAULT_ATOL = 1e-9
-
-_METHODS = ("RK45", "RK23", "Radau")
-
-_STATUS_NAMES = ("completed", "fell", "failed", "failed", "failed")
+#: The compiled integrators: Radau IIA of order 5, or an explicit pair given by its tableau.
+METHODS = {"Radau": None, "RK45": DORMAND_PRINCE_54, "RK23": BOGACKI_SHAMPINE_32}
 
 
-# ---------------------------------------------------------------------------
-# Shared set-up
-# ---------------------------------------------------------------------------
+def default_method(feedback_delay: float) -> str:
+    """The integrator the compiled engine chooses when none is asked for.
 
+    Radau IIA when the muscles act without delay: their viscosity on light links makes
+    the model stiff (case 1 has a pole at −554 1/s), and an implicit method's steps then
+    follow the motion instead of that mode. Dormand–Prince 5(4) when every pair's
+    feedback is delayed: the undelayed equations are then the passive chain, not stiff,
+    and an explicit pair is both accurate and cheaper (case 1 with a 10 ms delay: 1,858
+    RK45 steps against 6,875 for Radau at rtol 1e-6).
 
-@dataclass(frozen=True)
-class _Setup:
-    """Everything a kernel call needs that does not depend on the gains."""
-
-    x0: np.ndarray
-    grid: np.ndarray
-    mp0: np.ndarray
-    E: np.ndarray
-    one_sided: np.ndarray
-    dist: EncodedDisturbance
-    bps: np.ndarray
-    fpar: np.ndarray
-    ipar: np.ndarray
-    duration: float
-    max_switches: int
-    locked0: bool
-    fall_at_start: str | None
-    crosses: np.ndarray
-
-
-@functools.lru_cache(maxsize=32)
-def _output_grid(duration: float, sample_rate: float) -> np.ndarray:
-    # exactly the reference's grid (posturelab.simulate.simulate); read-only, shared
-    grid = np.arange(0.0, duration + 0.5 / sample_rate, 1.0 / sample_rate)
-    grid = grid[grid <= duration + 1e-12]
-    grid.setflags(write=False)
-    return grid
-
-
-def _unsupported(knee: KneeModel, fall: FallCriteria, torque_limits, feedback_delay) -> str:
-    """What the compiled simulator does not cover, in words ('' if nothing)."""
-    if torque_limits is not None and not np.all(np.isinf(np.asarray(torque_limits, float))):
-        return "joint torque limits"
-    if feedback_delay != 0.0:
-        return "a feedback delay"
-    if getattr(fall, "centre_of_pressure", False):
-        return "falls by the centre of pressure"
-    return ""
-
-
-def _fall_at_start(x: np.ndarray, n: int, body: Body, fall: FallCriteria) -> str | None:
-    """A fall criterion already violated at t = 0 (as simulate._outside_at_start)."""
-    over = np.nonzero(np.abs(x[:n]) > fall.max_link_angle)[0]
-    if over.size:
-        return f"link {over[0] + 1} angle beyond ±{fall.max_link_angle:.3g} rad at the start"
-    bos = fall.base_of_support
-    if bos is None:
-        return None
-    xc = body.gravity_coefficients @ np.sin(x[:n]) / body.total_mass
-    if not bos.heel <= xc <= bos.toe:
-        return f"centre of gravity ({xc:.3f} m) outside the foot at the start"
-    return None
-
-
-def _setup(body: Body, muscles: MuscleSet, disturbance: Disturbance, duration: float,
-           initial_state, rates_from: str, knee: KneeModel, fall: FallCriteria,
-           rtol: float, atol: float, sample_rate: float, max_switches: int,
-           settle_tolerance: float, method: str) -> _Setup:
-    """The gain-independent part of a run, memoised when every input is hashable.
-
-    Bodies, muscle sets, knee models, fall criteria and most disturbances are
-    frozen dataclasses; a measured profile (arrays) is not hashable and is set
-    up afresh each call. The cached arrays are never written by the kernels.
+    Parameters
+    ----------
+    feedback_delay : float
+        The run's neural delay. [s]
     """
-    key_state = None if initial_state is None else tuple(
-        np.asarray(initial_state, dtype=float).ravel().tolist())
-    try:
-        return _setup_cached(body, muscles, disturbance, duration, key_state, rates_from, knee,
-                             fall, rtol, atol, sample_rate, max_switches, settle_tolerance,
-                             method)
-    except TypeError:  # something unhashable (a measured profile)
-        return _setup_uncached(body, muscles, disturbance, duration, initial_state, rates_from,
-                               knee, fall, rtol, atol, sample_rate, max_switches,
-                               settle_tolerance, method)
+    return "Radau" if feedback_delay == 0.0 else "RK45"
+
+
+def _check_method(method: str) -> None:
+    if method not in METHODS:
+        raise ParameterError(f"method must be one of {', '.join(map(repr, METHODS))} for the "
+                             f"compiled engine, got {method!r}")
 
 
 @functools.lru_cache(maxsize=64)
-def _setup_cached(body, muscles, disturbance, duration, initial_state, rates_from, knee, fall,
-                  rtol, atol, sample_rate, max_switches, settle_tolerance, method) -> _Setup:
-    return _setup_uncached(body, muscles, disturbance, duration,
-                           None if initial_state is None else np.array(initial_state),
-                           rates_from, knee, fall, rtol, atol, sample_rate, max_switches,
-                           settle_tolerance, method)
+def _packed(setup: RunSetup) -> dict:
+    """The gain-independent arrays of a run (memoised per set-up object)."""
+    from ...model import events as ev
+
+    n = setup.n_links
+    fpar, ipar = enc.options(setup)
+    muscles = setup.muscles
+    limited = (np.isfinite(setup.torque_limits) if setup.torque_limits is not None
+               else np.zeros(n, bool))
+    slots = ev.event_slots(n, setup.fall.base_of_support is not None,
+                           setup.fall.centre_of_pressure, limited, muscles.one_sided_mask,
+                           setup.knee.mode == "stop")
+    return {
+        "x0": enc.readonly(setup.x0), "before": enc.readonly(setup.before),
+        "grid": enc.readonly(setup.grid), "bp": enc.body_array(setup.body),
+        "E": enc.readonly(muscles.selection_matrix), "C": enc.readonly(muscles.crossing_matrix),
+        "one_sided": enc.readonly(muscles.one_sided_mask.astype(np.int64)),
+        "dp": enc.encode_disturbance(setup.disturbance),
+        "bps": enc.readonly(setup.breakpoints.astype(float)), "fpar": fpar, "ipar": ipar,
+        "active0": enc.readonly(setup.active0), "slots": slots,
+        "ev_offset": ev.EVENT_OFFSET, "ev_direction": ev.EVENT_DIRECTION,
+        "ev_ends": ev.EVENT_ENDS_RUN, "n": n,
+    }
 
 
-def _setup_uncached(body: Body, muscles: MuscleSet, disturbance: Disturbance, duration: float,
-                    initial_state, rates_from: str, knee: KneeModel, fall: FallCriteria,
-                    rtol: float, atol: float, sample_rate: float, max_switches: int,
-                    settle_tolerance: float, method: str) -> _Setup:
-    if method not in _METHODS:
-        raise ParameterError(f"method must be one of {', '.join(map(repr, _METHODS))}, got "
-                             f"{method!r}")
-    if muscles.n_links != body.n_links:
-        raise ParameterError(
-            f"muscle set is for {muscles.n_links} links but the body has {body.n_links}"
-        )
-    duration = positive_float("duration [s]", duration)
-    rtol = float_in_range("rtol", rtol, 1e-14, 1e-1)
-    atol = float_in_range("atol", atol, 1e-16, 1e-1)
-    sample_rate = float_in_range("sample_rate [Hz]", sample_rate, 1.0, 1e6, unit="Hz")
-    if not isinstance(max_switches, int | np.integer) or max_switches < 0:
-        raise ParameterError(f"max_switches must be an integer >= 0, got {max_switches!r}")
-    n = body.n_links
-    if knee.mode != "free" and n < 2:
-        raise ParameterError("knee mode 'locked' or 'stop' needs a body with at least 2 links")
-    dist = encode_disturbance(disturbance)
-    x = initial_state_for(body, disturbance, initial_state, rates_from)
-    mp0 = model_array(body)
-    locked0 = knee.mode == "locked"
-    if locked0:
-        x[n:] = kern.project_velocity(x[:n].copy(), x[n:].copy(), mp0)
-    if knee.mode == "stop":
-        kappa = x[1] - x[0]
-        if kappa > knee.stop_angle + 1e-12:
-            raise ParameterError(
-                f"initial knee angle θ2 − θ1 = {kappa:g} rad is beyond the hyper-extension "
-                f"stop ({knee.stop_angle:g} rad)"
-            )
-        if abs(kappa - knee.stop_angle) <= 1e-12 and (x[n + 1] - x[n]) >= 0:
-            locked0 = True
-            x[n:] = kern.project_velocity(x[:n].copy(), x[n:].copy(), mp0)
-    max_step = min(dist.max_step, duration)
-    bps = np.array(sorted({b for b in dist.breakpoints if 0.0 < b < duration}), dtype=float)
-    fpar, ipar = control_arrays(body, fall, knee, rtol=rtol, atol=atol, max_step=max_step,
-                                duration=duration, max_switches=int(max_switches),
-                                locked0=locked0, settle_tolerance=settle_tolerance,
-                                method=method)
-    E, one_sided = pair_layout(muscles)
-    for arr in (x, mp0, E, one_sided, bps, fpar, ipar):
-        arr.setflags(write=False)  # shared by memoised calls: nothing may write them
-    crosses = crossings(muscles)
-    crosses.setflags(write=False)
-    return _Setup(x, _output_grid(duration, sample_rate), mp0, E, one_sided, dist, bps, fpar,
-                  ipar, duration, int(max_switches), locked0, _fall_at_start(x, n, body, fall),
-                  crosses)
+def _run_struct(a: dict, method: str, gains, lim, delay: float, sat0) -> Run:
+    """The C inputs of one run (the arrays in ``a`` must outlive it)."""
+    from ..setup import DELAY_BREAKPOINT_MULTIPLES
+
+    tab = METHODS[method]
+    n = a["n"]
+    run = Run(n=n, p=a["E"].shape[0], n_grid=a["grid"].size, n_bps=a["bps"].size,
+              n_slots=len(a["slots"]), method=METHOD_RADAU if tab is None else METHOD_EXPLICIT,
+              delay=float(delay), delay_multiples=DELAY_BREAKPOINT_MULTIPLES)
+    for name in ("x0", "before", "grid", "bp", "E", "C", "dp", "bps", "fpar", "active0",
+                 "ev_offset"):
+        setattr(run, name, pointer(a[name]))
+    for name in ("one_sided", "ipar", "ev_direction", "ev_ends"):
+        setattr(run, name, pointer(a[name], ctypes_int64))
+    slots = a["slots"]
+    run.slot_kind = pointer(slots.kind, ctypes_int64)
+    run.slot_index = pointer(slots.index, ctypes_int64)
+    run.slot_cond = pointer(slots.condition, ctypes_int64)
+    run.slot_side = pointer(slots.side)
+    run.gains, run.lim, run.sat0 = pointer(gains), pointer(lim), pointer(sat0)
+    if tab is not None:
+        run.n_stages = tab.nodes.size
+        run.tab_A, run.tab_c = pointer(tab.A), pointer(tab.nodes)
+        run.tab_e, run.tab_P = pointer(tab.error), pointer(tab.dense)
+        run.tab_error_order = tab.error_order
+    return run
 
 
-def _fall_reason(kind: int, n: int, fall: FallCriteria) -> str:
-    if kind < n:
-        return f"link {kind + 1} angle passed ±{fall.max_link_angle:.3g} rad"
-    bos = fall.base_of_support
-    if kind == n:
-        return f"centre of gravity passed the toe ({bos.toe:.3f} m)"
-    return f"centre of gravity passed the heel ({bos.heel:.3f} m)"
+def integrate_compiled(setup: RunSetup, method: str | None = None) -> SimulationResult:
+    """Integrate one run on the compiled engine.
+
+    Parameters
+    ----------
+    setup : RunSetup
+        The run (:func:`posturelab.simulation.setup.prepare_run`).
+    method : {"Radau", "RK45", "RK23"}, optional
+        Radau IIA of order 5 (implicit, for the model's stiff viscous modes),
+        Dormand–Prince 5(4) or Bogacki–Shampine 3(2) (explicit); by default
+        :func:`default_method`.
+
+    Returns
+    -------
+    SimulationResult
+        Its derived series are computed when first read.
+    """
+    method = default_method(setup.feedback_delay) if method is None else method
+    _check_method(method)
+    a = _packed(setup)
+    n = a["n"]
+    m = 2 * n
+    muscles = setup.muscles
+    delayed = setup.feedback_delay > 0
+    switches = np.zeros(0)
+    feedback = None
+    T = a["grid"].size
+    if setup.fall_at_start is not None:
+        status, t_reached = STATUS_FELL, 0.0
+        time = np.zeros(1)
+        samples = np.array(setup.x0[:, None])
+        locked = np.array([setup.locked0])
+        count = 1
+        fall_time, fall_reason = 0.0, setup.fall_at_start
+        message = outcome_message("fell", 0.0, setup, fall_reason=fall_reason)
+        if delayed:
+            feedback = np.array(setup.before[None, :])
+    else:
+        g = enc.readonly(enc.gains(muscles.stiffnesses, muscles.viscosities, delayed))
+        lim = enc.readonly(enc.limits(setup.torque_limits, n))
+        sat0 = enc.readonly(setup.saturation0)
+        run = _run_struct(a, method, g, lim, setup.feedback_delay, sat0)
+        samples = np.empty((m, T + 1))
+        fb = np.empty((m, T + 1)) if delayed else None
+        locked_u8 = np.zeros(T + 1, np.uint8)
+        switches = np.empty(setup.max_switches + 1)
+        peak, final, res = np.empty(n), np.empty(m), np.empty(N_RESULT)
+        out = Out(samples=pointer(samples), fb=pointer(fb),
+                  locked=pointer(locked_u8, ctypes_uint8), switches=pointer(switches),
+                  switch_cap=switches.size, peak=pointer(peak), final=pointer(final),
+                  res=pointer(res))
+        library().pl_run_one(run, out)
+        locked = locked_u8.astype(bool)
+        status = int(res[R_STATUS])
+        t_reached = float(res[R_T_REACHED])
+        n_grid = int(res[R_N_SAMPLES])
+        count = n_grid + int(res[R_FALL_SAMPLE])
+        time = setup.grid[:n_grid]
+        if count > n_grid:
+            time = np.append(time, t_reached)
+        switches = switches[:min(int(res[R_N_SWITCHES]), switches.size)]
+        if delayed:
+            feedback = fb[:, :count].T
+        if status == STATUS_FELL:
+            fall_time = float(res[R_FALL_TIME])
+            fall_reason = _fall_reason(int(res[R_FALL_KIND]), int(res[R_FALL_INDEX]), setup)
+            message = outcome_message("fell", fall_time, setup, fall_reason=fall_reason)
+        else:
+            fall_time, fall_reason = None, None
+            message = outcome_message(STATUS_OUTCOMES[status], t_reached, setup)
+    # the engine keeps time last; the result holds time-first views of the same memory
+    theta = samples[:n, :count].T
+    omega = samples[n:, :count].T
+    locked = locked[:count]
+    for arr in (time, theta, omega):
+        arr.setflags(write=False)
+    state = samples[:m, :count].T
+    derive = functools.partial(derived_series, setup, time, state, feedback, locked)
+    return SimulationResult(
+        time=time, theta=theta, omega=omega, pair_names=tuple(muscles.names),
+        status=STATUS_NAMES[status], message=message, fell=status == STATUS_FELL,
+        fall_time=fall_time, fall_reason=fall_reason,
+        switch_times=tuple(float(v) for v in switches), description=setup.description,
+        derived=derive,
+    )
 
 
-def _message(status: int, t: float, duration: float, max_switches: int) -> str:
-    if status == kern.STATUS_COMPLETED:
-        return f"ran to {duration:g} s"
-    if status == kern.STATUS_STEP_TOO_SMALL:
-        return (f"integrator failed at t = {t:.6g} s: required step size is less than "
-                "spacing between numbers")
-    if status == kern.STATUS_NONFINITE:
-        return f"state diverged (non-finite) at t = {t:.6g} s"
-    return f"more than {max_switches} switches by t = {t:.6g} s (chattering)"
-
-
-# ---------------------------------------------------------------------------
-# One simulation
-# ---------------------------------------------------------------------------
+def _fall_reason(kind: int, index: int, setup: RunSetup) -> str:
+    bos = setup.fall.base_of_support
+    return fall_message(kind, index, max_link_angle=setup.fall.max_link_angle,
+                        toe=bos.toe if bos is not None else 0.0,
+                        heel=bos.heel if bos is not None else 0.0)
 
 
 def simulate_fast(
@@ -303,135 +294,19 @@ def simulate_fast(
     sample_rate: float = 1000.0,
     max_switches: int = 10_000,
     description: str = "",
-    method: str = "Radau",
+    method: str | None = None,
 ) -> SimulationResult:
-    """Simulate the nonlinear chain with the compiled integrator.
+    """``posturelab.simulate(..., engine="compiled")``, under its former name.
 
-    Same model, events and result as :func:`posturelab.simulate.simulate`;
-    only the integrator differs (see the module docstring). Runs with joint
-    torque limits, a feedback delay or centre-of-pressure falls are handed to
-    :func:`posturelab.simulate.simulate` with the same arguments (and scipy's
-    DOP853), since those are not compiled.
-
-    Parameters
-    ----------
-    body : Body
-        The chain.
-    muscles : MuscleSet
-        Muscle pairs (one-sided pairs switch exactly where their stretch crosses 0).
-    disturbance : Disturbance, optional
-        Platform motion: a velocity step, half-sine, ramp-and-hold, sum of sines,
-        measured profile, or a combination; none by default.
-    duration : float
-        Simulated time. [s]
-    initial_state : array_like, shape (2N,), optional
-        ``[Θ, Θ̇]`` before any velocity step; upright at rest by default. [rad], [rad/s]
-    rates_from : {"upright", "posture"}
-        Where J⁻¹H is evaluated for a velocity step (see
-        :func:`posturelab.simulate.initial_state_for`).
-    knee : KneeModel, optional
-        Free (default), locked, or with a hyper-extension stop. Needs N >= 2.
-    fall : FallCriteria, optional
-        Default: any |θ_i| > π/3, no foot limit (the paper's model).
-    torque_limits : array_like, shape (N,), optional
-        Largest net muscle moment per joint [N·m] (reference simulator).
-    feedback_delay : float
-        Neural delay of the muscle feedback [s] (reference simulator if > 0).
-    rtol : float
-        Relative tolerance. [-]
-    atol : float
-        Absolute tolerance. [rad, rad/s]
-    sample_rate : float
-        Output samples per second. [Hz]
-    max_switches : int
-        More switches than this fail the run (chattering guard). [-]
-    description : str
-        Words stored in the result.
-    method : {"Radau", "RK45", "RK23"}
-        The compiled integrator: Radau IIA of order 5 (default; implicit, for the
-        model's stiff viscous modes), Dormand–Prince 5(4) or Bogacki–Shampine 3(2)
-        (explicit; see the module docstring). Ignored by the reference fallback
-        (DOP853).
-
-    Returns
-    -------
-    SimulationResult
-        As :func:`posturelab.simulate.simulate` returns it.
+    Parameters and result as :func:`posturelab.simulate`; the tolerances default to
+    the compiled engine's (rtol 1e-6, atol 1e-9 [rad, rad/s]) and the method to
+    :func:`default_method`.
     """
-    disturbance = NoDisturbance() if disturbance is None else disturbance
-    knee = KneeModel() if knee is None else knee
-    fall = FallCriteria() if fall is None else fall
-    if _unsupported(knee, fall, torque_limits, feedback_delay):
-        return simulate(body, muscles, disturbance, duration, initial_state=initial_state,
-                        rates_from=rates_from, knee=knee, fall=fall,
-                        torque_limits=torque_limits, feedback_delay=feedback_delay, rtol=rtol,
-                        atol=atol, sample_rate=sample_rate, max_switches=max_switches,
-                        description=description)
-    s = _setup(body, muscles, disturbance, duration, initial_state, rates_from, knee, fall,
-               rtol, atol, sample_rate, max_switches, 0.01, method)
-    n = body.n_links
-    kd = np.ascontiguousarray(muscles.stiffnesses, dtype=float)
-    ld = np.ascontiguousarray(muscles.viscosities, dtype=float)
-    switches = np.zeros(0)
-    if s.fall_at_start is not None:
-        status, t_reached = kern.STATUS_FELL, 0.0
-        time = np.zeros(1)
-        samples = np.array(s.x0[:, None])  # writable, like the kernel's
-        locked = np.array([s.locked0])
-        count = 1
-        fall_time, fall_reason = 0.0, s.fall_at_start
-        message = f"fell at t = 0 s: {fall_reason}"
-    else:
-        res, samples, sample_locked, switches = kern.run_one(
-            s.x0, s.grid, s.mp0, s.E, kd, ld, s.one_sided, s.dist.packed, s.bps, s.fpar,
-            s.ipar)
-        status = int(res[kern.R_STATUS])
-        t_reached = float(res[kern.R_T_REACHED])
-        n_grid = int(res[kern.R_N_SAMPLES])
-        count = n_grid + int(res[kern.R_FALL_SAMPLE])
-        time = s.grid[:n_grid]
-        if count > n_grid:
-            time = np.append(time, t_reached)
-        locked = sample_locked
-        switches = switches[:min(int(res[kern.R_N_SWITCHES]), switches.size)]
-        if status == kern.STATUS_FELL:
-            fall_time = float(res[kern.R_FALL_TIME])
-            fall_reason = _fall_reason(int(res[kern.R_FALL_KIND]), n, fall)
-            message = f"fell at t = {fall_time:.4f} s: {fall_reason}"
-        else:
-            fall_time, fall_reason = None, None
-            message = _message(status, t_reached, s.duration, s.max_switches)
-    # the kernels keep time last; the result holds time-first views of the same memory
-    theta = samples[:n, :count].T
-    omega = samples[n:, :count].T
-    for arr in (time, theta, omega):
-        arr.setflags(write=False)
-    derive = functools.partial(_derived_series, samples, count, locked, s, kd, ld,
-                               body.total_mass, time)
-    return SimulationResult(
-        time=time, theta=theta, omega=omega,
-        pair_names=tuple(muscles.names), status=_STATUS_NAMES[status], message=message,
-        fell=status == kern.STATUS_FELL, fall_time=fall_time, fall_reason=fall_reason,
-        switch_times=tuple(float(v) for v in switches),
-        description=description or disturbance.describe(), derived=derive,
-    )
-
-
-def _derived_series(samples: np.ndarray, count: int, locked: np.ndarray, s: _Setup,
-                    kd: np.ndarray, ld: np.ndarray, total_mass: float,
-                    time: np.ndarray) -> DerivedSeries:
-    """The derived series of a run (computed when the result is first asked for one)."""
-    (M, U, moments, alpha, cog, cogv, ground, cop, acc, vel, pos) = kern.derived_fields(
-        samples, count, locked, s.E, kd, ld, s.one_sided, s.crosses, s.mp0, total_mass,
-        np.array(time, dtype=float), s.dist.packed, *s.dist.velocity_change)
-    alpha = alpha.T
-    alpha.setflags(write=False)
-    return DerivedSeries(
-        pair_torques=M.T, joint_torques=U.T, joint_moments=moments.T, cog_position=cog.T,
-        cog_velocity=cogv.T, platform_acceleration=acc.T, platform_velocity=vel.T,
-        platform_position=pos.T, angular_acceleration=alpha, ground_reaction=ground.T,
-        centre_of_pressure=cop,
-    )
+    return simulate(body, muscles, disturbance, duration, initial_state=initial_state,
+                    rates_from=rates_from, knee=knee, fall=fall, torque_limits=torque_limits,
+                    feedback_delay=feedback_delay, rtol=rtol, atol=atol,
+                    sample_rate=sample_rate, max_switches=max_switches,
+                    description=description, method=method, engine="compiled")
 
 
 # ---------------------------------------------------------------------------
@@ -444,7 +319,7 @@ class BatchResult:
     """Outcomes of many runs (no trajectories); row r is run r.
 
     Every quantity is computed on the output samples, exactly as
-    :class:`~posturelab.results.SimulationResult` computes it for one run
+    :class:`~posturelab.simulation.results.SimulationResult` computes it for one run
     (including the state at a fall, which closes a fallen run's series).
 
     Attributes
@@ -467,9 +342,11 @@ class BatchResult:
     n_steps : numpy.ndarray of int64, shape (M,)
         Accepted integrator steps. [-]
     n_switches : numpy.ndarray of int64, shape (M,)
-        One-sided pair and knee-stop switches. [-]
+        Switches: one-sided pairs, the knee stop, torque saturation. [-]
     settle_tolerance : float
         Angle threshold of the settling time. [rad]
+    fall_kind : numpy.ndarray of int64, shape (M,), optional
+        Event code of the fall (:mod:`posturelab.model.events`), −1 if none. [-]
     """
 
     fell: np.ndarray
@@ -481,6 +358,7 @@ class BatchResult:
     n_steps: np.ndarray
     n_switches: np.ndarray
     settle_tolerance: float = 0.01
+    fall_kind: np.ndarray | None = None
 
     @property
     def n_runs(self) -> int:
@@ -490,7 +368,20 @@ class BatchResult:
     @property
     def status(self) -> np.ndarray:
         """"completed", "fell" or "failed" per run (as ``SimulationResult.status``)."""
-        return np.array(_STATUS_NAMES)[self.status_code]
+        return np.array(STATUS_NAMES)[self.status_code]
+
+
+def _per_run(name: str, value, m: int, width: int | None) -> np.ndarray:
+    """A scalar/row broadcast to every run, or one value/row per run."""
+    arr = np.asarray(value, dtype=float)
+    want = (m,) if width is None else (m, width)
+    if arr.shape == want:
+        return np.ascontiguousarray(arr)
+    single = () if width is None else (width,)
+    if arr.shape == single:
+        return np.ascontiguousarray(np.broadcast_to(arr, want))
+    raise ParameterError(f"{name} must have shape {single or '()'} (every run) or {want} (one "
+                         f"per run), got shape {arr.shape}")
 
 
 def _gain_array(name: str, value, n_pairs: int) -> np.ndarray:
@@ -517,20 +408,24 @@ def simulate_batch(
     rates_from: Literal["upright", "posture"] = "upright",
     knee: KneeModel | None = None,
     fall: FallCriteria | None = None,
+    torque_limits: np.ndarray | None = None,
+    feedback_delay: float | np.ndarray = 0.0,
     rtol: float = DEFAULT_RTOL,
     atol: float = DEFAULT_ATOL,
     sample_rate: float = 1000.0,
     settle_tolerance: float = 0.01,
     max_switches: int = 10_000,
     parallel: bool = True,
-    chunk: int = 8,
-    method: str = "Radau",
+    chunk: int = 64,
+    method: str | None = None,
     disturbance_scale: np.ndarray | None = None,
 ) -> BatchResult:
-    """Simulate M gain sets on one body and disturbance; keep only the outcomes.
+    """Simulate M parameter sets on one body and disturbance; keep only the outcomes.
 
-    Run r is ``simulate_fast(body, muscles with stiffness[r] and viscosity[r], …)``:
-    the same integration, bit for bit, without storing its trajectory.
+    Run r is ``posturelab.simulate(body, muscles with stiffness[r] and viscosity[r], …,
+    torque_limits=torque_limits[r], feedback_delay=feedback_delay[r],
+    engine="compiled")``: the same integration, bit for bit, without storing its
+    trajectory.
 
     Parameters
     ----------
@@ -541,7 +436,7 @@ def simulate_batch(
     viscosity : array_like, shape (M, P)
         Pair viscosity per run. [N·m·s/rad]
     disturbance : Disturbance, optional
-        Platform motion (as for :func:`simulate_fast`); none by default.
+        Platform motion; none by default.
     duration : float
         Simulated time. [s]
     initial_state : array_like, shape (2N,), optional
@@ -550,7 +445,12 @@ def simulate_batch(
         The pair layout (spans and one-sidedness, in column order); its own
         gains are ignored. Default: the paper's five pairs, two-sided (N = 3).
     rates_from, knee, fall
-        As for :func:`simulate_fast` (centre-of-pressure falls are not compiled).
+        As for :func:`posturelab.simulate`.
+    torque_limits : array_like, shape (N,) or (M, N), optional
+        Largest net muscle moment per joint, for every run or per run; ``inf`` for
+        none. [N·m]
+    feedback_delay : float or array_like, shape (M,)
+        Neural delay of the muscle feedback, for every run or per run. [s]
     rtol : float
         Relative tolerance. [-]
     atol : float
@@ -562,16 +462,17 @@ def simulate_batch(
     max_switches : int
         More switches than this fail a run. [-]
     parallel : bool
-        Spread the runs over numba's threads (see ``numba.set_num_threads``);
-        False runs them one after another in the calling thread, without the
-        GIL (for callers that bring their own threads, such as Dask workers).
+        Spread the runs over threads, one per CPU available (:func:`batch_threads`);
+        False runs them one after another in the calling thread, without the GIL
+        (for callers that bring their own threads, such as Dask workers).
     chunk : int
-        Runs per parallel work item. [-]
-    method : {"Radau", "RK45", "RK23"}
-        The compiled integrator, as for :func:`simulate_fast`.
+        Runs per call of the engine (a work item of the threads). [-]
+    method : {"Radau", "RK45", "RK23"}, optional
+        The compiled integrator of every run; by default each run's
+        :func:`default_method` (as its single run would choose).
     disturbance_scale : array_like, shape (M,), optional
         Run r's disturbance is ``disturbance.scaled(disturbance_scale[r])``
-        (:meth:`posturelab.platform.Disturbance.scaled`: the step speed, pulse
+        (:meth:`posturelab.model.platform.Disturbance.scaled`: the step speed, pulse
         peak, ramp displacement, sine amplitudes or measured accelerations times
         the factor); by default every run has ``disturbance`` as it is. [-]
 
@@ -579,13 +480,8 @@ def simulate_batch(
     -------
     BatchResult
     """
-    disturbance = NoDisturbance() if disturbance is None else disturbance
-    knee = KneeModel() if knee is None else knee
-    fall = FallCriteria() if fall is None else fall
-    what = _unsupported(knee, fall, None, 0.0)
-    if what:
-        raise ParameterError(f"simulate_batch does not compile {what}; use "
-                             "posturelab.simulate.simulate for such runs")
+    if method is not None:
+        _check_method(method)
     if muscles is None:
         if body.n_links != 3:
             raise ParameterError(
@@ -594,92 +490,210 @@ def simulate_batch(
             )
         muscles = paper_muscles("1")
     P = len(muscles.pairs)
+    n = body.n_links
     kd_all = _gain_array("stiffness [N·m/rad]", stiffness, P)
     ld_all = _gain_array("viscosity [N·m·s/rad]", viscosity, P)
     if kd_all.shape != ld_all.shape:
         raise ParameterError(f"stiffness and viscosity must have the same shape, got "
                              f"{kd_all.shape} and {ld_all.shape}")
     settle_tolerance = positive_float("settle_tolerance [rad]", settle_tolerance)
-    if not isinstance(chunk, int | np.integer) or chunk < 1:
+    if isinstance(chunk, bool) or not isinstance(chunk, int | np.integer) or chunk < 1:
         raise ParameterError(f"chunk must be an integer >= 1, got {chunk!r}")
-    s = _setup(body, muscles, disturbance, duration, initial_state, rates_from, knee, fall,
-               rtol, atol, sample_rate, max_switches, settle_tolerance, method)
     M = kd_all.shape[0]
-    n = body.n_links
-    if disturbance_scale is not None:
-        scale = finite_array("disturbance_scale [-]", disturbance_scale, (M,))
-    if disturbance_scale is None or M == 0:
-        levels = [s]
-        which = np.zeros(M, dtype=np.int64)
-    else:
-        values, which = np.unique(scale, return_inverse=True)
-        # one set-up per distinct scale: its initial state (a scaled velocity step) and
-        # its packed disturbance; the breakpoints do not depend on the scale
-        levels = [_setup(body, muscles, disturbance.scaled(float(v)), duration, initial_state,
-                         rates_from, knee, fall, rtol, atol, sample_rate, max_switches,
-                         settle_tolerance, method) for v in values]
-        which = np.ascontiguousarray(which.ravel(), dtype=np.int64)
-    # read-only like the single-run arrays, so that the kernels share one compiled form
-    # (whether the knee starts locked, in ipar, depends on the scaled initial state too)
-    x0_all = np.stack([lv.x0 for lv in levels])
-    dp_all = np.stack([lv.dist.packed for lv in levels])
-    ipar_all = np.stack([lv.ipar for lv in levels])
-    for arr in (x0_all, dp_all, ipar_all, which):
-        arr.setflags(write=False)
-    results = np.zeros((M, kern.N_RESULT))
+    delays = _per_run("feedback_delay [s]", feedback_delay, M, None)
+    lims = (np.full((M, n), math.inf) if torque_limits is None
+            else _per_run("torque_limits [N·m]", torque_limits, M, n))
+    scale = (np.ones(M) if disturbance_scale is None
+             else finite_array("disturbance_scale [-]", disturbance_scale, (M,)))
+
+    def level_setup(factor: float, delay: float, limits) -> RunSetup:
+        d = disturbance if disturbance is None or factor == 1.0 else disturbance.scaled(factor)
+        return prepare_run(body, muscles, d, duration, initial_state=initial_state,
+                           rates_from=rates_from, knee=knee, fall=fall,
+                           torque_limits=limits, feedback_delay=delay, rtol=rtol, atol=atol,
+                           sample_rate=sample_rate, max_switches=max_switches)
+
+    # every run's delay and limits are checked as a single run's would be
+    for d in np.unique(delays):
+        level_setup(1.0, float(d), None)
+    any_limit = bool(np.isfinite(lims).any())
+    for row in (np.unique(lims, axis=0) if M and any_limit else []):
+        level_setup(1.0, 0.0, None if np.all(np.isinf(row)) else row)
+    # one level per distinct (scale, delayed or not): start state, disturbance, knee, pairs
+    delayed = delays > 0
+    keys = np.stack([scale, delayed.astype(float)], axis=1)
+    values, which = np.unique(keys, axis=0, return_inverse=True) if M else (keys, [])
+    which = np.ascontiguousarray(np.asarray(which).ravel(), dtype=np.int64)
+    # a level's limits only decide which event slots exist: the finite ones of any run
+    slot_limits = np.where(np.isfinite(lims).any(axis=0), 1.0, math.inf) if any_limit else None
+    levels = [level_setup(float(f), 1.0 if dl else 0.0, slot_limits) for f, dl in values]
+    base = levels[0] if levels else level_setup(1.0, 0.0, slot_limits)
+    packed = [_packed(lv) for lv in levels] or [_packed(base)]
+    stack = lambda key: enc.readonly(np.stack([p[key] for p in packed]))  # noqa: E731
+    x0_all, before_all, ipar_all = stack("x0"), stack("before"), stack("ipar")
+    dp_len = max(p["dp"].size for p in packed)
+    dp_all = enc.readonly(np.stack([np.pad(p["dp"], (0, dp_len - p["dp"].size))
+                                    for p in packed]))
+    active_all = enc.readonly(np.stack(
+        [start_activity(muscles, lv.before if dl else lv.x0)
+         for lv, (_, dl) in zip(levels, values, strict=True)] or [packed[0]["active0"]]))
+    # per run: the gains in their slots (immediate or delayed), the saturation at the start
+    gains_all = enc.readonly(np.where(delayed[:, None, None], enc.gains(kd_all, ld_all, True),
+                                      enc.gains(kd_all, ld_all, False)))
+    feedback0 = np.where(delayed[:, None], before_all[which], x0_all[which])
+    moments0 = start_moments(muscles, feedback0, active_all[which], kd_all, ld_all)
+    sat0_all = enc.readonly(start_saturation(moments0, lims))
+    lim_all = enc.readonly(lims)
+    delay_all = enc.readonly(delays)
+    a = dict(packed[0])
+    a["fpar"] = enc.options(base, settle_tolerance)[0]
+    results = np.zeros((M, N_RESULT))
     peaks = np.zeros((M, n))
     finals = np.zeros((M, 2 * n))
-    at_start = np.array([lv.fall_at_start is not None for lv in levels])
-    if M and not at_start.all():
-        args = (x0_all, which, s.grid, s.mp0, s.E, kd_all, ld_all, s.one_sided, dp_all, s.bps,
-                s.fpar, ipar_all, results, peaks, finals)
-        if parallel:
-            kern.run_batch_parallel(*args, int(chunk))
-        else:
-            kern.run_batch_serial(*args)
+    # runs that fall at t = 0 whatever their gains (posture), or by their centre of pressure
+    at_start = np.zeros(M, dtype=bool)
+    for k, lv in enumerate(levels):
+        if fall_at_start_by_posture(lv) is not None:
+            at_start |= which == k
+    if M and base.fall.centre_of_pressure:
+        for k, lv in enumerate(levels):
+            rows = (which == k) & ~at_start
+            if rows.any():
+                xp = start_centre_of_pressure(lv, moments0[rows], lims[rows], sat0_all[rows])
+                bos = lv.fall.base_of_support
+                out = np.array([cop_fall_at_start(float(v), bos) is not None for v in xp])
+                at_start[np.nonzero(rows)[0][out]] = True
+    names = ([method] * M if method is not None
+             else [default_method(float(d)) for d in delays])
+    # (the runs that choose their own method choose RK45 or Radau: one tableau at most)
+    method_all = enc.readonly(np.array([METHOD_RADAU if METHODS[nm] is None
+                                        else METHOD_EXPLICIT for nm in names], np.int64))
+    shared = next((nm for nm in names if METHODS[nm] is not None), "Radau")
+    todo = np.nonzero(~at_start)[0]
+    if todo.size:
+        batch = Batch(base=_run_struct(a, shared, gains_all[0], lim_all[0], 0.0, sat0_all[0]),
+                      which=pointer(which, ctypes_int64), x0_all=pointer(x0_all),
+                      before_all=pointer(before_all), dp_all=pointer(dp_all),
+                      dp_stride=dp_len, ipar_all=pointer(ipar_all, ctypes_int64),
+                      active0_all=pointer(active_all), gains_all=pointer(gains_all),
+                      lim_all=pointer(lim_all), delay_all=pointer(delay_all),
+                      sat0_all=pointer(sat0_all), method_all=pointer(method_all, ctypes_int64),
+                      results=pointer(results),
+                      peaks=pointer(peaks), finals=pointer(finals))
+        _run_rows(batch, todo, parallel, int(chunk))
     if at_start.any():
-        # these runs fall at t = 0 whatever their gains (the reference's check at the start)
-        rows = at_start[which]
-        results[rows] = 0.0
-        results[rows, kern.R_STATUS] = kern.STATUS_FELL
-        results[rows, kern.R_FALL_TIME] = 0.0
-        peaks[rows] = np.abs(x0_all[which[rows], :n])
-        finals[rows] = x0_all[which[rows]]
-    status = results[:, kern.R_STATUS].astype(np.int8)
-    fell = status == kern.STATUS_FELL
-    fall_time = np.where(fell, results[:, kern.R_FALL_TIME], np.nan)
-    final_outside = results[:, kern.R_FINAL_OUTSIDE] > 0
-    any_outside = results[:, kern.R_ANY_OUTSIDE] > 0
+        results[at_start] = 0.0
+        results[at_start, R_STATUS] = STATUS_FELL
+        results[at_start, R_FALL_TIME] = 0.0
+        results[at_start, R_FALL_KIND] = -1
+        peaks[at_start] = np.abs(x0_all[which[at_start], :n])
+        finals[at_start] = x0_all[which[at_start]]
+    status = results[:, R_STATUS].astype(np.int8)
+    fell = status == STATUS_FELL
+    fall_time = np.where(fell, results[:, R_FALL_TIME], np.nan)
+    final_outside = results[:, R_FINAL_OUTSIDE] > 0
+    any_outside = results[:, R_ANY_OUTSIDE] > 0
     settling = np.where(fell | final_outside, np.nan,
-                        np.where(any_outside, results[:, kern.R_LAST_OUTSIDE], 0.0))
+                        np.where(any_outside, results[:, R_LAST_OUTSIDE], 0.0))
     return BatchResult(
         fell=fell, fall_time=fall_time, peak_theta=peaks, settling_time=settling,
         final_state=finals, status_code=status,
-        n_steps=results[:, kern.R_N_STEPS].astype(np.int64),
-        n_switches=results[:, kern.R_N_SWITCHES].astype(np.int64),
+        n_steps=results[:, R_N_STEPS].astype(np.int64),
+        n_switches=results[:, R_N_SWITCHES].astype(np.int64),
         settle_tolerance=settle_tolerance,
+        fall_kind=results[:, R_FALL_KIND].astype(np.int64),
     )
 
 
-def integrate_compiled(setup, method: str = "Radau") -> SimulationResult:
-    """Run a :class:`~posturelab.simulation.setup.RunSetup` on the compiled engine."""
-    return simulate_fast(
-        setup.body, setup.muscles, setup.disturbance, setup.duration,
-        initial_state=setup.before, rates_from=setup.rates_from, knee=setup.knee,
-        fall=setup.fall, torque_limits=setup.torque_limits,
-        feedback_delay=setup.feedback_delay, rtol=setup.rtol, atol=setup.atol,
-        sample_rate=setup.sample_rate, max_switches=setup.max_switches,
-        description=setup.description, method=method)
+#: Threads a parallel batch uses by default (the CPUs this process may run on). [-]
+def batch_threads() -> int:
+    """Number of threads of a parallel batch: the CPUs available to this process. [-]"""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:  # pragma: no cover - not on Linux
+        return max(1, os.cpu_count() or 1)
 
 
-def warm_up() -> None:
-    """Compile (or load from numba's cache) the kernels with a tiny run of each entry point."""
-    from ...model.body import paper_body
-    from ...model.platform import VelocityStep
+def _run_rows(batch: Batch, rows: np.ndarray, parallel: bool, chunk: int) -> None:
+    """Run the given rows of a batch: contiguous ranges, over threads when parallel."""
+    lib = library()
+    # contiguous ranges of the rows to run (the rows that fall at the start are skipped)
+    breaks = np.nonzero(np.diff(rows) != 1)[0] + 1
+    ranges = []
+    for part in np.split(rows, breaks):
+        for lo in range(int(part[0]), int(part[-1]) + 1, chunk):
+            ranges.append((lo, min(lo + chunk, int(part[-1]) + 1)))
+    threads = batch_threads() if parallel else 1
+    if threads == 1 or len(ranges) == 1:
+        for lo, hi in ranges:
+            lib.pl_run_batch(batch, lo, hi)
+        return
+    with ThreadPoolExecutor(max_workers=threads) as pool:
+        list(pool.map(lambda r: lib.pl_run_batch(batch, r[0], r[1]), ranges))
 
-    body = paper_body()
-    muscles = paper_muscles("1")
-    simulate_fast(body, muscles, VelocityStep.backward(0.1), 0.01)
-    g = np.asarray(muscles.stiffnesses)[None, :]
-    simulate_batch(body, g, 0.25 * g, VelocityStep.backward(0.1), 0.01)
-    simulate_batch(body, g, 0.25 * g, VelocityStep.backward(0.1), 0.01, parallel=False)
+
+def state_derivative(body: Body, muscles: MuscleSet, state, *, active=None, locked=False,
+                     platform_acceleration=(0.0, 0.0), delayed_moments=None,
+                     saturation=None, torque_limits=None, general=False) -> np.ndarray:
+    """[Θ̇, Θ̈] of the C right-hand side at one state (for tests and checks).
+
+    Parameters
+    ----------
+    state : array_like, shape (2N,)
+        [rad], [rad/s]
+    active : array_like, shape (P,), optional
+        Which pairs act (1) or are slack (0); all by default. [-]
+    locked : bool
+        The knee constraint holds.
+    platform_acceleration : (float, float)
+        (ẍ_d, ÿ_d). [m/s²]
+    delayed_moments : array_like, shape (N,), optional
+        τ_delayed added to the joint moments. [N·m]
+    saturation, torque_limits : array_like, shape (N,), optional
+        ±1 where a joint saturates at its limit [N·m].
+    general : bool
+        Use the general-N code even where generated straight-line code exists.
+
+    Returns
+    -------
+    numpy.ndarray, shape (2N,)
+        [rad/s], [rad/s²]
+    """
+    n = body.n_links
+    P = len(muscles.pairs)
+    x = np.ascontiguousarray(state, dtype=float)
+    act = np.ones(P) if active is None else np.ascontiguousarray(active, dtype=float)
+    g = np.ascontiguousarray(enc.gains(muscles.stiffnesses, muscles.viscosities, False))
+    lim = np.ascontiguousarray(enc.limits(torque_limits, n))
+    sat = np.zeros(n) if saturation is None else np.ascontiguousarray(saturation, dtype=float)
+    inp = np.zeros(2 + n)
+    inp[:2] = platform_acceleration
+    if delayed_moments is not None:
+        inp[2:] = delayed_moments
+    out = np.empty(2 * n)
+    tau = np.empty(n)
+    bp = enc.body_array(body)
+    E = np.ascontiguousarray(muscles.selection_matrix)
+    C = np.ascontiguousarray(muscles.crossing_matrix)
+    library().pl_state_derivative(n, P, pointer(bp), pointer(E), pointer(C), pointer(g),
+                                  pointer(act), pointer(lim), pointer(sat), pointer(x),
+                                  pointer(inp), int(bool(locked)), int(bool(general)),
+                                  pointer(out), pointer(tau))
+    return out
+
+
+def rotated_sine_cosine(theta: float, theta_b: float) -> tuple[float, float]:
+    """(sin θ, cos θ) as the C right-hand side computes them from those of θ_b (tests)."""
+    s, c = ctypes.c_double(), ctypes.c_double()
+    library().pl_rotate_value(theta, theta_b, math.sin(theta_b), math.cos(theta_b),
+                              ctypes.byref(s), ctypes.byref(c))
+    return s.value, c.value
+
+
+def warm_up(methods: tuple[str, ...] = ("Radau",),
+            entries: tuple[str, ...] = ("one", "parallel", "serial")) -> None:
+    """Load the engine and check that it runs (nothing is compiled at run time; the
+    arguments, which once chose what numba compiled, are kept for compatibility)."""
+    for method in methods:
+        _check_method(method)
+    library()

@@ -1,156 +1,134 @@
-"""Turn posturelab objects into the plain arrays the compiled kernels take."""
+"""Pack a run's set-up into the plain arrays the compiled kernels take (layouts in
+:mod:`._layout`)."""
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
 from ...errors import ParameterError
 from ...model.body import Body
-from ...model.events import RELEASE_HYSTERESIS as _RELEASE_HYSTERESIS
-from ...model.events import SWITCH_HYSTERESIS as _SWITCH_HYSTERESIS
-from ...model.muscles import MuscleSet
-from ...model.options import FallCriteria, KneeModel
-from ...model.platform import (
-    CombinedDisturbance,
-    Disturbance,
-    HalfSinePulse,
-    MeasuredProfile,
-    NoDisturbance,
-    RampAndHold,
-    SumOfSines,
-    VelocityStep,
+from ...model.platform import Disturbance, NoDisturbance
+from ..setup import RunSetup
+from ._layout import (
+    DIST_ROW,
+    DIST_SAMPLES,
+    DIST_SINE,
+    DIST_WINDOWED_SINE,
+    F_ATOL,
+    F_DURATION,
+    F_HEEL,
+    F_MAX_ANGLE,
+    F_MAX_STEP,
+    F_RTOL,
+    F_SETTLE_TOL,
+    F_STOP_ANGLE,
+    F_TOE,
+    I_KNEE_MODE,
+    I_LOCKED0,
+    I_MAX_SWITCHES,
+    I_USE_BOS,
+    I_USE_COP,
+    KNEE_FREE,
+    KNEE_LOCKED,
+    KNEE_STOP,
+    N_FPAR,
+    N_IPAR,
+    body_size,
 )
-from . import _kernels as kern
 
-_AXIS = {"x": 0, "y": 1}
-
-
-@dataclass(frozen=True)
-class EncodedDisturbance:
-    """A disturbance packed for the kernels.
-
-    Attributes
-    ----------
-    packed : numpy.ndarray
-        ``dp`` of :mod:`._kernels`: the number of components Q, then Q rows
-        (kind, axis, p0, p1, p2), then measured profiles. [s, m/s², Hz, rad]
-    breakpoints : tuple of float
-        Corners of the acceleration profile. [s]
-    max_step : float
-        Largest step that resolves the profile (inf if any). [s]
-    velocity_change : tuple of float
-        (Δẋ_d, Δẏ_d) at t = 0. [m/s]
-    """
-
-    packed: np.ndarray
-    breakpoints: tuple[float, ...]
-    max_step: float
-    velocity_change: tuple[float, float]
+_KINDS = {"windowed-sine": DIST_WINDOWED_SINE, "sine": DIST_SINE}
 
 
-def _components(d: Disturbance, rows: list, profiles: list) -> None:
-    if isinstance(d, CombinedDisturbance):
-        for part in d.parts:
-            _components(part, rows, profiles)
-    elif isinstance(d, NoDisturbance | VelocityStep) or type(d) is Disturbance:
-        return  # no acceleration (a velocity step only sets the initial rates)
-    elif isinstance(d, HalfSinePulse):
-        rows.append([kern.DIST_HALF_SINE, _AXIS[d.axis], d.peak_acceleration, d.duration,
-                     d.start])
-    elif isinstance(d, RampAndHold):
-        rows.append([kern.DIST_RAMP_AND_HOLD, _AXIS[d.axis], d.peak_acceleration, d.duration,
-                     d.start])
-    elif isinstance(d, SumOfSines):
-        for amp, freq, phase in zip(d.amplitudes, d.frequencies, d.phases, strict=True):
-            rows.append([kern.DIST_SINE, _AXIS[d.axis], amp, freq, phase])
-    elif isinstance(d, MeasuredProfile):
-        rows.append([kern.DIST_PROFILE, 0, -1.0, float(d.time.size), 0.0])
-        profiles.append((len(rows) - 1, np.concatenate(
-            [np.asarray(d.time, float), np.asarray(d.acceleration_x, float),
-             np.asarray(d.acceleration_y, float)])))
-    else:
-        raise ParameterError(
-            f"the fast simulator cannot compile a disturbance of type {type(d).__name__}; "
-            "use posturelab.simulate.simulate for it (supported: velocity step, half-sine, "
-            "ramp-and-hold, sum of sines, measured profile, and their combinations)"
-        )
+def readonly(arr) -> np.ndarray:
+    """A C-contiguous float or int array the kernels may not write (one compiled form)."""
+    out = np.ascontiguousarray(arr)
+    if out.flags.writeable:
+        out = out.copy() if out is arr else out
+        out.setflags(write=False)
+    return out
 
 
-def encode_disturbance(disturbance: Disturbance | None) -> EncodedDisturbance:
-    """Pack ``disturbance`` (None: the platform stays still) for the kernels."""
+def encode_disturbance(disturbance: Disturbance | None) -> np.ndarray:
+    """``dp``: the disturbance's :class:`~posturelab.model.platform.Primitive` terms packed."""
     d = NoDisturbance() if disturbance is None else disturbance
-    rows: list = []
-    profiles: list = []
-    _components(d, rows, profiles)
-    offset = 1 + 5 * len(rows)
+    try:
+        terms = d.primitives()
+    except NotImplementedError:
+        raise ParameterError(
+            f"the compiled engine cannot run a disturbance of type {type(d).__name__}: it "
+            "defines no primitives() (see posturelab.model.platform); use engine='reference'"
+        ) from None
+    rows: list[list[float]] = []
+    profiles: list[tuple[int, np.ndarray]] = []
+    for q in terms:
+        if q.kind == "samples":
+            time, ax, ay = (np.asarray(a, dtype=float) for a in q.samples)
+            rows.append([DIST_SAMPLES, 0, -1.0, float(time.size), 0.0, 0.0])
+            profiles.append((len(rows) - 1, np.concatenate([time, ax, ay])))
+        elif q.kind == "windowed-sine":
+            rows.append([DIST_WINDOWED_SINE, q.axis, q.amplitude, q.duration, q.start,
+                         q.cycles])
+        elif q.kind == "sine":
+            rows.append([DIST_SINE, q.axis, q.amplitude, q.frequency, q.phase, 0.0])
+        else:
+            raise ParameterError(f"unknown kind of platform motion term {q.kind!r}")
+    offset = 1 + DIST_ROW * len(rows)
     for row_index, data in profiles:
         rows[row_index][2] = float(offset)  # where this profile's times start in dp
         offset += data.size
     packed = np.concatenate([[float(len(rows))], np.array(rows, float).ravel()]
                             + [data for _, data in profiles])
-    vc = d.velocity_change
-    packed = np.ascontiguousarray(packed, dtype=float)
-    packed.setflags(write=False)
-    return EncodedDisturbance(packed,
-                              tuple(float(b) for b in d.breakpoints), float(d.max_step),
-                              (float(vc[0]), float(vc[1])))
+    return readonly(packed.astype(float))
 
 
-def model_array(body: Body) -> np.ndarray:
-    """``mp`` of :mod:`._kernels` with K = L = 0: a, J_ii, c_ij, K, L, g (SI units)."""
+def body_array(body: Body) -> np.ndarray:
+    """``bp``: a_i [kg·m], J_ii [kg·m²], c_ij row-major [kg·m²], g [m/s²], Σm [kg]."""
     n = body.n_links
-    mp = np.zeros(2 * n + 3 * n * n + 1)
-    mp[:n] = body.gravity_coefficients
-    mp[n:2 * n] = body.inertia_diagonal
-    mp[2 * n:2 * n + n * n] = body.coupling.ravel()
-    mp[-1] = body.gravity
-    return mp
+    bp = np.zeros(body_size(n))
+    bp[:n] = body.gravity_coefficients
+    bp[n:2 * n] = body.inertia_diagonal
+    bp[2 * n:2 * n + n * n] = body.coupling.ravel()
+    bp[2 * n + n * n] = body.gravity
+    bp[2 * n + n * n + 1] = body.total_mass
+    return readonly(bp)
 
 
-def pair_layout(muscles: MuscleSet) -> tuple[np.ndarray, np.ndarray]:
-    """(E (P, N) [-], one_sided (P,) as 0/1 int64)."""
-    return (np.ascontiguousarray(muscles.selection_matrix),
-            muscles.one_sided_mask.astype(np.int64))
-
-
-def crossings(muscles: MuscleSet) -> np.ndarray:
-    """(P, N): 1 where pair r crosses joint j (0 = ankle), as in simulate._assemble."""
-    crosses = np.zeros((len(muscles.pairs), muscles.n_links))
-    for r, p in enumerate(muscles.pairs):
-        crosses[r, p.lo:p.hi] = 1.0
-    return crosses
-
-
-def control_arrays(
-    body: Body, fall: FallCriteria, knee: KneeModel, *, rtol: float, atol: float,
-    max_step: float, duration: float, max_switches: int, locked0: bool,
-    settle_tolerance: float, method: str = "Radau",
-) -> tuple[np.ndarray, np.ndarray]:
-    """The kernels' scalar parameters ``fpar`` (floats) and ``ipar`` (int64)."""
-    fpar = np.zeros(kern.N_FPAR)
-    fpar[kern.F_GRAVITY] = body.gravity
-    fpar[kern.F_TOTAL_MASS] = body.total_mass
-    fpar[kern.F_MAX_ANGLE] = fall.max_link_angle
+def options(setup: RunSetup, settle_tolerance: float = 0.01) -> tuple[np.ndarray, np.ndarray]:
+    """The kernels' scalar options ``fpar`` (floats) and ``ipar`` (int64) of a run."""
+    fall, knee = setup.fall, setup.knee
+    fpar = np.zeros(N_FPAR)
+    fpar[F_MAX_ANGLE] = fall.max_link_angle
     bos = fall.base_of_support
-    fpar[kern.F_HEEL] = bos.heel if bos is not None else -math.inf
-    fpar[kern.F_TOE] = bos.toe if bos is not None else math.inf
-    fpar[kern.F_STOP_ANGLE] = knee.stop_angle
-    fpar[kern.F_RTOL] = rtol
-    fpar[kern.F_ATOL] = atol
-    fpar[kern.F_MAX_STEP] = max_step
-    fpar[kern.F_DURATION] = duration
-    fpar[kern.F_SWITCH_HYST] = _SWITCH_HYSTERESIS
-    fpar[kern.F_RELEASE_HYST] = _RELEASE_HYSTERESIS
-    fpar[kern.F_SETTLE_TOL] = settle_tolerance
-    ipar = np.zeros(kern.N_IPAR, dtype=np.int64)
-    ipar[kern.I_USE_BOS] = 1 if bos is not None else 0
-    ipar[kern.I_KNEE_MODE] = {"free": kern.KNEE_FREE, "locked": kern.KNEE_LOCKED,
-                              "stop": kern.KNEE_STOP}[knee.mode]
-    ipar[kern.I_MAX_SWITCHES] = max_switches
-    ipar[kern.I_LOCKED0] = 1 if locked0 else 0
-    ipar[kern.I_METHOD] = {"RK45": kern.METHOD_RK45, "RK23": kern.METHOD_RK23,
-                           "Radau": kern.METHOD_RADAU}[method]
-    return fpar, ipar
+    fpar[F_HEEL] = bos.heel if bos is not None else -math.inf
+    fpar[F_TOE] = bos.toe if bos is not None else math.inf
+    fpar[F_STOP_ANGLE] = knee.stop_angle
+    fpar[F_RTOL] = setup.rtol
+    fpar[F_ATOL] = setup.atol
+    fpar[F_MAX_STEP] = min(setup.disturbance.max_step, setup.duration)
+    fpar[F_DURATION] = setup.duration
+    fpar[F_SETTLE_TOL] = settle_tolerance
+    ipar = np.zeros(N_IPAR, dtype=np.int64)
+    ipar[I_USE_BOS] = 1 if bos is not None else 0
+    ipar[I_USE_COP] = 1 if fall.centre_of_pressure else 0
+    ipar[I_KNEE_MODE] = {"free": KNEE_FREE, "locked": KNEE_LOCKED, "stop": KNEE_STOP}[knee.mode]
+    ipar[I_MAX_SWITCHES] = setup.max_switches
+    ipar[I_LOCKED0] = 1 if setup.locked0 else 0
+    return readonly(fpar), readonly(ipar)
+
+
+def gains(stiffness: np.ndarray, viscosity: np.ndarray, delayed: bool) -> np.ndarray:
+    """(4, P) = (k_d, l_d, delayed k_d, delayed l_d): all of a pair's feedback is immediate,
+    or all of it delayed. [N·m/rad], [N·m·s/rad]"""
+    k = np.asarray(stiffness, dtype=float)
+    v = np.asarray(viscosity, dtype=float)
+    z = np.zeros_like(k)
+    return np.stack([z, z, k, v] if delayed else [k, v, z, z], axis=-2)
+
+
+def limits(torque_limits: np.ndarray | None, n: int) -> np.ndarray:
+    """Torque limits per joint, inf where none. [N·m]"""
+    if torque_limits is None:
+        return np.full(n, math.inf)
+    return np.asarray(torque_limits, dtype=float)

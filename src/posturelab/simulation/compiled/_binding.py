@@ -1,0 +1,90 @@
+"""The C engine (``_engine``, built by ``setup.py`` from ``csrc/``) seen from Python.
+
+The structs mirror ``csrc/pl.h`` field by field; :func:`library` loads the extension once
+and checks that it was built from the sources beside it. Calls go through ctypes, which
+releases the GIL for their duration, so batch chunks run in parallel on Python threads.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import functools
+import importlib.util
+
+from ...errors import PostureLabError
+from ._sources import source_hash
+
+_P = ctypes.POINTER
+_d = _P(ctypes.c_double)
+_i = _P(ctypes.c_int64)
+
+
+class Run(ctypes.Structure):
+    """``pl_run``: one run's inputs."""
+
+    _fields_ = [(name, ctypes.c_int64) for name in
+                ("n", "p", "n_grid", "n_bps", "n_slots", "n_stages", "method")] + [
+        ("x0", _d), ("before", _d), ("grid", _d), ("bp", _d), ("E", _d), ("C", _d),
+        ("one_sided", _i), ("gains", _d), ("lim", _d), ("delay", ctypes.c_double),
+        ("dp", _d), ("bps", _d), ("fpar", _d), ("ipar", _i), ("active0", _d), ("sat0", _d),
+        ("slot_kind", _i), ("slot_index", _i), ("slot_cond", _i), ("slot_side", _d),
+        ("ev_offset", _d), ("ev_direction", _i), ("ev_ends", _i),
+        ("tab_A", _d), ("tab_c", _d), ("tab_e", _d), ("tab_P", _d),
+        ("tab_error_order", ctypes.c_int64), ("delay_multiples", ctypes.c_int64),
+    ]
+
+
+class Out(ctypes.Structure):
+    """``pl_out``: where one run's outputs go."""
+
+    _fields_ = [("samples", _d), ("fb", _d), ("locked", _P(ctypes.c_uint8)),
+                ("switches", _d), ("switch_cap", ctypes.c_int64), ("peak", _d),
+                ("final", _d), ("res", _d)]
+
+
+class Batch(ctypes.Structure):
+    """``pl_batch``: a batch's shared inputs, per-level and per-run arrays, outputs."""
+
+    _fields_ = [("base", Run), ("which", _i), ("x0_all", _d), ("before_all", _d),
+                ("dp_all", _d), ("dp_stride", ctypes.c_int64), ("ipar_all", _i),
+                ("active0_all", _d), ("gains_all", _d), ("lim_all", _d), ("delay_all", _d),
+                ("sat0_all", _d), ("method_all", _i), ("results", _d), ("peaks", _d),
+                ("finals", _d)]
+
+
+def pointer(arr, kind=_d):
+    """A ctypes pointer to a C-contiguous numpy array's data (None for None)."""
+    if arr is None:
+        return None
+    if not arr.flags.c_contiguous:
+        raise ValueError("array must be C-contiguous")
+    return arr.ctypes.data_as(kind)
+
+
+@functools.cache
+def library() -> ctypes.CDLL:
+    """The loaded engine, its functions typed."""
+    spec = importlib.util.find_spec("posturelab.simulation.compiled._engine")
+    if spec is None or spec.origin is None:
+        raise PostureLabError(
+            "posturelab's compiled engine is not built: reinstall posturelab "
+            "(pip install -e . in a source checkout; a C compiler is needed)")
+    importlib.import_module("posturelab.simulation.compiled._engine")  # runs its set-up
+    lib = ctypes.CDLL(spec.origin)
+    lib.pl_source_hash.restype = ctypes.c_char_p
+    built = lib.pl_source_hash().decode()
+    here = source_hash()
+    if here and built != here:
+        raise PostureLabError(
+            f"posturelab's compiled engine was built from other C sources ({built}) than "
+            f"those installed ({here}): rebuild it (pip install -e . in a source checkout)")
+    lib.pl_run_one.argtypes = [_P(Run), _P(Out)]
+    lib.pl_run_one.restype = ctypes.c_int64
+    lib.pl_run_batch.argtypes = [_P(Batch), ctypes.c_int64, ctypes.c_int64]
+    lib.pl_run_batch.restype = None
+    lib.pl_state_derivative.argtypes = [ctypes.c_int64, ctypes.c_int64, _d, _d, _d, _d, _d,
+                                        _d, _d, _d, _d, ctypes.c_int64, ctypes.c_int64, _d, _d]
+    lib.pl_state_derivative.restype = None
+    lib.pl_rotate_value.argtypes = [ctypes.c_double] * 4 + [_d, _d]
+    lib.pl_rotate_value.restype = None
+    return lib

@@ -1,0 +1,150 @@
+"""Generates ``csrc/pl_rhs_small.c``: the right-hand side for N = 1, 2, 3 links as
+straight-line C.
+
+Run ``python -m posturelab.simulation.compiled._codegen`` to rewrite the file; a test
+regenerates it and compares. The formulas are those of the general-N right-hand side
+(``pl_rhs_general`` in ``csrc/pl_rhs.c``), unrolled: for link i,
+
+* τ_j = (T_K Θ + T_L Θ̇ + τ_delayed)_j, or ±limit_j while joint j saturates; U_i = τ_{i+1} − τ_i
+* r_i = U_i − Σ_{j≠i} c_ij sin(θ_i − θ_j) θ̇_j² + a_i ((g + ÿ_d) sin θ_i − ẍ_d cos θ_i)
+* J_ii = I_i + m_i k_i² + …, J_ij = c_ij cos(θ_j − θ_i); Θ̈ = adj(J) r / det J
+* with the knee locked, Θ̈ − J⁻¹C (C·Θ̈)/(C·J⁻¹C), C = (−1, 1, 0).
+
+The adjugates come from sympy (a development dependency), with common
+subexpressions shared; the determinant is the first row's cofactor expansion.
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+TARGET = Path(__file__).with_name("csrc") / "pl_rhs_small.c"
+SIZES = (1, 2, 3)
+
+HEADER = """/* Right-hand sides for N = 1, 2, 3 links: GENERATED, do not edit.
+ *
+ * python -m posturelab.simulation.compiled._codegen writes this file from the formulas
+ * stated in _codegen.py (those of pl_rhs_general in pl_rhs.c, unrolled); a test regenerates
+ * it and compares. */
+#include "pl.h"
+"""
+
+
+def _printer():
+    from sympy.printing.str import StrPrinter
+
+    class Printer(StrPrinter):
+        """C expressions with squares as products."""
+
+        def _print_Pow(self, expr, rational=False):
+            base, exp = expr.as_base_exp()
+            if exp == 2:
+                b = self._print(base)
+                return f"{b}*{b}" if base.is_Symbol else f"({b})*({b})"
+            raise ValueError(f"unexpected power {expr}")
+
+        def _print_Integer(self, expr):
+            return f"{int(expr)}.0"
+
+    return Printer()
+
+
+def _adjugate_lines(n: int, printer) -> tuple[list[str], list[list[str]]]:
+    """C statements computing the adjugate m_ij of the symmetric J (entries j_ab, a <= b)."""
+    import sympy as sp
+
+    J = sp.Matrix(n, n, lambda i, j: sp.Symbol(f"j{min(i, j)}{max(i, j)}"))
+    adj = J.adjugate()
+    entries = [adj[i, j] for i in range(n) for j in range(n)]
+    subs, reduced = sp.cse(entries, symbols=sp.numbered_symbols("q"), optimizations="basic")
+    lines = [f"const double {printer.doprint(s)} = {printer.doprint(e)};" for s, e in subs]
+    names = [[f"m{i}{j}" for j in range(n)] for i in range(n)]
+    for k, expr in enumerate(reduced):
+        lines.append(f"const double {names[k // n][k % n]} = {printer.doprint(expr)};")
+    return lines, names
+
+
+def _rhs_function(n: int, printer) -> str:
+    L = [f"void pl_rhs{n}(const pl_model *md, const double *x, double *out, const double *inp,",
+         "             int locked)", "{",
+         "    const double *bp = md->bp, *tk = md->tm, *tl = md->tm + " + str(n * n) + ";",
+         "    const double *base = md->base;"]
+    if n == 1:
+        L.append("    (void)locked;")
+    for i in range(n):
+        L.append(f"    const double th{i} = x[{i}], w{i} = x[{n + i}];")
+    for i in range(n):
+        L.append(f"    double s{i}, c{i};")
+        L.append(f"    pl_rotate(th{i}, base[{i}], base[{n + i}], base[{2 * n + i}], "
+                 f"&s{i}, &c{i});")
+    L.append("    const double ax = inp[0];")
+    L.append(f"    const double ga = bp[{2 * n + n * n}] + inp[1];")
+    for j in range(n):
+        k_terms = " + ".join(f"tk[{j * n + k}] * th{k}" for k in range(n))
+        l_terms = " + ".join(f"tl[{j * n + k}] * w{k}" for k in range(n))
+        L.append(f"    double t{j} = inp[{2 + j}] + ({k_terms}) + ({l_terms});")
+        L.append(f"    if (md->sat[{j}] != 0.0)")
+        L.append(f"        t{j} = md->sat[{j}] * md->lim[{j}];")
+    for i in range(n):
+        rhs = f"t{i + 1} - t{i}" if i + 1 < n else f"-t{i}"
+        L.append(f"    const double u{i} = {rhs};")
+    for i in range(n):
+        for j in range(i + 1, n):
+            L.append(f"    const double n{i}{j} = bp[{2 * n + i * n + j}] "
+                     f"* (s{i} * c{j} - c{i} * s{j});")
+    for i in range(n):
+        terms = []
+        for j in range(n):
+            if j != i:
+                coef = f"n{i}{j}" if i < j else f"-n{j}{i}"
+                terms.append(f"{coef} * (w{j} * w{j})")
+        bterm = f" - ({' + '.join(terms)})" if terms else ""
+        L.append(f"    const double r{i} = u{i}{bterm} + bp[{i}] * (ga * s{i} - ax * c{i});")
+    for i in range(n):
+        L.append(f"    const double j{i}{i} = bp[{n + i}];")
+        for j in range(i + 1, n):
+            L.append(f"    const double j{i}{j} = bp[{2 * n + i * n + j}] "
+                     f"* (c{i} * c{j} + s{i} * s{j});")
+    lines, names = _adjugate_lines(n, printer)
+    L += [f"    {line}" for line in lines]
+    det = " + ".join(f"j{min(0, k)}{max(0, k)} * {names[k][0]}" for k in range(n))
+    L.append(f"    const double inv_det = 1.0 / ({det});")
+    for i in range(n):
+        terms = " + ".join(f"{names[i][k]} * r{k}" for k in range(n))
+        L.append(f"    double a{i} = ({terms}) * inv_det;")
+    if n >= 2:
+        L.append("    if (locked) {  /* knee constraint C = (−1, 1, 0): "
+                 "Θ̈ −= J⁻¹C (C·Θ̈)/(C·J⁻¹C) */")
+        for i in range(n):
+            L.append(f"        const double y{i} = {names[i][1]} - {names[i][0]};")
+        L.append("        const double lam = (a1 - a0) / (y1 - y0);")
+        for i in range(n):
+            L.append(f"        a{i} -= y{i} * lam;")
+        L.append("    }")
+    # every store last: out and tau may not be read again, whatever they alias
+    for j in range(n):
+        L.append(f"    md->tau[{j}] = t{j};")
+    for i in range(n):
+        L.append(f"    out[{i}] = w{i};")
+    for i in range(n):
+        L.append(f"    out[{n + i}] = a{i};")
+    L.append("}")
+    return "\n".join(L) + "\n"
+
+
+def generate() -> str:
+    """The text of ``csrc/pl_rhs_small.c``."""
+    printer = _printer()
+    return HEADER + "".join("\n" + _rhs_function(n, printer) for n in SIZES)
+
+
+def main() -> int:
+    """Write ``csrc/pl_rhs_small.c``."""
+    TARGET.write_text(generate(), encoding="utf-8")
+    print(f"wrote {TARGET}")
+    return 0
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -1,0 +1,378 @@
+/* The integration loop of one run, written once for every integrator (pl_method: the
+ * explicit pairs of pl_explicit.c or Radau, pl_radau.c).
+ *
+ * Events sit outside every method: after each kept step the loop evaluates the segment's
+ * event functions at the step's end, finds the earliest root on its dense output, and either
+ * ends the run (a fall) or applies the switch and restarts the integrator, as the reference
+ * engine does. With a feedback delay τ each kept step's dense output goes to the history,
+ * the inputs of every stage include the delayed joint moments, steps are at most τ long and
+ * land on kτ (k = 1 … delay_multiples). */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include "pl.h"
+#include "pl_events.h"
+
+#define EPS 2.220446049250313e-16
+
+typedef struct {
+    double *tm, *sat, *base, *work, *tau, *active, *x, *y, *Q, *inp, *g_old, *g_new, *sc_out,
+        *sc_inp, *sc_x, *ys, *ev_side;
+    int64_t *ev_kind, *ev_index;
+} buffers;
+
+static void free_buffers(buffers *b)
+{
+    double *d[] = {b->tm, b->sat, b->base, b->work, b->tau, b->active, b->x, b->y, b->Q,
+                   b->inp, b->g_old, b->g_new, b->sc_out, b->sc_inp, b->sc_x, b->ys,
+                   b->ev_side};
+    for (size_t k = 0; k < sizeof(d) / sizeof(d[0]); k++)
+        free(d[k]);
+    free(b->ev_kind);
+    free(b->ev_index);
+}
+
+static int alloc_buffers(buffers *b, int64_t n, int64_t p, int64_t n_nodes, int64_t n_slots)
+{
+    const int64_t m = 2 * n, cap = n_slots > 0 ? n_slots : 1;
+    memset(b, 0, sizeof(*b));
+    b->tm = calloc(4 * n * n, sizeof(double));
+    b->sat = calloc(n, sizeof(double));
+    b->base = calloc(3 * n, sizeof(double));
+    b->work = calloc(n * (n + 4), sizeof(double));
+    b->tau = calloc(n, sizeof(double));
+    b->active = calloc(p > 0 ? p : 1, sizeof(double));
+    b->x = calloc(m, sizeof(double));
+    b->y = calloc(m, sizeof(double));
+    b->Q = calloc(4 * m, sizeof(double));
+    b->inp = calloc(n_nodes * (2 + n), sizeof(double));
+    b->g_old = calloc(cap, sizeof(double));
+    b->g_new = calloc(cap, sizeof(double));
+    b->ev_side = calloc(cap, sizeof(double));
+    b->ev_kind = calloc(cap, sizeof(int64_t));
+    b->ev_index = calloc(cap, sizeof(int64_t));
+    b->sc_out = calloc(m, sizeof(double));
+    b->sc_inp = calloc(2 + n, sizeof(double));
+    b->sc_x = calloc(m, sizeof(double));
+    b->ys = calloc(m, sizeof(double));
+    return b->tm && b->sat && b->base && b->work && b->tau && b->active && b->x && b->y
+           && b->Q && b->inp && b->g_old && b->g_new && b->ev_side && b->ev_kind
+           && b->ev_index && b->sc_out && b->sc_inp && b->sc_x && b->ys;
+}
+
+/* The events of a smooth segment: the slots (posturelab.model.events.event_slots) whose
+ * condition holds now, in slot order. */
+static int64_t segment_events(const pl_run *run, const double *sat, const double *active,
+                              int locked, int64_t *kind, int64_t *index, double *side)
+{
+    int64_t k = 0;
+    for (int64_t s = 0; s < run->n_slots; s++) {
+        const int64_t i = run->slot_index[s];
+        int on;
+        switch (run->slot_cond[s]) {
+        case COND_JOINT_FREE: on = sat[i] == 0.0; break;
+        case COND_JOINT_SATURATED: on = sat[i] != 0.0; break;
+        case COND_PAIR_ACTIVE: on = active[i] > 0.0; break;
+        case COND_PAIR_SLACK: on = !(active[i] > 0.0); break;
+        case COND_KNEE_FREE: on = !locked; break;
+        case COND_KNEE_LOCKED: on = locked; break;
+        default: on = 1;
+        }
+        if (!on)
+            continue;
+        kind[k] = run->slot_kind[s];
+        index[k] = i;
+        side[k] = run->slot_kind[s] == EV_LETS_GO ? sat[i] : run->slot_side[s];
+        k++;
+    }
+    return k;
+}
+
+static double next_stop(const pl_run *run, int64_t bi, int64_t di, double duration)
+{
+    double t_stop = bi < run->n_bps ? run->bps[bi] : duration;
+    if (run->delay > 0.0 && di <= run->delay_multiples)
+        t_stop = fmin(t_stop, di * run->delay);
+    return t_stop;
+}
+
+int64_t pl_integrate(const pl_run *run, pl_out *out)
+{
+    const int64_t n = run->n, m = 2 * n, T = run->n_grid, width = 2 + n;
+    const double *fpar = run->fpar, *grid = run->grid;
+    const double rtol = fpar[F_RTOL], atol = fpar[F_ATOL], duration = fpar[F_DURATION];
+    const double settle_tol = fpar[F_SETTLE_TOL], stop_angle = fpar[F_STOP_ANGLE];
+    const double delay = run->delay;
+    double max_step = fpar[F_MAX_STEP];
+    if (delay > 0.0)
+        max_step = fmin(max_step, delay);  /* the method of steps: the past is computed */
+    const int64_t max_switches = run->ipar[I_MAX_SWITCHES];
+    int locked = run->ipar[I_LOCKED0] != 0;
+    const int has_inputs = run->dp[0] > 0.0 || delay > 0.0;
+    double *res = out->res;
+    for (int64_t k = 0; k < N_RESULT; k++)
+        res[k] = 0.0;
+
+    pl_method me = {0};
+    buffers b;
+    pl_history hist = {0};
+    memset(&b, 0, sizeof(b));
+    int ok = run->method == METHOD_RADAU ? pl_radau_init(&me, n)
+                                         : pl_explicit_init(&me, run, n);
+    ok = ok && alloc_buffers(&b, n, run->p, me.n_nodes, run->n_slots);
+    ok = ok && pl_history_init(&hist, m, delay > 0.0 ? 256 : 1);
+    if (!ok) {
+        if (me.release)
+            me.release(&me);
+        free_buffers(&b);
+        pl_history_free(&hist);
+        res[R_STATUS] = PL_NO_MEMORY;
+        return PL_NO_MEMORY;
+    }
+    memcpy(b.sat, run->sat0, sizeof(double) * n);
+    memcpy(b.active, run->active0, sizeof(double) * run->p);
+    memcpy(b.x, run->x0, sizeof(double) * m);
+    pl_model md = {n, run->bp, b.tm, run->lim, b.sat, b.base, b.work, b.tau};
+    pl_ctx cx = {&md, run->E, run->dp, fpar, run->before, run->ev_offset, &hist, delay,
+                 b.sc_out, b.sc_inp, b.sc_x, b.ys};
+    double *x = b.x, *y = b.y, *Q = b.Q, *inp = b.inp;
+    for (int64_t i = 0; i < n; i++)
+        out->peak[i] = 0.0;
+    for (int64_t i = 0; i < m; i++)
+        out->final[i] = NAN;
+
+    double t = 0.0, h = 0.0, fall_time = NAN, last_outside = NAN;
+    int64_t status = PL_COMPLETED, fall_kind = -1, fall_index = -1, n_switches = 0;
+    int64_t n_steps = 0, n_rejected = 0, n_evals = 0, gi = 0, bi = 0, di = 1, n_ev = 0;
+    int any_outside = 0, final_outside = 0, fall_sample = 0, restart = 1;
+
+    while (t < duration) {
+        if (restart) {  /* a smooth segment starts (t = 0, or after a switch) */
+            while (bi < run->n_bps && run->bps[bi] <= t + 1e-12)
+                bi++;
+            while (delay > 0.0 && di <= run->delay_multiples && di * delay <= t + 1e-12)
+                di++;
+            pl_moment_gains(run->E, run->C, run->gains, run->gains + run->p, b.active, run->p,
+                            n, b.tm, b.tm + n * n);
+            pl_moment_gains(run->E, run->C, run->gains + 2 * run->p, run->gains + 3 * run->p,
+                            b.active, run->p, n, b.tm + 2 * n * n, b.tm + 3 * n * n);
+            pl_set_base(x, b.base, n);
+            n_ev = segment_events(run, b.sat, b.active, locked, b.ev_kind, b.ev_index,
+                                  b.ev_side);
+            for (int64_t e = 0; e < n_ev; e++)
+                b.g_old[e] = pl_event_value(&cx, b.ev_kind[e], b.ev_index[e], b.ev_side[e], t,
+                                            x, locked);
+            pl_inputs_at(&cx, t, inp);
+            h = me.start(&me, &md, t, x, next_stop(run, bi, di, duration), max_step, rtol,
+                         atol, locked, inp, &n_evals);
+            restart = 0;
+        }
+        const double t_stop = next_stop(run, bi, di, duration);
+        h = me.limit(&me, h, max_step);
+        int landing = 0;
+        if (t + 1.01 * h >= t_stop) {
+            h = t_stop - t;  /* land exactly on the breakpoint (or the end) */
+            landing = 1;
+        }
+        if (!(h > 10.0 * EPS * fabs(t))) {
+            status = PL_STEP_TOO_SMALL;
+            break;
+        }
+        const double t_new = landing ? t_stop : t + h;
+        if (has_inputs)
+            for (int64_t k = 0; k < me.n_nodes; k++)
+                pl_inputs_at(&cx, me.nodes[k] == 1.0 ? t_new : t + me.nodes[k] * h,
+                             inp + k * width);
+        double h_next;
+        if (!me.attempt(&me, &md, t, h, x, y, Q, inp, rtol, atol, locked, &h_next, &n_evals)) {
+            n_rejected++;
+            h = h_next;
+            continue;
+        }
+        n_steps++;
+        if (delay > 0.0 && !pl_history_add(&hist, t, h, x, Q)) {
+            status = PL_NO_MEMORY;
+            break;
+        }
+
+        /* events that fired in (t, t_new]: the earliest root on the interpolant */
+        int64_t ev_hit = -1;
+        double t_ev = t_new;
+        for (int64_t e = 0; e < n_ev; e++) {
+            const int64_t kind = b.ev_kind[e];
+            const double gn = pl_event_value(&cx, kind, b.ev_index[e], b.ev_side[e], t_new, y,
+                                             locked);
+            const double go = b.g_old[e];
+            b.g_new[e] = gn;
+            const int fired = run->ev_direction[kind] > 0 ? (go <= 0.0 && gn >= 0.0)
+                                                          : (go >= 0.0 && gn <= 0.0);
+            if (!fired)
+                continue;
+            const double root = pl_event_root(&cx, kind, b.ev_index[e], b.ev_side[e], t, t_new,
+                                              go, gn, x, Q, h, locked);
+            if (ev_hit < 0 || root < t_ev - 1e-12 * fmax(1.0, t_ev)) {
+                ev_hit = e;
+                t_ev = root;
+            } else if (root < t_ev) {
+                t_ev = root;  /* a tie within 1e-12 s: the earlier-listed event wins */
+            }
+        }
+
+        /* output samples in [t, end of this piece], as the reference selects them */
+        const double t_end = ev_hit >= 0 ? t_ev : t_new;
+        const int inclusive = ev_hit >= 0 || t_new >= duration;
+        const int64_t first_gi = gi;
+        while (gi < T && (grid[gi] < t_end - 1e-12 || (inclusive && grid[gi] <= t_end + 1e-12))) {
+            /* the angles (all of the state when storing it): the same expression either way,
+             * so that a batch row equals its single run bit for bit */
+            pl_dense_at(x, Q, out->samples ? m : n, t, h, grid[gi], b.ys);
+            int outside = 0;
+            for (int64_t i = 0; i < n; i++) {
+                const double v = fabs(b.ys[i]);
+                if (v > out->peak[i])
+                    out->peak[i] = v;
+                if (v > settle_tol)
+                    outside = 1;
+            }
+            if (outside) {
+                last_outside = grid[gi];
+                any_outside = 1;
+            }
+            final_outside = outside;
+            if (out->samples) {
+                for (int64_t i = 0; i < m; i++)
+                    out->samples[i * (T + 1) + gi] = b.ys[i];
+                out->locked[gi] = (uint8_t)locked;
+            }
+            if (out->fb) {
+                pl_history_at(&hist, run->before, grid[gi] - delay, b.sc_x);
+                for (int64_t i = 0; i < m; i++)
+                    out->fb[i * (T + 1) + gi] = b.sc_x[i];
+            }
+            gi++;
+        }
+        if (gi > first_gi) {
+            pl_dense_at(x, Q, m, t, h, grid[gi - 1], b.ys);
+            memcpy(out->final, b.ys, sizeof(double) * m);
+        }
+
+        if (ev_hit >= 0) {
+            pl_dense_at(x, Q, m, t, h, t_ev, b.ys);
+            memcpy(x, b.ys, sizeof(double) * m);
+            const int64_t kind = b.ev_kind[ev_hit], j = b.ev_index[ev_hit];
+            t = t_ev;
+            if (run->ev_ends[kind]) {
+                status = PL_FELL;
+                fall_time = t_ev;
+                fall_kind = kind;
+                fall_index = j;
+                if (gi == 0 || grid[gi - 1] < t_ev - 1e-12) {
+                    /* the state at the fall closes the series (off the sample grid) */
+                    fall_sample = 1;
+                    int outside = 0;
+                    for (int64_t i = 0; i < n; i++) {
+                        const double v = fabs(x[i]);
+                        if (v > out->peak[i])
+                            out->peak[i] = v;
+                        if (v > settle_tol)
+                            outside = 1;
+                    }
+                    if (outside) {
+                        last_outside = t_ev;
+                        any_outside = 1;
+                    }
+                    final_outside = outside;
+                    memcpy(out->final, x, sizeof(double) * m);
+                    if (out->samples) {
+                        for (int64_t i = 0; i < m; i++)
+                            out->samples[i * (T + 1) + gi] = x[i];
+                        out->locked[gi] = (uint8_t)locked;
+                    }
+                    if (out->fb) {
+                        pl_history_at(&hist, run->before, t_ev - delay, b.sc_x);
+                        for (int64_t i = 0; i < m; i++)
+                            out->fb[i * (T + 1) + gi] = b.sc_x[i];
+                    }
+                }
+                break;
+            }
+            if (out->switches && n_switches < out->switch_cap)
+                out->switches[n_switches] = t_ev;
+            n_switches++;
+            if (n_switches > max_switches) {
+                status = PL_CHATTERING;
+                break;
+            }
+            if (kind == EV_PAIR_SLACKENS || kind == EV_PAIR_ENGAGES) {
+                /* the pair engages if its (fed-back) stretch is now growing, else goes slack */
+                const double *s = x;
+                if (delay > 0.0) {
+                    pl_history_at(&hist, run->before, t_ev - delay, b.sc_x);
+                    s = b.sc_x;
+                }
+                double sd = 0.0;
+                for (int64_t k = 0; k < n; k++)
+                    sd += run->E[j * n + k] * s[n + k];
+                b.active[j] = sd >= 0.0 ? 1.0 : 0.0;
+            } else if (kind == EV_KNEE_HITS_STOP) {
+                x[1] = x[0] + stop_angle;
+                pl_project_velocity(x, run->bp, b.work, n);
+                locked = 1;
+            } else if (kind == EV_KNEE_LEAVES_STOP) {
+                locked = 0;
+            } else if (kind == EV_SATURATES) {
+                b.sat[j] = b.ev_side[ev_hit];
+            } else if (kind == EV_LETS_GO) {
+                b.sat[j] = 0.0;
+            }
+            int finite = 1;
+            for (int64_t i = 0; i < m; i++)
+                finite = finite && isfinite(x[i]);
+            if (!finite) {
+                status = PL_NONFINITE;
+                break;
+            }
+            restart = 1;
+            continue;
+        }
+
+        int finite = 1;
+        for (int64_t i = 0; i < m; i++)
+            finite = finite && isfinite(y[i]);
+        if (!finite) {
+            status = PL_NONFINITE;
+            break;
+        }
+        t = t_new;
+        memcpy(x, y, sizeof(double) * m);
+        me.commit(&me);
+        memcpy(b.g_old, b.g_new, sizeof(double) * n_ev);
+        pl_set_base(x, b.base, n);
+        if (landing) {
+            while (bi < run->n_bps && run->bps[bi] <= t + 1e-12)
+                bi++;
+            while (delay > 0.0 && di <= run->delay_multiples && di * delay <= t + 1e-12)
+                di++;
+        }
+        h = h_next;
+    }
+
+    res[R_STATUS] = (double)status;
+    res[R_N_SAMPLES] = (double)gi;
+    res[R_FALL_KIND] = (double)fall_kind;
+    res[R_FALL_INDEX] = (double)fall_index;
+    res[R_FALL_TIME] = fall_time;
+    res[R_N_SWITCHES] = (double)n_switches;
+    res[R_T_REACHED] = t;
+    res[R_N_STEPS] = (double)n_steps;
+    res[R_N_REJECTED] = (double)n_rejected;
+    res[R_N_EVALS] = (double)n_evals;
+    res[R_LAST_OUTSIDE] = last_outside;
+    res[R_ANY_OUTSIDE] = any_outside;
+    res[R_FINAL_OUTSIDE] = final_outside;
+    res[R_FALL_SAMPLE] = fall_sample;
+    me.release(&me);
+    free_buffers(&b);
+    pl_history_free(&hist);
+    return status;
+}

@@ -1,0 +1,470 @@
+/* Radau IIA of order 5: scipy's Radau (Hairer & Wanner's RADAU5).
+ *
+ * Simplified Newton iterations with scipy's convergence-rate tests, the Jacobian
+ * re-evaluated only when Newton converges slowly, the embedded error estimate with one extra
+ * smoothing after a rejection, Gustafsson's predictive step control, and the cubic
+ * collocation polynomial as dense output (also the next step's first Newton guess).
+ *
+ * The Jacobian of [Θ̇, Θ̈] is [[0, I], [P, Q]] (P = ∂Θ̈/∂Θ, Q = ∂Θ̈/∂Θ̇, forward differences),
+ * so each Newton system (c·I − Jac) v = r of size 2N reduces to
+ * S(c) a = r₂ + (c·I − Q) r₁, b = c·a − r₁, S(c) = c²I − c·Q − P of size N, for the real
+ * eigenvalue c = μ_r/h and the complex one (solved as the real 2N×2N system
+ * [[Re S, −Im S], [Im S, Re S]]). The inputs rows are (t, t + c1 h, t + c2 h, t + h). */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include "pl.h"
+
+#define NEWTON_MAXITER 6
+#define SQRT_EPS 1.4901161193847656e-08
+#define EPS 2.220446049250313e-16
+/* up to this many links the factored Newton matrices are inverted outright (one dense
+ * matrix–vector product per solve beats pivoted triangular solves at these sizes) */
+#define SMALL_N 4
+
+static const double S6 = 2.449489742783178;  /* √6 */
+static double NODES[4];
+static double MU_REAL, MU_CRE, MU_CIM, E1, E2, E3;
+static double P[3][3];
+static int constants_ready = 0;
+/* the transformation that diagonalises the inverse Radau matrix, to the digits scipy prints */
+static const double T[3][3] = {{0.09443876248897524, -0.14125529502095421, 0.03002919410514742},
+                               {0.25021312296533332, 0.20412935229379994, -0.38294211275726192},
+                               {1.0, 1.0, 0.0}};
+static const double TI[3][3] = {{4.17871859155190428, 0.32768282076106237, 0.52337644549944951},
+                                {-4.17871859155190428, -0.32768282076106237,
+                                 0.47662355450055044},
+                                {0.50287263494578682, -2.57192694985560522,
+                                 0.59603920482822492}};
+
+void pl_radau_constants(void)
+{
+    if (constants_ready)
+        return;
+    NODES[0] = 0.0;
+    NODES[1] = (4.0 - S6) / 10.0;
+    NODES[2] = (4.0 + S6) / 10.0;
+    NODES[3] = 1.0;
+    E1 = (-13.0 - 7.0 * S6) / 3.0;
+    E2 = (-13.0 + 7.0 * S6) / 3.0;
+    E3 = -1.0 / 3.0;
+    MU_REAL = 3.0 + pow(3.0, 2.0 / 3.0) - pow(3.0, 1.0 / 3.0);
+    MU_CRE = 3.0 + 0.5 * (pow(3.0, 1.0 / 3.0) - pow(3.0, 2.0 / 3.0));
+    MU_CIM = -0.5 * (pow(3.0, 5.0 / 6.0) + pow(3.0, 7.0 / 6.0));
+    const double p[3][3] = {
+        {13.0 / 3.0 + 7.0 * S6 / 3.0, -23.0 / 3.0 - 22.0 * S6 / 3.0, 10.0 / 3.0 + 5.0 * S6},
+        {13.0 / 3.0 - 7.0 * S6 / 3.0, -23.0 / 3.0 + 22.0 * S6 / 3.0, 10.0 / 3.0 - 5.0 * S6},
+        {1.0 / 3.0, -8.0 / 3.0, 10.0 / 3.0}};
+    memcpy(P, p, sizeof(P));
+    constants_ready = 1;
+}
+
+typedef struct radau_ws radau_ws;
+static void invert_factored(double *A, const int64_t *piv, int64_t k, double *col);
+static void prepared_solve(const radau_ws *w, const double *A, const int64_t *piv, double *b,
+                           int64_t k);
+
+struct radau_ws {
+    int64_t n, m;
+    double *Z, *Z0, *W, *F;       /* (3, m) */
+    double *jac;                  /* (n, m) acceleration rows */
+    double *lur; int64_t *pivr;   /* (n, n) real system: its factors, or inverse */
+    double *luc; int64_t *pivc;   /* (2n, 2n) complex system, embedded: likewise */
+    double *inv_tmp;              /* (2n) */
+    int small;                    /* n <= SMALL_N: explicit inverses (matrix–vector solves) */
+    double *scale, *fr, *fcr, *fci, *tmp, *err, *xt, *s1, *s2, *xold, *f0, *fnew;
+    double h_lu, h_old, err_old, h_start, t_prev, h_prev, newton_tol;
+    int have_sol, current_jac, err_rejected, last_rejected;
+};
+
+static int64_t jacobian(radau_ws *w, const pl_model *md, const double *x, const double *f0,
+                        const double *inp, int locked)
+{
+    const int64_t n = w->n, m = w->m;
+    memcpy(w->xt, x, sizeof(double) * m);
+    for (int64_t j = 0; j < m; j++) {
+        double d = SQRT_EPS * fmax(fabs(x[j]), 1e-2);
+        d = (x[j] + d) - x[j];
+        w->xt[j] = x[j] + d;
+        pl_rhs(md, w->xt, w->s1, inp, locked);
+        w->xt[j] = x[j];
+        for (int64_t i = 0; i < n; i++)
+            w->jac[i * m + j] = (w->s1[n + i] - f0[n + i]) / d;
+    }
+    return m;
+}
+
+/* S(c) = c²I − c·Q − P for c = μ_r/h (real) and μ_c/h (complex, embedded), factored */
+static void factor(radau_ws *w, double h)
+{
+    const int64_t n = w->n, m = w->m, n2 = 2 * n;
+    const double cr = MU_REAL / h, ccr = MU_CRE / h, cci = MU_CIM / h;
+    const double c2r = ccr * ccr - cci * cci, c2i = 2.0 * ccr * cci;
+    for (int64_t i = 0; i < n; i++)
+        for (int64_t j = 0; j < n; j++) {
+            const double p = w->jac[i * m + j], q = w->jac[i * m + n + j];
+            const double id = i == j ? 1.0 : 0.0;
+            w->lur[i * n + j] = cr * cr * id - cr * q - p;
+            const double sr = c2r * id - ccr * q - p, si = c2i * id - cci * q;
+            w->luc[i * n2 + j] = sr;
+            w->luc[i * n2 + n + j] = -si;
+            w->luc[(n + i) * n2 + j] = si;
+            w->luc[(n + i) * n2 + n + j] = sr;
+        }
+    pl_lu_factor(w->lur, w->pivr, n);
+    pl_lu_factor(w->luc, w->pivc, n2);
+    if (w->small) {
+        invert_factored(w->lur, w->pivr, n, w->inv_tmp);
+        invert_factored(w->luc, w->pivc, n2, w->inv_tmp);
+    }
+    w->h_lu = h;
+}
+
+/* replace the LU factors in A (k, k), k <= 2 SMALL_N, by the inverse: k solves of unit
+ * vectors through col (k values) */
+static void invert_factored(double *A, const int64_t *piv, int64_t k, double *col)
+{
+    double inv[4 * SMALL_N * SMALL_N];
+    for (int64_t j = 0; j < k; j++) {
+        for (int64_t i = 0; i < k; i++)
+            col[i] = i == j ? 1.0 : 0.0;
+        pl_lu_solve(A, piv, col, k);
+        for (int64_t i = 0; i < k; i++)
+            inv[i * k + j] = col[i];
+    }
+    memcpy(A, inv, sizeof(double) * k * k);
+}
+
+/* b = A⁻¹ b with the prepared matrix: a product with the inverse, or triangular solves */
+static void prepared_solve(const radau_ws *w, const double *A, const int64_t *piv, double *b,
+                           int64_t k)
+{
+    if (!w->small) {
+        pl_lu_solve(A, piv, b, k);
+        return;
+    }
+    double out[2 * SMALL_N];
+    for (int64_t i = 0; i < k; i++) {
+        double s = 0.0;
+        for (int64_t j = 0; j < k; j++)
+            s += A[i * k + j] * b[j];
+        out[i] = s;
+    }
+    memcpy(b, out, sizeof(double) * k);
+}
+
+/* (c·I − Jac) v = r in place, c real: a = S⁻¹(r₂ + c r₁ − Q r₁), rates c·a − r₁ */
+static void solve_real(radau_ws *w, double c, double *r)
+{
+    const int64_t n = w->n, m = w->m;
+    for (int64_t i = 0; i < n; i++) {
+        double s = r[n + i] + c * r[i];
+        for (int64_t j = 0; j < n; j++)
+            s -= w->jac[i * m + n + j] * r[j];
+        w->tmp[i] = s;
+    }
+    prepared_solve(w, w->lur, w->pivr, w->tmp, n);
+    for (int64_t i = 0; i < n; i++) {
+        r[n + i] = c * w->tmp[i] - r[i];
+        r[i] = w->tmp[i];
+    }
+}
+
+/* the same for complex c = (cre, cim) and r = (rr, ri) */
+static void solve_complex(radau_ws *w, double cre, double cim, double *rr, double *ri)
+{
+    const int64_t n = w->n, m = w->m;
+    for (int64_t i = 0; i < n; i++) {
+        double ur = rr[n + i] + (cre * rr[i] - cim * ri[i]);
+        double ui = ri[n + i] + (cre * ri[i] + cim * rr[i]);
+        for (int64_t j = 0; j < n; j++) {
+            const double q = w->jac[i * m + n + j];
+            ur -= q * rr[j];
+            ui -= q * ri[j];
+        }
+        w->tmp[i] = ur;
+        w->tmp[n + i] = ui;
+    }
+    prepared_solve(w, w->luc, w->pivc, w->tmp, 2 * n);
+    for (int64_t i = 0; i < n; i++) {
+        const double ar = w->tmp[i], ai = w->tmp[n + i];
+        rr[n + i] = (cre * ar - cim * ai) - rr[i];
+        ri[n + i] = (cre * ai + cim * ar) - ri[i];
+        rr[i] = ar;
+        ri[i] = ai;
+    }
+}
+
+/* scipy's solve_collocation_system from the guess in Z; returns converged, sets iterations
+ * and the rate of convergence (−1 when not measured) */
+static int newton(radau_ws *w, const pl_model *md, double h, const double *x, const double *inp,
+                  int locked, int64_t *iters, double *rate_out)
+{
+    const int64_t m = w->m, width = 2 + md->n;
+    const double cr = MU_REAL / h, ccr = MU_CRE / h, cci = MU_CIM / h;
+    double *Z = w->Z, *W = w->W, *F = w->F;
+    for (int64_t i = 0; i < m; i++)
+        for (int64_t s = 0; s < 3; s++)
+            W[s * m + i] = TI[s][0] * Z[i] + TI[s][1] * Z[m + i] + TI[s][2] * Z[2 * m + i];
+    double norm_old = -1.0, rate = -1.0;
+    int converged = 0;
+    *iters = 0;
+    for (int64_t k = 0; k < NEWTON_MAXITER; k++) {
+        *iters = k + 1;
+        for (int64_t s = 0; s < 3; s++) {
+            for (int64_t i = 0; i < m; i++)
+                w->xt[i] = x[i] + Z[s * m + i];
+            pl_rhs(md, w->xt, F + s * m, inp + (s + 1) * width, locked);
+        }
+        double total = 0.0;
+        for (int64_t i = 0; i < 3 * m; i++)
+            total += F[i];
+        if (!isfinite(total))
+            break;
+        for (int64_t i = 0; i < m; i++) {
+            const double f0 = F[i], f1 = F[m + i], f2 = F[2 * m + i];
+            const double w1 = W[m + i], w2 = W[2 * m + i];
+            w->fr[i] = (TI[0][0] * f0 + TI[0][1] * f1 + TI[0][2] * f2) - cr * W[i];
+            w->fcr[i] = (TI[1][0] * f0 + TI[1][1] * f1 + TI[1][2] * f2) - (ccr * w1 - cci * w2);
+            w->fci[i] = (TI[2][0] * f0 + TI[2][1] * f1 + TI[2][2] * f2) - (ccr * w2 + cci * w1);
+        }
+        solve_real(w, cr, w->fr);
+        solve_complex(w, ccr, cci, w->fcr, w->fci);
+        double acc = 0.0;
+        for (int64_t i = 0; i < m; i++) {
+            const double a = w->fr[i] / w->scale[i], b = w->fcr[i] / w->scale[i],
+                         c = w->fci[i] / w->scale[i];
+            acc += a * a + b * b + c * c;
+        }
+        const double norm = sqrt(acc / (3.0 * m));
+        if (norm_old >= 0.0)
+            rate = norm / norm_old;
+        if (rate >= 0.0 && (rate >= 1.0
+                            || pow(rate, (double)(NEWTON_MAXITER - k)) / (1.0 - rate) * norm
+                                   > w->newton_tol))
+            break;
+        for (int64_t i = 0; i < m; i++) {
+            W[i] += w->fr[i];
+            W[m + i] += w->fcr[i];
+            W[2 * m + i] += w->fci[i];
+            const double w0 = W[i], w1 = W[m + i], w2 = W[2 * m + i];
+            for (int64_t s = 0; s < 3; s++)
+                Z[s * m + i] = T[s][0] * w0 + T[s][1] * w1 + T[s][2] * w2;
+        }
+        if (norm == 0.0 || (rate >= 0.0 && rate / (1.0 - rate) * norm < w->newton_tol)) {
+            converged = 1;
+            break;
+        }
+        norm_old = norm;
+    }
+    *rate_out = rate;
+    return converged;
+}
+
+/* the embedded error estimate (μ_r/h·I − Jac)⁻¹ (f0 + Σ e_s Z_s / h) into w->err; its norm */
+static double error_norm(radau_ws *w, double h, const double *x, const double *y,
+                         const double *f0, double rtol, double atol)
+{
+    const int64_t m = w->m;
+    for (int64_t i = 0; i < m; i++)
+        w->err[i] = f0[i] + (E1 * w->Z[i] + E2 * w->Z[m + i] + E3 * w->Z[2 * m + i]) / h;
+    solve_real(w, MU_REAL / h, w->err);
+    double acc = 0.0;
+    for (int64_t i = 0; i < m; i++) {
+        const double v = w->err[i] / (atol + rtol * fmax(fabs(x[i]), fabs(y[i])));
+        acc += v * v;
+    }
+    return sqrt(acc / m);
+}
+
+/* scipy's predict_factor, except that a previous error of exactly 0 counts as no history */
+static double predict(double h, double h_old, double err, double err_old)
+{
+    double mult = 1.0;
+    if (!(err_old <= 0.0 || h_old <= 0.0 || err == 0.0))
+        mult = h / h_old * pow(err_old / err, 0.25);
+    if (err == 0.0)
+        return INFINITY;
+    return fmin(1.0, mult) * pow(err, -0.25);
+}
+
+static double radau_start(pl_method *me, const pl_model *md, double t, const double *x,
+                          double t_stop, double max_step, double rtol, double atol,
+                          int locked, const double *inp, int64_t *evals)
+{
+    radau_ws *w = me->ws;
+    pl_rhs(md, x, w->f0, inp, locked);
+    const double h = pl_initial_step(md, t, x, w->f0, t_stop, max_step, rtol, atol, locked, inp,
+                                     w->s1, w->s2, w->m, 3);
+    *evals += 2 + jacobian(w, md, x, w->f0, inp, locked);
+    w->current_jac = 1;
+    w->have_sol = 0;
+    w->err_rejected = 0;
+    w->last_rejected = 0;
+    w->h_lu = w->h_old = w->err_old = -1.0;
+    w->newton_tol = fmax(10.0 * EPS / rtol, fmin(0.03, sqrt(rtol)));
+    return h;
+}
+
+static double radau_limit(pl_method *me, double h, double max_step)
+{
+    radau_ws *w = me->ws;
+    if (h > max_step) {  /* a capped step forgets the step-size history (scipy) */
+        w->h_old = w->err_old = -1.0;
+        return max_step;
+    }
+    return h;
+}
+
+static int radau_attempt(pl_method *me, const pl_model *md, double t, double h,
+                         const double *x, double *y, double *Q, const double *inp, double rtol,
+                         double atol, int locked, double *h_next, int64_t *evals)
+{
+    radau_ws *w = me->ws;
+    const int64_t m = w->m, width = 2 + md->n;
+    if (!w->last_rejected)
+        w->h_start = h;
+    if (h != w->h_lu)
+        factor(w, h);
+    for (int64_t s = 0; s < 3; s++) {  /* first guess: the last collocation polynomial */
+        if (w->have_sol) {
+            const double sg = (t + NODES[s + 1] * h - w->t_prev) / w->h_prev;
+            for (int64_t i = 0; i < m; i++) {
+                const double *q = Q + 4 * i;
+                w->Z0[s * m + i] = w->xold[i] + sg * (q[0] + sg * (q[1] + sg * q[2])) - x[i];
+            }
+        } else {
+            for (int64_t i = 0; i < m; i++)
+                w->Z0[s * m + i] = 0.0;
+        }
+    }
+    for (int64_t i = 0; i < m; i++)
+        w->scale[i] = atol + fabs(x[i]) * rtol;
+    int converged;
+    int64_t n_iter;
+    double rate;
+    for (;;) {
+        memcpy(w->Z, w->Z0, sizeof(double) * 3 * m);
+        converged = newton(w, md, h, x, inp, locked, &n_iter, &rate);
+        *evals += 3 * n_iter;
+        if (converged || w->current_jac)
+            break;
+        *evals += jacobian(w, md, x, w->f0, inp, locked);
+        w->current_jac = 1;
+        factor(w, h);
+    }
+    if (!converged) {
+        w->last_rejected = 1;  /* a retry of the same step (keeps h_start) */
+        *h_next = 0.5 * h;
+        return 0;
+    }
+    for (int64_t i = 0; i < m; i++)
+        y[i] = x[i] + w->Z[2 * m + i];
+    double err = error_norm(w, h, x, y, w->f0, rtol, atol);
+    const double safety = 0.9 * (2 * NEWTON_MAXITER + 1) / (2 * NEWTON_MAXITER + n_iter);
+    if (w->err_rejected && err > 1.0) {  /* one more smoothing after a rejection */
+        for (int64_t i = 0; i < m; i++)
+            w->xt[i] = x[i] + w->err[i];
+        pl_rhs(md, w->xt, w->s1, inp, locked);
+        *evals += 1;
+        err = error_norm(w, h, x, y, w->s1, rtol, atol);
+    }
+    if (!(err <= 1.0)) {
+        *h_next = err == err ? h * fmax(0.2, safety * predict(h, w->h_old, err, w->err_old))
+                             : 0.2 * h;
+        w->last_rejected = 1;
+        w->err_rejected = 1;
+        return 0;
+    }
+    const int recompute_jac = n_iter > 2 && rate > 1e-3;
+    double fac = fmin(10.0, safety * predict(h, w->h_old, err, w->err_old));
+    if (!recompute_jac && fac < 1.2)
+        fac = 1.0;
+    pl_rhs(md, y, w->fnew, inp + 3 * width, locked);
+    *evals += 1;
+    if (recompute_jac) {
+        *evals += jacobian(w, md, y, w->fnew, inp + 3 * width, locked);
+        w->current_jac = 1;
+        w->h_lu = -1.0;
+    } else {
+        w->current_jac = 0;
+    }
+    w->h_old = w->h_start;
+    w->err_old = err;
+    w->last_rejected = 0;
+    w->err_rejected = 0;
+    for (int64_t i = 0; i < m; i++) {
+        const double z0 = w->Z[i], z1 = w->Z[m + i], z2 = w->Z[2 * m + i];
+        for (int64_t k = 0; k < 3; k++)
+            Q[4 * i + k] = (z0 * P[0][k] + z1 * P[1][k]) + z2 * P[2][k];
+        Q[4 * i + 3] = 0.0;
+        w->xold[i] = x[i];
+    }
+    w->have_sol = 1;
+    w->t_prev = t;
+    w->h_prev = h;
+    *h_next = h * fac;
+    return 1;
+}
+
+static void radau_commit(pl_method *me)
+{
+    radau_ws *w = me->ws;
+    memcpy(w->f0, w->fnew, sizeof(double) * w->m);
+}
+
+static void radau_release(pl_method *me)
+{
+    radau_ws *w = me->ws;
+    if (w) {
+        double *arrays[] = {w->Z, w->Z0, w->W, w->F, w->jac, w->lur, w->luc, w->scale, w->fr,
+                            w->fcr, w->fci, w->tmp, w->err, w->xt, w->s1, w->s2, w->xold,
+                            w->f0, w->fnew};
+        for (size_t k = 0; k < sizeof(arrays) / sizeof(arrays[0]); k++)
+            free(arrays[k]);
+        free(w->pivr);
+        free(w->pivc);
+        free(w->inv_tmp);
+        free(w);
+    }
+    me->ws = NULL;
+}
+
+int pl_radau_init(pl_method *me, int64_t n)
+{
+    pl_radau_constants();
+    radau_ws *w = calloc(1, sizeof(radau_ws));
+    me->ws = w;
+    me->start = radau_start;
+    me->limit = radau_limit;
+    me->attempt = radau_attempt;
+    me->commit = radau_commit;
+    me->release = radau_release;
+    me->n_nodes = 4;
+    me->nodes = NODES;
+    if (!w)
+        return 0;
+    const int64_t m = 2 * n;
+    w->n = n;
+    w->m = m;
+    w->Z = calloc(3 * m, sizeof(double));
+    w->Z0 = calloc(3 * m, sizeof(double));
+    w->W = calloc(3 * m, sizeof(double));
+    w->F = calloc(3 * m, sizeof(double));
+    w->jac = calloc(n * m, sizeof(double));
+    w->lur = calloc(n * n, sizeof(double));
+    w->luc = calloc(4 * n * n, sizeof(double));
+    w->pivr = calloc(n, sizeof(int64_t));
+    w->pivc = calloc(2 * n, sizeof(int64_t));
+    w->inv_tmp = calloc(2 * n, sizeof(double));
+    w->small = n <= SMALL_N;
+    double **vectors[] = {&w->scale, &w->fr, &w->fcr, &w->fci, &w->tmp, &w->err, &w->xt,
+                          &w->s1, &w->s2, &w->xold, &w->f0, &w->fnew};
+    int ok = w->Z && w->Z0 && w->W && w->F && w->jac && w->lur && w->luc && w->pivr && w->pivc
+             && w->inv_tmp;
+    for (size_t k = 0; k < sizeof(vectors) / sizeof(vectors[0]); k++) {
+        *vectors[k] = calloc(m, sizeof(double));
+        ok = ok && *vectors[k];
+    }
+    return ok;
+}
