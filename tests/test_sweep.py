@@ -189,7 +189,7 @@ def test_bad_vary_is_one_line_and_exit_2(tmp_path, capsys, vary, words):
 
 @pytest.mark.parametrize("extra, words", [
     (["--vary", "ankle=0:1:2", "--vary", "ankle=0:1:2"], "more than once"),
-    (["--vary", "ankle=0:1:2", "--torque-limits", "50,inf,inf"], "torque limits"),
+    (["--vary", "ankle=0:1:100000", "--vary", "knee=0:1:1000"], "at most 10,000,000"),
     (["--vary", "ankle=0:1:2", "--out-format"], "unrecognized"),
 ])
 def test_other_bad_input_exit_2(tmp_path, capsys, extra, words):
@@ -218,3 +218,39 @@ def test_parse_vary_values():
     assert parse_vary("viscosity_ratio=0.25:0.25:1").values.tolist() == [0.25]
     with pytest.raises(ParameterError):
         sweep_grid(builtin_scenario("paper-backward-case1"), [])
+
+
+def test_sweep_over_feedback_delay_equals_single_runs():
+    """--vary feedback_delay: each row is the compiled single run with that delay (a row
+    without delay chooses Radau, the others RK45, as their single runs do)."""
+    sc = builtin_scenario("paper-backward-case1").replace(duration=1.0)
+    result = run_sweep(sc, [parse_vary("feedback_delay=0:0.04:5"),
+                            parse_vary("ankle=400:800:2")])
+    o = result.outcomes
+    assert result.grid.names == ("feedback_delay", "ankle")
+    for r, (delay, ankle) in enumerate(result.grid.values):
+        k = result.grid.stiffness[r]
+        assert k[0] == ankle
+        one = sc.run(engine="compiled", feedback_delay=float(delay),
+                     muscles=paper_muscles(stiffness=k, viscosity=0.25 * k),
+                     rtol=1e-6, atol=1e-9)
+        assert one.fell == o.fell[r]
+        np.testing.assert_array_equal(one.max_abs_theta, o.peak_theta[r])
+    assert o.fell[-1] and not o.fell[0]
+
+
+def test_sweep_over_a_joint_torque_limit_equals_single_runs(tmp_path):
+    """--vary ankle_torque_limit keeps the base experiment's other limits (here the hip's)."""
+    sc = builtin_scenario("paper-backward-case1").replace(
+        duration=1.0, torque_limits=(math.inf, math.inf, 40.0))
+    result = run_sweep(sc, [parse_vary("ankle_torque_limit=30:120:4")])
+    for r, (limit,) in enumerate(result.grid.values):
+        one = sc.run(engine="compiled", torque_limits=(float(limit), math.inf, 40.0),
+                     rtol=1e-6, atol=1e-9)
+        assert one.fell == result.outcomes.fell[r]
+        np.testing.assert_array_equal(one.final_state, result.outcomes.final_state[r])
+    assert main(["sweep", "--case", "1", "--disturbance", "backward", "--duration", "0.5",
+                 "--vary", "knee_torque_limit=20:60:3", "--torque-limits", "inf,inf,30",
+                 "--out", str(tmp_path / "limits.csv")]) == 0
+    header = (tmp_path / "limits.csv").read_text().splitlines()[0]
+    assert header.startswith("knee_torque_limit,fell")

@@ -8,7 +8,7 @@ from ..model.muscles import PAPER_PAIR_NAMES
 from ..simulation.results import atomic_write_text
 from ..studies.identification import ENGINES, VISCOSITY_RATIO, fit_stiffness, read_trajectory_csv
 from . import CONVENTIONS_EPILOG
-from ._common import load_compiled, print_json
+from ._common import print_json
 from .simulate import add_experiment_arguments, scenario_from_args
 
 DESCRIPTION = """\
@@ -35,9 +35,10 @@ def add_parser(sub, name: str) -> argparse.ArgumentParser:
     g.add_argument("--free", required=True, metavar="NAME[,NAME…]",
                    help="parameters to fit: pair names (" + ", ".join(PAPER_PAIR_NAMES)
                    + f") and/or {VISCOSITY_RATIO}.")
-    g.add_argument("--engine", choices=ENGINES, default="fast",
-                   help="simulator inside the fit: fast (compiled Radau at the scenario's "
-                   "tolerances; default) or reference (scipy, the scenario's solver).")
+    g.add_argument("--engine", choices=ENGINES, default="compiled",
+                   help="engine inside the fit: compiled (default; the scenario's "
+                   "tolerances) or reference (scipy, the scenario's solver); fast is a "
+                   "former name of compiled.")
     g.add_argument("--report", metavar="FIT.json", help="also write the JSON summary to a file.")
     g.add_argument("--json", action="store_true", help="print one JSON object instead of text.")
     return p
@@ -50,10 +51,6 @@ def run(args: argparse.Namespace) -> int:
     time, theta = read_trajectory_csv(args.data, sc.body.n_links)
     sc = sc.replace(duration=max(float(time[-1]), 1e-3))
     free = [s.strip() for s in args.free.split(",") if s.strip()]
-    if args.engine == "fast":
-        from ..simulation.compiled import warm_up
-
-        load_compiled(warm_up, "the simulator")
     fit = fit_stiffness(sc, time, theta, free, viscosity_ratio=args.viscosity_ratio,
                         engine=args.engine)
     summary = fit.to_dict()

@@ -7,29 +7,33 @@ import sys
 import time
 
 from ..errors import ParameterError
-from ..model.muscles import DEFAULT_VISCOSITY_RATIO
+from ..model.muscles import DEFAULT_VISCOSITY_RATIO, PAPER_PAIR_NAMES
 from ..studies.sweep import (
+    MAX_RUNS,
     OUTCOME_COLUMNS,
     SWEEP_PARAMETERS,
+    TORQUE_LIMIT_PARAMETERS,
     ProgressBar,
     parse_vary,
     run_sweep,
     table_format,
 )
 from . import CONVENTIONS_EPILOG, UsageError
-from ._common import check_writable, load_compiled
+from ._common import check_writable
 from .simulate import add_experiment_arguments, scenario_from_args
 
 DESCRIPTION = f"""\
 Simulate the nonlinear model for every combination of the --vary values (the full grid,
-the first --vary varying slowest) with the compiled simulator, and write one row per run.
+the first --vary varying slowest) with the compiled engine, and write one row per run.
 
 --vary NAME=LO:HI:N takes N evenly spaced values from LO to HI inclusive (N >= 1; N = 1
-needs LO = HI). NAME is a pair stiffness [N·m/rad] ({", ".join(SWEEP_PARAMETERS[:-2])}),
-viscosity_ratio [s], or disturbance_scale [-], a factor on the base experiment's platform
-motion (velocity-step speed, pulse peak, ramp displacement, sine amplitudes, measured
-accelerations: --vary disturbance_scale=0.5:3:26 with a 1 m/s step sweeps 0.5-3 m/s);
-repeat --vary for each parameter. Every other gain comes from the
+needs LO = HI; at most {MAX_RUNS:,} runs in all). NAME is a pair stiffness [N·m/rad]
+({", ".join(PAPER_PAIR_NAMES)}), viscosity_ratio [s], disturbance_scale [-], a factor on
+the base experiment's platform motion (velocity-step speed, pulse peak, ramp
+displacement, sine amplitudes, measured accelerations: --vary disturbance_scale=0.5:3:26
+with a 1 m/s step sweeps 0.5-3 m/s), feedback_delay [s], the neural delay of every
+pair's feedback, or {", ".join(TORQUE_LIMIT_PARAMETERS)} [N·m], the largest net muscle
+moment at a joint; repeat --vary for each parameter. Every other gain comes from the
 base experiment: --case/--stiffness with --disturbance (as in posturelab simulate),
 --scenario FILE.toml or --builtin NAME. A pair's viscosity is the ratio times its
 stiffness: the varied viscosity_ratio, else --viscosity-ratio, else the base experiment's
@@ -42,12 +46,13 @@ some |θ_i| exceeded 0.01 rad (0 if none did; empty if the run fell or had not s
 the end). The file type follows the suffix of --out: .csv or .parquet (pyarrow); it is
 written to a temporary file and renamed, so no half-written file is left behind.
 
-Parallelism: the runs use all cores (numba threads). --workers N sends chunks of runs to a
-Dask LocalCluster of N single-threaded worker processes, --scheduler ADDRESS to a running
-Dask cluster (its workers need posturelab installed); the results are identical.
-Tolerances default to the fast simulator's (rtol 1e-6, atol 1e-9: angles within 1e-6 rad of
-a tight DOP853 reference); --rtol/--atol override them. Torque limits, a feedback delay
-and centre-of-pressure falls are not compiled: use posturelab simulate for those.
+Everything of the base experiment carries into every run: --torque-limits, --feedback-delay,
+--foot with --centre-of-pressure, the knee model. Parallelism: the runs use every CPU
+available (one thread each). --workers N sends chunks of runs to a Dask LocalCluster of N
+single-threaded worker processes, --scheduler ADDRESS to a running Dask cluster (its
+workers need posturelab installed); the results are identical. Tolerances default to the
+compiled engine's (rtol 1e-6, atol 1e-9: angles within 1e-6 rad of a tight DOP853
+reference for undelayed runs); --rtol/--atol override them.
 """
 
 
@@ -102,10 +107,6 @@ def run(args: argparse.Namespace) -> int:
         tolerances["rtol"] = scenario.rtol
     if args.atol is not None:
         tolerances["atol"] = scenario.atol
-
-    from ..simulation.compiled import warm_up
-
-    load_compiled(warm_up, "the simulator")  # before the clock and the bar start
     bar = None
     if args.progress or sys.stderr.isatty():
         total = 1

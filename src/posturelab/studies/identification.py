@@ -11,11 +11,10 @@ from the Gauss–Newton covariance s² (JᵀJ)⁻¹.
 The model of viscosity: every pair's viscosity is ``viscosity_ratio`` times
 its stiffness (the paper's L_d = 0.25 K_d); the ratio is fixed or fitted.
 
-The simulations run on the compiled simulator (:func:`posturelab.fast.simulate_fast`,
-at the scenario's tolerances) by default, or on the reference
-:func:`posturelab.simulate.simulate` with ``engine="reference"``; runs with
-features the compiled simulator does not cover (torque limits, a feedback
-delay, centre-of-pressure falls) go to the reference either way.
+The simulations run on the compiled engine (at the scenario's tolerances) by
+default, or on the reference engine with ``engine="reference"``; both do every
+feature of a scenario (torque limits, feedback delay, centre-of-pressure falls).
+scipy's optimiser and statistics are imported when a fit runs.
 """
 
 from __future__ import annotations
@@ -27,8 +26,6 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from scipy import stats
-from scipy.optimize import least_squares
 
 from .._validation import finite_array
 from ..errors import DataFileError, ParameterError, UnknownNameError
@@ -39,8 +36,8 @@ from ..simulation.results import SimulationResult
 __all__ = ["FitResult", "fit_stiffness", "read_trajectory_csv"]
 
 VISCOSITY_RATIO = "viscosity_ratio"
-#: The simulators ``fit_stiffness`` can run the model on.
-ENGINES = ("fast", "reference")
+#: The engines ``fit_stiffness`` can run the model on ("fast" is a former name of "compiled").
+ENGINES = ("compiled", "reference", "fast")
 
 
 @dataclass(frozen=True)
@@ -127,7 +124,7 @@ def fit_stiffness(
     initial_guess: Sequence[float] | None = None,
     upper_bound: float = 1e5,
     max_simulations: int = 400,
-    engine: str = "fast",
+    engine: str = "compiled",
 ) -> FitResult:
     """Fit pair stiffnesses (and optionally the viscosity ratio) to measured angles.
 
@@ -153,15 +150,17 @@ def fit_stiffness(
         Largest stiffness allowed. [N·m/rad]
     max_simulations : int
         Budget of simulations for the optimiser.
-    engine : {"fast", "reference"}
-        Which simulator runs the model: the compiled one (default; the first use
-        after installing compiles it, about a minute) or scipy's (the scenario's
-        ``solver.method``).
+    engine : {"compiled", "reference"}
+        Which engine runs the model: the compiled one (default) or the reference
+        (scipy, the scenario's ``solver.method``); "fast" is a former name of "compiled".
 
     Returns
     -------
     FitResult
     """
+    from scipy import stats
+    from scipy.optimize import least_squares
+
     if engine not in ENGINES:
         raise ParameterError(f"engine must be one of {', '.join(ENGINES)}, got {engine!r}")
     names = list(free)

@@ -11,14 +11,18 @@ fall time, peak |θ_i|, settling time).
 
 Parameters that can vary (:data:`SWEEP_PARAMETERS`): the stiffness of the
 paper's pairs ``ankle``, ``knee``, ``hip``, ``quadriceps``, ``gastrocnemius``
-[N·m/rad], ``viscosity_ratio`` [s], and ``disturbance_scale`` [-], which
+[N·m/rad], ``viscosity_ratio`` [s], ``disturbance_scale`` [-], which
 multiplies the base experiment's platform motion (the velocity step's speed,
 a pulse's peak, a ramp's displacement, the sines' amplitudes, a measured
-profile's accelerations; see :meth:`posturelab.platform.Disturbance.scaled`),
+profile's accelerations; see :meth:`posturelab.model.platform.Disturbance.scaled`),
 so that a sweep over it finds how large a perturbation each gain set
-absorbs. The viscosity of a pair is the ratio times its stiffness: the
-varied ratio, else the one given, else the base experiment's own ratio for
-that pair (0.25, the paper's, where its stiffness is 0).
+absorbs, ``feedback_delay`` [s], the neural delay of the muscle feedback, and
+``ankle_torque_limit``, ``knee_torque_limit``, ``hip_torque_limit`` [N·m], the
+largest net muscle moment at each joint (the others keep the base experiment's
+limits; none by default). Every feature of the base experiment (torque limits, a
+delay, centre-of-pressure falls) carries into the sweep. The viscosity of a pair is
+the ratio times its stiffness: the varied ratio, else the one given, else the base
+experiment's own ratio for that pair (0.25, the paper's, where its stiffness is 0).
 
 Work can go to a Dask distributed cluster (:func:`run_sweep` with
 ``workers``/``scheduler``/``client``) in chunks; the results are identical to
@@ -61,12 +65,20 @@ __all__ = [
     "ProgressBar",
 ]
 
-#: Names a sweep can vary: the paper's pair stiffnesses, the viscosity ratio and the scale
-#: of the platform motion.
-SWEEP_PARAMETERS: tuple[str, ...] = (*PAPER_PAIR_NAMES, "viscosity_ratio", "disturbance_scale")
+#: The joints whose torque limit a sweep can vary, in joint order.
+TORQUE_LIMIT_PARAMETERS: tuple[str, ...] = ("ankle_torque_limit", "knee_torque_limit",
+                                            "hip_torque_limit")
+#: Names a sweep can vary: the paper's pair stiffnesses, the viscosity ratio, the scale of
+#: the platform motion, the feedback delay and the joint torque limits.
+SWEEP_PARAMETERS: tuple[str, ...] = (*PAPER_PAIR_NAMES, "viscosity_ratio", "disturbance_scale",
+                                     "feedback_delay", *TORQUE_LIMIT_PARAMETERS)
 #: Unit of each sweep parameter.
 PARAMETER_UNITS: dict[str, str] = {**{n: "N·m/rad" for n in PAPER_PAIR_NAMES},
-                                   "viscosity_ratio": "s", "disturbance_scale": "-"}
+                                   "viscosity_ratio": "s", "disturbance_scale": "-",
+                                   "feedback_delay": "s",
+                                   **{n: "N·m" for n in TORQUE_LIMIT_PARAMETERS}}
+#: Largest number of runs one sweep may ask for (a bound on the work and memory). [-]
+MAX_RUNS = 10_000_000
 #: Outcome columns of a sweep table (after the varied parameters), for 3 links.
 OUTCOME_COLUMNS: tuple[str, ...] = ("fell", "fall_time", "peak_theta1", "peak_theta2",
                                     "peak_theta3", "settling_time")
@@ -188,6 +200,11 @@ class SweepGrid:
     disturbance_scale : numpy.ndarray, shape (M,), optional
         Factor on the base experiment's platform motion per run; None when not
         varied (every run has the base motion). [-]
+    feedback_delay : numpy.ndarray, shape (M,)
+        Neural delay of the muscle feedback per run. [s]
+    torque_limits : numpy.ndarray, shape (M, 3), optional
+        Largest net moment at the ankle, knee and hip per run (inf for none); None
+        when no run has a limit. [N·m]
     """
 
     names: tuple[str, ...]
@@ -195,6 +212,8 @@ class SweepGrid:
     stiffness: np.ndarray
     viscosity: np.ndarray
     disturbance_scale: np.ndarray | None = None
+    feedback_delay: np.ndarray | None = None
+    torque_limits: np.ndarray | None = None
 
     @property
     def n_runs(self) -> int:
@@ -220,23 +239,12 @@ def _base_ratios(scenario: Scenario, viscosity_ratio: float | None) -> np.ndarra
 
 
 def check_base(scenario: Scenario) -> None:
-    """The base experiment must have the paper's five pairs and nothing the fast simulator
-    does not compile (torque limits, a feedback delay, centre-of-pressure falls)."""
+    """The base experiment must have the paper's five pairs on 3 links."""
     names = tuple(scenario.muscles.names)
     if names != PAPER_PAIR_NAMES or scenario.body.n_links != 3:
         raise ParameterError(f"a sweep needs the paper's five pairs ({', '.join(PAPER_PAIR_NAMES)})"
                              f" on 3 links; the base experiment has {', '.join(names)} on "
                              f"{scenario.body.n_links} links")
-    limits = getattr(scenario, "torque_limits", None)
-    if limits is not None and not np.all(np.isinf(np.asarray(limits, dtype=float))):
-        raise ParameterError("a sweep cannot use torque limits (the fast simulator does not "
-                             "compile them); use posturelab simulate for such runs")
-    if getattr(scenario, "feedback_delay", 0.0):
-        raise ParameterError("a sweep cannot use a feedback delay (the fast simulator does "
-                             "not compile it); use posturelab simulate for such runs")
-    if getattr(scenario.fall, "centre_of_pressure", False):
-        raise ParameterError("a sweep cannot use centre-of-pressure falls (the fast simulator "
-                             "does not compile them); use posturelab simulate for such runs")
 
 
 def sweep_grid(scenario: Scenario, varies: Sequence[VaryRange],
@@ -261,9 +269,12 @@ def sweep_grid(scenario: Scenario, varies: Sequence[VaryRange],
     dup = sorted({n for n in names if names.count(n) > 1})
     if dup:
         raise ParameterError(f"--vary names a parameter more than once: {', '.join(dup)}")
+    m = math.prod(v.count for v in varies)
+    if m > MAX_RUNS:
+        raise ParameterError(f"the grid has {m:,} runs ({' × '.join(str(v.count) for v in varies)})"
+                             f"; a sweep takes at most {MAX_RUNS:,}")
     values = np.array(list(itertools.product(*[v.values for v in varies])), dtype=float)
     values = values.reshape(-1, len(varies))
-    m = values.shape[0]
     stiffness = np.tile(np.asarray(scenario.muscles.stiffnesses, dtype=float), (m, 1))
     ratios = np.tile(_base_ratios(scenario, viscosity_ratio), (m, 1))
     if "disturbance_scale" in names and isinstance(scenario.disturbance, NoDisturbance):
@@ -271,14 +282,23 @@ def sweep_grid(scenario: Scenario, varies: Sequence[VaryRange],
                              "motion, and it has none: give --disturbance, a profile or a "
                              "scenario with a disturbance")
     scale = None
+    delay = np.full(m, float(scenario.feedback_delay))
+    base_limits = (np.full(3, math.inf) if scenario.torque_limits is None
+                   else np.asarray(scenario.torque_limits, dtype=float))
+    limits = np.tile(base_limits, (m, 1))
     for k, name in enumerate(names):
         if name == "viscosity_ratio":
             ratios[:] = values[:, k:k + 1]
         elif name == "disturbance_scale":
             scale = np.ascontiguousarray(values[:, k])
+        elif name == "feedback_delay":
+            delay = np.ascontiguousarray(values[:, k])
+        elif name in TORQUE_LIMIT_PARAMETERS:
+            limits[:, TORQUE_LIMIT_PARAMETERS.index(name)] = values[:, k]
         else:
             stiffness[:, PAPER_PAIR_NAMES.index(name)] = values[:, k]
-    return SweepGrid(tuple(names), values, stiffness, ratios * stiffness, scale)
+    return SweepGrid(tuple(names), values, stiffness, ratios * stiffness, scale, delay,
+                     None if np.all(np.isinf(limits)) else limits)
 
 
 # ---------------------------------------------------------------------------
@@ -396,20 +416,20 @@ class _Task:
     rtol: float
     atol: float
 
-    def run(self, stiffness: np.ndarray, viscosity: np.ndarray, scale: np.ndarray | None,
-            parallel: bool) -> BatchResult:
+    def run(self, grid: SweepGrid, lo: int, hi: int, parallel: bool) -> BatchResult:
         sc = self.scenario
         return simulate_batch(
-            sc.body, stiffness, viscosity, sc.disturbance, sc.duration, sc.initial_state,
-            muscles=sc.muscles, rates_from=sc.rates_from, knee=sc.knee, fall=sc.fall,
-            rtol=self.rtol, atol=self.atol, sample_rate=sc.sample_rate,
-            settle_tolerance=SETTLE_TOLERANCE, parallel=parallel, disturbance_scale=scale)
+            sc.body, grid.stiffness[lo:hi], grid.viscosity[lo:hi], sc.disturbance,
+            sc.duration, sc.initial_state, muscles=sc.muscles, rates_from=sc.rates_from,
+            knee=sc.knee, fall=sc.fall, torque_limits=_rows(grid.torque_limits, lo, hi),
+            feedback_delay=grid.feedback_delay[lo:hi], rtol=self.rtol, atol=self.atol,
+            sample_rate=sc.sample_rate, settle_tolerance=SETTLE_TOLERANCE, parallel=parallel,
+            disturbance_scale=_rows(grid.disturbance_scale, lo, hi))
 
 
-def _run_chunk(task: _Task, stiffness: np.ndarray, viscosity: np.ndarray,
-               scale: np.ndarray | None) -> BatchResult:
+def _run_chunk(task: _Task, grid: SweepGrid, lo: int, hi: int) -> BatchResult:
     """A chunk on a Dask worker: one thread per task (the worker's threads run tasks)."""
-    return task.run(stiffness, viscosity, scale, parallel=False)
+    return task.run(grid, lo, hi, parallel=False)
 
 
 def _rows(values: np.ndarray | None, lo: int, hi: int) -> np.ndarray | None:
@@ -530,8 +550,7 @@ def run_sweep(
         parts = []
         done = 0
         for lo, hi in bounds:
-            parts.append(task.run(grid.stiffness[lo:hi], grid.viscosity[lo:hi],
-                                  _rows(grid.disturbance_scale, lo, hi), parallel=True))
+            parts.append(task.run(grid, lo, hi, parallel=True))
             done += hi - lo
             if progress is not None:
                 progress(done, m)
@@ -563,9 +582,9 @@ def _run_on_dask(task, grid, bounds, workers, scheduler, client, progress) -> li
                     dashboard_address=None, silence_logs=logging.ERROR)
                 own_client = client = distributed.Client(own_cluster)
         shared = client.scatter(task, broadcast=True)
-        futures = [client.submit(_run_chunk, shared, grid.stiffness[lo:hi],
-                                 grid.viscosity[lo:hi], _rows(grid.disturbance_scale, lo, hi),
-                                 pure=False) for lo, hi in bounds]
+        shared_grid = client.scatter(grid, broadcast=True)
+        futures = [client.submit(_run_chunk, shared, shared_grid, lo, hi, pure=False)
+                   for lo, hi in bounds]
         index = {f.key: k for k, f in enumerate(futures)}
         parts: list[BatchResult | None] = [None] * len(futures)
         done = 0

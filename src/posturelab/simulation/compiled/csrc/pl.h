@@ -125,6 +125,8 @@ void pl_project_velocity(double *x, const double *bp, double *work, int64_t n);
 void pl_solve_into(double *M, int64_t n, int64_t ncol, int64_t stride);
 void pl_lu_factor(double *A, int64_t *piv, int64_t n);
 void pl_lu_solve(const double *A, const int64_t *piv, double *b, int64_t n);
+void pl_inverse3(const double *a, double *out);
+void pl_inverse3_complex(const double *ar, const double *ai, double *outr, double *outi);
 
 /* platform (pl_platform.c) */
 void pl_platform_acceleration(double t, const double *dp, double *ax, double *ay);

@@ -14,10 +14,11 @@
 #include "pl_events.h"
 
 #define EPS 2.220446049250313e-16
+#define SAMPLE_BLOCK 64  /* samples evaluated together */
 
 typedef struct {
     double *tm, *sat, *base, *work, *tau, *active, *x, *y, *Q, *inp, *g_old, *g_new, *sc_out,
-        *sc_inp, *sc_x, *ys, *ev_side;
+        *sc_inp, *sc_x, *ys, *ev_side, *block;
     int64_t *ev_kind, *ev_index;
 } buffers;
 
@@ -25,7 +26,7 @@ static void free_buffers(buffers *b)
 {
     double *d[] = {b->tm, b->sat, b->base, b->work, b->tau, b->active, b->x, b->y, b->Q,
                    b->inp, b->g_old, b->g_new, b->sc_out, b->sc_inp, b->sc_x, b->ys,
-                   b->ev_side};
+                   b->ev_side, b->block};
     for (size_t k = 0; k < sizeof(d) / sizeof(d[0]); k++)
         free(d[k]);
     free(b->ev_kind);
@@ -55,9 +56,10 @@ static int alloc_buffers(buffers *b, int64_t n, int64_t p, int64_t n_nodes, int6
     b->sc_inp = calloc(2 + n, sizeof(double));
     b->sc_x = calloc(m, sizeof(double));
     b->ys = calloc(m, sizeof(double));
+    b->block = calloc(m * SAMPLE_BLOCK, sizeof(double));
     return b->tm && b->sat && b->base && b->work && b->tau && b->active && b->x && b->y
            && b->Q && b->inp && b->g_old && b->g_new && b->ev_side && b->ev_kind
-           && b->ev_index && b->sc_out && b->sc_inp && b->sc_x && b->ys;
+           && b->ev_index && b->sc_out && b->sc_inp && b->sc_x && b->ys && b->block;
 }
 
 /* The events of a smooth segment: the slots (posturelab.model.events.event_slots) whose
@@ -222,38 +224,68 @@ int64_t pl_integrate(const pl_run *run, pl_out *out)
         const double t_end = ev_hit >= 0 ? t_ev : t_new;
         const int inclusive = ev_hit >= 0 || t_new >= duration;
         const int64_t first_gi = gi;
-        while (gi < T && (grid[gi] < t_end - 1e-12 || (inclusive && grid[gi] <= t_end + 1e-12))) {
-            /* the angles (all of the state when storing it): the same expression either way,
-             * so that a batch row equals its single run bit for bit */
-            pl_dense_at(x, Q, out->samples ? m : n, t, h, grid[gi], b.ys);
-            int outside = 0;
-            for (int64_t i = 0; i < n; i++) {
-                const double v = fabs(b.ys[i]);
-                if (v > out->peak[i])
-                    out->peak[i] = v;
-                if (v > settle_tol)
-                    outside = 1;
+        int64_t g_end = gi;
+        while (g_end < T
+               && (grid[g_end] < t_end - 1e-12 || (inclusive && grid[g_end] <= t_end + 1e-12)))
+            g_end++;
+        /* the angles (all of the state when it is stored) at the samples of this step, a
+         * component at a time (independent samples: the evaluations overlap), then the
+         * outcomes sample by sample; the same code for a single run and a batch row */
+        const int64_t comps = out->samples ? m : n;
+        for (int64_t g0 = gi; g0 < g_end; g0 += SAMPLE_BLOCK) {
+            const int64_t g1 = g0 + SAMPLE_BLOCK < g_end ? g0 + SAMPLE_BLOCK : g_end;
+            const int64_t len = g1 - g0;
+            const double inv_h = 1.0 / h;
+            /* component i of samples g0 … g1 − 1: straight into the stored rows, or into the
+             * block (a batch row keeps the angles only) */
+            for (int64_t i = 0; i < comps; i++) {
+                const double xi = x[i], q0 = Q[4 * i], q1 = Q[4 * i + 1], q2 = Q[4 * i + 2],
+                             q3 = Q[4 * i + 3];
+                double *restrict row = out->samples ? out->samples + i * (T + 1) + g0
+                                                    : b.block + i * SAMPLE_BLOCK;
+                for (int64_t g = 0; g < len; g++) {
+                    const double sg = (grid[g0 + g] - t) * inv_h;
+                    row[g] = xi + sg * (q0 + sg * (q1 + sg * (q2 + sg * q3)));
+                }
             }
-            if (outside) {
-                last_outside = grid[gi];
+            /* peaks, and the last sample outside the settling band */
+            int64_t last_out = -1;
+            for (int64_t i = 0; i < n; i++) {
+                const double *restrict row = out->samples ? out->samples + i * (T + 1) + g0
+                                                          : b.block + i * SAMPLE_BLOCK;
+                double pk = out->peak[i];
+                for (int64_t g = 0; g < len; g++) {
+                    const double v = fabs(row[g]);
+                    pk = v > pk ? v : pk;
+                }
+                out->peak[i] = pk;
+                for (int64_t g = len - 1; g > last_out; g--)
+                    if (fabs(row[g]) > settle_tol) {
+                        last_out = g;
+                        break;
+                    }
+            }
+            if (last_out >= 0) {
+                last_outside = grid[g0 + last_out];
                 any_outside = 1;
             }
-            final_outside = outside;
-            if (out->samples) {
-                for (int64_t i = 0; i < m; i++)
-                    out->samples[i * (T + 1) + gi] = b.ys[i];
-                out->locked[gi] = (uint8_t)locked;
-            }
-            if (out->fb) {
-                pl_history_at(&hist, run->before, grid[gi] - delay, b.sc_x);
-                for (int64_t i = 0; i < m; i++)
-                    out->fb[i * (T + 1) + gi] = b.sc_x[i];
-            }
-            gi++;
+            final_outside = last_out == len - 1;
+            if (out->samples)
+                memset(out->locked + g0, locked ? 1 : 0, (size_t)len);
+            if (out->fb)
+                for (int64_t g = g0; g < g1; g++) {
+                    pl_history_at(&hist, run->before, grid[g] - delay, b.sc_x);
+                    for (int64_t i = 0; i < m; i++)
+                        out->fb[i * (T + 1) + g] = b.sc_x[i];
+                }
         }
+        gi = g_end;
         if (gi > first_gi) {
-            pl_dense_at(x, Q, m, t, h, grid[gi - 1], b.ys);
-            memcpy(out->final, b.ys, sizeof(double) * m);
+            const double s = (grid[gi - 1] - t) / h;
+            for (int64_t i = 0; i < m; i++) {
+                const double *q = Q + 4 * i;
+                out->final[i] = x[i] + s * (q[0] + s * (q[1] + s * (q[2] + s * q[3])));
+            }
         }
 
         if (ev_hit >= 0) {

@@ -94,3 +94,41 @@ void pl_lu_solve(const double *A, const int64_t *piv, double *b, int64_t n)
         b[i] = s / A[i * n + i];
     }
 }
+
+/* The inverse of a 3×3 matrix (row-major) by its cofactors, in their cyclic form:
+ * inv[i][j] = (a[j+1][i+1] a[j+2][i+2] − a[j+1][i+2] a[j+2][i+1]) / det, indices mod 3. */
+void pl_inverse3(const double *a, double *out)
+{
+    double cof[9];
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) {
+            const int j1 = (j + 1) % 3, j2 = (j + 2) % 3, i1 = (i + 1) % 3, i2 = (i + 2) % 3;
+            cof[i * 3 + j] = a[j1 * 3 + i1] * a[j2 * 3 + i2] - a[j1 * 3 + i2] * a[j2 * 3 + i1];
+        }
+    const double inv = 1.0 / (a[0] * cof[0] + a[1] * cof[3] + a[2] * cof[6]);
+    for (int k = 0; k < 9; k++)
+        out[k] = cof[k] * inv;
+}
+
+/* The same for a complex matrix ar + i·ai, into outr + i·outi. */
+void pl_inverse3_complex(const double *ar, const double *ai, double *outr, double *outi)
+{
+    double cr[9], ci[9];
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) {
+            const int p = ((j + 1) % 3) * 3 + (i + 1) % 3, q = ((j + 2) % 3) * 3 + (i + 2) % 3;
+            const int u = ((j + 1) % 3) * 3 + (i + 2) % 3, v = ((j + 2) % 3) * 3 + (i + 1) % 3;
+            cr[i * 3 + j] = (ar[p] * ar[q] - ai[p] * ai[q]) - (ar[u] * ar[v] - ai[u] * ai[v]);
+            ci[i * 3 + j] = (ar[p] * ai[q] + ai[p] * ar[q]) - (ar[u] * ai[v] + ai[u] * ar[v]);
+        }
+    double dr = 0.0, di = 0.0;
+    for (int k = 0; k < 3; k++) {
+        dr += ar[k] * cr[k * 3] - ai[k] * ci[k * 3];
+        di += ar[k] * ci[k * 3] + ai[k] * cr[k * 3];
+    }
+    const double d2 = dr * dr + di * di, invr = dr / d2, invi = -di / d2;
+    for (int k = 0; k < 9; k++) {
+        outr[k] = cr[k] * invr - ci[k] * invi;
+        outi[k] = cr[k] * invi + ci[k] * invr;
+    }
+}

@@ -18,9 +18,6 @@
 #define NEWTON_MAXITER 6
 #define SQRT_EPS 1.4901161193847656e-08
 #define EPS 2.220446049250313e-16
-/* up to this many links the factored Newton matrices are inverted outright (one dense
- * matrix–vector product per solve beats pivoted triangular solves at these sizes) */
-#define SMALL_N 4
 
 static const double S6 = 2.449489742783178;  /* √6 */
 static double NODES[4];
@@ -60,7 +57,6 @@ void pl_radau_constants(void)
 }
 
 typedef struct radau_ws radau_ws;
-static void invert_factored(double *A, const int64_t *piv, int64_t k, double *col);
 static void prepared_solve(const radau_ws *w, const double *A, const int64_t *piv, double *b,
                            int64_t k);
 
@@ -70,8 +66,7 @@ struct radau_ws {
     double *jac;                  /* (n, m) acceleration rows */
     double *lur; int64_t *pivr;   /* (n, n) real system: its factors, or inverse */
     double *luc; int64_t *pivc;   /* (2n, 2n) complex system, embedded: likewise */
-    double *inv_tmp;              /* (2n) */
-    int small;                    /* n <= SMALL_N: explicit inverses (matrix–vector solves) */
+    int closed;                   /* N = 3: closed-form inverses (matrix–vector solves) */
     double *scale, *fr, *fcr, *fci, *tmp, *err, *xt, *s1, *s2, *xold, *f0, *fnew;
     double h_lu, h_old, err_old, h_start, t_prev, h_prev, newton_tol;
     int have_sol, current_jac, err_rejected, last_rejected;
@@ -94,56 +89,59 @@ static int64_t jacobian(radau_ws *w, const pl_model *md, const double *x, const 
     return m;
 }
 
-/* S(c) = c²I − c·Q − P for c = μ_r/h (real) and μ_c/h (complex, embedded), factored */
+/* S(c) = c²I − c·Q − P for c = μ_r/h (real) and μ_c/h (complex, as the real 2N × 2N
+ * [[Re S, −Im S], [Im S, Re S]]), prepared for solves: inverted in closed form for N = 3
+ * (the cyclic cofactor formula), LU-factored otherwise */
 static void factor(radau_ws *w, double h)
 {
     const int64_t n = w->n, m = w->m, n2 = 2 * n;
     const double cr = MU_REAL / h, ccr = MU_CRE / h, cci = MU_CIM / h;
     const double c2r = ccr * ccr - cci * cci, c2i = 2.0 * ccr * cci;
+    double sr[9], si[9];
     for (int64_t i = 0; i < n; i++)
         for (int64_t j = 0; j < n; j++) {
             const double p = w->jac[i * m + j], q = w->jac[i * m + n + j];
             const double id = i == j ? 1.0 : 0.0;
             w->lur[i * n + j] = cr * cr * id - cr * q - p;
-            const double sr = c2r * id - ccr * q - p, si = c2i * id - cci * q;
-            w->luc[i * n2 + j] = sr;
-            w->luc[i * n2 + n + j] = -si;
-            w->luc[(n + i) * n2 + j] = si;
-            w->luc[(n + i) * n2 + n + j] = sr;
+            const double re = c2r * id - ccr * q - p, im = c2i * id - cci * q;
+            if (w->closed) {
+                sr[i * 3 + j] = re;
+                si[i * 3 + j] = im;
+            }
+            w->luc[i * n2 + j] = re;
+            w->luc[i * n2 + n + j] = -im;
+            w->luc[(n + i) * n2 + j] = im;
+            w->luc[(n + i) * n2 + n + j] = re;
         }
-    pl_lu_factor(w->lur, w->pivr, n);
-    pl_lu_factor(w->luc, w->pivc, n2);
-    if (w->small) {
-        invert_factored(w->lur, w->pivr, n, w->inv_tmp);
-        invert_factored(w->luc, w->pivc, n2, w->inv_tmp);
+    if (w->closed) {
+        double a[9], ir[9], ii[9];
+        memcpy(a, w->lur, sizeof(a));
+        pl_inverse3(a, w->lur);
+        pl_inverse3_complex(sr, si, ir, ii);
+        for (int64_t i = 0; i < 3; i++)
+            for (int64_t j = 0; j < 3; j++) {
+                w->luc[i * 6 + j] = ir[i * 3 + j];
+                w->luc[i * 6 + 3 + j] = -ii[i * 3 + j];
+                w->luc[(3 + i) * 6 + j] = ii[i * 3 + j];
+                w->luc[(3 + i) * 6 + 3 + j] = ir[i * 3 + j];
+            }
+    } else {
+        pl_lu_factor(w->lur, w->pivr, n);
+        pl_lu_factor(w->luc, w->pivc, n2);
     }
     w->h_lu = h;
 }
 
-/* replace the LU factors in A (k, k), k <= 2 SMALL_N, by the inverse: k solves of unit
- * vectors through col (k values) */
-static void invert_factored(double *A, const int64_t *piv, int64_t k, double *col)
-{
-    double inv[4 * SMALL_N * SMALL_N];
-    for (int64_t j = 0; j < k; j++) {
-        for (int64_t i = 0; i < k; i++)
-            col[i] = i == j ? 1.0 : 0.0;
-        pl_lu_solve(A, piv, col, k);
-        for (int64_t i = 0; i < k; i++)
-            inv[i * k + j] = col[i];
-    }
-    memcpy(A, inv, sizeof(double) * k * k);
-}
-
-/* b = A⁻¹ b with the prepared matrix: a product with the inverse, or triangular solves */
+/* b = A⁻¹ b with the prepared matrix: a product with the inverse (N = 3) or triangular
+ * solves */
 static void prepared_solve(const radau_ws *w, const double *A, const int64_t *piv, double *b,
                            int64_t k)
 {
-    if (!w->small) {
+    if (!w->closed) {
         pl_lu_solve(A, piv, b, k);
         return;
     }
-    double out[2 * SMALL_N];
+    double out[6];
     for (int64_t i = 0; i < k; i++) {
         double s = 0.0;
         for (int64_t j = 0; j < k; j++)
@@ -239,10 +237,13 @@ static int newton(radau_ws *w, const pl_model *md, double h, const double *x, co
         const double norm = sqrt(acc / (3.0 * m));
         if (norm_old >= 0.0)
             rate = norm / norm_old;
-        if (rate >= 0.0 && (rate >= 1.0
-                            || pow(rate, (double)(NEWTON_MAXITER - k)) / (1.0 - rate) * norm
-                                   > w->newton_tol))
-            break;
+        if (rate >= 0.0) {
+            double power = 1.0;  /* rate^(NEWTON_MAXITER − k) */
+            for (int64_t e = k; e < NEWTON_MAXITER; e++)
+                power *= rate;
+            if (rate >= 1.0 || power / (1.0 - rate) * norm > w->newton_tol)
+                break;
+        }
         for (int64_t i = 0; i < m; i++) {
             W[i] += w->fr[i];
             W[m + i] += w->fcr[i];
@@ -282,10 +283,10 @@ static double predict(double h, double h_old, double err, double err_old)
 {
     double mult = 1.0;
     if (!(err_old <= 0.0 || h_old <= 0.0 || err == 0.0))
-        mult = h / h_old * pow(err_old / err, 0.25);
+        mult = h / h_old * sqrt(sqrt(err_old / err));
     if (err == 0.0)
         return INFINITY;
-    return fmin(1.0, mult) * pow(err, -0.25);
+    return fmin(1.0, mult) / sqrt(sqrt(err));
 }
 
 static double radau_start(pl_method *me, const pl_model *md, double t, const double *x,
@@ -424,7 +425,6 @@ static void radau_release(pl_method *me)
             free(arrays[k]);
         free(w->pivr);
         free(w->pivc);
-        free(w->inv_tmp);
         free(w);
     }
     me->ws = NULL;
@@ -456,12 +456,10 @@ int pl_radau_init(pl_method *me, int64_t n)
     w->luc = calloc(4 * n * n, sizeof(double));
     w->pivr = calloc(n, sizeof(int64_t));
     w->pivc = calloc(2 * n, sizeof(int64_t));
-    w->inv_tmp = calloc(2 * n, sizeof(double));
-    w->small = n <= SMALL_N;
+    w->closed = n == 3;
     double **vectors[] = {&w->scale, &w->fr, &w->fcr, &w->fci, &w->tmp, &w->err, &w->xt,
                           &w->s1, &w->s2, &w->xold, &w->f0, &w->fnew};
-    int ok = w->Z && w->Z0 && w->W && w->F && w->jac && w->lur && w->luc && w->pivr && w->pivc
-             && w->inv_tmp;
+    int ok = w->Z && w->Z0 && w->W && w->F && w->jac && w->lur && w->luc && w->pivr && w->pivc;
     for (size_t k = 0; k < sizeof(vectors) / sizeof(vectors[0]); k++) {
         *vectors[k] = calloc(m, sizeof(double));
         ok = ok && *vectors[k];
