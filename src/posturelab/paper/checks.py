@@ -505,8 +505,8 @@ def foot_finding(runs: PaperRuns) -> FootFinding:
 
 def ramp_and_hold_run(body: Body, muscles: MuscleSet, distance: float,
                       fall: FallCriteria) -> SimulationResult:
-    """The runner of :func:`recovery_finding`: the reference simulator on a backward
-    ramp-and-hold.
+    """The runner of :func:`recovery_finding`: the compiled engine on a backward
+    ramp-and-hold (its default tolerances, rtol 1e-6).
 
     Parameters
     ----------
@@ -520,7 +520,7 @@ def ramp_and_hold_run(body: Body, muscles: MuscleSet, distance: float,
     from ..simulation import simulate
 
     return simulate(body, muscles, RampAndHold(-distance, RECOVERY_RAMP_DURATION), 4.0,
-                    fall=fall, sample_rate=50.0, engine="reference")
+                    fall=fall, sample_rate=50.0, engine="compiled")
 
 
 def recovery_finding(
@@ -554,9 +554,9 @@ def recovery_finding(
 
 
 def delayed_run(scenario: Scenario, delay: float) -> SimulationResult:
-    """The runner of :func:`delay_finding`: ``scenario`` on the reference simulator with a
-    feedback delay of ``delay`` [s]."""
-    return scenario.run(feedback_delay=delay, engine="reference")
+    """The runner of :func:`delay_finding`: ``scenario`` on the compiled engine (at the
+    scenario's tolerances) with a feedback delay of ``delay`` [s]."""
+    return scenario.run(feedback_delay=delay, engine="compiled")
 
 
 def delay_finding(

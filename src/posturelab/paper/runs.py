@@ -102,13 +102,17 @@ def run_paper(tick: Callable[[str], None] | None = None,
         scen[key] = builtin_scenario(sname)
         runs[key] = scen[key].run()
     step(f"simulate paper-forward-case3 continued to {CASE3_LONG_DURATION:g} s")
+    # (60 s of a slowly settling run: the compiled engine, at the scenario's tolerances)
     long3 = scen["forward3"].run(duration=CASE3_LONG_DURATION,
-                                 sample_rate=CASE3_LONG_SAMPLE_RATE)
+                                 sample_rate=CASE3_LONG_SAMPLE_RATE, engine="compiled")
     step("simulate forward case 1 with the real one-sided gastrocnemius (beyond the paper)")
-    one_sided = scen["forward1"].run(muscles=paper_muscles("1", gastrocnemius="one-sided"))
+    # the runs beyond the paper on the compiled engine, at the scenarios' tolerances
+    one_sided = scen["forward1"].run(muscles=paper_muscles("1", gastrocnemius="one-sided"),
+                                     engine="compiled")
     # the same runs with posturelab's own base-of-support fall check (an independent path to
     # the foot finding: events in the integrator instead of post-processing)
-    with_foot = {k: scen[k].run(fall=FallCriteria(scen[k].fall.max_link_angle, foot))
+    with_foot = {k: scen[k].run(fall=FallCriteria(scen[k].fall.max_link_angle, foot),
+                                engine="compiled")
                  for k in ("backward", "forward1")}
     return PaperRuns(
         backward=runs["backward"], forward1=runs["forward1"], forward2=runs["forward2"],
