@@ -12,11 +12,9 @@ from pathlib import Path
 from setuptools import Extension, setup
 
 CSRC = Path("src/posturelab/simulation/compiled/csrc")
-digest = runpy.run_path("src/posturelab/simulation/compiled/_sources.py")["source_hash"](CSRC)
-# C99, optimised, no floating-point contraction (a·b + c rounded twice everywhere, so results
-# are the same on every machine and a batch row equals its single run bit for bit)
-flags = [] if sys.platform == "win32" else ["-std=c99", "-O3", "-ffp-contract=off",
-                                            "-fvisibility=hidden"]
+SOURCES = runpy.run_path("src/posturelab/simulation/compiled/_sources.py")
+digest = SOURCES["source_hash"](CSRC)
+flags = [] if sys.platform == "win32" else list(SOURCES["COMPILE_FLAGS"])
 
 setup(ext_modules=[Extension(
     "posturelab.simulation.compiled._engine",
