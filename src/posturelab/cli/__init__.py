@@ -13,7 +13,8 @@ from collections.abc import Sequence
 
 from ..errors import PostureLabError
 
-#: Subcommand name -> module in this package (each defines ``add_parser`` and ``run``).
+#: Subcommand name -> module in this package: each defines ``HELP`` (one line), ``DESCRIPTION``,
+#: ``add_arguments(parser)`` and ``run(args)`` (or ``add_parser(sub, name)`` and ``run``).
 SUBCOMMANDS: dict[str, str] = {
     "poles": "poles",
     "sensitivity": "sensitivity",
@@ -65,7 +66,13 @@ def build_parser() -> OneLineParser:
             if exc.name == f"{__name__}.{module_name}":
                 continue
             raise
-        p = module.add_parser(sub, name)
+        if hasattr(module, "add_arguments"):
+            p = sub.add_parser(name, help=module.HELP, description=module.DESCRIPTION,
+                               epilog=CONVENTIONS_EPILOG,
+                               formatter_class=argparse.RawDescriptionHelpFormatter)
+            module.add_arguments(p)
+        else:
+            p = module.add_parser(sub, name)
         p.set_defaults(_run=module.run)
     return parser
 

@@ -7,7 +7,6 @@ import argparse
 from ..model.muscles import PAPER_PAIR_NAMES
 from ..simulation.results import atomic_write_text
 from ..studies.identification import ENGINES, VISCOSITY_RATIO, fit_stiffness, read_trajectory_csv
-from . import CONVENTIONS_EPILOG
 from ._common import print_json
 from .simulate import add_experiment_arguments, scenario_from_args
 
@@ -22,12 +21,11 @@ estimate with its standard error and 95 % confidence interval.
 """
 
 
-def add_parser(sub, name: str) -> argparse.ArgumentParser:
-    p = sub.add_parser(
-        name, help="fit pair stiffness to measured angles (with confidence intervals)",
-        description=DESCRIPTION, epilog=CONVENTIONS_EPILOG,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
-    )
+HELP = "fit pair stiffness to measured angles (with confidence intervals)"
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    """The options of ``posturelab fit``."""
     add_experiment_arguments(p)
     g = p.add_argument_group("fit")
     g.add_argument("--data", required=True, metavar="ANGLES.csv",
@@ -41,7 +39,6 @@ def add_parser(sub, name: str) -> argparse.ArgumentParser:
                    "former name of compiled.")
     g.add_argument("--report", metavar="FIT.json", help="also write the JSON summary to a file.")
     g.add_argument("--json", action="store_true", help="print one JSON object instead of text.")
-    return p
 
 
 def run(args: argparse.Namespace) -> int:

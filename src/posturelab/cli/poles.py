@@ -7,7 +7,6 @@ import argparse
 from ..linear.analysis import analyse_both_sides
 from ..model.body import paper_body
 from ..paper.compare import erratum, table2_comparison
-from . import CONVENTIONS_EPILOG
 from ._common import add_muscle_arguments, muscles_from_args, print_json
 
 DESCRIPTION = """\
@@ -24,17 +23,15 @@ system is reported stable only if both sides are.
 """
 
 
-def add_parser(sub, name: str) -> argparse.ArgumentParser:
-    p = sub.add_parser(
-        name, help="poles and stability of the linearised model (Table II)",
-        description=DESCRIPTION, epilog=CONVENTIONS_EPILOG,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
-    )
+HELP = "poles and stability of the linearised model (Table II)"
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    """The options of ``posturelab poles``."""
     add_muscle_arguments(p)
     p.add_argument("--all", action="store_true",
                    help="Table II: every case as printed beside what we compute, errata flagged.")
     p.add_argument("--json", action="store_true", help="print one JSON object instead of text.")
-    return p
 
 
 def _fmt_pole(z: complex) -> str:

@@ -5,8 +5,6 @@ from __future__ import annotations
 import argparse
 import sys
 
-from . import CONVENTIONS_EPILOG
-
 DESCRIPTION = """\
 Regenerate the ankle-strategy paper into DIR: Table II (printed beside computed,
 disagreements flagged with their erratum), the disturbance-severity vector J⁻¹H,
@@ -23,16 +21,14 @@ output.
 """
 
 
-def add_parser(sub, name: str) -> argparse.ArgumentParser:
-    p = sub.add_parser(
-        name, help="regenerate the paper's tables and figures (HTML report)",
-        description=DESCRIPTION, epilog=CONVENTIONS_EPILOG,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
-    )
+HELP = "regenerate the paper's tables and figures (HTML report)"
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    """The options of ``posturelab reproduce``."""
     p.add_argument("--out", required=True, metavar="DIR",
                    help="output directory (created if missing; must not be a file).")
     p.add_argument("--quiet", action="store_true", help="no progress lines on standard error.")
-    return p
 
 
 def _progress(step: int, total: int, message: str) -> None:

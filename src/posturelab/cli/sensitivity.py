@@ -6,7 +6,6 @@ import argparse
 
 from ..linear.analysis import disturbance_sensitivity
 from ..model.body import paper_body
-from . import CONVENTIONS_EPILOG
 from ._common import parse_float_list, print_json
 
 DESCRIPTION = """\
@@ -16,17 +15,15 @@ posture Θ (default upright). The paper prints [2.5580, -0.0654, 0.0027] at upri
 """
 
 
-def add_parser(sub, name: str) -> argparse.ArgumentParser:
-    p = sub.add_parser(
-        name, help="disturbance severity J⁻¹H at a posture",
-        description=DESCRIPTION, epilog=CONVENTIONS_EPILOG,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
-    )
+HELP = "disturbance severity J⁻¹H at a posture"
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    """The options of ``posturelab sensitivity``."""
     p.add_argument("--posture", metavar="T1,T2,T3", default="0,0,0",
                    help="link angles θ1,θ2,θ3 [rad] from the vertical, forward positive "
                    "(default 0,0,0).")
     p.add_argument("--json", action="store_true", help="print one JSON object instead of text.")
-    return p
 
 
 def run(args: argparse.Namespace) -> int:

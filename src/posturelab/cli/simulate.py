@@ -14,7 +14,7 @@ from ..model.options import FOOT_FROM_LITERATURE, BaseOfSupport, FallCriteria, K
 from ..model.platform import NoDisturbance, VelocityStep, read_profile_csv
 from ..paper.printed import BACKWARD_INITIAL_STATE
 from ..scenarios import Scenario, builtin_scenario, builtin_scenario_names, load_scenario
-from . import CONVENTIONS_EPILOG, UsageError
+from . import UsageError
 from ._common import (
     add_muscle_arguments,
     check_writable,
@@ -45,12 +45,11 @@ platform_y [m].
 """
 
 
-def add_parser(sub, name: str) -> argparse.ArgumentParser:
-    p = sub.add_parser(
-        name, help="simulate a platform disturbance (nonlinear model)",
-        description=DESCRIPTION, epilog=CONVENTIONS_EPILOG,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
-    )
+HELP = "simulate a platform disturbance (nonlinear model)"
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    """The options of ``posturelab simulate``."""
     add_experiment_arguments(p)
     out = p.add_argument_group("output")
     out.add_argument("--out", metavar="RUN.csv", help="write the time series as CSV.")
@@ -64,7 +63,6 @@ def add_parser(sub, name: str) -> argparse.ArgumentParser:
                    "scenario's solver settings; compiled: the C engine (hundreds of times "
                    "faster, its own integrator: Radau, or RK45 with a feedback delay), at "
                    "the same tolerances.")
-    return p
 
 
 def add_experiment_arguments(p: argparse.ArgumentParser) -> None:

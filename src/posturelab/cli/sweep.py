@@ -18,7 +18,7 @@ from ..studies.sweep import (
     run_sweep,
     table_format,
 )
-from . import CONVENTIONS_EPILOG, UsageError
+from . import UsageError
 from ._common import check_writable
 from .simulate import add_experiment_arguments, scenario_from_args
 
@@ -56,13 +56,12 @@ reference for undelayed runs); --rtol/--atol override them.
 """
 
 
-def add_parser(sub, name: str) -> argparse.ArgumentParser:
-    p = sub.add_parser(
-        name, help="simulate a grid of pair gains and perturbation sizes; outcomes to CSV "
-        "or Parquet",
-        description=DESCRIPTION, epilog=CONVENTIONS_EPILOG,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
-    )
+HELP = ("simulate a grid of gains, delays, torque limits and perturbation sizes; outcomes "
+        "to CSV or Parquet")
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    """The options of ``posturelab sweep``."""
     g = p.add_argument_group("sweep")
     g.add_argument("--vary", action="append", metavar="NAME=LO:HI:N", default=[],
                    help="N evenly spaced values of NAME from LO to HI inclusive; names: "
@@ -80,7 +79,6 @@ def add_parser(sub, name: str) -> argparse.ArgumentParser:
     add_experiment_arguments(p)
     # None means "not given": a scenario then keeps its own ratio
     p.set_defaults(viscosity_ratio=None)
-    return p
 
 
 def run(args: argparse.Namespace) -> int:

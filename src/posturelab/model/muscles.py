@@ -267,17 +267,8 @@ def joint_moments(muscles: MuscleSet, theta: np.ndarray, omega: np.ndarray,
                   active: np.ndarray | None = None) -> np.ndarray:
     """Net muscle moment at each joint, τ = Cᵀ M: the sum of the pairs crossing it.
 
-    Parameters
-    ----------
-    theta, omega : array_like, shape (..., N)
-        Link angles [rad] and rates [rad/s].
-    active : array_like, shape (P,), optional
-        As for :func:`pair_torques`. [-]
-
-    Returns
-    -------
-    numpy.ndarray, shape (..., N)
-        Ankle, knee, hip, … moments. [N·m]
+    Arguments as for :func:`pair_torques`; returns the ankle, knee, hip, … moments,
+    shape (..., N). [N·m]
     """
     return pair_torques(muscles, theta, omega, active) @ muscles.crossing_matrix
 

@@ -37,6 +37,7 @@ from ..model.platform import Disturbance, NoDisturbance
 
 __all__ = [
     "RunSetup",
+    "RUN_OPTIONS",
     "prepare_run",
     "initial_state_for",
     "model_response",
@@ -204,34 +205,36 @@ def _expect(name: str, value, kind: type) -> None:
                              f"{value!r:.60}")
 
 
-def prepare_run(
-    body: Body,
-    muscles: MuscleSet,
-    disturbance: Disturbance | None = None,
-    duration: float = 5.0,
-    *,
-    initial_state: np.ndarray | None = None,
-    rates_from: Literal["upright", "posture"] = "upright",
-    knee: KneeModel | None = None,
-    fall: FallCriteria | None = None,
-    torque_limits: np.ndarray | None = None,
-    feedback_delay: float = 0.0,
-    rtol: float = 1e-8,
-    atol: float = 1e-10,
-    sample_rate: float = 1000.0,
-    max_switches: int = 10_000,
-    description: str = "",
-) -> RunSetup:
+#: The keyword options of a run and their defaults (meanings and units:
+#: :func:`posturelab.simulate`).
+RUN_OPTIONS: dict[str, object] = {
+    "initial_state": None, "rates_from": "upright", "knee": None, "fall": None,
+    "torque_limits": None, "feedback_delay": 0.0, "rtol": 1e-8, "atol": 1e-10,
+    "sample_rate": 1000.0, "max_switches": 10_000, "description": "",
+}
+
+
+def prepare_run(body: Body, muscles: MuscleSet, disturbance: Disturbance | None = None,
+                duration: float = 5.0, **options) -> RunSetup:
     """Validate the arguments of a run and work out everything both engines share.
 
-    Parameters are those of :func:`posturelab.simulate` (units there).
+    Parameters are those of :func:`posturelab.simulate` (units there); the keyword
+    options and their defaults are :data:`RUN_OPTIONS`.
 
     Raises
     ------
     ParameterError
-        An argument of the wrong type or outside its range, the knee beyond its stop, a
-        muscle set for another number of links.
+        An unknown option, an argument of the wrong type or outside its range, the knee
+        beyond its stop, a muscle set for another number of links.
     """
+    from .._validation import reject_unknown_keys
+
+    reject_unknown_keys("the options of a run", options, RUN_OPTIONS)
+    o = {**RUN_OPTIONS, **options}
+    initial_state, rates_from = o["initial_state"], o["rates_from"]
+    knee, fall, torque_limits = o["knee"], o["fall"], o["torque_limits"]
+    rtol, atol, sample_rate = o["rtol"], o["atol"], o["sample_rate"]
+    max_switches, description = o["max_switches"], o["description"]
     _expect("body", body, Body)
     _expect("muscles", muscles, MuscleSet)
     disturbance = NoDisturbance() if disturbance is None else disturbance
@@ -254,7 +257,7 @@ def prepare_run(
     n = body.n_links
     if knee.mode != "free" and n < 2:
         raise ParameterError("knee mode 'locked' or 'stop' needs a body with at least 2 links")
-    delay = float_in_range("feedback_delay [s]", feedback_delay, 0.0, MAX_FEEDBACK_DELAY,
+    delay = float_in_range("feedback_delay [s]", o["feedback_delay"], 0.0, MAX_FEEDBACK_DELAY,
                            unit="s")
     limits = torque_limit_array(torque_limits, n)
     before = (np.zeros(2 * n) if initial_state is None

@@ -139,12 +139,12 @@ def largest_recoverable_batch(
     **batch_options,
 ) -> BatchRecoveryBoundaries:
     """Bisect, for every gain set at once, for the largest factor on ``disturbance`` that
-    does not fall (the compiled simulator, :func:`posturelab.fast.simulate_batch`).
+    does not fall (the compiled simulator, :func:`posturelab.simulation.compiled.simulate_batch`).
 
     Each round runs every still-open gain set at the midpoint of its own bracket
     (``disturbance_scale``), so M gain sets cost about log2((high − low)/tolerance)
     batches. Row r's bracket is the one :func:`largest_recoverable` finds with
-    ``run(s) = simulate_fast(..., disturbance.scaled(s))`` for gain set r.
+    ``run(s) = simulate(..., disturbance.scaled(s), engine="compiled")`` for gain set r.
 
     Parameters
     ----------
@@ -164,7 +164,7 @@ def largest_recoverable_batch(
     max_rounds : int
         Most bisection rounds. [-]
     **batch_options
-        Passed to :func:`posturelab.fast.simulate_batch` (``initial_state``,
+        Passed to :func:`posturelab.simulation.compiled.simulate_batch` (``initial_state``,
         ``muscles``, ``knee``, ``fall``, ``rtol``, …).
 
     Returns

@@ -5,7 +5,7 @@ with the paper's five muscle pairs) and a list of parameters to vary, each
 over N evenly spaced values from LO to HI inclusive
 (:class:`VaryRange`, written ``NAME=LO:HI:N`` on the command line). It
 simulates the full grid (the cartesian product, the first parameter varying
-slowest) with the compiled simulator (:func:`posturelab.fast.simulate_batch`)
+slowest) with the compiled simulator (:func:`posturelab.simulation.compiled.simulate_batch`)
 and returns one row per run: the varied values, then the outcomes (fell,
 fall time, peak |θ_i|, settling time).
 

@@ -277,36 +277,20 @@ def _fall_reason(kind: int, index: int, setup: RunSetup) -> str:
                         heel=bos.heel if bos is not None else 0.0)
 
 
-def simulate_fast(
-    body: Body,
-    muscles: MuscleSet,
-    disturbance: Disturbance | None = None,
-    duration: float = 5.0,
-    *,
-    initial_state: np.ndarray | None = None,
-    rates_from: Literal["upright", "posture"] = "upright",
-    knee: KneeModel | None = None,
-    fall: FallCriteria | None = None,
-    torque_limits: np.ndarray | None = None,
-    feedback_delay: float = 0.0,
-    rtol: float = DEFAULT_RTOL,
-    atol: float = DEFAULT_ATOL,
-    sample_rate: float = 1000.0,
-    max_switches: int = 10_000,
-    description: str = "",
-    method: str | None = None,
-) -> SimulationResult:
+def simulate_fast(body: Body, muscles: MuscleSet, disturbance: Disturbance | None = None,
+                  duration: float = 5.0, **options) -> SimulationResult:
     """``posturelab.simulate(..., engine="compiled")``, under its former name.
 
-    Parameters and result as :func:`posturelab.simulate`; the tolerances default to
-    the compiled engine's (rtol 1e-6, atol 1e-9 [rad, rad/s]) and the method to
-    :func:`default_method`.
+    Parameters (keywords ``initial_state``, ``rates_from``, ``knee``, ``fall``,
+    ``torque_limits``, ``feedback_delay``, ``rtol``, ``atol``, ``sample_rate``,
+    ``max_switches``, ``description``, ``method``) and result as
+    :func:`posturelab.simulate`; the tolerances default to the compiled engine's
+    (rtol 1e-6, atol 1e-9 [rad, rad/s]) and the method to :func:`default_method`.
     """
-    return simulate(body, muscles, disturbance, duration, initial_state=initial_state,
-                    rates_from=rates_from, knee=knee, fall=fall, torque_limits=torque_limits,
-                    feedback_delay=feedback_delay, rtol=rtol, atol=atol,
-                    sample_rate=sample_rate, max_switches=max_switches,
-                    description=description, method=method, engine="compiled")
+    if "engine" in options:
+        raise ParameterError("simulate_fast always runs the compiled engine; use "
+                             "posturelab.simulate(..., engine=...) to choose")
+    return simulate(body, muscles, disturbance, duration, engine="compiled", **options)
 
 
 # ---------------------------------------------------------------------------
