@@ -25,7 +25,7 @@ import hashlib
 import types
 from pathlib import Path
 
-__all__ = ["kernel", "specialise", "SOURCE_HASH", "KERNEL_SOURCES", "CONTRACT"]
+__all__ = ["kernel", "specialise", "kernel_files", "SOURCE_HASH", "KERNEL_SOURCES", "CONTRACT"]
 
 _ROOT = Path(__file__).resolve().parent
 
@@ -37,14 +37,22 @@ KERNEL_SOURCES: tuple[str, ...] = ("_jit.py", "linear")
 CONTRACT = frozenset({"contract"})
 
 
-def _source_hash() -> str:
-    digest = hashlib.sha256()
+def kernel_files(root: Path = _ROOT) -> list[Path]:
+    """The files :data:`KERNEL_SOURCES` names under ``root`` (the package folder by default):
+    each listed file, and the ``*.py`` files directly in each listed folder."""
     files: list[Path] = []
     for rel in KERNEL_SOURCES:
-        path = _ROOT / rel
+        path = root / rel
         files.extend(sorted(path.glob("*.py")) if path.is_dir() else [path])
-    for path in files:
-        digest.update(path.relative_to(_ROOT).as_posix().encode())
+    return files
+
+
+def _source_hash(root: Path = _ROOT) -> str:
+    """Digest (12 hex digits) of the path and content of every :func:`kernel_files` of
+    ``root``; a missing file counts as empty."""
+    digest = hashlib.sha256()
+    for path in kernel_files(root):
+        digest.update(path.relative_to(root).as_posix().encode())
         digest.update(path.read_bytes() if path.exists() else b"")
     return digest.hexdigest()[:12]
 
