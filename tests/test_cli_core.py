@@ -309,20 +309,40 @@ def test_help_mentions_units_and_sign_convention(capsys, command, units):
     assert "vertical" in out
 
 
-def test_load_compiled_is_quiet_when_fast_and_says_so_when_slow():
-    """The notice appears only when loading takes longer than the threshold."""
+def test_load_compiled_says_so_only_when_numba_compiles():
+    """The notice follows numba's compile events: a slow load that compiles nothing is
+    quiet; a fresh njit function compiled inside load() is announced."""
     import io
     import time
 
+    import numba
+
     from posturelab.cli._common import load_compiled
 
+    def fresh():
+        @numba.njit(cache=False)
+        def add_one(x):
+            return x + 1.0
+
+        return add_one
+
     quiet = io.StringIO()
-    load_compiled(lambda: None, "nothing", stream=quiet, notice_after=5.0)
-    assert quiet.getvalue() == ""
-    loud = io.StringIO()
-    seconds = load_compiled(lambda: time.sleep(0.3), "the simulator", stream=loud,
+    load_compiled(lambda: None, "nothing", stream=quiet, notice_after=0.0)
+    seconds = load_compiled(lambda: time.sleep(0.3), "a slow cache load", stream=quiet,
                             notice_after=0.05)
+    compiled = fresh()
+    compiled(1.0)
+    load_compiled(lambda: compiled(2.0), "compiled code", stream=quiet, notice_after=0.0)
+    assert quiet.getvalue() == ""
+    assert seconds >= 0.3
+    brief = io.StringIO()
+    kernel = fresh()
+    load_compiled(lambda: kernel(1.0), "a quick compile", stream=brief, notice_after=60.0)
+    assert brief.getvalue() == ""  # compiled, but within notice_after
+    loud = io.StringIO()
+    kernel = fresh()
+    load_compiled(lambda: kernel(1.0), "the simulator", stream=loud, notice_after=0.0)
     lines = loud.getvalue().splitlines()
+    assert len(lines) == 2
     assert lines[0].startswith("posturelab: compiling the simulator")
     assert lines[1].startswith("posturelab: compiled the simulator in")
-    assert seconds >= 0.3

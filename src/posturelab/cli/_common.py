@@ -112,34 +112,59 @@ def check_writable(paths: list[str]) -> None:
 
 
 def load_compiled(load, what: str, stream=None, notice_after: float = 2.0) -> float:
-    """Run ``load()`` (which compiles or loads numba kernels) and say so if it takes long.
+    """Run ``load()`` (which compiles or loads numba kernels) and say so if numba compiles.
 
-    Loading from numba's cache takes well under a second and prints nothing;
-    when ``load()`` is still running after ``notice_after`` seconds (the first
-    use after installing, which compiles), one line on ``stream`` (standard
-    error by default) says what is happening, and a second when it is done.
-    Returns the seconds ``load()`` took. [s]
+    numba announces a compilation with a ``"numba:compile"`` event, which a load
+    from its on-disk cache does not raise. Once numba has been compiling for
+    ``notice_after`` seconds (the first use after installing, or after a kernel
+    source changed), one line on ``stream`` (standard error by default) says what
+    is happening, and a second line when ``load()`` is done. Loading from the
+    cache prints nothing, however long it takes; so does a compilation that is
+    over within ``notice_after``. Returns the seconds ``load()`` took. [s]
     """
     import threading
     import time
 
+    from numba.core import event
+
     stream = sys.stderr if stream is None else stream
-    said = threading.Event()
+    lock = threading.Lock()
+    state = {"compiling": False, "said": False, "over": False, "timer": None}
 
     def notice() -> None:
-        said.set()
-        print(f"posturelab: compiling {what} (once after installing; cached for later runs)…",
-              file=stream, flush=True)
+        with lock:
+            if state["over"] or state["said"]:
+                return
+            state["said"] = True
+            print(f"posturelab: compiling {what} (once after installing; cached for later "
+                  "runs)…", file=stream, flush=True)
 
-    timer = threading.Timer(notice_after, notice)
-    timer.daemon = True
+    class CompileStarted(event.Listener):
+        def on_start(self, ev) -> None:
+            with lock:
+                if state["compiling"]:
+                    return
+                state["compiling"] = True
+                if notice_after > 0:
+                    state["timer"] = threading.Timer(notice_after, notice)
+                    state["timer"].daemon = True
+                    state["timer"].start()
+            if notice_after <= 0:
+                notice()
+
+        def on_end(self, ev) -> None:
+            pass
+
     t0 = time.perf_counter()
-    timer.start()
     try:
-        load()
+        with event.install_listener("numba:compile", CompileStarted()):
+            load()
     finally:
-        timer.cancel()
+        with lock:
+            state["over"] = True
+            if state["timer"] is not None:
+                state["timer"].cancel()
     seconds = time.perf_counter() - t0
-    if said.is_set():
+    if state["said"]:
         print(f"posturelab: compiled {what} in {seconds:.0f} s", file=stream, flush=True)
     return seconds
