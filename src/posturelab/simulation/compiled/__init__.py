@@ -419,12 +419,8 @@ def simulate_batch(
         Pair stiffness per run. [N·m/rad]
     viscosity : array_like, shape (M, P)
         Pair viscosity per run. [N·m·s/rad]
-    disturbance : Disturbance, optional
-        Platform motion; none by default.
-    duration : float
-        Simulated time. [s]
-    initial_state : array_like, shape (2N,), optional
-        ``[Θ, Θ̇]`` before any velocity step; upright at rest by default. [rad], [rad/s]
+    disturbance, duration, initial_state
+        As for :func:`posturelab.simulate` (platform motion; [s]; [rad], [rad/s]).
     muscles : MuscleSet, optional
         The pair layout (spans and one-sidedness, in column order); its own
         gains are ignored. Default: the paper's five pairs, two-sided (N = 3).
