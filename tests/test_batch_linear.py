@@ -332,3 +332,80 @@ def test_three_link_fast_path_equals_general_expansion(rng):
         s = 0.7
         assert np.polyval(fast[::-1], s) == pytest.approx(
             np.linalg.det(s**2 * jac + s * damp + load), rel=1e-10, abs=1e-12)
+
+
+def reference_csv(smap) -> str:
+    """The CSV text as Python's %-formatting gives it (the writer's specification)."""
+    g = smap.grid
+    lines = [f"{g.x.name},{g.y.name},max_real_part,stable\n"]
+    for iy, y in enumerate(g.y_values):
+        for ix, x in enumerate(g.x_values):
+            lines.append("%.12g,%.12g,%.12g,%d\n" % (x, y, smap.max_real_part[iy, ix],  # noqa: UP031
+                                                     smap.stable[iy, ix]))
+    return "".join(lines)
+
+
+#: Values whose %.12g text is easy to get wrong, or that the compiled writer leaves to Python.
+SPECIAL_VALUES = [0.0, -0.0, np.nan, np.inf, -np.inf, 1e-300, -5e-324, 1.7e308, 1e-4, 1e-5,
+                  9.99999999999949e-5, 99999.9999999995, 999999999999.5, 0.1, 1 / 3, -2 / 3,
+                  -1e-11, 1e12, -0.5, 2.5, 123456789012.5, 1e-15]
+
+
+def awkward_values(rng, count):
+    """SPECIAL_VALUES, exact ties at the 12th digit, powers of ten and their neighbours,
+    and ``count`` values spread over 27 decades and around 0."""
+    ties = (rng.integers(10**11, 10**12, count) + 0.5) * 10.0 ** rng.integers(-12, 1, count)
+    edges = [10.0**k for k in range(-12, 14)]
+    edges += [np.nextafter(v, s) for v in edges for s in (0.0, np.inf)]
+    spread = rng.choice([-1.0, 1.0], count) * 10.0 ** rng.uniform(-13, 14, count)
+    return np.concatenate([SPECIAL_VALUES, ties, edges, spread, rng.normal(size=count)])
+
+
+def test_compiled_g12_equals_python_formatting(rng):
+    from posturelab.linear import _format_kernels as fmt
+
+    values = awkward_values(rng, 20_000)
+    text = np.zeros((values.size, fmt.WIDTH), dtype=np.uint8)
+    lengths = np.empty(values.size, dtype=np.int64)
+    fmt.format_g12(values, text, lengths)
+    left = set(fmt.special_values(values).tolist())
+    for i, v in enumerate(values.tolist()):
+        if lengths[i] < 0:
+            assert i in left, v  # every value the kernel declines is preformatted
+            continue
+        assert i not in left or v == 0.0
+        assert text[i, :lengths[i]].tobytes().decode() == "%.12g" % v, v  # noqa: UP031
+
+
+@pytest.mark.parametrize("rows_per_block", [1, 7, 100_000])
+def test_write_csv_is_the_percent_format_text(rng, tmp_path, rows_per_block):
+    """The compiled writer gives the text of "%.12g,%.12g,%.12g,%d" row by row, to a
+    text file (bytes written beneath it) or any text stream, block by block."""
+    import io
+
+    from posturelab.linear.batch import StabilityMap
+
+    grid = parameter_grid(("ankle", 0, 1999.9), ("viscosity_ratio", 1e-5, 0.6), (9, 6))
+    values = awkward_values(rng, 2)[:54].reshape(6, 9)
+    smap = StabilityMap(grid, values, rng.random((6, 9)) < 0.5)
+    expected = reference_csv(smap)
+    stream = io.StringIO()
+    calls = []
+    smap.write_csv(stream, rows_per_block=rows_per_block,
+                   progress=lambda done, total: calls.append((done, total)))
+    assert stream.getvalue() == expected
+    assert calls[-1] == (54, 54) and len(calls) == -(-54 // rows_per_block)
+    path = tmp_path / "map.csv"
+    with open(path, "w", encoding="utf-8", newline="") as f:
+        f.write("")  # the header goes through the text layer, the rows beneath it
+        smap.write_csv(f, rows_per_block=rows_per_block)
+    assert path.read_bytes() == expected.encode("ascii")
+
+
+def test_write_csv_of_a_computed_map_is_the_percent_format_text():
+    import io
+
+    smap = stability_map(("ankle", 0, 2000), ("gastrocnemius", 0, 1000), (23, 17))
+    stream = io.StringIO()
+    smap.write_csv(stream, rows_per_block=50)
+    assert stream.getvalue() == reference_csv(smap)

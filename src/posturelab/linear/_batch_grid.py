@@ -309,21 +309,49 @@ class StabilityMap:
         progress : callable(done, total), optional
             Called after each block with the rows written and the total. [-]
         """
+        from . import _format_kernels as fmt  # imports numba
+
         g = self.grid
         stream.write(f"{g.x.name},{g.y.name},max_real_part,stable\n")
-        nx = g.x_values.size
-        flat_re = self.max_real_part.ravel()
-        flat_st = self.stable.ravel()
+        values = np.ascontiguousarray(self.max_real_part, dtype=float).ravel()
+        stable = np.ascontiguousarray(self.stable, dtype=bool).ravel()
+        x_text, x_len = fmt.text_table(g.x_values)
+        y_text, y_len = fmt.text_table(g.y_values)
+        special = fmt.special_values(values)  # 0, NaN, ±inf, tiny or huge: Python's text
+        special_text, special_len = fmt.text_table(values[special])
+        row_bytes = int(x_len.max() + y_len.max()) + fmt.WIDTH + 4
+        rows_per_block = max(1, int(rows_per_block))
+        buffer = np.empty(min(g.size, rows_per_block) * row_bytes, dtype=np.uint8)
+        raw = _ascii_buffer(stream)  # the bytes beneath a UTF-8/ASCII file, if any
         for start in range(0, g.size, rows_per_block):
             stop = min(g.size, start + rows_per_block)
-            idx = np.arange(start, stop)
-            block = np.column_stack([g.x_values[idx % nx], g.y_values[idx // nx],
-                                     flat_re[start:stop], flat_st[start:stop]])
-            # one %-format of the whole block: the same text as numpy.savetxt, 2× faster
-            row_format = "%.12g,%.12g,%.12g,%d\n" * (stop - start)
-            stream.write(row_format % tuple(block.ravel().tolist()))
+            # the text of "%.12g,%.12g,%.12g,%d\n" % row for each row, compiled
+            end = fmt.csv_rows(start, stop, g.x_values.size, x_text, x_len, y_text, y_len,
+                               values, stable, special, special_text, special_len, buffer)
+            if raw is not None:
+                raw.write(memoryview(buffer)[:end])
+            else:
+                stream.write(buffer[:end].tobytes().decode("ascii"))
             if progress is not None:
                 progress(stop, g.size)
+
+
+def _ascii_buffer(stream):
+    """The binary buffer beneath ``stream`` when ASCII bytes can go there directly (a
+    file opened in text mode with UTF-8 or ASCII encoding, flushed first), else None."""
+    import codecs
+    import io
+
+    if not isinstance(stream, io.TextIOWrapper):
+        return None
+    try:
+        name = codecs.lookup(stream.encoding).name
+    except LookupError:
+        return None
+    if name not in ("utf-8", "ascii"):
+        return None
+    stream.flush()
+    return stream.buffer
 
 
 def stability_map(

@@ -303,8 +303,9 @@ def _aberth(coef, roots, done, hull, logs, directions, max_iterations):
 
 
 @kernel(fastmath=False)
-def _tidy_roots(roots, paired):
-    """Make conjugate pairs exact and near-real roots real, then sort like sorted_poles."""
+def _tidy_roots(roots, paired, sort):
+    """Make conjugate pairs exact and near-real roots real, then (``sort``) sort like
+    sorted_poles; the largest real part does not depend on the order."""
     n = roots.shape[0]
     for j in range(n):
         paired[j] = False
@@ -330,6 +331,8 @@ def _tidy_roots(roots, paired):
             w = 0.5 * (zj + roots[best].conjugate())
             roots[j] = w
             roots[best] = w.conjugate()
+    if not sort:
+        return
     # insertion sort: real part rounded to 9 decimals ascending, then imag descending
     for j in range(1, n):
         z = roots[j]
@@ -379,7 +382,7 @@ def batch_kernel(start, stop, mode, E_rows, E_cols, E_pair, E_weight, stiffness,
                 stable[i] = _routh_stable(coef, shifted, row_a, row_b, row_c)
             else:
                 converged[i] = _aberth(coef, roots, done, hull, logs, directions, max_iterations)
-                _tidy_roots(roots, done)
+                _tidy_roots(roots, done, keep_poles)
                 top = roots[0].real
                 for j in range(1, 2 * n):
                     if roots[j].real > top:
