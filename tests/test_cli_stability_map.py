@@ -174,3 +174,12 @@ def test_real_subprocess_bad_axis_is_one_line(tmp_path):
     assert proc.stdout == ""
     assert proc.stderr.strip().count("\n") == 0 and "LO < HI" in proc.stderr
     assert list(tmp_path.iterdir()) == []
+
+
+def test_known_figure_formats_are_matplotlib_formats():
+    """--out suffixes accepted without importing matplotlib are ones it writes."""
+    from matplotlib.figure import Figure
+
+    supported = set(Figure().canvas.get_supported_filetypes())
+    assert cli_map.FIGURE_FORMATS <= supported
+    assert {"png", "pdf", "svg"} <= cli_map.FIGURE_FORMATS and "csv" not in supported

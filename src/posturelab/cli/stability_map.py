@@ -3,10 +3,12 @@
 from __future__ import annotations
 
 import argparse
+import io
 import math
 import os
 import sys
 import tempfile
+from concurrent.futures import ThreadPoolExecutor, wait
 from pathlib import Path
 from typing import IO
 
@@ -126,18 +128,25 @@ def parse_viscosity_ratio(text: str | None) -> float | None:
     return value
 
 
+#: Figure formats (file suffixes) that matplotlib writes, known without importing it (a test
+#: checks them against matplotlib's list); another suffix is checked with matplotlib itself.
+FIGURE_FORMATS = frozenset({"eps", "jpeg", "jpg", "pdf", "pgf", "png", "ps", "raw", "rgba",
+                            "svg", "svgz", "tif", "tiff", "webp"})
+
+
 def output_paths(out: str) -> tuple[Path, Path, str]:
     """Figure path, CSV path beside it, and the figure format; checks the directory."""
-    from matplotlib.figure import Figure
-
     figure = Path(out)
     fmt = figure.suffix.lower().lstrip(".")
-    supported = Figure().canvas.get_supported_filetypes()
-    if fmt not in supported or fmt == "csv":
-        raise ParameterError(
-            f"--out must end in a figure suffix ({', '.join('.' + s for s in sorted(supported))})"
-            f", got {out!r}"
-        )
+    if fmt not in FIGURE_FORMATS:
+        from matplotlib.backend_bases import FigureCanvasBase
+
+        supported = FigureCanvasBase.get_supported_filetypes()
+        if fmt not in supported or fmt == "csv":
+            raise ParameterError(
+                "--out must end in a figure suffix "
+                f"({', '.join('.' + s for s in sorted(supported))}), got {out!r}"
+            )
     directory = figure.parent
     if not directory.is_dir():
         raise ParameterError(f"--out directory {str(directory)!r} does not exist")
@@ -277,6 +286,22 @@ def _temporary_beside(path: Path) -> Path:
     return Path(name)
 
 
+def _import_plotting() -> None:
+    """Import what :func:`plot_stability_map` uses (matplotlib's figure, Agg, fonts)."""
+    from matplotlib import font_manager
+    from matplotlib.backends import backend_agg  # noqa: F401
+    from matplotlib.figure import Figure  # noqa: F401
+
+    font_manager.fontManager  # noqa: B018 (loads the font list)
+
+
+def _write_csv(smap, path: Path, show: bool) -> None:
+    """Write ``smap``'s CSV to ``path`` (a progress bar on standard error if ``show``)."""
+    with open(path, "w", encoding="utf-8", newline="") as stream:
+        smap.write_csv(stream, progress=ProgressBar(sys.stderr, "writing CSV  ", "rows")
+                       if show else None)
+
+
 def run(args: argparse.Namespace) -> int:
     x = parse_axis(args.x, "--x")
     y = parse_axis(args.y, "--y")
@@ -293,8 +318,8 @@ def run(args: argparse.Namespace) -> int:
     from ..linear.batch import parameter_grid, stability_map
 
     parameter_grid(x, y, resolution, case=args.case, viscosity_ratio=ratio)  # validates --case
-    load_compiled(lambda: stability_map(x, y, 2, case=args.case, viscosity_ratio=ratio),
-                  "the stability evaluator")
+    load_compiled(lambda: stability_map(x, y, 2, case=args.case, viscosity_ratio=ratio)
+                  .write_csv(io.StringIO()), "the stability evaluator")
 
     temporaries: list[Path] = []
     try:
@@ -306,13 +331,20 @@ def run(args: argparse.Namespace) -> int:
 
         show = args.progress or sys.stderr.isatty()
         progress = ProgressBar(sys.stderr, "stability-map") if show else None
-        smap = stability_map(x, y, resolution, case=args.case, viscosity_ratio=ratio,
-                             progress=progress)
-        with open(tmp_csv, "w", encoding="utf-8", newline="") as stream:
-            smap.write_csv(stream, progress=ProgressBar(sys.stderr, "writing CSV  ", "rows")
-                           if show else None)
-        with open(tmp_figure, "wb") as stream:
-            plot_stability_map(smap, stream, fmt)
+        # The compiled map and CSV writer release the GIL: each runs on a worker thread
+        # while this one imports matplotlib and then draws the figure.
+        with ThreadPoolExecutor(max_workers=1) as worker:
+            computing = worker.submit(stability_map, x, y, resolution, case=args.case,
+                                      viscosity_ratio=ratio, progress=progress)
+            _import_plotting()
+            smap = computing.result()
+            writing = worker.submit(_write_csv, smap, tmp_csv, show)
+            try:
+                with open(tmp_figure, "wb") as stream:
+                    plot_stability_map(smap, stream, fmt)
+            finally:
+                wait([writing])  # before the temporaries may be removed
+            writing.result()
         os.replace(tmp_csv, csv_path)
         temporaries.remove(tmp_csv)
         os.replace(tmp_figure, figure_path)
