@@ -14,7 +14,10 @@ Everything is measured in this one run on this machine:
   (|Δλ| / max(1, |λ|), target 1e-8) and of the stable flags;
 * the cold-compile time (a fresh process with an empty numba cache) and the
   cached-load time (a fresh process loading the cache), both as wall time of
-  ``python -c "import ...; first call"``.
+  ``python -c "import ...; first call"``;
+* the whole ``posturelab stability-map`` command at resolution 1000 (10⁶ sets:
+  start-up, kernel, CSV and PNG), a fresh process each time with the numba cache
+  warm, median of 3 after one warm-up run (``--skip-command`` leaves it out).
 
 Random sets: each pair stiffness uniform in [0, 1500] N·m/rad, 15 % of them
 set to 0 (pairs switched off, as in Table I); viscosity ratio uniform in
@@ -120,6 +123,26 @@ def first_call_times(cache_dir: str, runs: int) -> list[tuple[float, float, floa
     return out
 
 
+COMMAND = ["stability-map", "--x", "ankle:0:2000", "--y", "gastrocnemius:0:1000",
+           "--resolution", "1000"]
+COMMAND_SETS = 1000 * 1000
+
+
+def command_times(runs: int) -> list[float]:
+    """Wall time of ``posturelab stability-map`` (COMMAND) in fresh processes, after one
+    untimed warm-up run (which fills the numba cache if needed)."""
+    out = []
+    with tempfile.TemporaryDirectory(prefix="posturelab-map-") as folder:
+        argv = [sys.executable, "-m", "posturelab", *COMMAND, "--out",
+                os.path.join(folder, "map.png")]
+        for i in range(runs + 1):
+            t = time.perf_counter()
+            subprocess.run(argv, capture_output=True, text=True, check=True)
+            if i:
+                out.append(time.perf_counter() - t)
+    return out
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sets", type=int, default=1_000_000)
@@ -127,6 +150,8 @@ def main() -> None:
     parser.add_argument("--baseline-sets", type=int, default=20_000)
     parser.add_argument("--skip-compile", action="store_true",
                         help="skip the cold-compile / cached-load subprocess timings")
+    parser.add_argument("--skip-command", action="store_true",
+                        help="skip timing the whole stability-map command")
     args = parser.parse_args()
 
     print(f"machine: {machine()}")
@@ -180,6 +205,11 @@ def main() -> None:
     ]
     for label, t in rows:
         print(f"{label:<56}{t:>11.3f}{1e6 * t / args.sets:>14.3f}{t_base / t:>9.1f}×")
+    if not args.skip_command:
+        t_cmd = statistics.median(command_times(3))
+        base_cmd = t_base * COMMAND_SETS / args.sets  # the baseline for as many sets
+        print(f"{'stability-map command, resolution 1000 (warm, whole)':<56}{t_cmd:>11.3f}"
+              f"{1e6 * t_cmd / COMMAND_SETS:>14.3f}{base_cmd / t_cmd:>9.1f}×")
     print()
     print(f"agreement with numpy eigvals on {nb:,} sets:")
     print(f"  poles |Δλ|/max(1,|λ|): max {err.max():.2e}, 99.9th percentile "
