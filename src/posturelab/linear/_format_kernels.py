@@ -35,7 +35,7 @@ _POW10 = np.array([10.0**k for k in range(23)])  # exact: 10^k < 2^53 · 2^k for
 _COMMA, _NEWLINE, _MINUS, _POINT, _ZERO = 44, 10, 45, 46, 48
 
 
-@kernel(fastmath=False, inline="always")
+@kernel(fastmath=False)
 def _two_product(a, b):
     """Exact product a·b = p + e (Dekker; IEEE arithmetic without contraction)."""
     p = a * b
@@ -49,7 +49,7 @@ def _two_product(a, b):
     return p, e
 
 
-@kernel(fastmath=False, inline="always")
+@kernel(fastmath=False)
 def _put_g12(v, out, pos):
     """Write ``"%.12g" % v`` into ``out`` at ``pos``; return the new position, or −1 when v
     is outside [FAST_LOW, FAST_HIGH) in magnitude (and not 0) or not finite."""
@@ -130,7 +130,7 @@ def _put_g12(v, out, pos):
     return pos + 2
 
 
-@kernel(fastmath=False, inline="always")
+@kernel(fastmath=False)
 def _put_digits(d, count, out, pos, point):
     """The ``count`` decimal digits of ``d`` (uint64) at ``pos``, with a decimal point
     after the first ``point`` digits when ``point`` >= 1 (then count + 1 bytes)."""
@@ -165,7 +165,14 @@ def csv_rows(start, stop, nx, x_text, x_len, y_text, y_len, values, stable, spec
     is enough).
     """
     pos = 0
-    s = np.searchsorted(special_index, start)
+    s = 0  # the first special row at or after start (binary search)
+    high = special_index.shape[0]
+    while s < high:
+        middle = (s + high) // 2
+        if special_index[middle] < start:
+            s = middle + 1
+        else:
+            high = middle
     for i in range(start, stop):
         ix = i % nx
         iy = i // nx
