@@ -36,20 +36,6 @@ _COMMA, _NEWLINE, _MINUS, _POINT, _ZERO = 44, 10, 45, 46, 48
 
 
 @kernel(fastmath=False)
-def _two_product(a, b):
-    """Exact product a·b = p + e (Dekker; IEEE arithmetic without contraction)."""
-    p = a * b
-    ca = 134217729.0 * a  # 2^27 + 1
-    a_hi = ca - (ca - a)
-    a_lo = a - a_hi
-    cb = 134217729.0 * b
-    b_hi = cb - (cb - b)
-    b_lo = b - b_hi
-    e = ((a_hi * b_hi - p) + a_hi * b_lo + a_lo * b_hi) + a_lo * b_lo
-    return p, e
-
-
-@kernel(fastmath=False)
 def _put_g12(v, out, pos):
     """Write ``"%.12g" % v`` into ``out`` at ``pos``; return the new position, or −1 when v
     is outside [FAST_LOW, FAST_HIGH) in magnitude (and not 0) or not finite."""
@@ -62,21 +48,29 @@ def _put_g12(v, out, pos):
     a = abs(v)
     if not (a >= FAST_LOW and a < FAST_HIGH):  # also NaN
         return -1
-    e = int(math.floor(math.log10(a)))
-    e = min(11, max(-11, e))
+    e = min(11, max(-11, int(math.floor(math.log10(a)))))
     hi = 0.0
     lo = 0.0
     for _ in range(4):  # log10 may be one off near a power of ten
-        hi, lo = _two_product(a, _POW10[11 - e])
+        # hi + lo = a · 10^(11 − e) exactly: Dekker's product (splitting by 2^27 + 1)
+        b = _POW10[11 - e]
+        hi = a * b
+        ca = 134217729.0 * a
+        a_hi = ca - (ca - a)
+        a_lo = a - a_hi
+        cb = 134217729.0 * b
+        b_hi = cb - (cb - b)
+        b_lo = b - b_hi
+        lo = ((a_hi * b_hi - hi) + a_hi * b_lo + a_lo * b_hi) + a_lo * b_lo
         if (hi > 1e12 or (hi == 1e12 and lo >= 0.0)) and e < 11:
             e += 1
         elif (hi < 1e11 or (hi == 1e11 and lo < 0.0)) and e > -11:
             e -= 1
         else:
             break
-    # hi + lo = a · 10^(11 − e) exactly, in [1e11, 1e12): round to an integer, ties to
-    # even. r is a multiple of ulp(hi) >= 2|lo|, so only r == 0.5 needs lo (r == 0 with
-    # lo < 0 is just below the integer f, and rounds to it).
+    # hi + lo in [1e11, 1e12): round to an integer, ties to even. r is a multiple of
+    # ulp(hi) >= 2|lo|, so only r == 0.5 needs lo (r == 0 with lo < 0 is just below
+    # the integer f, and rounds to it).
     f = math.floor(hi)
     r = hi - f  # exact
     digits = np.int64(f)
@@ -85,39 +79,45 @@ def _put_g12(v, out, pos):
     if digits == 1_000_000_000_000:
         digits = 100_000_000_000
         e += 1
-    # drop trailing zeros: ``used`` significant digits remain in ``d``
-    d = np.uint64(digits)
-    used = DIGITS
-    while used > 1 and d % np.uint64(10) == 0:
-        d //= np.uint64(10)
+    used = DIGITS  # significant digits left once trailing zeros are dropped
+    while used > 1 and digits % 10 == 0:
+        digits //= 10
         used -= 1
     if v < 0.0:
         out[pos] = _MINUS
         pos += 1
-    if 0 <= e < DIGITS:  # fixed notation, e + 1 digits before the point
-        if used <= e + 1:
-            _put_digits(d, used, out, pos, -1)
-            for k in range(pos + used, pos + e + 1):
-                out[k] = _ZERO
-            return pos + e + 1
-        _put_digits(d, used, out, pos, e + 1)
-        return pos + used + 1
-    if -4 <= e < 0:  # fixed notation: 0.000ddd
+    # the layout of %g: fixed notation for -4 <= e < 12, else d.ddd e±XX
+    point = -1  # digits before the decimal point, when there is one among the digits
+    pad = 0  # zeros after the digits (an integer with trailing zeros)
+    if 0 <= e < DIGITS:
+        if used > e + 1:
+            point = e + 1
+        else:
+            pad = e + 1 - used
+    elif -4 <= e < 0:
         out[pos] = _ZERO
         out[pos + 1] = _POINT
         pos += 2
         for _ in range(-e - 1):
             out[pos] = _ZERO
             pos += 1
-        _put_digits(d, used, out, pos, -1)
-        return pos + used
-    # exponent notation: d.ddd e±XX
-    if used > 1:
-        _put_digits(d, used, out, pos, 1)
-        pos += used + 1
-    else:
-        _put_digits(d, 1, out, pos, -1)
+    elif used > 1:
+        point = 1
+    end = pos + used + (1 if point > 0 else 0)
+    k = end - 1
+    for j in range(used - 1, -1, -1):  # the digits, last first
+        out[k] = _ZERO + digits % 10
+        digits //= 10
+        k -= 1
+        if j == point:
+            out[k] = _POINT
+            k -= 1
+    pos = end
+    for _ in range(pad):
+        out[pos] = _ZERO
         pos += 1
+    if -4 <= e < DIGITS:
+        return pos
     out[pos] = 101  # "e"
     out[pos + 1] = _MINUS if e < 0 else 43  # "-" or "+"
     pos += 2
@@ -128,21 +128,6 @@ def _put_g12(v, out, pos):
     out[pos] = _ZERO + (x // 10) % 10
     out[pos + 1] = _ZERO + x % 10
     return pos + 2
-
-
-@kernel(fastmath=False)
-def _put_digits(d, count, out, pos, point):
-    """The ``count`` decimal digits of ``d`` (uint64) at ``pos``, with a decimal point
-    after the first ``point`` digits when ``point`` >= 1 (then count + 1 bytes)."""
-    end = pos + count + (1 if point >= 1 else 0)
-    k = end - 1
-    for j in range(count - 1, -1, -1):
-        out[k] = _ZERO + np.uint8(d % np.uint64(10))
-        d //= np.uint64(10)
-        k -= 1
-        if j == point:
-            out[k] = _POINT
-            k -= 1
 
 
 @kernel(nogil=True, entry=True, fastmath=False)
