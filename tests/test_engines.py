@@ -179,6 +179,20 @@ def test_delayed_batch_equals_its_single_runs_bit_for_bit(rng):
     assert out.fell[6] and not out.fell[0]
 
 
+def test_batch_of_random_gains_equals_its_single_runs_bit_for_bit(rng):
+    """Random gains (stiff and soft, falling and recovering): peak angles, the last sample
+    and the outcome of every row are those of its single run, to the last bit."""
+    m = 40
+    k = np.empty((m, 5))
+    k[:, 0] = rng.uniform(400.0, 1500.0, m)
+    k[:, 1:] = rng.uniform(0.0, 600.0, (m, 4))
+    d = pl.VelocityStep.backward(1.0)
+    out = simulate_batch(pl.paper_body(), k, 0.25 * k, d, 5.0, POSTURE)
+    for r in range(m):
+        assert_row_is_run(out, r, _single(pl.paper_body(), k[r], d, 5.0, initial_state=POSTURE))
+    assert 0 < out.fell.sum() < m
+
+
 def test_batch_with_per_run_torque_limits_and_cop_equals_single_runs():
     """Per-run limits (including none), centre-of-pressure falls, and a run whose centre of
     pressure is outside the foot at t = 0."""

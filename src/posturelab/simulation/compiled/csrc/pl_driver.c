@@ -281,7 +281,8 @@ int64_t pl_integrate(const pl_run *run, pl_out *out)
         }
         gi = g_end;
         if (gi > first_gi) {
-            const double s = (grid[gi - 1] - t) / h;
+            /* the expression of the samples above (a batch row keeps no samples) */
+            const double s = (grid[gi - 1] - t) * (1.0 / h);
             for (int64_t i = 0; i < m; i++) {
                 const double *q = Q + 4 * i;
                 out->final[i] = x[i] + s * (q[0] + s * (q[1] + s * (q[2] + s * q[3])));
