@@ -105,8 +105,8 @@ def simulate(
         Words stored in the result.
     engine : {"reference", "compiled"}
         ``reference``: the numpy model integrated by scipy (slow, obvious, the check);
-        ``compiled``: the numba engine (hundreds of times faster; the first call
-        after installing compiles it). Same model, events and result.
+        ``compiled``: the C engine (hundreds of times faster, built when posturelab is
+        installed). Same model, events and result.
 
     Returns
     -------

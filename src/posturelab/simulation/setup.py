@@ -214,12 +214,30 @@ RUN_OPTIONS: dict[str, object] = {
 }
 
 
+def _frozen(value):
+    """A hashable form of an option value (arrays and lists as tuples)."""
+    if isinstance(value, np.ndarray | list | tuple):
+        return tuple(np.asarray(value, dtype=float).ravel().tolist())
+    return value
+
+
+@functools.lru_cache(maxsize=128)
+def _prepare_cached(body, muscles, disturbance, duration, frozen_options) -> RunSetup:
+    options = dict(frozen_options)
+    for key in ("initial_state", "torque_limits"):
+        if options.get(key) is not None:
+            options[key] = np.array(options[key])
+    return _prepare(body, muscles, disturbance, duration, **options)
+
+
 def prepare_run(body: Body, muscles: MuscleSet, disturbance: Disturbance | None = None,
                 duration: float = 5.0, **options) -> RunSetup:
     """Validate the arguments of a run and work out everything both engines share.
 
     Parameters are those of :func:`posturelab.simulate` (units there); the keyword
-    options and their defaults are :data:`RUN_OPTIONS`.
+    options and their defaults are :data:`RUN_OPTIONS`. A set-up is immutable, so the
+    same arguments (when every one is hashable: a measured profile is not) return the
+    same object, computed once.
 
     Raises
     ------
@@ -227,6 +245,16 @@ def prepare_run(body: Body, muscles: MuscleSet, disturbance: Disturbance | None 
         An unknown option, an argument of the wrong type or outside its range, the knee
         beyond its stop, a muscle set for another number of links.
     """
+    try:
+        key = tuple(sorted((k, _frozen(v)) for k, v in options.items()))
+        return _prepare_cached(body, muscles, disturbance, duration, key)
+    except TypeError:  # something unhashable (a measured profile): set up afresh
+        return _prepare(body, muscles, disturbance, duration, **options)
+
+
+def _prepare(body: Body, muscles: MuscleSet, disturbance: Disturbance | None = None,
+             duration: float = 5.0, **options) -> RunSetup:
+    """:func:`prepare_run` without the memo."""
     from .._validation import reject_unknown_keys
 
     reject_unknown_keys("the options of a run", options, RUN_OPTIONS)

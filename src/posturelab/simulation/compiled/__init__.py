@@ -156,14 +156,26 @@ def _packed(setup: RunSetup) -> dict:
 
 
 def _run_struct(a: dict, method: str, gains, lim, delay: float, sat0) -> Run:
-    """The C inputs of one run (the arrays in ``a`` must outlive it)."""
+    """The C inputs of one run (the arrays in ``a`` must outlive it): a copy of the run's
+    gain-independent inputs (built once per set-up and method) with these filled in."""
+    base = a.get(("run", method))
+    if base is None:
+        base = a[("run", method)] = _base_run_struct(a, method)
+    run = Run.from_buffer_copy(base)
+    run.gains, run.lim, run.sat0 = pointer(gains), pointer(lim), pointer(sat0)
+    run.delay = float(delay)
+    return run
+
+
+def _base_run_struct(a: dict, method: str) -> Run:
+    """The gain-independent C inputs of a run."""
     from ..setup import DELAY_BREAKPOINT_MULTIPLES
 
     tab = METHODS[method]
     n = a["n"]
     run = Run(n=n, p=a["E"].shape[0], n_grid=a["grid"].size, n_bps=a["bps"].size,
               n_slots=len(a["slots"]), method=METHOD_RADAU if tab is None else METHOD_EXPLICIT,
-              delay=float(delay), delay_multiples=DELAY_BREAKPOINT_MULTIPLES)
+              delay_multiples=DELAY_BREAKPOINT_MULTIPLES)
     for name in ("x0", "before", "grid", "bp", "E", "C", "dp", "bps", "fpar", "active0",
                  "ev_offset"):
         setattr(run, name, pointer(a[name]))
@@ -174,7 +186,6 @@ def _run_struct(a: dict, method: str, gains, lim, delay: float, sat0) -> Run:
     run.slot_index = pointer(slots.index, ctypes_int64)
     run.slot_cond = pointer(slots.condition, ctypes_int64)
     run.slot_side = pointer(slots.side)
-    run.gains, run.lim, run.sat0 = pointer(gains), pointer(lim), pointer(sat0)
     if tab is not None:
         run.n_stages = tab.nodes.size
         run.tab_A, run.tab_c = pointer(tab.A), pointer(tab.nodes)
@@ -525,7 +536,7 @@ def simulate_batch(
     sat0_all = enc.readonly(start_saturation(moments0, lims))
     lim_all = enc.readonly(lims)
     delay_all = enc.readonly(delays)
-    a = dict(packed[0])
+    a = {key: v for key, v in packed[0].items() if isinstance(key, str)}  # no cached run
     a["fpar"] = enc.options(base, settle_tolerance)[0]
     results = np.zeros((M, N_RESULT))
     peaks = np.zeros((M, n))
