@@ -12,6 +12,15 @@ A *one-sided* pair acts only while its stretch is >= 0 (the real
 gastrocnemius, which acts while θ2 >= 0); a *two-sided* pair acts always
 (the paper's "artificial antagonist").
 
+Two kinds of feedback per pair. The *intrinsic* stiffness and viscosity (``stiffness``,
+``viscosity``: the muscles' visco-elasticity) act at once on the stretch relative to the
+foot. The *active* (neural) stiffness and viscosity (``active_stiffness``,
+``active_viscosity``) act on the state a feedback delay τ earlier. A muscle set with no
+active gains at all (every pair's ``None``, the paper's model) reads its pair gains as the
+whole feedback: a run's ``feedback_delay`` then delays all of it, as before the split.
+:func:`feedback_gains` states the rule once: it gives the (immediate, delayed) gains every
+engine uses.
+
 Table I's nine stiffness sets are the presets ``"1" … "7", "6a", "6b"``
 (:data:`STIFFNESS_CASES`).
 """
@@ -19,7 +28,7 @@ Table I's nine stiffness sets are the presets ``"1" … "7", "6a", "6b"``
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import cached_property
 from typing import Literal
 
@@ -43,6 +52,8 @@ __all__ = [
     "joint_crossing_matrix",
     "joint_moments",
     "moments_to_link_torques",
+    "feedback_gains",
+    "feedback_pair_torques",
 ]
 
 #: Viscosity as a fraction of stiffness used throughout the paper (Appendix C). [s]
@@ -68,6 +79,11 @@ class MusclePair:
         Pair viscosity, the diagonal entry of L_d. [N·m·s/rad]
     one_sided : bool
         If true the pair acts only while its stretch is >= 0.
+    active_stiffness : float, optional
+        Active (neural, delayed) stiffness; None for none. [N·m/rad]
+    active_viscosity : float, optional
+        Active (neural, delayed) viscosity; None for none (0 if only the active
+        stiffness is given). [N·m·s/rad]
     """
 
     name: str
@@ -76,6 +92,8 @@ class MusclePair:
     stiffness: float
     viscosity: float
     one_sided: bool = False
+    active_stiffness: float | None = None
+    active_viscosity: float | None = None
 
     def __post_init__(self) -> None:
         label = f"muscle pair {self.name!r}"
@@ -96,6 +114,16 @@ class MusclePair:
             self, "viscosity", nonnegative_float(f"{label} viscosity", self.viscosity, "N·m·s/rad")
         )
         object.__setattr__(self, "one_sided", bool(self.one_sided))
+        for field, unit in (("active_stiffness", "N·m/rad"), ("active_viscosity", "N·m·s/rad")):
+            value = getattr(self, field)
+            if value is not None:
+                object.__setattr__(self, field, nonnegative_float(
+                    f"{label} {field.replace('_', ' ')}", value, unit))
+
+    @property
+    def has_active(self) -> bool:
+        """The pair has an active (delayed) part."""
+        return self.active_stiffness is not None or self.active_viscosity is not None
 
 
 @dataclass(frozen=True)
@@ -126,6 +154,12 @@ class MuscleSet:
                     f"muscle pair {p.name!r} spans link {p.hi}, but the body has "
                     f"{self.n_links} links (allowed hi: 1..{self.n_links})"
                 )
+        if any(p.has_active for p in pairs) and any(p.one_sided for p in pairs):
+            one = next(p.name for p in pairs if p.one_sided)
+            raise ParameterError(
+                f"muscle pair {one!r} is one-sided: one-sided pairs cannot be combined with "
+                "active (delayed) gains (make it two-sided, or give no active gains)"
+            )
         object.__setattr__(self, "pairs", pairs)
         object.__setattr__(self, "n_links", int(self.n_links))
 
@@ -169,6 +203,27 @@ class MuscleSet:
         return np.array([p.viscosity for p in self.pairs])
 
     @cached_property
+    def has_active_feedback(self) -> bool:
+        """Some pair has active (delayed) gains: the pair gains are then the intrinsic part
+        only (undelayed); without any, a feedback delay applies to the whole pair feedback."""
+        return any(p.has_active for p in self.pairs)
+
+    @cached_property
+    def active_stiffnesses(self) -> np.ndarray:
+        """Active (neural) pair stiffness, 0 where none. [N·m/rad]"""
+        return np.array([p.active_stiffness or 0.0 for p in self.pairs])
+
+    @cached_property
+    def active_viscosities(self) -> np.ndarray:
+        """Active (neural) pair viscosity, 0 where none. [N·m·s/rad]"""
+        return np.array([p.active_viscosity or 0.0 for p in self.pairs])
+
+    @cached_property
+    def spans_foot(self) -> np.ndarray:
+        """True for the pairs with lo = 0 (they span the ankle and feel a platform tilt)."""
+        return np.array([p.lo == 0 for p in self.pairs], dtype=bool)
+
+    @cached_property
     def one_sided_mask(self) -> np.ndarray:
         """True for pairs that act only while their stretch is >= 0."""
         return np.array([p.one_sided for p in self.pairs], dtype=bool)
@@ -206,19 +261,43 @@ class MuscleSet:
             raise UnknownNameError(
                 f"unknown muscle pair {unknown[0]!r}; known pairs: {', '.join(self.names)}"
             )
-        pairs = tuple(
-            MusclePair(p.name, p.lo, p.hi, stiffness.get(p.name, p.stiffness), p.viscosity,
-                       p.one_sided)
-            for p in self.pairs
-        )
+        pairs = tuple(replace(p, stiffness=stiffness.get(p.name, p.stiffness))
+                      for p in self.pairs)
         return MuscleSet(pairs, self.n_links)
+
+    def with_active_feedback(self, stiffness: Sequence[float] | None,
+                             viscosity: Sequence[float] | None = None) -> MuscleSet:
+        """A copy with these active (neural, delayed) gains, one per pair in row order, or
+        with none (``stiffness=None``, ``viscosity=None``: the paper's model).
+
+        Parameters
+        ----------
+        stiffness : sequence of float, shape (P,), or None
+            Active pair stiffness. [N·m/rad]
+        viscosity : sequence of float, shape (P,), optional
+            Active pair viscosity; 0 if only ``stiffness`` is given. [N·m·s/rad]
+        """
+        P = len(self.pairs)
+        if stiffness is None and viscosity is None:
+            return MuscleSet(tuple(replace(p, active_stiffness=None, active_viscosity=None)
+                                   for p in self.pairs), self.n_links)
+        k = (np.zeros(P) if stiffness is None
+             else np.atleast_1d(finite_array("active stiffness [N·m/rad]", stiffness)))
+        v = (np.zeros(P) if viscosity is None
+             else np.atleast_1d(finite_array("active viscosity [N·m·s/rad]", viscosity)))
+        for label, arr in (("active stiffness [N·m/rad]", k),
+                           ("active viscosity [N·m·s/rad]", v)):
+            if arr.shape != (P,):
+                raise ParameterError(
+                    f"{label} must have {P} values (one per pair: {', '.join(self.names)}), "
+                    f"got {arr.size}")
+        return MuscleSet(tuple(replace(p, active_stiffness=float(k[i]),
+                                       active_viscosity=float(v[i]))
+                               for i, p in enumerate(self.pairs)), self.n_links)
 
     def as_two_sided(self) -> MuscleSet:
         """A copy in which every pair acts on both sides (artificial antagonists added)."""
-        pairs = tuple(
-            MusclePair(p.name, p.lo, p.hi, p.stiffness, p.viscosity, False) for p in self.pairs
-        )
-        return MuscleSet(pairs, self.n_links)
+        return MuscleSet(tuple(replace(p, one_sided=False) for p in self.pairs), self.n_links)
 
     def without_one_sided(self) -> MuscleSet:
         """A copy with the one-sided pairs removed (their inactive side)."""
@@ -283,6 +362,92 @@ def moments_to_link_torques(moments: np.ndarray) -> np.ndarray:
     return above - moments
 
 
+def feedback_gains(stiffness, viscosity, active_stiffness=None, active_viscosity=None,
+                   delay=0.0) -> np.ndarray:
+    """The pair gains by when they act: (immediate k, immediate l, delayed k, delayed l).
+
+    The one statement of which feedback is delayed, for every engine and batch:
+
+    - no active gains (``active_stiffness is None``): the pair gains are the whole
+      feedback, delayed when ``delay > 0``, immediate otherwise;
+    - active gains: the pair gains (intrinsic) act at once, the active gains after
+      ``delay``; with no delay both act at once and are summed.
+
+    Parameters
+    ----------
+    stiffness, viscosity : array_like, shape (..., P)
+        Pair (intrinsic) gains. [N·m/rad], [N·m·s/rad]
+    active_stiffness, active_viscosity : array_like, shape (..., P), optional
+        Active (neural) gains, or None for none. [N·m/rad], [N·m·s/rad]
+    delay : float or array_like, shape (...)
+        Feedback delay τ per row. [s]
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 4, P)
+        [N·m/rad], [N·m·s/rad], [N·m/rad], [N·m·s/rad].
+    """
+    k = np.asarray(stiffness, dtype=float)
+    v = np.asarray(viscosity, dtype=float)
+    z = np.zeros(np.broadcast_shapes(k.shape, v.shape))
+    k, v = k + z, v + z
+    delayed = (np.asarray(delay, dtype=float) > 0)[..., None, None]
+    if active_stiffness is None and active_viscosity is None:
+        return np.where(delayed, np.stack([z, z, k, v], axis=-2), np.stack([k, v, z, z], axis=-2))
+    ka = z if active_stiffness is None else np.asarray(active_stiffness, dtype=float) + z
+    va = z if active_viscosity is None else np.asarray(active_viscosity, dtype=float) + z
+    return np.where(delayed, np.stack([k, v, ka, va], axis=-2),
+                    np.stack([k + ka, v + va, z, z], axis=-2))
+
+
+def muscle_set_gains(muscles: MuscleSet, delay: float) -> np.ndarray:
+    """:func:`feedback_gains` of a muscle set's own gains, shape (4, P)."""
+    if muscles.has_active_feedback:
+        return feedback_gains(muscles.stiffnesses, muscles.viscosities,
+                              muscles.active_stiffnesses, muscles.active_viscosities, delay)
+    return feedback_gains(muscles.stiffnesses, muscles.viscosities, None, None, delay)
+
+
+def feedback_pair_torques(muscles: MuscleSet, gains: np.ndarray, state: np.ndarray,
+                          delayed_state: np.ndarray, active: np.ndarray | None = None,
+                          ) -> np.ndarray:
+    """Pair torques from the immediate part on ``state`` and the delayed part on
+    ``delayed_state``: M = k E Θ + l E Θ̇ + k_τ E Θ_τ + l_τ E Θ̇_τ (a part whose gains are
+    all zero is left out, so that a run without it is computed exactly as before).
+
+    Parameters
+    ----------
+    gains : numpy.ndarray, shape (..., 4, P)
+        From :func:`feedback_gains`. [N·m/rad], [N·m·s/rad]
+    state, delayed_state : array_like, shape (..., 2N)
+        ``[Θ, Θ̇]`` now and τ earlier. [rad], [rad/s]
+    active : array_like, shape (..., P), optional
+        Which pairs act (1) or are slack (0). [-]
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., P)
+        [N·m]
+    """
+    n = muscles.n_links
+    E = muscles.selection_matrix
+    gains = np.asarray(gains, dtype=float)
+    M = None
+    for first, x in ((0, state), (2, delayed_state)):
+        k, v = gains[..., first, :], gains[..., first + 1, :]
+        if not (np.any(k) or np.any(v)):
+            continue
+        x = np.asarray(x, dtype=float)
+        part = k * (x[..., :n] @ E.T) + v * (x[..., n:] @ E.T)
+        M = part if M is None else M + part
+    if M is None:
+        shape = np.broadcast_shapes(np.shape(state)[:-1], gains.shape[:-2])
+        M = np.zeros(shape + (len(muscles.pairs),))
+    if active is not None:
+        M = M * np.asarray(active, dtype=float)
+    return M
+
+
 # ---------------------------------------------------------------------------
 # The paper's five pairs and Table I
 # ---------------------------------------------------------------------------
@@ -338,6 +503,9 @@ def paper_muscles(
     viscosity_ratio: float = DEFAULT_VISCOSITY_RATIO,
     viscosity: Sequence[float] | None = None,
     gastrocnemius: Gastrocnemius = "two-sided",
+    active_stiffness: Sequence[float] | None = None,
+    active_viscosity: Sequence[float] | None = None,
+    active_viscosity_ratio: float | None = None,
 ) -> MuscleSet:
     """The paper's five pairs on the three-link body.
 
@@ -357,6 +525,14 @@ def paper_muscles(
     gastrocnemius : {"two-sided", "one-sided"}
         ``"two-sided"`` adds the paper's artificial antagonist; ``"one-sided"``
         lets the gastrocnemius act only while θ2 >= 0.
+    active_stiffness : sequence of 5 floats, optional
+        Active (neural, delayed) pair stiffness, same order; none by default (the
+        paper's model, whose pair gains are then the whole feedback). [N·m/rad]
+    active_viscosity : sequence of 5 floats, optional
+        Active pair viscosity. [N·m·s/rad]
+    active_viscosity_ratio : float, optional
+        Active viscosity = ratio × active stiffness instead (default 0 when only the
+        active stiffness is given). [s]
 
     Returns
     -------
@@ -389,7 +565,21 @@ def paper_muscles(
                    one_sided=(name == "gastrocnemius" and gastrocnemius == "one-sided"))
         for i, (name, (lo, hi, _)) in enumerate(PAPER_PAIRS.items())
     )
-    return MuscleSet(pairs, 3)
+    muscles = MuscleSet(pairs, 3)
+    if active_stiffness is None and active_viscosity is None:
+        if active_viscosity_ratio is not None:
+            raise ParameterError("active_viscosity_ratio needs active_stiffness")
+        return muscles
+    if active_viscosity is not None and active_viscosity_ratio is not None:
+        raise ParameterError("give active_viscosity or active_viscosity_ratio, not both")
+    ka = (np.zeros(5) if active_stiffness is None
+          else _five("active stiffness [N·m/rad]", active_stiffness))
+    if active_viscosity_ratio is not None:
+        va = nonnegative_float("active_viscosity_ratio [s]", active_viscosity_ratio) * ka
+    else:
+        va = (np.zeros(5) if active_viscosity is None
+              else _five("active viscosity [N·m·s/rad]", active_viscosity))
+    return muscles.with_active_feedback(ka, va)
 
 
 def _five(name: str, values) -> np.ndarray:

@@ -16,7 +16,7 @@ from ..model.kinematics import (
     centre_of_pressure,
     ground_reaction,
 )
-from ..model.muscles import moments_to_link_torques, pair_torques
+from ..model.muscles import feedback_pair_torques, moments_to_link_torques
 from .results import DerivedSeries
 from .setup import RunSetup
 
@@ -37,8 +37,8 @@ def derived_series(setup: RunSetup, time: np.ndarray, state: np.ndarray,
     state : numpy.ndarray, shape (T, 2N)
         ``[Θ, Θ̇]`` at the samples. [rad], [rad/s]
     feedback_state : numpy.ndarray, shape (T, 2N), optional
-        The state the muscles responded to at each sample (x(t − τ) with a delay);
-        ``state`` by default. [rad], [rad/s]
+        The state the delayed part of the feedback responded to at each sample
+        (x(t − τ)); ``state`` by default. [rad], [rad/s]
     locked : numpy.ndarray of bool, shape (T,), optional
         Samples at which the knee constraint held.
 
@@ -54,7 +54,10 @@ def derived_series(setup: RunSetup, time: np.ndarray, state: np.ndarray,
     state = np.asarray(state, dtype=float).reshape(-1, 2 * n)
     theta, omega = state[:, :n], state[:, n:]
     fb = state if feedback_state is None else np.asarray(feedback_state, dtype=float)
-    M = pair_torques(muscles, fb[:, :n], fb[:, n:])
+    M = feedback_pair_torques(muscles, setup.gains, state, fb)
+    if muscles.one_sided_mask.any():  # (such pairs are all-immediate or all-delayed)
+        slack = muscles.one_sided_mask & (fb[:, :n] @ muscles.selection_matrix.T < 0.0)
+        M = np.where(slack, 0.0, M)
     moments = M @ muscles.crossing_matrix
     if setup.torque_limits is not None:
         moments = np.clip(moments, -setup.torque_limits, setup.torque_limits)

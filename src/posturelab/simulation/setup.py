@@ -31,7 +31,12 @@ from ..model.dynamics import (
     platform_vector,
 )
 from ..model.kinematics import centre_of_pressure, ground_reaction
-from ..model.muscles import MuscleSet, joint_moments, moments_to_link_torques
+from ..model.muscles import (
+    MuscleSet,
+    feedback_pair_torques,
+    moments_to_link_torques,
+    muscle_set_gains,
+)
 from ..model.options import FallCriteria, KneeModel, torque_limit_array
 from ..model.platform import Disturbance, NoDisturbance
 
@@ -74,6 +79,10 @@ class RunSetup:
         Largest net muscle moment per joint, ``inf`` where none; None if none limit. [N·m]
     feedback_delay : float
         Neural delay τ of the muscle feedback; 0 for none. [s]
+    gains : numpy.ndarray, shape (4, P)
+        The pair gains by when they act (:func:`posturelab.model.muscles.feedback_gains`):
+        immediate stiffness and viscosity, delayed stiffness and viscosity.
+        [N·m/rad], [N·m·s/rad], [N·m/rad], [N·m·s/rad]
     rtol, atol : float
         Integrator tolerances [-], [rad, rad/s].
     sample_rate : float
@@ -119,6 +128,7 @@ class RunSetup:
     fall: FallCriteria
     torque_limits: np.ndarray | None
     feedback_delay: float
+    gains: np.ndarray
     rtol: float
     atol: float
     sample_rate: float
@@ -303,21 +313,20 @@ def _prepare(body: Body, muscles: MuscleSet, disturbance: Disturbance | None = N
         locked0 = abs(kappa - knee.stop_angle) <= 1e-12 and (x0[n + 1] - x0[n]) >= 0
     if locked0:
         x0[n:] = constrained_velocity(body, x0[:n], x0[n:], knee_row)
-    feedback0 = before if delay > 0 else x0
-    active0 = start_activity(muscles, feedback0)
-    saturation0 = start_saturation(
-        start_moments(muscles, feedback0, active0, muscles.stiffnesses, muscles.viscosities),
-        limits)
+    gains = muscle_set_gains(muscles, delay)
+    active0 = start_activity(muscles, before if delay > 0 else x0)  # (one-sided pairs have
+    # no active gains: their whole feedback is delayed or none is)
+    saturation0 = start_saturation(start_moments(muscles, x0, before, active0, gains), limits)
     breakpoints = np.array(sorted({b for b in disturbance.breakpoints if 0.0 < b < duration}),
                            dtype=float)
     delay_bps = np.array([k * delay for k in range(1, DELAY_BREAKPOINT_MULTIPLES + 1)
                           if delay > 0 and k * delay < duration])
     max_step = min(disturbance.max_step, duration, delay if delay > 0 else math.inf)
-    for arr in (before, x0, active0, saturation0, breakpoints, delay_bps):
+    for arr in (before, x0, active0, saturation0, breakpoints, delay_bps, gains):
         arr.setflags(write=False)
     setup = RunSetup(
         body=body, muscles=muscles, disturbance=disturbance, duration=duration, knee=knee,
-        fall=fall, torque_limits=limits, feedback_delay=delay, rtol=rtol, atol=atol,
+        fall=fall, torque_limits=limits, feedback_delay=delay, gains=gains, rtol=rtol, atol=atol,
         sample_rate=sample_rate, max_switches=int(max_switches),
         description=description or disturbance.describe(), before=before, x0=x0,
         locked0=bool(locked0), active0=active0, saturation0=saturation0,
@@ -340,16 +349,13 @@ def start_activity(muscles: MuscleSet, state: np.ndarray) -> np.ndarray:
     return act.astype(float)
 
 
-def start_moments(muscles: MuscleSet, state: np.ndarray, active: np.ndarray,
-                  stiffness: np.ndarray, viscosity: np.ndarray) -> np.ndarray:
-    """Unsaturated joint moments τ = Cᵀ diag(active)(k_d E Θ + l_d E Θ̇) for gains that may
-    differ per run: state (..., 2N), active and gains (..., P). Returns (..., N). [N·m]"""
-    n = muscles.n_links
-    E = muscles.selection_matrix
-    state = np.asarray(state, dtype=float)
-    pair = (np.asarray(stiffness) * (state[..., :n] @ E.T)
-            + np.asarray(viscosity) * (state[..., n:] @ E.T)) * active
-    return pair @ muscles.crossing_matrix
+def start_moments(muscles: MuscleSet, state: np.ndarray, before: np.ndarray,
+                  active: np.ndarray, gains: np.ndarray) -> np.ndarray:
+    """Unsaturated joint moments at t = 0, τ = Cᵀ M, for gains that may differ per run:
+    the immediate part on ``state`` (..., 2N), the delayed part on ``before`` (..., 2N),
+    ``active`` (..., P), ``gains`` (..., 4, P) (:func:`feedback_pair_torques`).
+    Returns (..., N). [N·m]"""
+    return feedback_pair_torques(muscles, gains, state, before, active) @ muscles.crossing_matrix
 
 
 def start_saturation(moments: np.ndarray, limits: np.ndarray | None) -> np.ndarray:
@@ -399,7 +405,8 @@ def model_response(setup: RunSetup, t: float, x: np.ndarray, feedback: np.ndarra
     x : numpy.ndarray, shape (2N,)
         The state. [rad], [rad/s]
     feedback : numpy.ndarray, shape (2N,)
-        The state the muscles respond to (x itself, or x(t − τ)). [rad], [rad/s]
+        The state the delayed part of the feedback responds to, x(t − τ) (x itself
+        without a delay). [rad], [rad/s]
     active : numpy.ndarray, shape (P,)
         Which pairs act. [-]
     locked : bool
@@ -415,7 +422,7 @@ def model_response(setup: RunSetup, t: float, x: np.ndarray, feedback: np.ndarra
         Θ̈ (on the knee constraint if locked). [rad/s²]
     """
     n = setup.n_links
-    tau = joint_moments(setup.muscles, feedback[:n], feedback[n:], active)
+    tau = raw_moments(setup, x, feedback, active)
     if saturation is not None and setup.torque_limits is not None:
         bound = np.where(np.isfinite(setup.torque_limits), setup.torque_limits, 0.0)
         tau = np.where(saturation != 0, saturation * bound, tau)
@@ -427,10 +434,12 @@ def model_response(setup: RunSetup, t: float, x: np.ndarray, feedback: np.ndarra
     return tau, acc
 
 
-def raw_moments(setup: RunSetup, feedback: np.ndarray, active: np.ndarray) -> np.ndarray:
-    """Unsaturated net muscle moment per joint from the fed-back state. [N·m]"""
-    n = setup.n_links
-    return joint_moments(setup.muscles, feedback[:n], feedback[n:], active)
+def raw_moments(setup: RunSetup, x: np.ndarray, feedback: np.ndarray, active: np.ndarray
+                ) -> np.ndarray:
+    """Unsaturated net muscle moment per joint: the immediate part on the state ``x``, the
+    delayed part on ``feedback`` (x(t − τ)). [N·m]"""
+    return (feedback_pair_torques(setup.muscles, setup.gains, x, feedback, active)
+            @ setup.muscles.crossing_matrix)
 
 
 def cop_at(setup: RunSetup, t: float, x: np.ndarray, feedback: np.ndarray, active, locked,

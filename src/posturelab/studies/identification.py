@@ -22,14 +22,14 @@ from __future__ import annotations
 import csv
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
 
 from .._validation import finite_array
 from ..errors import DataFileError, ParameterError, UnknownNameError
-from ..model.muscles import MusclePair, MuscleSet
+from ..model.muscles import MuscleSet
 from ..scenarios import Scenario
 from ..simulation.results import SimulationResult
 
@@ -107,8 +107,8 @@ class FitResult:
 
 def _muscles_with(muscles: MuscleSet, stiffness: dict[str, float], ratio: float) -> MuscleSet:
     pairs = tuple(
-        MusclePair(p.name, p.lo, p.hi, stiffness.get(p.name, p.stiffness),
-                   ratio * stiffness.get(p.name, p.stiffness), p.one_sided)
+        replace(p, stiffness=stiffness.get(p.name, p.stiffness),
+                viscosity=ratio * stiffness.get(p.name, p.stiffness))
         for p in muscles.pairs
     )
     return MuscleSet(pairs, muscles.n_links)

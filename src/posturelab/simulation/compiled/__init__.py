@@ -39,7 +39,7 @@ from ..._validation import finite_array, positive_float
 from ...errors import ParameterError
 from ...model.body import Body
 from ...model.events import fall_message
-from ...model.muscles import MuscleSet, paper_muscles
+from ...model.muscles import MuscleSet, feedback_gains, muscle_set_gains, paper_muscles
 from ...model.options import FallCriteria, KneeModel
 from ...model.platform import Disturbance
 from ..derived import derived_series
@@ -232,7 +232,7 @@ def integrate_compiled(setup: RunSetup, method: str | None = None) -> Simulation
         if delayed:
             feedback = np.array(setup.before[None, :])
     else:
-        g = enc.readonly(enc.gains(muscles.stiffnesses, muscles.viscosities, delayed))
+        g = enc.readonly(np.ascontiguousarray(setup.gains))
         lim = enc.readonly(enc.limits(setup.torque_limits, n))
         sat0 = enc.readonly(setup.saturation0)
         run = _run_struct(a, method, g, lim, setup.feedback_delay, sat0)
@@ -405,6 +405,8 @@ def simulate_batch(
     fall: FallCriteria | None = None,
     torque_limits: np.ndarray | None = None,
     feedback_delay: float | np.ndarray = 0.0,
+    active_stiffness: np.ndarray | None = None,
+    active_viscosity: np.ndarray | None = None,
     rtol: float = DEFAULT_RTOL,
     atol: float = DEFAULT_ATOL,
     sample_rate: float = 1000.0,
@@ -442,6 +444,11 @@ def simulate_batch(
         none. [N·m]
     feedback_delay : float or array_like, shape (M,)
         Neural delay of the muscle feedback, for every run or per run. [s]
+    active_stiffness, active_viscosity : array_like, shape (M, P), optional
+        Active (neural, delayed) pair gains per run; with either given, ``stiffness`` and
+        ``viscosity`` are the intrinsic (undelayed) part and the delay applies to these
+        only; with neither, the delay applies to the whole pair feedback
+        (:func:`posturelab.model.muscles.feedback_gains`). [N·m/rad], [N·m·s/rad]
     rtol : float
         Relative tolerance. [-]
     atol : float
@@ -491,6 +498,20 @@ def simulate_batch(
     if isinstance(chunk, bool) or not isinstance(chunk, int | np.integer) or chunk < 1:
         raise ParameterError(f"chunk must be an integer >= 1, got {chunk!r}")
     M = kd_all.shape[0]
+    ka_all = la_all = None
+    if active_stiffness is not None or active_viscosity is not None:
+        if muscles.one_sided_mask.any():
+            raise ParameterError("one-sided pairs cannot be combined with active (delayed) "
+                                 "gains (make them two-sided, or give no active gains)")
+        zeros = np.zeros_like(kd_all)
+        ka_all = (zeros if active_stiffness is None
+                  else _gain_array("active_stiffness [N·m/rad]", active_stiffness, P))
+        la_all = (zeros if active_viscosity is None
+                  else _gain_array("active_viscosity [N·m·s/rad]", active_viscosity, P))
+        for label, arr in (("active_stiffness", ka_all), ("active_viscosity", la_all)):
+            if arr.shape != kd_all.shape:
+                raise ParameterError(f"{label} must have the shape of stiffness, "
+                                     f"{kd_all.shape}, got {arr.shape}")
     delays = _per_run("feedback_delay [s]", feedback_delay, M, None)
     lims = (np.full((M, n), math.inf) if torque_limits is None
             else _per_run("torque_limits [N·m]", torque_limits, M, n))
@@ -528,11 +549,11 @@ def simulate_batch(
     active_all = enc.readonly(np.stack(
         [start_activity(muscles, lv.before if dl else lv.x0)
          for lv, (_, dl) in zip(levels, values, strict=True)] or [packed[0]["active0"]]))
-    # per run: the gains in their slots (immediate or delayed), the saturation at the start
-    gains_all = enc.readonly(np.where(delayed[:, None, None], enc.gains(kd_all, ld_all, True),
-                                      enc.gains(kd_all, ld_all, False)))
-    feedback0 = np.where(delayed[:, None], before_all[which], x0_all[which])
-    moments0 = start_moments(muscles, feedback0, active_all[which], kd_all, ld_all)
+    # per run: the gains by when they act, the saturation at the start
+    gains_all = enc.readonly(np.ascontiguousarray(
+        feedback_gains(kd_all, ld_all, ka_all, la_all, delays)))
+    moments0 = start_moments(muscles, x0_all[which], before_all[which], active_all[which],
+                             gains_all)
     sat0_all = enc.readonly(start_saturation(moments0, lims))
     lim_all = enc.readonly(lims)
     delay_all = enc.readonly(delays)
@@ -654,7 +675,7 @@ def state_derivative(body: Body, muscles: MuscleSet, state, *, active=None, lock
     P = len(muscles.pairs)
     x = np.ascontiguousarray(state, dtype=float)
     act = np.ones(P) if active is None else np.ascontiguousarray(active, dtype=float)
-    g = np.ascontiguousarray(enc.gains(muscles.stiffnesses, muscles.viscosities, False))
+    g = np.ascontiguousarray(muscle_set_gains(muscles, 0.0))
     lim = np.ascontiguousarray(enc.limits(torque_limits, n))
     sat = np.zeros(n) if saturation is None else np.ascontiguousarray(saturation, dtype=float)
     inp = np.zeros(2 + n)

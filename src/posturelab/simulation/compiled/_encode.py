@@ -118,15 +118,6 @@ def options(setup: RunSetup, settle_tolerance: float = 0.01) -> tuple[np.ndarray
     return readonly(fpar), readonly(ipar)
 
 
-def gains(stiffness: np.ndarray, viscosity: np.ndarray, delayed: bool) -> np.ndarray:
-    """(4, P) = (k_d, l_d, delayed k_d, delayed l_d): all of a pair's feedback is immediate,
-    or all of it delayed. [N·m/rad], [N·m·s/rad]"""
-    k = np.asarray(stiffness, dtype=float)
-    v = np.asarray(viscosity, dtype=float)
-    z = np.zeros_like(k)
-    return np.stack([z, z, k, v] if delayed else [k, v, z, z], axis=-2)
-
-
 def limits(torque_limits: np.ndarray | None, n: int) -> np.ndarray:
     """Torque limits per joint, inf where none. [N·m]"""
     if torque_limits is None:
