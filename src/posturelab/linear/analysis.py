@@ -26,7 +26,7 @@ from .._validation import finite_array
 from ..errors import ParameterError
 from ..model.body import Body
 from ..model.dynamics import mass_matrix, platform_vector, state_derivative
-from ..model.muscles import MuscleSet, joint_torques
+from ..model.muscles import MuscleSet, feedback_pair_torques, muscle_set_gains
 
 __all__ = [
     "LinearAnalysis",
@@ -71,11 +71,13 @@ def state_matrix(body: Body, muscles: MuscleSet, one_sided: OneSided = "active")
     m = _effective(muscles, one_sided)
     n = body.n_links
     J0 = mass_matrix(body, np.zeros(n))
-    stiff = body.gravity * np.diag(body.gravity_coefficients) - m.stiffness_matrix()
+    gains = muscle_set_gains(m, 0.0)  # without a delay: intrinsic + active
+    E = m.selection_matrix
+    stiff = body.gravity * np.diag(body.gravity_coefficients) - E.T @ (gains[0][:, None] * E)
     A = np.zeros((2 * n, 2 * n))
     A[:n, n:] = np.eye(n)
     A[n:, :n] = np.linalg.solve(J0, stiff)
-    A[n:, n:] = -np.linalg.solve(J0, m.viscosity_matrix())
+    A[n:, n:] = -np.linalg.solve(J0, E.T @ (gains[1][:, None] * E))
     return A
 
 
@@ -96,8 +98,10 @@ def finite_difference_state_matrix(
     m = _effective(muscles, one_sided)
     n = body.n_links
 
+    gains = muscle_set_gains(m, 0.0)
+
     def f(x: np.ndarray) -> np.ndarray:
-        u = joint_torques(m, x[:n], x[n:])
+        u = -feedback_pair_torques(m, gains, x, x) @ m.selection_matrix
         return state_derivative(body, x, u)
 
     A = np.zeros((2 * n, 2 * n))
