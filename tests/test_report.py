@@ -269,3 +269,24 @@ def test_searches_take_their_runner():
             f"τ = {delay.falls * 1000:.0f} ms") in delay.text
     never = delay_finding(Scenario(), run=lambda sc, tau: SimpleNamespace(fell=False))
     assert never.text == "Neural delay: the bracket of delays searched did not bracket a fall."
+
+
+def test_delay_finding_states_the_margin_and_the_oscillation_above_it():
+    """The report's delay finding gives the linear delay margin and shows that the largest
+    delay the run survives leaves it oscillating, not upright (issue: 'survives' misled)."""
+    import math
+
+    import posturelab as pl
+    from posturelab.linear.delay import delay_margin
+    from posturelab.paper.checks import with_delay_margin
+    from posturelab.paper.findings import DelayFinding
+
+    sc = pl.builtin_scenario("paper-backward-case1")
+    margin = delay_margin(sc.body, sc.muscles)
+    found = with_delay_margin(DelayFinding(0.016, 0.017), sc)
+    assert found.margin == margin.delay_margin < 0.016
+    assert found.crossing_frequency == margin.crossing_frequency
+    assert found.oscillation > 0.1  # [rad]: far from settled
+    assert f"τ = {margin.delay_margin * 1000:.2f} ms (its delay margin)" in found.text
+    assert f"{margin.crossing_frequency / (2 * math.pi):.1f} Hz" in found.text
+    assert "Not falling within a run is not stability." in found.text

@@ -52,6 +52,7 @@ __all__ = [
     "check_fig3", "check_fig4", "check_fig5_6", "check_fig7", "check_fig8", "check_fig9",
     "check_fig10", "erratum_notes", "one_sided_finding", "foot_finding",
     "ramp_and_hold_run", "recovery_finding", "delayed_run", "delay_finding",
+    "with_delay_margin",
 ]
 
 #: |θ_i| below this counts as back upright (the settling criterion). [rad]
@@ -584,3 +585,22 @@ def delay_finding(
         else:
             lo = mid
     return DelayFinding(lo, hi)
+
+
+def with_delay_margin(finding: DelayFinding, backward: Scenario) -> DelayFinding:
+    """``finding`` with the linearised delay margin of ``backward``'s body and gains, and the
+    oscillation its nonlinear run keeps at the largest delay it survives (1.5 s on the
+    compiled engine, sampled at 2 kHz to resolve the fast mode)."""
+    from dataclasses import replace
+
+    from ..linear.delay import delay_margin
+
+    margin = delay_margin(backward.body, backward.muscles)
+    oscillation = None
+    if finding.survives is not None:
+        r = backward.replace(duration=1.5, sample_rate=2000.0).run(
+            feedback_delay=finding.survives, engine="compiled")
+        knee = (r.theta[:, 1] - r.theta[:, 0])[r.time >= r.time[-1] - 0.5]
+        oscillation = float(np.abs(knee - knee.mean()).max())
+    return replace(finding, margin=margin.delay_margin,
+                   crossing_frequency=margin.crossing_frequency, oscillation=oscillation)

@@ -6,6 +6,7 @@ The findings are computed in :mod:`.checks`; this module only holds them.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -242,30 +243,56 @@ class RecoveryFinding:
 
 @dataclass(frozen=True)
 class DelayFinding:
-    """The largest neural delay of the muscle feedback case 1 survives (beyond the paper).
+    """What a neural delay of the whole muscle feedback does to case 1 (beyond the paper).
 
     Attributes
     ----------
     survives : float or None
-        Largest delay found to survive; None when the bracket did not bracket a fall. [s]
+        Largest delay at which the nonlinear backward run does not fall; None when the
+        bracket did not bracket a fall. [s]
     falls : float or None
         Smallest delay found to fall. [s]
+    margin : float or None
+        Delay margin of the linearised model (:func:`posturelab.delay_margin`); None if not
+        computed. [s]
+    crossing_frequency : float or None
+        Frequency of the mode that crosses at the margin. [rad/s]
+    oscillation : float or None
+        At τ = ``survives``: the largest swing of the knee angle about its mean over the
+        last 0.5 s of the run, where a stable run would have settled. [rad]
     """
 
     survives: float | None
     falls: float | None
+    margin: float | None = None
+    crossing_frequency: float | None = None
+    oscillation: float | None = None
 
     @property
     def text(self) -> str:
         """The finding in words, with its numbers."""
         if self.survives is None or self.falls is None:
             return "Neural delay: the bracket of delays searched did not bracket a fall."
-        return (
-            "Neural delay (feedback_delay): with every muscle pair responding to the state "
-            f"delayed by τ, the backward case 1 run survives τ = {self.survives * 1000:.0f} ms "
-            f"but falls at τ = {self.falls * 1000:.0f} ms. The paper itself cites 70–120 ms "
-            "onsets for the muscle responses to a platform perturbation (Section III.A), so its "
-            "gains, whose fast modes (poles near −554 and −89 1/s) come from large viscosity "
-            "acting on light links, can only be read as instantaneous, intrinsic (muscle) "
-            "impedance, not as reflexes."
+        lead = "Neural delay (feedback_delay): with every muscle pair responding to the state " \
+               "delayed by τ, "
+        if self.margin is not None and self.crossing_frequency is not None:
+            lead += (
+                f"the linearised case 1 loses stability at τ = {self.margin * 1000:.2f} ms "
+                f"(its delay margin), to a mode at {self.crossing_frequency / (2 * math.pi):.1f}"
+                " Hz. Above the margin the nonlinear run does not settle, yet it does not fall "
+                "at once: the backward case 1 run "
+            )
+        else:
+            lead += "the backward case 1 run "
+        text = (f"{lead}survives τ = {self.survives * 1000:.0f} ms but falls at "
+                f"τ = {self.falls * 1000:.0f} ms.")
+        if self.oscillation is not None:
+            text += (f" At {self.survives * 1000:.0f} ms it is not upright but oscillating: the "
+                     f"knee angle still swings by {self.oscillation:.3g} rad in the run's last "
+                     "0.5 s. Not falling within a run is not stability.")
+        return text + (
+            " The paper itself cites 70–120 ms onsets for the muscle responses to a platform "
+            "perturbation (Section III.A), so its gains, whose fast modes (poles near −554 and "
+            "−89 1/s) come from large viscosity acting on light links, can only be read as "
+            "instantaneous, intrinsic (muscle) impedance, not as reflexes."
         )

@@ -395,7 +395,8 @@ def _build(tmp: Path, progress: ProgressCallback | None) -> tuple[PaperChecks, l
     tick("largest recoverable platform move, with a foot that can tip (beyond the paper)")
     findings.append(_checks.recovery_finding(body, runs.foot))
     tick("neural delay the paper's case 1 gains tolerate (beyond the paper)")
-    findings.append(_checks.delay_finding(runs.scenarios["backward"]))
+    backward = runs.scenarios["backward"]
+    findings.append(_checks.with_delay_margin(_checks.delay_finding(backward), backward))
 
     tick("write table2.csv and index.html")
     paper = PaperChecks(body, table2, sensitivity, figure_checks, tuple(findings),
