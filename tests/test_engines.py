@@ -298,7 +298,8 @@ def test_codes_in_python_equal_those_in_the_c_header():
                  "F_ATOL", "F_MAX_STEP", "F_DURATION", "F_SETTLE_TOL", "N_FPAR", "I_USE_BOS",
                  "I_USE_COP", "I_KNEE_MODE", "I_MAX_SWITCHES", "I_LOCKED0", "N_IPAR",
                  "KNEE_FREE", "KNEE_LOCKED", "KNEE_STOP", "DIST_ROW", "DIST_WINDOWED_SINE",
-                 "DIST_SINE", "DIST_SAMPLES", "METHOD_RADAU", "METHOD_EXPLICIT"):
+                 "DIST_SINE", "DIST_SAMPLES", "METHOD_RADAU", "METHOD_EXPLICIT", "TILT_ROW",
+                 "TILT_SINE", "TILT_RAISED_COSINE", "TILT_PPOLY"):
         assert c[name] == getattr(lay, name), name
     statuses = {"PL_COMPLETED": lay.STATUS_COMPLETED, "PL_FELL": lay.STATUS_FELL,
                 "PL_STEP_TOO_SMALL": lay.STATUS_STEP_TOO_SMALL,

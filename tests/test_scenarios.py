@@ -129,3 +129,60 @@ def test_scenario_run_on_either_engine():
     np.testing.assert_allclose(fast.theta, ref.theta, rtol=0, atol=1e-6)
     with pytest.raises(ParameterError, match="engine"):
         sc.run(engine="turbo")
+
+
+TILTED = """
+duration = 1.0
+[muscles]
+case = "1"
+active_stiffness = [100.0, 0.0, 0.0, 0.0, 50.0]
+active_viscosity_ratio = 0.3
+feedback_delay = 0.02
+proprioceptive_weight = 0.7
+[tilt]
+type = "sine"
+amplitude = 0.01
+frequency = 0.5
+"""
+
+
+def test_scenario_with_active_gains_and_tilt_runs_as_the_api_does(tmp_path):
+    import posturelab as pl
+    from posturelab.model.tilt import PRTSTilt, SineTilt
+
+    sc = load_scenario(write(tmp_path, TILTED))
+    assert sc.tilt == SineTilt(0.01, 0.5) and sc.proprioceptive_weight == 0.7
+    np.testing.assert_array_equal(sc.muscles.active_stiffnesses, [100, 0, 0, 0, 50])
+    np.testing.assert_array_equal(sc.muscles.active_viscosities, [30, 0, 0, 0, 15])
+    muscles = pl.paper_muscles("1", active_stiffness=[100, 0, 0, 0, 50],
+                               active_viscosity_ratio=0.3)
+    api = pl.simulate(pl.paper_body(), muscles, None, 1.0, feedback_delay=0.02,
+                      proprioceptive_weight=0.7, tilt=SineTilt(0.01, 0.5), engine="compiled",
+                      rtol=sc.rtol, atol=sc.atol)
+    np.testing.assert_array_equal(sc.run(engine="compiled").theta, api.theta)
+    prts = load_scenario(write(tmp_path, MINIMAL + '[tilt]\ntype = "prts"\namplitude = 0.02\n',
+                               "p.toml"))
+    assert prts.tilt == PRTSTilt.peterka_2002(0.02)
+    csv = tmp_path / "tilt.csv"
+    t = np.linspace(0, 2, 201)
+    csv.write_text("time [s],tilt [rad]\n" + "".join(f"{a},{0.01 * np.sin(a)}\n" for a in t))
+    measured = load_scenario(write(tmp_path, MINIMAL + '[tilt]\ntype = "profile"\n'
+                                   'file = "tilt.csv"\n', "m.toml"))
+    np.testing.assert_allclose(measured.tilt.angle(1.0), 0.01 * np.sin(1.0), atol=1e-9)
+
+
+@pytest.mark.parametrize("extra,needle", [
+    ('[tilt]\ntype = "wobble"\n', "tilt.type must be one of"),
+    ('[tilt]\ntype = "sine"\namplitude = 0.01\nfrequency = 1.0\nperiod = 2\n',
+     r"unknown key 'period' in \[tilt\]"),
+    ('[tilt]\ntype = "sine"\namplitude = 3.0\nfrequency = 1.0\n', "tilt amplitude"),
+])
+def test_bad_tilt_tables(tmp_path, extra, needle):
+    with pytest.raises((ScenarioError, Exception), match=needle):
+        load_scenario(write(tmp_path, MINIMAL + extra))
+
+
+def test_bad_weight_in_a_scenario(tmp_path):
+    text = MINIMAL.replace('case = "1"', 'case = "1"\nproprioceptive_weight = 1.5')
+    with pytest.raises(ScenarioError, match=r"proprioceptive_weight \[-\] must be in \[0, 1\]"):
+        load_scenario(write(tmp_path, text))

@@ -23,6 +23,18 @@ Schema (every table optional except where noted; units in brackets)::
     viscosity_ratio = 0.25               # [s]
     gastrocnemius = "two-sided"          # or "one-sided"
     feedback_delay = 0.0                 # neural delay of the muscle feedback [s]
+    active_stiffness = [5 values]        # active (neural, delayed) gains [N·m/rad]; with
+    active_viscosity = [5 values]        #   pairs = [...], per pair instead [N·m·s/rad]
+    active_viscosity_ratio = 0.3         # or the active viscosity as a ratio [s]
+    proprioceptive_weight = 1.0          # W of the active error, in [0, 1] [-]
+
+    [tilt]                               # support-surface tilt, positive toes-up
+    type = "sine"                        # sine | raised-cosine | prts | profile
+    # sine: amplitude [rad], frequency [Hz], phase [rad]
+    # raised-cosine: amplitude [rad], duration [s], start [s]
+    # prts: amplitude [rad] peak to peak; state_duration [s], registers, taps, seed
+    #       (default: Peterka 2002's 80-state, 20 s sequence)
+    # profile: file = "tilt.csv" with columns time [s] and tilt [rad]
 
     [disturbance]                        # or [[disturbance]] several, summed
     type = "velocity-step"               # velocity-step | half-sine | ramp-and-hold |
@@ -85,6 +97,15 @@ from ..model.platform import (
     combine,
     read_profile_csv,
 )
+from ..model.tilt import (
+    PETERKA_SEED,
+    PETERKA_TAPS,
+    PRTSTilt,
+    RaisedCosineTilt,
+    SineTilt,
+    Tilt,
+    read_tilt_csv,
+)
 from ..simulation.engines import engine_name, simulate
 from ..simulation.results import SimulationResult
 
@@ -131,6 +152,10 @@ class Scenario:
         none. [N·m]
     feedback_delay : float
         Neural delay of the muscle feedback. [s]
+    tilt : Tilt or None
+        Support-surface tilt (:mod:`posturelab.model.tilt`).
+    proprioceptive_weight : float
+        W of the active part's error for pairs that span the foot. [-]
     """
 
     name: str
@@ -151,6 +176,8 @@ class Scenario:
     case: str | None = None
     torque_limits: tuple[float, ...] | None = None
     feedback_delay: float = 0.0
+    tilt: Tilt | None = None
+    proprioceptive_weight: float = 1.0
 
     def run(self, *, engine: str = "reference", **overrides: Any) -> SimulationResult:
         """Simulate this scenario; keyword ``overrides`` replace fields first.
@@ -168,7 +195,8 @@ class Scenario:
             fall=sc.fall, torque_limits=sc.torque_limits,
             feedback_delay=sc.feedback_delay, rtol=sc.rtol, atol=sc.atol,
             sample_rate=sc.sample_rate, description=sc.description,
-            method=sc.method if name == "reference" else None, engine=name,
+            method=sc.method if name == "reference" else None, engine=name, tilt=sc.tilt,
+            proprioceptive_weight=sc.proprioceptive_weight,
         )
 
     def replace(self, **changes: Any) -> Scenario:
@@ -179,7 +207,7 @@ class Scenario:
 
 
 TOP_KEYS = ("name", "description", "source", "duration", "body", "muscles", "disturbance",
-            "initial", "knee", "fall", "limits", "solver")
+            "initial", "knee", "fall", "limits", "solver", "tilt")
 
 
 def load_scenario(path: str | Path) -> Scenario:
@@ -240,13 +268,21 @@ def _parse(data: dict, base_dir: Path, origin: str) -> Scenario:
 
     body = _parse_body(_table(data, "body", ("preset", "segments", "gravity"), origin), origin)
     mt = _table(data, "muscles", ("case", "stiffness", "pairs", "viscosity_ratio",
-                                  "gastrocnemius", "feedback_delay"), origin)
+                                  "gastrocnemius", "feedback_delay", "active_stiffness",
+                                  "active_viscosity", "active_viscosity_ratio",
+                                  "proprioceptive_weight"), origin)
     mt = dict(mt)
     delay = finite_float("muscles.feedback_delay [s]", mt.pop("feedback_delay", 0.0))
     if not 0.0 <= delay <= 1.0:
         raise ScenarioError(f"{origin}: muscles.feedback_delay [s] must be in [0, 1], "
                             f"got {delay:g}")
+    weight = finite_float("muscles.proprioceptive_weight [-]",
+                          mt.pop("proprioceptive_weight", 1.0))
+    if not 0.0 <= weight <= 1.0:
+        raise ScenarioError(f"{origin}: muscles.proprioceptive_weight [-] must be in [0, 1], "
+                            f"got {weight:g}")
     muscles, case = _parse_muscles(mt, body, origin)
+    tilt = _parse_tilt(_table(data, "tilt", TILT_KEYS, origin), base_dir, origin)
     disturbance = _parse_disturbances(data.get("disturbance"), base_dir, origin)
 
     it = _table(data, "initial", ("posture", "rates", "rates_from"), origin)
@@ -305,7 +341,43 @@ def _parse(data: dict, base_dir: Path, origin: str) -> Scenario:
         atol=finite_float("solver.atol", st.get("atol", 1e-10)),
         sample_rate=finite_float("solver.sample_rate [Hz]", st.get("sample_rate", 1000.0)),
         method=method, case=case, torque_limits=torque_limits, feedback_delay=delay,
+        tilt=tilt, proprioceptive_weight=weight,
     )
+
+
+TILT_KEYS = ("type", "amplitude", "frequency", "phase", "duration", "start", "state_duration",
+             "registers", "taps", "seed", "file")
+
+
+def _parse_tilt(tt: dict, base_dir: Path, origin: str) -> Tilt | None:
+    """The [tilt] table (module docstring), or None when there is none."""
+    if not tt:
+        return None
+    kind = tt.get("type")
+    allowed = {"sine": ("amplitude", "frequency", "phase"),
+               "raised-cosine": ("amplitude", "duration", "start"),
+               "prts": ("amplitude", "state_duration", "registers", "taps", "seed"),
+               "profile": ("file",)}
+    if kind not in allowed:
+        raise ScenarioError(f"{origin}: tilt.type must be one of {', '.join(allowed)}; "
+                            f"got {kind!r}")
+    _reject(tt, ("type", *allowed[kind]), f"tilt (type {kind})", origin)
+    try:
+        if kind == "sine":
+            return SineTilt(tt.get("amplitude"), tt.get("frequency"), tt.get("phase", 0.0))
+        if kind == "raised-cosine":
+            return RaisedCosineTilt(tt.get("amplitude"), tt.get("duration"), tt.get("start", 0.0))
+        if kind == "prts":
+            if set(tt) <= {"type", "amplitude"}:
+                return PRTSTilt.peterka_2002(tt.get("amplitude"))
+            return PRTSTilt(tt.get("amplitude"), tt.get("state_duration", 0.25),
+                            tt.get("registers", 4), tuple(tt.get("taps", PETERKA_TAPS)),
+                            tuple(tt.get("seed", PETERKA_SEED)))
+        if "file" not in tt:
+            raise ScenarioError(f"{origin}: tilt (type profile) needs file")
+        return read_tilt_csv(base_dir / str(tt["file"]))
+    except TypeError as exc:
+        raise ScenarioError(f"{origin}: tilt: {exc}") from None
 
 
 def finite_or_inf(name: str, value) -> float:
@@ -351,11 +423,17 @@ def _parse_muscles(mt: dict, body: Body, origin: str) -> tuple[MuscleSet, str | 
     if len(given) != 1:
         raise ScenarioError(f"{origin}: [muscles] needs exactly one of case, stiffness, pairs")
     if "pairs" in mt:
+        stray = [k for k in ("active_stiffness", "active_viscosity", "active_viscosity_ratio")
+                 if k in mt]
+        if stray:
+            raise ScenarioError(f"{origin}: muscles.{stray[0]} is for case / stiffness; with "
+                                "pairs give active_stiffness and active_viscosity per pair")
         pairs = []
         for i, p in enumerate(mt["pairs"]):
             if not isinstance(p, dict):
                 raise ScenarioError(f"{origin}: muscles.pairs[{i}] must be a table")
-            keys = ("name", "lo", "hi", "stiffness", "viscosity", "one_sided")
+            keys = ("name", "lo", "hi", "stiffness", "viscosity", "one_sided",
+                    "active_stiffness", "active_viscosity")
             _reject(p, keys, f"muscles.pairs[{i}]", origin)
             for k in ("lo", "hi", "stiffness"):
                 if k not in p:
@@ -363,7 +441,8 @@ def _parse_muscles(mt: dict, body: Body, origin: str) -> tuple[MuscleSet, str | 
             ratio = finite_float("muscles.viscosity_ratio [s]", mt.get("viscosity_ratio", 0.25))
             visc = p.get("viscosity", ratio * finite_float("stiffness", p["stiffness"]))
             pairs.append(MusclePair(str(p.get("name", f"pair{i + 1}")), p["lo"], p["hi"],
-                                    p["stiffness"], visc, bool(p.get("one_sided", False))))
+                                    p["stiffness"], visc, bool(p.get("one_sided", False)),
+                                    p.get("active_stiffness"), p.get("active_viscosity")))
         return MuscleSet(tuple(pairs), body.n_links), None
     if body.n_links != 3:
         raise ScenarioError(f"{origin}: muscles.case / muscles.stiffness are the paper's five "
@@ -373,6 +452,8 @@ def _parse_muscles(mt: dict, body: Body, origin: str) -> tuple[MuscleSet, str | 
         None if case is None else str(case), stiffness=mt.get("stiffness"),
         viscosity_ratio=mt.get("viscosity_ratio", 0.25),
         gastrocnemius=mt.get("gastrocnemius", "two-sided"),
+        active_stiffness=mt.get("active_stiffness"), active_viscosity=mt.get("active_viscosity"),
+        active_viscosity_ratio=mt.get("active_viscosity_ratio"),
     ), (None if case is None else str(case))
 
 

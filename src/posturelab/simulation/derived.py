@@ -18,7 +18,7 @@ from ..model.kinematics import (
 )
 from ..model.muscles import feedback_pair_torques, moments_to_link_torques
 from .results import DerivedSeries
-from .setup import RunSetup
+from .setup import RunSetup, tilt_torques
 
 __all__ = ["derived_series"]
 
@@ -58,6 +58,8 @@ def derived_series(setup: RunSetup, time: np.ndarray, state: np.ndarray,
     if muscles.one_sided_mask.any():  # (such pairs are all-immediate or all-delayed)
         slack = muscles.one_sided_mask & (fb[:, :n] @ muscles.selection_matrix.T < 0.0)
         M = np.where(slack, 0.0, M)
+    if setup.tilt is not None:
+        M = M + tilt_torques(setup.tilt, setup.tilt_gains, setup.feedback_delay, time)
     moments = M @ muscles.crossing_matrix
     if setup.torque_limits is not None:
         moments = np.clip(moments, -setup.torque_limits, setup.torque_limits)

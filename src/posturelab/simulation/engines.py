@@ -16,6 +16,7 @@ from ..model.body import Body
 from ..model.muscles import MuscleSet
 from ..model.options import FallCriteria, KneeModel
 from ..model.platform import Disturbance
+from ..model.tilt import Tilt
 from .results import SimulationResult
 from .setup import prepare_run
 
@@ -60,6 +61,8 @@ def simulate(
     max_switches: int = 10_000,
     description: str = "",
     engine: str = "reference",
+    tilt: Tilt | None = None,
+    proprioceptive_weight: float = 1.0,
 ) -> SimulationResult:
     """Simulate the nonlinear chain.
 
@@ -87,8 +90,10 @@ def simulate(
         pairs crossing each joint); ``inf`` for no limit. A joint saturates and
         lets go at events, never inside the right-hand side. [N·m]
     feedback_delay : float
-        Neural delay τ of the muscle feedback: every pair's torque responds to the
-        state at t − τ (before t = 0, to the state before any velocity step). [s]
+        Neural delay τ [s]. With active gains in ``muscles`` it delays their part only
+        (the intrinsic gains act at once); without any, every pair's whole torque
+        responds to the state at t − τ (before t = 0, the state before any velocity
+        step). See :func:`posturelab.model.muscles.feedback_gains`.
     rtol, atol : float, optional
         Integrator tolerances (relative [-], absolute [rad, rad/s]); by default
         1e-8 and 1e-10 for the reference engine, 1e-6 and 1e-9 for the compiled one.
@@ -107,6 +112,12 @@ def simulate(
         ``reference``: the numpy model integrated by scipy (slow, obvious, the check);
         ``compiled``: the C engine (hundreds of times faster, built when posturelab is
         installed). Same model, events and result.
+    tilt : Tilt, optional
+        Support-surface tilt α(t), positive toes-up, about the ankle axis
+        (:mod:`posturelab.model.tilt`); none by default. [rad]
+    proprioceptive_weight : float
+        W in [0, 1]: the active part's error for pairs that span the foot is
+        θ_hi + W·α (1: relative to the foot; 0: to the vertical). [-]
 
     Returns
     -------
@@ -122,7 +133,8 @@ def simulate(
         rates_from=rates_from, knee=knee, fall=fall, torque_limits=torque_limits,
         feedback_delay=feedback_delay, rtol=d_rtol if rtol is None else rtol,
         atol=d_atol if atol is None else atol, sample_rate=sample_rate,
-        max_switches=max_switches, description=description)
+        max_switches=max_switches, description=description, tilt=tilt,
+        proprioceptive_weight=proprioceptive_weight)
     method = d_method if method is None else method
     if name == "reference":
         from .reference import integrate_reference

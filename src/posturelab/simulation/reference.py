@@ -121,7 +121,7 @@ def integrate_reference(setup: RunSetup, method: str = "DOP853") -> SimulationRe
             return lambda t, y: cop_at(setup, t, y, feedback(t, y), _active, _locked,
                                        _sat) - bos.heel
         if k in (ev.SATURATES, ev.LETS_GO):
-            return lambda t, y: sd * raw_moments(setup, y, feedback(t, y), _active)[j] \
+            return lambda t, y: sd * raw_moments(setup, t, y, feedback(t, y), _active)[j] \
                 - limits[j] + offset
         if k in (ev.PAIR_SLACKENS, ev.PAIR_ENGAGES):
             return lambda t, y: E[j] @ feedback(t, y)[:n] + offset

@@ -39,6 +39,7 @@ from ..model.muscles import (
 )
 from ..model.options import FallCriteria, KneeModel, torque_limit_array
 from ..model.platform import Disturbance, NoDisturbance
+from ..model.tilt import Tilt, check_proprioceptive_weight, tilt_pair_gains
 
 __all__ = [
     "RunSetup",
@@ -118,6 +119,14 @@ class RunSetup:
         The row C of the knee constraint when the knee can lock. [-]
     rates_from : {"upright", "posture"}
         Where J⁻¹H was evaluated for a velocity step.
+    tilt : Tilt or None
+        The support-surface tilt α(t) (:mod:`posturelab.model.tilt`), None for none.
+    proprioceptive_weight : float
+        W of the active part's error for pairs that span the foot. [-]
+    tilt_gains : numpy.ndarray, shape (4, P), or None
+        Pair gains on α(t), α̇(t), α(t − τ), α̇(t − τ)
+        (:func:`posturelab.model.tilt.tilt_pair_gains`); None without a tilt.
+        [N·m/rad], [N·m·s/rad], [N·m/rad], [N·m·s/rad]
     """
 
     body: Body
@@ -146,6 +155,9 @@ class RunSetup:
     fall_at_start: str | None
     knee_row: np.ndarray | None
     rates_from: str = "upright"
+    tilt: Tilt | None = None
+    proprioceptive_weight: float = 1.0
+    tilt_gains: np.ndarray | None = None
 
     @property
     def n_links(self) -> int:
@@ -220,7 +232,8 @@ def _expect(name: str, value, kind: type) -> None:
 RUN_OPTIONS: dict[str, object] = {
     "initial_state": None, "rates_from": "upright", "knee": None, "fall": None,
     "torque_limits": None, "feedback_delay": 0.0, "rtol": 1e-8, "atol": 1e-10,
-    "sample_rate": 1000.0, "max_switches": 10_000, "description": "",
+    "sample_rate": 1000.0, "max_switches": 10_000, "description": "", "tilt": None,
+    "proprioceptive_weight": 1.0,
 }
 
 
@@ -273,6 +286,13 @@ def _prepare(body: Body, muscles: MuscleSet, disturbance: Disturbance | None = N
     knee, fall, torque_limits = o["knee"], o["fall"], o["torque_limits"]
     rtol, atol, sample_rate = o["rtol"], o["atol"], o["sample_rate"]
     max_switches, description = o["max_switches"], o["description"]
+    tilt = o["tilt"]
+    weight = check_proprioceptive_weight(o["proprioceptive_weight"])
+    if tilt is not None:
+        _expect("tilt", tilt, Tilt)
+        if muscles.one_sided_mask.any():
+            raise ParameterError("a platform tilt cannot be combined with one-sided pairs "
+                                 "(make them two-sided)")
     _expect("body", body, Body)
     _expect("muscles", muscles, MuscleSet)
     disturbance = NoDisturbance() if disturbance is None else disturbance
@@ -316,12 +336,24 @@ def _prepare(body: Body, muscles: MuscleSet, disturbance: Disturbance | None = N
     gains = muscle_set_gains(muscles, delay)
     active0 = start_activity(muscles, before if delay > 0 else x0)  # (one-sided pairs have
     # no active gains: their whole feedback is delayed or none is)
-    saturation0 = start_saturation(start_moments(muscles, x0, before, active0, gains), limits)
-    breakpoints = np.array(sorted({b for b in disturbance.breakpoints if 0.0 < b < duration}),
-                           dtype=float)
+    tilt_gains = None
+    if tilt is not None:
+        tilt_gains = tilt_pair_gains(muscle_set_gains(muscles, 1.0), muscles.spans_foot, delay,
+                                     weight)
+        tilt_gains.setflags(write=False)
+    moments0 = start_moments(muscles, x0, before, active0, gains)
+    if tilt is not None:
+        moments0 = moments0 + tilt_torques(tilt, tilt_gains, delay, 0.0) @ muscles.crossing_matrix
+    saturation0 = start_saturation(moments0, limits)
+    corners = set(disturbance.breakpoints)
+    if tilt is not None:  # the tilt's corners, and where the delayed part feels them
+        tilt_corners = tilt.breakpoints(duration)
+        corners |= set(tilt_corners) | {b + delay for b in tilt_corners if delay > 0}
+    breakpoints = np.array(sorted({b for b in corners if 0.0 < b < duration}), dtype=float)
     delay_bps = np.array([k * delay for k in range(1, DELAY_BREAKPOINT_MULTIPLES + 1)
                           if delay > 0 and k * delay < duration])
-    max_step = min(disturbance.max_step, duration, delay if delay > 0 else math.inf)
+    max_step = min(disturbance.max_step, duration, delay if delay > 0 else math.inf,
+                   tilt.max_step if tilt is not None else math.inf)
     for arr in (before, x0, active0, saturation0, breakpoints, delay_bps, gains):
         arr.setflags(write=False)
     setup = RunSetup(
@@ -332,7 +364,7 @@ def _prepare(body: Body, muscles: MuscleSet, disturbance: Disturbance | None = N
         locked0=bool(locked0), active0=active0, saturation0=saturation0,
         grid=output_grid(duration, sample_rate), breakpoints=breakpoints,
         delay_breakpoints=delay_bps, max_step=max_step, fall_at_start=None, knee_row=knee_row,
-        rates_from=rates_from,
+        rates_from=rates_from, tilt=tilt, proprioceptive_weight=weight, tilt_gains=tilt_gains,
     )
     object.__setattr__(setup, "fall_at_start", _fall_at_start(setup))
     return setup
@@ -422,7 +454,7 @@ def model_response(setup: RunSetup, t: float, x: np.ndarray, feedback: np.ndarra
         Θ̈ (on the knee constraint if locked). [rad/s²]
     """
     n = setup.n_links
-    tau = raw_moments(setup, x, feedback, active)
+    tau = raw_moments(setup, t, x, feedback, active)
     if saturation is not None and setup.torque_limits is not None:
         bound = np.where(np.isfinite(setup.torque_limits), setup.torque_limits, 0.0)
         tau = np.where(saturation != 0, saturation * bound, tau)
@@ -434,12 +466,26 @@ def model_response(setup: RunSetup, t: float, x: np.ndarray, feedback: np.ndarra
     return tau, acc
 
 
-def raw_moments(setup: RunSetup, x: np.ndarray, feedback: np.ndarray, active: np.ndarray
-                ) -> np.ndarray:
-    """Unsaturated net muscle moment per joint: the immediate part on the state ``x``, the
-    delayed part on ``feedback`` (x(t − τ)). [N·m]"""
-    return (feedback_pair_torques(setup.muscles, setup.gains, x, feedback, active)
-            @ setup.muscles.crossing_matrix)
+def raw_moments(setup: RunSetup, t: float, x: np.ndarray, feedback: np.ndarray,
+                active: np.ndarray) -> np.ndarray:
+    """Unsaturated net muscle moment per joint at time ``t`` [s]: the immediate part on the
+    state ``x``, the delayed part on ``feedback`` (x(t − τ)), and the tilt's part. [N·m]"""
+    M = feedback_pair_torques(setup.muscles, setup.gains, x, feedback, active)
+    if setup.tilt is not None:
+        M = M + tilt_torques(setup.tilt, setup.tilt_gains, setup.feedback_delay, t)
+    return M @ setup.muscles.crossing_matrix
+
+
+def tilt_torques(tilt: Tilt, tilt_gains: np.ndarray, delay: float, t) -> np.ndarray:
+    """Pair torques from the tilt at times ``t`` (any shape), shape t.shape + (P,):
+    g₀ α(t) + g₁ α̇(t) + g₂ α(t − τ) + g₃ α̇(t − τ) for ``tilt_gains`` g (..., 4, P). [N·m]"""
+    t = np.asarray(t, dtype=float)
+    a, ad = tilt.angle_and_rate(t)
+    out = tilt_gains[..., 0, :] * a[..., None] + tilt_gains[..., 1, :] * ad[..., None]
+    if delay > 0:
+        a, ad = tilt.angle_and_rate(t - delay)
+        out = out + tilt_gains[..., 2, :] * a[..., None] + tilt_gains[..., 3, :] * ad[..., None]
+    return out
 
 
 def cop_at(setup: RunSetup, t: float, x: np.ndarray, feedback: np.ndarray, active, locked,

@@ -42,6 +42,7 @@ from ...model.events import fall_message
 from ...model.muscles import MuscleSet, feedback_gains, muscle_set_gains, paper_muscles
 from ...model.options import FallCriteria, KneeModel
 from ...model.platform import Disturbance
+from ...model.tilt import Tilt, tilt_pair_gains
 from ..derived import derived_series
 from ..engines import simulate
 from ..results import SimulationResult
@@ -147,7 +148,10 @@ def _packed(setup: RunSetup) -> dict:
         "grid": enc.readonly(setup.grid), "bp": enc.body_array(setup.body),
         "E": enc.readonly(muscles.selection_matrix), "C": enc.readonly(muscles.crossing_matrix),
         "one_sided": enc.readonly(muscles.one_sided_mask.astype(np.int64)),
-        "dp": enc.encode_disturbance(setup.disturbance),
+        "dp": enc.encode_disturbance(setup.disturbance), "tp": enc.encode_tilt(setup.tilt),
+        "tilt_gain": enc.readonly(np.ascontiguousarray(
+            setup.tilt_gains @ muscles.crossing_matrix if setup.tilt_gains is not None
+            else np.zeros((4, n)))),
         "bps": enc.readonly(setup.breakpoints.astype(float)), "fpar": fpar, "ipar": ipar,
         "active0": enc.readonly(setup.active0), "slots": slots,
         "ev_offset": ev.EVENT_OFFSET, "ev_direction": ev.EVENT_DIRECTION,
@@ -177,7 +181,7 @@ def _base_run_struct(a: dict, method: str) -> Run:
               n_slots=len(a["slots"]), method=METHOD_RADAU if tab is None else METHOD_EXPLICIT,
               delay_multiples=DELAY_BREAKPOINT_MULTIPLES)
     for name in ("x0", "before", "grid", "bp", "E", "C", "dp", "bps", "fpar", "active0",
-                 "ev_offset"):
+                 "ev_offset", "tp", "tilt_gain"):
         setattr(run, name, pointer(a[name]))
     for name in ("one_sided", "ipar", "ev_direction", "ev_ends"):
         setattr(run, name, pointer(a[name], ctypes_int64))
@@ -407,6 +411,8 @@ def simulate_batch(
     feedback_delay: float | np.ndarray = 0.0,
     active_stiffness: np.ndarray | None = None,
     active_viscosity: np.ndarray | None = None,
+    tilt: Tilt | None = None,
+    proprioceptive_weight: float = 1.0,
     rtol: float = DEFAULT_RTOL,
     atol: float = DEFAULT_ATOL,
     sample_rate: float = 1000.0,
@@ -449,6 +455,10 @@ def simulate_batch(
         ``viscosity`` are the intrinsic (undelayed) part and the delay applies to these
         only; with neither, the delay applies to the whole pair feedback
         (:func:`posturelab.model.muscles.feedback_gains`). [N·m/rad], [N·m·s/rad]
+    tilt : Tilt, optional
+        The support-surface tilt of every run (:mod:`posturelab.model.tilt`).
+    proprioceptive_weight : float
+        W of the active part's error for pairs that span the foot, in [0, 1]. [-]
     rtol : float
         Relative tolerance. [-]
     atol : float
@@ -523,7 +533,8 @@ def simulate_batch(
         return prepare_run(body, muscles, d, duration, initial_state=initial_state,
                            rates_from=rates_from, knee=knee, fall=fall,
                            torque_limits=limits, feedback_delay=delay, rtol=rtol, atol=atol,
-                           sample_rate=sample_rate, max_switches=max_switches)
+                           sample_rate=sample_rate, max_switches=max_switches, tilt=tilt,
+                           proprioceptive_weight=proprioceptive_weight)
 
     # every run's delay and limits are checked as a single run's would be
     for d in np.unique(delays):
@@ -554,6 +565,17 @@ def simulate_batch(
         feedback_gains(kd_all, ld_all, ka_all, la_all, delays)))
     moments0 = start_moments(muscles, x0_all[which], before_all[which], active_all[which],
                              gains_all)
+    tilt_gain_all = enc.readonly(np.zeros((M, 4, n)))
+    if base.tilt is not None:  # the tilt's gains follow each run's gains and delay
+        split = feedback_gains(kd_all, ld_all, ka_all, la_all, np.ones(M))
+        pair_gains = tilt_pair_gains(split, muscles.spans_foot, delays,
+                                     base.proprioceptive_weight)
+        a0, ad0 = base.tilt.angle_and_rate(0.0)
+        ab, adb = base.tilt.angle_and_rate(-delays)  # what the delayed part feels at t = 0
+        at_start = (pair_gains[:, 0] * a0 + pair_gains[:, 1] * ad0
+                    + pair_gains[:, 2] * ab[:, None] + pair_gains[:, 3] * adb[:, None])
+        moments0 = moments0 + at_start @ muscles.crossing_matrix
+        tilt_gain_all = enc.readonly(np.ascontiguousarray(pair_gains @ muscles.crossing_matrix))
     sat0_all = enc.readonly(start_saturation(moments0, lims))
     lim_all = enc.readonly(lims)
     delay_all = enc.readonly(delays)
@@ -591,7 +613,8 @@ def simulate_batch(
                       lim_all=pointer(lim_all), delay_all=pointer(delay_all),
                       sat0_all=pointer(sat0_all), method_all=pointer(method_all, ctypes_int64),
                       results=pointer(results),
-                      peaks=pointer(peaks), finals=pointer(finals))
+                      peaks=pointer(peaks), finals=pointer(finals),
+                      tilt_gain_all=pointer(tilt_gain_all))
         _run_rows(batch, todo, parallel, int(chunk))
     if at_start.any():
         results[at_start] = 0.0

@@ -31,6 +31,7 @@ class Run(ctypes.Structure):
         ("ev_offset", _d), ("ev_direction", _i), ("ev_ends", _i),
         ("tab_A", _d), ("tab_c", _d), ("tab_e", _d), ("tab_P", _d),
         ("tab_error_order", ctypes.c_int64), ("delay_multiples", ctypes.c_int64),
+        ("tp", _d), ("tilt_gain", _d),
     ]
 
 
@@ -49,7 +50,7 @@ class Batch(ctypes.Structure):
                 ("dp_all", _d), ("dp_stride", ctypes.c_int64), ("ipar_all", _i),
                 ("active0_all", _d), ("gains_all", _d), ("lim_all", _d), ("delay_all", _d),
                 ("sat0_all", _d), ("method_all", _i), ("results", _d), ("peaks", _d),
-                ("finals", _d)]
+                ("finals", _d), ("tilt_gain_all", _d)]
 
 
 def pointer(arr, kind=_d):

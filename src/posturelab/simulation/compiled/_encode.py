@@ -35,6 +35,10 @@ from ._layout import (
     KNEE_STOP,
     N_FPAR,
     N_IPAR,
+    TILT_PPOLY,
+    TILT_RAISED_COSINE,
+    TILT_ROW,
+    TILT_SINE,
     body_size,
 )
 
@@ -81,6 +85,34 @@ def encode_disturbance(disturbance: Disturbance | None) -> np.ndarray:
     packed = np.concatenate([[float(len(rows))], np.array(rows, float).ravel()]
                             + [data for _, data in profiles])
     return readonly(packed.astype(float))
+
+
+def encode_tilt(tilt) -> np.ndarray:
+    """``tp``: the tilt's :class:`~posturelab.model.tilt.TiltTerm` terms packed ([0] for none)."""
+    if tilt is None:
+        return readonly(np.zeros(1))
+    rows: list[list[float]] = []
+    data: list[tuple[int, np.ndarray]] = []
+    for q in tilt.terms():
+        if q.kind == "sine":
+            rows.append([TILT_SINE, q.amplitude, q.frequency, q.phase, 0.0, 0.0, 0.0])
+        elif q.kind == "raised-cosine":
+            rows.append([TILT_RAISED_COSINE, q.amplitude, q.start, q.duration, 0.0, 0.0, 0.0])
+        elif q.kind == "ppoly":
+            knots = np.asarray(q.knots, dtype=float)
+            coefficients = np.asarray(q.coefficients, dtype=float)
+            rows.append([TILT_PPOLY, -1.0, float(coefficients.shape[0]), q.period, 0.0, 0.0,
+                         0.0])
+            data.append((len(rows) - 1, np.concatenate([knots, coefficients.ravel()])))
+        else:
+            raise ParameterError(f"unknown kind of tilt term {q.kind!r}")
+    offset = 1 + TILT_ROW * len(rows)
+    for row_index, block in data:
+        rows[row_index][1] = float(offset)
+        offset += block.size
+    packed = np.concatenate([[float(len(rows))], np.array(rows, float).ravel()]
+                            + [block for _, block in data])
+    return readonly(packed)
 
 
 def body_array(body: Body) -> np.ndarray:

@@ -34,6 +34,15 @@ DIST_WINDOWED_SINE = 1
 DIST_SINE = 2
 #: linear interpolation of a sampled profile, zero outside: (index of its times in dp, S, 0, 0)
 DIST_SAMPLES = 3
+# Packed tilt ``tp``: tp[0] = number of terms, then rows of TILT_ROW numbers, then the
+# piecewise-cubic data (csrc/pl.h states the layout).
+TILT_ROW = 7
+#: (kind, amplitude [rad], frequency [Hz], phase [rad])
+TILT_SINE = 1
+#: (kind, amplitude [rad], start [s], duration [s])
+TILT_RAISED_COSINE = 2
+#: (kind, offset of the knots in tp, K intervals, period [s] or 0)
+TILT_PPOLY = 3
 
 # Options, floats ``fpar``
 F_MAX_ANGLE = 0  # [rad]

@@ -32,6 +32,12 @@ enum { KNEE_FREE = 0, KNEE_LOCKED = 1, KNEE_STOP = 2 };
  * (kind, axis, p0, p1, p2, p3), then sampled profiles (posturelab.model.platform.Primitive). */
 enum { DIST_ROW = 6, DIST_WINDOWED_SINE = 1, DIST_SINE = 2, DIST_SAMPLES = 3 };
 
+/* Packed tilt: tp[0] = number of terms, then rows of TILT_ROW numbers
+ * (kind, p0 … p5), then piecewise-cubic data (posturelab.model.tilt.TiltTerm):
+ * sine (A, f, φ), raised cosine (A, start, duration), ppoly (offset, K, period): at
+ * tp[offset] K + 1 knots, then K rows of 4 coefficients in ascending powers of t − knot. */
+enum { TILT_ROW = 7, TILT_SINE = 1, TILT_RAISED_COSINE = 2, TILT_PPOLY = 3 };
+
 /* Event kinds (posturelab.model.events) and the conditions of the segment's event slots */
 enum { EV_LINK_ANGLE = 0, EV_COG_TOE, EV_COG_HEEL, EV_COP_TOE, EV_COP_HEEL, EV_SATURATES,
        EV_LETS_GO, EV_PAIR_SLACKENS, EV_PAIR_ENGAGES, EV_KNEE_HITS_STOP, EV_KNEE_LEAVES_STOP };
@@ -62,6 +68,8 @@ typedef struct {
     const double *tab_A, *tab_c, *tab_e, *tab_P;  /* explicit tableau (n_stages ...) */
     int64_t tab_error_order;
     int64_t delay_multiples;            /* land on k·delay for k = 1 … this */
+    const double *tp;                   /* packed tilt (tp[0] = 0: none) */
+    const double *tilt_gain;            /* (4, n) joint moments per α(t), α̇(t), α(t−τ), α̇(t−τ) */
 } pl_run;
 
 /* Outputs of one run (any pointer may be NULL where noted). */
@@ -130,6 +138,7 @@ void pl_inverse3_complex(const double *ar, const double *ai, double *outr, doubl
 
 /* platform (pl_platform.c) */
 void pl_platform_acceleration(double t, const double *dp, double *ax, double *ay);
+void pl_tilt(double t, const double *tp, double *angle, double *rate);
 
 /* history of a delayed run (pl_history.c) */
 typedef struct {

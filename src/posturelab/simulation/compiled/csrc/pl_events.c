@@ -32,6 +32,18 @@ void pl_inputs_at(const pl_ctx *cx, double t, double *out)
         for (int64_t j = 0; j < n; j++)
             out[2 + j] = 0.0;
     }
+    if (cx->tp[0] > 0.0) {  /* the tilt's moments: now, and as the delayed part felt it */
+        const double *g = cx->tilt_gain;
+        double a, ad;
+        pl_tilt(t, cx->tp, &a, &ad);
+        for (int64_t j = 0; j < n; j++)
+            out[2 + j] += g[j] * a + g[n + j] * ad;
+        if (cx->delay > 0.0) {
+            pl_tilt(t - cx->delay, cx->tp, &a, &ad);
+            for (int64_t j = 0; j < n; j++)
+                out[2 + j] += g[2 * n + j] * a + g[3 * n + j] * ad;
+        }
+    }
 }
 
 double pl_event_value(const pl_ctx *cx, int64_t kind, int64_t idx, double side, double t,

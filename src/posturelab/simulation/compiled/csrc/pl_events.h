@@ -10,6 +10,7 @@ typedef struct {
     const double *E, *dp, *fpar, *before, *ev_offset;
     const pl_history *hist;
     double delay;
+    const double *tp, *tilt_gain;          /* packed tilt, (4, n) joint gains on it */
     double *sc_out, *sc_inp, *sc_x, *ys;   /* scratch (2n), (2 + n), (2n), (2n) */
 } pl_ctx;
 

@@ -1,5 +1,6 @@
 /* Platform acceleration from a packed disturbance (the terms of
- * posturelab.model.platform.Primitive; layout in pl.h). */
+ * posturelab.model.platform.Primitive) and the tilt angle and rate from a packed tilt (the
+ * terms of posturelab.model.tilt.TiltTerm); layouts in pl.h. */
 #include <math.h>
 #include "pl.h"
 
@@ -53,4 +54,59 @@ void pl_platform_acceleration(double t, const double *dp, double *ax, double *ay
     }
     *ax = sx;
     *ay = sy;
+}
+
+/* α and α̇ of one piecewise cubic: knots x[0..K], coefficients c[4k .. 4k+3] */
+static void ppoly(double t, const double *x, const double *c, int64_t K, double period,
+                  double *angle, double *rate)
+{
+    if (period > 0.0 && t >= x[0])
+        t = x[0] + fmod(t - x[0], period);
+    int inside = t >= x[0] && t <= x[K];
+    if (t < x[0])
+        t = x[0];
+    if (t > x[K])
+        t = x[K];
+    int64_t lo = 0, hi = K;
+    while (hi - lo > 1) {
+        const int64_t mid = (lo + hi) >> 1;
+        if (x[mid] <= t)
+            lo = mid;
+        else
+            hi = mid;
+    }
+    const double u = t - x[lo], *q = c + 4 * lo;
+    *angle = q[0] + u * (q[1] + u * (q[2] + u * q[3]));
+    *rate = inside ? q[1] + u * (2.0 * q[2] + u * 3.0 * q[3]) : 0.0;
+}
+
+void pl_tilt(double t, const double *tp, double *angle, double *rate)
+{
+    double a = 0.0, ad = 0.0;
+    const int64_t nq = (int64_t)tp[0];
+    for (int64_t q = 0; q < nq; q++) {
+        const double *r = tp + 1 + TILT_ROW * q;
+        const int kind = (int)r[0];
+        if (kind == TILT_SINE) {
+            const double w = 2.0 * PI * r[2], tt = t > 0.0 ? t : 0.0;
+            a += r[1] * sin(w * tt + r[3]);
+            if (t >= 0.0)
+                ad += r[1] * w * cos(w * tt + r[3]);
+        } else if (kind == TILT_RAISED_COSINE) {
+            double s = (t - r[2]) / r[3];
+            const int inside = t > r[2] && t < r[2] + r[3];
+            s = s < 0.0 ? 0.0 : (s > 1.0 ? 1.0 : s);
+            a += r[1] * 0.5 * (1.0 - cos(PI * s));
+            if (inside)
+                ad += r[1] * 0.5 * PI / r[3] * sin(PI * s);
+        } else if (kind == TILT_PPOLY) {
+            const int64_t off = (int64_t)r[1], K = (int64_t)r[2];
+            double pa, pr;
+            ppoly(t, tp + off, tp + off + K + 1, K, r[3], &pa, &pr);
+            a += pa;
+            ad += pr;
+        }
+    }
+    *angle = a;
+    *rate = ad;
 }

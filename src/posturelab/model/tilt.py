@@ -1,0 +1,525 @@
+"""Support-surface tilt α(t): profiles, and what a tilt does to the muscle pairs.
+
+Convention (docs/conventions.md): α [rad] is positive toes-up and turns the foot about the
+ankle axis. In the link-angle sense (from the vertical, positive forward) the foot's angle
+is then −α, so a pair that spans the foot (lo = 0) is stretched by θ_hi + α rather than
+θ_hi. Its intrinsic part always feels that stretch relative to the foot. Its active
+(neural) part feels the sensory-weighted error of the independent-channel model,
+W·(θ_hi + α) + (1 − W)·θ_hi = θ_hi + W·α, with W the proprioceptive weight (1: relative to
+the foot only; 0: relative to the vertical only). A muscle set without active gains reads
+its pair gains as the whole (neural) feedback, so W applies to them. The axis is the
+ankle's: the ankle does not move, and the tilt acts on the chain only through the pairs.
+
+Profiles (each gives α(t) and α̇(t) for any t; before t = 0 the surface is held at α(0)):
+
+- :class:`SineTilt`: α = A sin(2π f t + φ);
+- :class:`RaisedCosineTilt`: a smooth ramp to A over a duration, then held;
+- :class:`PRTSTilt`: a pseudorandom ternary sequence (PRTS) of surface velocities from a
+  shift register, integrated, repeated cycle after cycle (Peterka 2002's 80-state, 20 s
+  sequence is :meth:`PRTSTilt.peterka_2002`);
+- :class:`MeasuredTilt`: sampled α, interpolated by a cubic spline whose derivative gives a
+  smooth rate for the viscous terms.
+
+Every profile is a sum of :class:`TiltTerm` (a sine, a raised-cosine ramp, or a piecewise
+cubic, possibly periodic), the form both engines evaluate.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from functools import cached_property
+
+import numpy as np
+
+from .._validation import finite_array, finite_float, float_in_range
+from ..errors import ParameterError
+
+__all__ = [
+    "Tilt",
+    "TiltTerm",
+    "SineTilt",
+    "RaisedCosineTilt",
+    "PRTSTilt",
+    "MeasuredTilt",
+    "prts_sequence",
+    "tilt_pair_gains",
+    "read_tilt_csv",
+    "MAX_TILT",
+    "PETERKA_2002_CITATION",
+]
+
+#: Largest |α| a profile may reach. [rad]
+MAX_TILT = 0.5
+
+PETERKA_2002_CITATION = (
+    "Peterka RJ (2002) Sensorimotor integration in human postural control. "
+    "J Neurophysiol 88:1097–1118 (80-state PRTS, 0.25 s per state, 20 s cycle)"
+)
+
+
+@dataclass(frozen=True)
+class TiltTerm:
+    """One term of a tilt profile, in the form the engines evaluate.
+
+    Attributes
+    ----------
+    kind : {"sine", "raised-cosine", "ppoly"}
+        ``sine``: α = amplitude · sin(2π · frequency · t + phase) for t >= 0 (held at its
+        t = 0 value before); ``raised-cosine``: α = amplitude · (1 − cos(π s))/2 for
+        s = (t − start)/duration in [0, 1], 0 before, amplitude after; ``ppoly``: a
+        piecewise cubic on ``knots`` with ``coefficients`` (c0, c1, c2, c3) per interval in
+        powers of (t − knot), held at its end values outside, repeated with ``period``
+        when that is > 0.
+    amplitude : float
+        [rad]
+    frequency : float
+        [Hz]
+    phase : float
+        [rad]
+    start, duration : float
+        The ramp of a raised cosine. [s]
+    knots : numpy.ndarray, shape (K + 1,), optional
+        [s]
+    coefficients : numpy.ndarray, shape (K, 4), optional
+        [rad], [rad/s], [rad/s²], [rad/s³]
+    period : float
+        0 for a profile that is not repeated. [s]
+    """
+
+    kind: str
+    amplitude: float = 0.0
+    frequency: float = 0.0
+    phase: float = 0.0
+    start: float = 0.0
+    duration: float = 0.0
+    knots: np.ndarray | None = None
+    coefficients: np.ndarray | None = None
+    period: float = 0.0
+
+    def evaluate(self, t) -> tuple[np.ndarray, np.ndarray]:
+        """(α, α̇) at ``t`` (any shape). [rad], [rad/s]"""
+        t = np.asarray(t, dtype=float)
+        if self.kind == "sine":
+            w = 2 * math.pi * self.frequency
+            tt = np.maximum(t, 0.0)
+            rate = np.where(t >= 0.0, self.amplitude * w * np.cos(w * tt + self.phase), 0.0)
+            return self.amplitude * np.sin(w * tt + self.phase), rate
+        if self.kind == "raised-cosine":
+            s = np.clip((t - self.start) / self.duration, 0.0, 1.0)
+            inside = (t > self.start) & (t < self.start + self.duration)
+            angle = self.amplitude * 0.5 * (1.0 - np.cos(math.pi * s))
+            rate = np.where(inside, self.amplitude * 0.5 * math.pi / self.duration
+                            * np.sin(math.pi * s), 0.0)
+            return angle, rate
+        # piecewise cubic
+        x, c = self.knots, self.coefficients
+        tt = t
+        if self.period > 0:
+            tt = np.where(t >= x[0], x[0] + np.mod(t - x[0], self.period), t)
+        inside = (tt >= x[0]) & (tt <= x[-1])
+        tc = np.clip(tt, x[0], x[-1])
+        k = np.clip(np.searchsorted(x, tc, side="right") - 1, 0, len(c) - 1)
+        u = tc - x[k]
+        ck = c[k]
+        angle = ck[..., 0] + u * (ck[..., 1] + u * (ck[..., 2] + u * ck[..., 3]))
+        rate = ck[..., 1] + u * (2 * ck[..., 2] + u * 3 * ck[..., 3])
+        return angle, np.where(inside, rate, 0.0)
+
+
+class Tilt:
+    """A support-surface tilt profile α(t) (base class; see the module notes)."""
+
+    def terms(self) -> tuple[TiltTerm, ...]:
+        """The profile as a sum of :class:`TiltTerm`."""
+        raise NotImplementedError(type(self).__name__)
+
+    def angle_and_rate(self, t) -> tuple[np.ndarray, np.ndarray]:
+        """(α, α̇) at ``t``, the shape of ``t``. [rad], [rad/s]"""
+        t = np.asarray(t, dtype=float)
+        angle, rate = np.zeros(t.shape), np.zeros(t.shape)
+        for term in self.terms():
+            a, r = term.evaluate(t)
+            angle, rate = angle + a, rate + r
+        return angle, rate
+
+    def angle(self, t) -> np.ndarray:
+        """α(t). [rad]"""
+        return self.angle_and_rate(t)[0]
+
+    def rate(self, t) -> np.ndarray:
+        """α̇(t). [rad/s]"""
+        return self.angle_and_rate(t)[1]
+
+    def breakpoints(self, duration: float) -> tuple[float, ...]:
+        """Times in (0, duration) where the rate has a corner or a jump. [s]"""
+        return ()
+
+    @property
+    def max_step(self) -> float:
+        """Largest integrator step that resolves the profile. [s]"""
+        return math.inf
+
+    def describe(self) -> str:
+        """One line with units."""
+        raise NotImplementedError(type(self).__name__)
+
+
+@dataclass(frozen=True)
+class SineTilt(Tilt):
+    """α(t) = amplitude · sin(2π · frequency · t + phase).
+
+    Parameters
+    ----------
+    amplitude : float
+        [rad], |amplitude| <= :data:`MAX_TILT`.
+    frequency : float
+        (0, 1000]. [Hz]
+    phase : float
+        [rad]
+    """
+
+    amplitude: float
+    frequency: float
+    phase: float = 0.0
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "amplitude", float_in_range(
+            "tilt amplitude [rad]", self.amplitude, -MAX_TILT, MAX_TILT, unit="rad"))
+        object.__setattr__(self, "frequency", float_in_range(
+            "tilt frequency [Hz]", self.frequency, 1e-6, 1000.0, unit="Hz"))
+        object.__setattr__(self, "phase", finite_float("tilt phase [rad]", self.phase))
+
+    def terms(self) -> tuple[TiltTerm, ...]:
+        return (TiltTerm("sine", amplitude=self.amplitude, frequency=self.frequency,
+                         phase=self.phase),)
+
+    @property
+    def max_step(self) -> float:
+        return 0.05 / self.frequency
+
+    def describe(self) -> str:
+        return (f"sine tilt {self.amplitude:g} rad at {self.frequency:g} Hz"
+                + (f", phase {self.phase:g} rad" if self.phase else ""))
+
+
+@dataclass(frozen=True)
+class RaisedCosineTilt(Tilt):
+    """A smooth tilt to ``amplitude`` over ``duration`` from ``start``, then held:
+    α = amplitude · (1 − cos(π (t − start)/duration))/2 on the ramp.
+
+    Parameters
+    ----------
+    amplitude : float
+        [rad], |amplitude| <= :data:`MAX_TILT`.
+    duration : float
+        Ramp time, > 0. [s]
+    start : float
+        Ramp start, >= 0. [s]
+    """
+
+    amplitude: float
+    duration: float
+    start: float = 0.0
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "amplitude", float_in_range(
+            "tilt amplitude [rad]", self.amplitude, -MAX_TILT, MAX_TILT, unit="rad"))
+        object.__setattr__(self, "duration", float_in_range(
+            "tilt duration [s]", self.duration, 1e-4, 1e4, unit="s"))
+        object.__setattr__(self, "start", float_in_range(
+            "tilt start [s]", self.start, 0.0, 1e4, unit="s"))
+
+    def terms(self) -> tuple[TiltTerm, ...]:
+        return (TiltTerm("raised-cosine", amplitude=self.amplitude, start=self.start,
+                         duration=self.duration),)
+
+    def breakpoints(self, duration: float) -> tuple[float, ...]:
+        return tuple(b for b in (self.start, self.start + self.duration) if 0 < b < duration)
+
+    @property
+    def max_step(self) -> float:
+        return self.duration / 20
+
+    def describe(self) -> str:
+        return (f"raised-cosine tilt to {self.amplitude:g} rad over {self.duration:g} s"
+                + (f" from {self.start:g} s" if self.start else ""))
+
+
+def prts_sequence(registers: int, taps: tuple[int, ...], seed: tuple[int, ...]) -> np.ndarray:
+    """One period of a pseudorandom ternary sequence from a shift register over GF(3).
+
+    The register holds ``registers`` digits in {0, 1, 2}; each step the new digit is
+    Σ taps[i] · register[i] (mod 3), the register shifts by one, and the digit that leaves
+    it is the output. Digits map to the values 0 → 0, 1 → +1, 2 → −1. With a primitive
+    feedback polynomial the period is 3^registers − 1 and the sequence sums to zero.
+
+    Parameters
+    ----------
+    registers : int
+        1 … 8. [-]
+    taps : tuple of int
+        One coefficient in {0, 1, 2} per register (the oldest digit first). [-]
+    seed : tuple of int
+        The register's start, digits in {0, 1, 2}, not all zero. [-]
+
+    Returns
+    -------
+    numpy.ndarray, shape (period,)
+        Values in {−1, 0, 1}. [-]
+    """
+    if isinstance(registers, bool) or not isinstance(registers, int) or not 1 <= registers <= 8:
+        raise ParameterError(f"PRTS registers must be an integer in [1, 8], got {registers!r}")
+    for name, digits in (("taps", taps), ("seed", seed)):
+        if len(digits) != registers or any(d not in (0, 1, 2) for d in digits):
+            raise ParameterError(f"PRTS {name} must be {registers} digits in {{0, 1, 2}}, "
+                                 f"got {tuple(digits)!r}")
+    if not any(seed):
+        raise ParameterError("PRTS seed must not be all zeros")
+    state = list(seed)
+    out = []
+    start = tuple(state)
+    for _ in range(3**registers):
+        new = sum(t * s for t, s in zip(taps, state, strict=True)) % 3
+        out.append(state[0])
+        state = state[1:] + [new]
+        if tuple(state) == start:
+            break
+    values = np.array([0.0, 1.0, -1.0])[np.array(out)]
+    return values
+
+
+#: The 4-register feedback of the 80-state sequence: new = x_{k−4} + x_{k−3} (mod 3), from
+#: the primitive polynomial x⁴ + 2x + 2 over GF(3) (a test checks that its period is 80).
+PETERKA_TAPS = (1, 1, 0, 0)
+PETERKA_SEED = (1, 0, 0, 0)
+
+
+@dataclass(frozen=True)
+class PRTSTilt(Tilt):
+    """A pseudorandom ternary tilt: the surface velocity takes the sequence's values
+    {+v, 0, −v} for ``state_duration`` each, and α is its integral (piecewise linear),
+    scaled to the peak-to-peak ``amplitude`` and repeated every cycle.
+
+    Parameters
+    ----------
+    amplitude : float
+        Peak-to-peak tilt (Peterka's convention), (0, 2·MAX_TILT]. [rad]
+    state_duration : float
+        Time per state, > 0. [s]
+    registers, taps, seed
+        The shift register (:func:`prts_sequence`). [-]
+    """
+
+    amplitude: float
+    state_duration: float = 0.25
+    registers: int = 4
+    taps: tuple[int, ...] = PETERKA_TAPS
+    seed: tuple[int, ...] = PETERKA_SEED
+    _term: TiltTerm = field(init=False, repr=False, compare=False, default=None)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "amplitude", float_in_range(
+            "PRTS amplitude (peak to peak) [rad]", self.amplitude, 1e-9, 2 * MAX_TILT,
+            unit="rad"))
+        object.__setattr__(self, "state_duration", float_in_range(
+            "PRTS state duration [s]", self.state_duration, 1e-3, 100.0, unit="s"))
+        object.__setattr__(self, "taps", tuple(int(t) for t in self.taps))
+        object.__setattr__(self, "seed", tuple(int(s) for s in self.seed))
+        velocity = prts_sequence(self.registers, self.taps, self.seed)
+        if abs(velocity.sum()) > 0.5:
+            raise ParameterError("PRTS taps do not give a zero-mean sequence (the tilt would "
+                                 "drift): use a primitive feedback polynomial")
+        dt = self.state_duration
+        angle = np.concatenate([[0.0], np.cumsum(velocity) * dt])
+        span = angle.max() - angle.min()
+        scale = self.amplitude / span
+        offset = -0.5 * (angle.max() + angle.min()) * scale  # centred on 0 (mean level)
+        knots = np.arange(angle.size) * dt
+        coefficients = np.zeros((velocity.size, 4))
+        coefficients[:, 0] = angle[:-1] * scale + offset
+        coefficients[:, 1] = velocity * scale
+        object.__setattr__(self, "_term", TiltTerm(
+            "ppoly", knots=knots, coefficients=coefficients, period=knots[-1]))
+
+    @classmethod
+    def peterka_2002(cls, amplitude: float) -> PRTSTilt:
+        """Peterka's 80-state PRTS with 0.25 s per state (a 20 s cycle), peak-to-peak
+        ``amplitude`` [rad] (:data:`PETERKA_2002_CITATION`)."""
+        return cls(amplitude, 0.25, 4, PETERKA_TAPS, PETERKA_SEED)
+
+    @cached_property
+    def velocity_sequence(self) -> np.ndarray:
+        """The sequence's values {−1, 0, 1}, one cycle. [-]"""
+        return prts_sequence(self.registers, self.taps, self.seed)
+
+    @property
+    def cycle(self) -> float:
+        """Cycle length. [s]"""
+        return float(self._term.period)
+
+    def terms(self) -> tuple[TiltTerm, ...]:
+        return (self._term,)
+
+    def breakpoints(self, duration: float) -> tuple[float, ...]:
+        dt = self.state_duration
+        count = int(math.floor(duration / dt))
+        return tuple(k * dt for k in range(1, count + 1) if k * dt < duration)
+
+    @property
+    def max_step(self) -> float:
+        return self.state_duration
+
+    def describe(self) -> str:
+        return (f"PRTS tilt {self.amplitude:g} rad peak to peak, {self.velocity_sequence.size} "
+                f"states of {self.state_duration:g} s ({self.cycle:g} s cycle)")
+
+
+@dataclass(frozen=True)
+class MeasuredTilt(Tilt):
+    """A sampled tilt, interpolated by a not-a-knot cubic spline (its derivative is the
+    rate), held at the end values outside the samples.
+
+    Parameters
+    ----------
+    time : array_like, shape (S,)
+        Strictly increasing, S >= 4. [s]
+    angle : array_like, shape (S,)
+        α at those times, |α| <= :data:`MAX_TILT`. [rad]
+    source : str
+        Where it came from.
+    """
+
+    time: np.ndarray
+    angle_samples: np.ndarray
+    source: str = ""
+    _term: TiltTerm = field(init=False, repr=False, compare=False, default=None)
+
+    def __post_init__(self) -> None:
+        from scipy.interpolate import CubicSpline
+
+        t = finite_array("tilt time [s]", self.time, (None,))
+        if t.size < 4:
+            raise ParameterError(f"tilt time [s] must have at least 4 samples, got {t.size}")
+        if np.any(np.diff(t) <= 0):
+            raise ParameterError("tilt time [s] must be strictly increasing")
+        a = finite_array("tilt [rad]", self.angle_samples, (t.size,))
+        if np.abs(a).max() > MAX_TILT:
+            raise ParameterError(f"tilt [rad] must be within ±{MAX_TILT:g} rad, got "
+                                 f"{a[np.argmax(np.abs(a))]:g}")
+        spline = CubicSpline(t, a)
+        coefficients = np.ascontiguousarray(spline.c[::-1].T)  # (K, 4), ascending powers
+        for name, arr in (("time", t), ("angle_samples", a)):
+            arr.setflags(write=False)
+            object.__setattr__(self, name, arr)
+        object.__setattr__(self, "_term", TiltTerm("ppoly", knots=t.copy(),
+                                                   coefficients=coefficients))
+
+    def terms(self) -> tuple[TiltTerm, ...]:
+        return (self._term,)
+
+    def breakpoints(self, duration: float) -> tuple[float, ...]:
+        return tuple(b for b in (float(self.time[0]), float(self.time[-1])) if 0 < b < duration)
+
+    @property
+    def max_step(self) -> float:
+        return float(np.diff(self.time).min()) * 4
+
+    def describe(self) -> str:
+        src = f" from {self.source}" if self.source else ""
+        return (f"measured tilt{src}: {self.time.size} samples, "
+                f"{self.time[0]:g}–{self.time[-1]:g} s")
+
+
+def read_tilt_csv(path) -> MeasuredTilt:
+    """A measured tilt from a CSV file with a header row and the columns ``time`` [s] and
+    ``tilt`` [rad] (by name, a ``[unit]`` suffix ignored; other columns are ignored, so a
+    measured platform profile may carry its tilt).
+
+    Raises
+    ------
+    DataFileError
+        With the file, line and column of the first problem.
+    """
+    import csv
+    from pathlib import Path
+
+    from ..errors import DataFileError
+
+    path = Path(path)
+    try:
+        with path.open(newline="", encoding="utf-8-sig") as fh:
+            rows = [r for r in csv.reader(fh) if r and any(c.strip() for c in r)]
+    except OSError as exc:
+        raise DataFileError(f"cannot read tilt profile {str(path)!r}: {exc.strerror}") from None
+    except UnicodeDecodeError:
+        raise DataFileError(f"tilt profile {str(path)!r} is not a UTF-8 CSV file") from None
+    if len(rows) < 5:
+        raise DataFileError(f"tilt profile {str(path)!r} needs a header row and at least 4 "
+                            "samples")
+    header = [h.split("[")[0].strip().lower() for h in rows[0]]
+    header = ["time" if h == "t" else h for h in header]
+    for name in ("time", "tilt"):
+        if name not in header:
+            raise DataFileError(f"tilt profile {str(path)!r} lacks column {name!r}; needs "
+                                "time [s] and tilt [rad]")
+    it, ia = header.index("time"), header.index("tilt")
+    values = np.empty((len(rows) - 1, 2))
+    for lineno, r in enumerate(rows[1:], start=2):
+        for col, j, name in ((0, it, "time"), (1, ia, "tilt")):
+            try:
+                v = float(r[j])
+            except (IndexError, ValueError):
+                raise DataFileError(f"tilt profile {str(path)!r} line {lineno}: column "
+                                    f"{name!r} is not a number") from None
+            if not math.isfinite(v):
+                raise DataFileError(f"tilt profile {str(path)!r} line {lineno}: column "
+                                    f"{name!r} is not finite")
+            values[lineno - 2, col] = v
+    try:
+        return MeasuredTilt(values[:, 0], values[:, 1], source=path.name)
+    except ParameterError as exc:
+        raise DataFileError(f"tilt profile {str(path)!r}: {exc}") from None
+
+
+def tilt_pair_gains(split_gains: np.ndarray, spans_foot: np.ndarray, delay,
+                    proprioceptive_weight) -> np.ndarray:
+    """Pair gains on the tilt, (…, 4, P): on α(t), α̇(t), α(t − τ), α̇(t − τ).
+
+    A pair that spans the foot feels α in its intrinsic part and W·α in its active part
+    (module notes); other pairs feel no tilt.
+
+    Parameters
+    ----------
+    split_gains : numpy.ndarray, shape (..., 4, P)
+        The gains split as with a delay (:func:`posturelab.model.muscles.feedback_gains`
+        for any τ > 0): intrinsic k, l, active k, l. [N·m/rad], [N·m·s/rad]
+    spans_foot : numpy.ndarray of bool, shape (P,)
+    delay : float or array_like, shape (...)
+        τ. [s]
+    proprioceptive_weight : float or array_like, shape (...)
+        W in [0, 1]. [-]
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 4, P)
+        [N·m/rad], [N·m·s/rad], [N·m/rad], [N·m·s/rad]
+    """
+    g = np.asarray(split_gains, dtype=float) * np.asarray(spans_foot, dtype=float)
+    w = np.asarray(proprioceptive_weight, dtype=float)[..., None]
+    delayed = (np.asarray(delay, dtype=float) > 0)[..., None]
+    intrinsic_k, intrinsic_l = g[..., 0, :], g[..., 1, :]
+    active_k, active_l = w * g[..., 2, :], w * g[..., 3, :]
+    zero = np.zeros_like(intrinsic_k)
+    return np.stack([
+        intrinsic_k + np.where(delayed, zero, active_k),
+        intrinsic_l + np.where(delayed, zero, active_l),
+        np.where(delayed, active_k, zero),
+        np.where(delayed, active_l, zero),
+    ], axis=-2)
+
+
+def check_proprioceptive_weight(value) -> float:
+    """W in [0, 1], a finite number. [-]"""
+    return float_in_range("proprioceptive_weight [-]", value, 0.0, 1.0)
+

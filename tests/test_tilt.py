@@ -1,0 +1,165 @@
+"""Support-surface tilt (posturelab.model.tilt) and sensory weighting, in both engines.
+
+Checked against: the linear static solve under a constant tilt; the closed-form steady
+state of the one-link body under a sine tilt; a 1 kHz sampled sine against the analytic
+one; the PRTS's defining properties; the engines against each other; a batch against its
+single runs; and bad input.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import posturelab as pl
+from posturelab.errors import ParameterError
+from posturelab.model.muscles import MusclePair, MuscleSet
+from posturelab.model.tilt import (
+    MeasuredTilt,
+    PRTSTilt,
+    RaisedCosineTilt,
+    SineTilt,
+    prts_sequence,
+)
+from posturelab.simulation.compiled import simulate_batch
+
+ENGINES = ["reference", "compiled"]
+LOOSE_FALL = pl.FallCriteria(math.pi / 2)
+
+
+def split_case_1(weight_share=0.5):
+    k = pl.paper_muscles("1").stiffnesses
+    return pl.paper_muscles(stiffness=(1 - weight_share) * k, active_stiffness=weight_share * k,
+                            active_viscosity_ratio=0.25)
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+def test_constant_tilt_equilibrium_is_the_linear_solve(engine):
+    """Held at α: (K − gA) Θ = −Eᵀ diag(k_i + W k_a) f α (f: pairs that span the foot)."""
+    body, muscles, alpha, w = pl.paper_body(), split_case_1(), 0.002, 0.6
+    r = pl.simulate(body, muscles, None, 20.0, tilt=RaisedCosineTilt(alpha, 1.0),
+                    proprioceptive_weight=w, feedback_delay=0.02, sample_rate=50,
+                    engine=engine)
+    E = muscles.selection_matrix
+    ki, ka = muscles.stiffnesses, muscles.active_stiffnesses
+    K = E.T @ ((ki + ka)[:, None] * E)
+    G = body.gravity * np.diag(body.gravity_coefficients)
+    rhs = -E.T @ ((ki + w * ka) * muscles.spans_foot) * alpha
+    expected = np.linalg.solve(K - G, rhs)
+    np.testing.assert_allclose(r.theta[-1], expected, rtol=1e-4, atol=1e-9)
+    assert np.all(np.abs(r.omega[-1]) < 1e-9)
+
+
+def pendulum(k=1000.0, l=300.0):
+    return pl.get_body("paper-1link"), MuscleSet((MusclePair("ankle", 0, 1, k, l),), 1)
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+def test_sine_tilt_on_one_link_reaches_the_closed_form_steady_state(engine):
+    """J θ̈ + L θ̇ + (K − mgh) θ = −(K α + L α̇): θ = A·Im[H e^{iωt}],
+    H = −(K + iωL)/(K − mgh − Jω² + iωL), once the start has decayed (poles at −2.6 1/s)."""
+    body, muscles = pendulum()
+    amplitude, frequency = 1e-3, 0.7
+    r = pl.simulate(body, muscles, None, 14.0, tilt=SineTilt(amplitude, frequency),
+                    sample_rate=100, engine=engine, fall=LOOSE_FALL)
+    J, load, w = body.inertia_diagonal[0], body.load_stiffness, 2 * math.pi * frequency
+    H = -(1000.0 + 1j * w * 300.0) / (1000.0 - load - J * w * w + 1j * w * 300.0)
+    late = r.time > 11.0
+    expected = amplitude * np.imag(H * np.exp(1j * w * r.time[late]))
+    np.testing.assert_allclose(r.theta[late, 0], expected, rtol=0, atol=1e-8)
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+def test_a_1_khz_sampled_sine_reproduces_the_analytic_sine(engine):
+    body, muscles = pendulum()
+    t = np.arange(0, 6.0005, 0.001)
+    sampled = MeasuredTilt(t, 0.01 * np.sin(2 * math.pi * 0.8 * t))
+    kwargs = dict(sample_rate=100, engine=engine, fall=LOOSE_FALL)
+    a = pl.simulate(body, muscles, None, 6.0, tilt=SineTilt(0.01, 0.8), **kwargs)
+    b = pl.simulate(body, muscles, None, 6.0, tilt=sampled, **kwargs)
+    np.testing.assert_allclose(b.theta, a.theta, rtol=0, atol=1e-6)
+
+
+@pytest.mark.parametrize("tilt", [SineTilt(0.03, 0.4, 0.3), RaisedCosineTilt(-0.04, 0.6, 0.3),
+                                  PRTSTilt.peterka_2002(0.06)])
+def test_the_engines_agree_on_tilt_with_delay_and_sensory_weight(tilt):
+    body, muscles = pl.paper_body(), split_case_1()
+    kwargs = dict(tilt=tilt, proprioceptive_weight=0.7, feedback_delay=0.03, sample_rate=100,
+                  initial_state=[0.02, 0.0, 0.01, 0.0, 0.0, 0.0])
+    fast = pl.simulate(body, muscles, None, 4.0, engine="compiled", rtol=1e-10, atol=1e-13,
+                       **kwargs)
+    ref = pl.simulate(body, muscles, None, 4.0, engine="reference", rtol=1e-10, atol=1e-12,
+                      **kwargs)
+    assert fast.status == ref.status == "completed"
+    np.testing.assert_allclose(fast.theta, ref.theta, rtol=0, atol=1e-6)
+    np.testing.assert_allclose(fast.pair_torques, ref.pair_torques, rtol=0, atol=1e-4)
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+def test_the_sensory_weight_splits_the_active_error(engine):
+    """All-active gains with W = 0 feel no tilt at all (relative to the vertical); intrinsic
+    gains feel it whatever W is."""
+    body, muscles = pendulum()
+    tilt = RaisedCosineTilt(0.05, 0.5)
+    vertical = pl.simulate(body, muscles, None, 2.0, tilt=tilt, proprioceptive_weight=0.0,
+                           feedback_delay=0.05, engine=engine, sample_rate=100)
+    assert np.all(vertical.theta == 0.0)
+    intrinsic = MuscleSet((MusclePair("ankle", 0, 1, 1000.0, 300.0, active_stiffness=0.0),), 1)
+    felt = pl.simulate(body, intrinsic, None, 2.0, tilt=tilt, proprioceptive_weight=0.0,
+                       feedback_delay=0.05, engine=engine, sample_rate=100)
+    assert felt.theta[-1, 0] < -0.05  # toes-up: the body follows the foot backward, and more
+
+
+def test_prts_has_the_properties_of_peterkas_sequence():
+    v = prts_sequence(4, (1, 1, 0, 0), (1, 0, 0, 0))
+    assert v.size == 80 and v.sum() == 0 and np.count_nonzero(v) == 54
+    np.testing.assert_array_equal(v[40:], -v[:40])  # half-period antisymmetry: odd harmonics
+    tilt = PRTSTilt.peterka_2002(0.0349)
+    assert tilt.cycle == 20.0
+    t = np.linspace(0, 40, 40_001)
+    a, rate = tilt.angle_and_rate(t)
+    assert a.max() - a.min() == pytest.approx(0.0349, rel=1e-12)
+    np.testing.assert_allclose(a[t < 20], tilt.angle(t[t < 20] + 20.0), atol=1e-15)
+    spectrum = np.abs(np.fft.rfft(a[:20_000]))
+    even = spectrum[2:60:2].max()
+    odd = spectrum[1:60:2].max()
+    assert even < 1e-9 * odd
+    assert set(np.round(np.unique(rate) / rate.max(), 12)) <= {-1.0, 0.0, 1.0}
+
+
+def test_batch_with_tilt_equals_its_single_runs(rng):
+    m = 4
+    k = np.tile(np.asarray(pl.paper_muscles("1").stiffnesses), (m, 1))
+    ka = rng.uniform(50.0, 300.0, (m, 5))
+    delays = np.array([0.0, 0.02, 0.05, 0.1])
+    tilt = SineTilt(0.02, 0.5)
+    out = simulate_batch(pl.paper_body(), 0.6 * k, 0.15 * k, None, 3.0, feedback_delay=delays,
+                         active_stiffness=ka, active_viscosity=0.25 * ka, tilt=tilt,
+                         proprioceptive_weight=0.8)
+    for r in range(m):
+        muscles = pl.paper_muscles(stiffness=0.6 * k[r], viscosity=0.15 * k[r],
+                                   active_stiffness=ka[r], active_viscosity=0.25 * ka[r])
+        one = pl.simulate(pl.paper_body(), muscles, None, 3.0, feedback_delay=float(delays[r]),
+                          tilt=tilt, proprioceptive_weight=0.8, engine="compiled")
+        np.testing.assert_array_equal(out.final_state[r], np.r_[one.theta[-1], one.omega[-1]])
+        np.testing.assert_array_equal(out.peak_theta[r], np.abs(one.theta).max(axis=0))
+
+
+def test_bad_tilt_input_is_refused_naming_the_field():
+    body, muscles = pendulum()
+    with pytest.raises(ParameterError, match=r"proprioceptive_weight \[-\]"):
+        pl.simulate(body, muscles, None, 1.0, tilt=SineTilt(0.01, 1.0),
+                    proprioceptive_weight=1.5)
+    with pytest.raises(ParameterError, match="tilt amplitude"):
+        SineTilt(2.0, 1.0)
+    with pytest.raises(ParameterError, match="tilt duration"):
+        RaisedCosineTilt(0.1, -1.0)
+    with pytest.raises(ParameterError, match="one-sided"):
+        pl.simulate(pl.paper_body(), pl.paper_muscles("1", gastrocnemius="one-sided"), None,
+                    1.0, tilt=SineTilt(0.01, 1.0))
+    with pytest.raises(ParameterError, match="tilt must be a Tilt"):
+        pl.simulate(body, muscles, None, 1.0, tilt=0.1)
+    with pytest.raises(ParameterError, match="PRTS taps"):
+        PRTSTilt(0.05, taps=(1, 0, 0, 0))
