@@ -103,8 +103,14 @@ def test_poles_case_3_json(capsys):
     code, out, err = run(capsys, "poles", "--case", "3", "--json")
     assert code == 0 and err == ""
     obj = one_json_object(out)
-    assert set(obj) == {"stiffness", "viscosity_ratio", "poles", "stable"}
+    assert set(obj) == {"stiffness", "viscosity", "stiffness_fraction_of_mgh", "viscosity_ratio",
+                        "poles", "stable"}
     assert obj["stiffness"] == [1000.0, 300.0, 300.0, 300.0, 0.0]
+    assert obj["viscosity"] == [250.0, 75.0, 75.0, 75.0, 0.0]
+    from posturelab import paper_body
+
+    mgh = paper_body().load_stiffness
+    assert obj["stiffness_fraction_of_mgh"] == [k / mgh for k in obj["stiffness"]]
     assert all(isinstance(x, float | int) for x in obj["stiffness"])
     assert obj["viscosity_ratio"] == 0.25
     assert obj["stable"] is True

@@ -23,6 +23,7 @@ SUBCOMMANDS: dict[str, str] = {
     "stability-map": "stability_map",
     "sweep": "sweep",
     "fit": "fit",
+    "delay-margin": "delay_margin",
 }
 
 

@@ -54,40 +54,174 @@ def parse_limit_list(text: str, field: str, n: int) -> list[float]:
 
 
 def add_muscle_arguments(p: argparse.ArgumentParser, *, require: bool = False) -> None:
-    """--case / --stiffness / --viscosity-ratio / --gastrocnemius."""
-    g = p.add_mutually_exclusive_group(required=require)
-    g.add_argument(
-        "--case", metavar="CASE",
-        help=f"Table I stiffness set: {', '.join(STIFFNESS_CASES)}.",
-    )
-    g.add_argument(
-        "--stiffness", metavar="K1,K2,K3,K4,K5",
-        help="five pair stiffnesses [N·m/rad] in the order "
-        + ", ".join(PAPER_PAIR_NAMES) + ".",
-    )
-    p.add_argument(
-        "--viscosity-ratio", type=float, default=0.25, metavar="R",
-        help="pair viscosity = R × pair stiffness [s] (default 0.25, as in the paper).",
-    )
-    p.add_argument(
-        "--gastrocnemius", choices=["two-sided", "one-sided"], default="two-sided",
-        help=GASTROCNEMIUS_HELP,
-    )
+    """The body and its feedback: --body / --height --mass, --case / --stiffness /
+    --controller, --viscosity / --viscosity-ratio, --gastrocnemius, the active gains,
+    --feedback-delay and --proprioceptive-weight."""
+    from ..model.body import BODY_PRESETS
+    from ..model.controllers import CONTROLLERS
+
+    body = p.add_argument_group("body")
+    body.add_argument("--body", metavar="PRESET",
+                      help=f"body preset: {', '.join(BODY_PRESETS)} (default paper).")
+    body.add_argument("--height", type=str, metavar="M",
+                      help="subject height [m], with --mass: leg, thigh and HAT scaled by "
+                      "Winter's anthropometric table (three links).")
+    body.add_argument("--mass", type=str, metavar="KG", help="subject mass [kg], with --height.")
+    fb = p.add_argument_group("feedback (muscle pairs)")
+    g = fb.add_mutually_exclusive_group(required=require)
+    g.add_argument("--case", metavar="CASE",
+                   help=f"Table I stiffness set (three links): {', '.join(STIFFNESS_CASES)}.")
+    g.add_argument("--stiffness", metavar="LIST",
+                   help="pair stiffnesses [N·m/rad], one per pair: five for three links ("
+                   + ", ".join(PAPER_PAIR_NAMES) + "), one per joint otherwise (one for a "
+                   "one-link body). With active gains this is the intrinsic (undelayed) part.")
+    g.add_argument("--controller", metavar="NAME",
+                   help="a published one-link controller (intrinsic and active gains as "
+                   f"fractions of mgh, delay, weight): {', '.join(CONTROLLERS)}.")
+    fb.add_argument("--viscosity", metavar="LIST",
+                    help="pair viscosities [N·m·s/rad], one per pair (instead of a ratio).")
+    fb.add_argument("--viscosity-ratio", type=float, default=None, metavar="R",
+                    help="pair viscosity = R × pair stiffness [s] (default 0.25, the paper's).")
+    fb.add_argument("--gastrocnemius", choices=["two-sided", "one-sided"], default="two-sided",
+                    help=GASTROCNEMIUS_HELP)
+    fb.add_argument("--active-stiffness", metavar="LIST",
+                    help="active (neural) pair stiffnesses [N·m/rad], delayed by "
+                    "--feedback-delay; one per pair.")
+    fb.add_argument("--active-viscosity", metavar="LIST",
+                    help="active pair viscosities [N·m·s/rad], one per pair.")
+    fb.add_argument("--active-viscosity-ratio", type=float, default=None, metavar="R",
+                    help="active viscosity = R × active stiffness [s] (default 0).")
+    fb.add_argument("--feedback-delay", type=float, default=None, metavar="SECONDS",
+                    help="neural delay τ [s], in [0, 1]. With active gains it delays their "
+                    "part only (the intrinsic gains act at once); without any, it delays "
+                    "every pair's whole feedback (the paper's gains read as neural).")
+    fb.add_argument("--proprioceptive-weight", type=float, default=None, metavar="W",
+                    help="W in [0, 1]: the active error of pairs that span the foot is "
+                    "θ + W·α under a tilt α (1, the default: relative to the foot; 0: to the "
+                    "vertical).")
 
 
-def muscles_from_args(args: argparse.Namespace):
-    """Build the paper's MuscleSet from --case / --stiffness arguments."""
-    from ..model.muscles import paper_muscles
+def body_from_args(args: argparse.Namespace):
+    """The body of --body / --height --mass (the paper's by default)."""
+    from ..model.anthropometry import body_from_anthropometry
+    from ..model.body import get_body, paper_body
 
+    given = [getattr(args, "height", None), getattr(args, "mass", None)]
+    if any(v is not None for v in given):
+        if None in given:
+            raise ParameterError("--height [m] and --mass [kg] go together")
+        if args.body is not None:
+            raise ParameterError("give --body or --height/--mass, not both")
+        height = parse_float_list(args.height, "--height [m]", 1)[0]
+        mass = parse_float_list(args.mass, "--mass [kg]", 1)[0]
+        return body_from_anthropometry(height, mass)
+    if getattr(args, "body", None) is not None:
+        return get_body(args.body)
+    if getattr(args, "controller", None) is not None:
+        return get_body("paper-1link")
+    return paper_body()
+
+
+def _pairs(body) -> int:
+    from ..model.muscles import joint_pair_names
+
+    return 5 if body.n_links == 3 else len(joint_pair_names(body.n_links))
+
+
+def muscles_from_args(args: argparse.Namespace, body=None):
+    """The MuscleSet of --case / --stiffness / --controller and the gain options."""
+    from ..model.controllers import get_controller
+    from ..model.muscles import muscles_for, paper_muscles
+
+    body = body_from_args(args) if body is None else body
+    if getattr(args, "controller", None) is not None:
+        clash = [f for f in ("viscosity", "viscosity_ratio", "active_stiffness",
+                             "active_viscosity", "active_viscosity_ratio")
+                 if getattr(args, f, None) is not None]
+        if clash:
+            raise ParameterError(f"--controller sets every gain; it cannot be combined with "
+                                 f"--{clash[0].replace('_', '-')}")
+        return get_controller(args.controller).muscles(body)
     if args.case is None and args.stiffness is None:
-        raise ParameterError("give --case (Table I) or --stiffness K1,K2,K3,K4,K5")
-    stiffness = None
-    if args.stiffness is not None:
-        stiffness = parse_float_list(args.stiffness, "--stiffness [N·m/rad]", 5)
-    return paper_muscles(
-        args.case, stiffness=stiffness, viscosity_ratio=args.viscosity_ratio,
-        gastrocnemius=args.gastrocnemius,
-    )
+        raise ParameterError("give --case (Table I), --stiffness LIST or --controller NAME")
+    if args.viscosity is not None and args.viscosity_ratio is not None:
+        raise ParameterError("give --viscosity or --viscosity-ratio, not both")
+    if args.active_viscosity is not None and args.active_viscosity_ratio is not None:
+        raise ParameterError("give --active-viscosity or --active-viscosity-ratio, not both")
+    P = _pairs(body)
+    ratio = 0.25 if args.viscosity_ratio is None else args.viscosity_ratio
+    if not (math.isfinite(ratio) and ratio >= 0):
+        raise ParameterError(f"--viscosity-ratio [s] must be a finite number >= 0, got {ratio:g}")
+    lists = {}
+    for flag in ("viscosity", "active_stiffness", "active_viscosity"):
+        text = getattr(args, flag, None)
+        unit = "[N·m/rad]" if flag == "active_stiffness" else "[N·m·s/rad]"
+        lists[flag] = (None if text is None
+                       else parse_float_list(text, f"--{flag.replace('_', '-')} {unit}", P))
+    active_ratio = args.active_viscosity_ratio
+    if active_ratio is not None and not (math.isfinite(active_ratio) and active_ratio >= 0):
+        raise ParameterError(f"--active-viscosity-ratio [s] must be a finite number >= 0, "
+                             f"got {active_ratio:g}")
+    if args.case is not None:
+        if body.n_links != 3:
+            raise ParameterError(f"--case is a Table I set for the three-link body; this body "
+                                 f"has {body.n_links} links: give --stiffness ({P} values)")
+        return paper_muscles(args.case, viscosity_ratio=ratio, viscosity=lists["viscosity"],
+                             gastrocnemius=args.gastrocnemius,
+                             active_stiffness=lists["active_stiffness"],
+                             active_viscosity=lists["active_viscosity"],
+                             active_viscosity_ratio=active_ratio)
+    stiffness = parse_float_list(args.stiffness, "--stiffness [N·m/rad]", P)
+    return muscles_for(body.n_links, stiffness, lists["viscosity"], viscosity_ratio=ratio,
+                       active_stiffness=lists["active_stiffness"],
+                       active_viscosity=lists["active_viscosity"],
+                       active_viscosity_ratio=active_ratio, gastrocnemius=args.gastrocnemius)
+
+
+def feedback_options_from_args(args: argparse.Namespace) -> dict:
+    """``feedback_delay`` [s] and ``proprioceptive_weight`` [-] given on the command line (or
+    by --controller), checked; keys absent when not given."""
+    from ..model.controllers import get_controller
+
+    out = {}
+    if getattr(args, "controller", None) is not None:
+        out.update(get_controller(args.controller).run_options())
+    delay = getattr(args, "feedback_delay", None)
+    if delay is not None:
+        if not (math.isfinite(delay) and 0 <= delay <= 1):
+            raise ParameterError(f"--feedback-delay [s] must be in [0, 1], got {delay:g}")
+        out["feedback_delay"] = float(delay)
+    weight = getattr(args, "proprioceptive_weight", None)
+    if weight is not None:
+        if not (math.isfinite(weight) and 0 <= weight <= 1):
+            raise ParameterError(f"--proprioceptive-weight [-] must be in [0, 1], got {weight:g}")
+        out["proprioceptive_weight"] = float(weight)
+    return out
+
+
+def parse_tilt(text: str):
+    """``--tilt``: ``sine:AMPLITUDE_RAD:FREQUENCY_HZ[:PHASE_RAD]``,
+    ``raised-cosine:AMPLITUDE_RAD:DURATION_S[:START_S]`` or
+    ``prts:AMPLITUDE_RAD[:STATE_DURATION_S]`` (peak to peak; Peterka's 80-state sequence)."""
+    from ..model.tilt import PRTSTilt, RaisedCosineTilt, SineTilt
+
+    forms = ("sine:AMPLITUDE_RAD:FREQUENCY_HZ[:PHASE_RAD], "
+             "raised-cosine:AMPLITUDE_RAD:DURATION_S[:START_S] or "
+             "prts:AMPLITUDE_RAD[:STATE_DURATION_S]")
+    kind, _, rest = str(text).partition(":")
+    kind = kind.strip().lower()
+    counts = {"sine": (2, 3), "raised-cosine": (2, 3), "prts": (1, 2)}
+    if kind not in counts or not rest:
+        raise ParameterError(f"--tilt must be {forms}, got {text!r}")
+    values = parse_float_list(rest.replace(":", ","), f"--tilt {kind}", None)
+    lo, hi = counts[kind]
+    if not lo <= len(values) <= hi:
+        raise ParameterError(f"--tilt must be {forms}, got {text!r}")
+    if kind == "sine":
+        return SineTilt(*values)
+    if kind == "raised-cosine":
+        return RaisedCosineTilt(*values)
+    return PRTSTilt(values[0], values[1]) if len(values) == 2 else PRTSTilt.peterka_2002(values[0])
 
 
 def print_json(obj) -> None:

@@ -48,7 +48,8 @@ def run(args: argparse.Namespace) -> int:
     time, theta = read_trajectory_csv(args.data, sc.body.n_links)
     sc = sc.replace(duration=max(float(time[-1]), 1e-3))
     free = [s.strip() for s in args.free.split(",") if s.strip()]
-    fit = fit_stiffness(sc, time, theta, free, viscosity_ratio=args.viscosity_ratio,
+    ratio = 0.25 if args.viscosity_ratio is None else args.viscosity_ratio
+    fit = fit_stiffness(sc, time, theta, free, viscosity_ratio=ratio,
                         engine=args.engine)
     summary = fit.to_dict()
     if args.report:

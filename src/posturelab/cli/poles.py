@@ -5,9 +5,8 @@ from __future__ import annotations
 import argparse
 
 from ..linear.analysis import analyse_both_sides
-from ..model.body import paper_body
 from ..paper.compare import erratum, table2_comparison
-from ._common import add_muscle_arguments, muscles_from_args, print_json
+from ._common import add_muscle_arguments, body_from_args, muscles_from_args, print_json
 
 DESCRIPTION = """\
 Poles [1/s] of the paper's three-link biped (Appendix A) linearised about upright
@@ -34,6 +33,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--json", action="store_true", help="print one JSON object instead of text.")
 
 
+def _ratio(args: argparse.Namespace) -> float:
+    """--viscosity-ratio, 0.25 (the paper's) when not given. [s]"""
+    return 0.25 if args.viscosity_ratio is None else args.viscosity_ratio
+
+
 def _fmt_pole(z: complex) -> str:
     if abs(z.imag) < 1e-12:
         return f"{z.real:.3f}"
@@ -47,15 +51,18 @@ def run(args: argparse.Namespace) -> int:
 
             raise UsageError("poles: --all takes no --case or --stiffness")
         return _run_all(args)
-    body = paper_body()
-    muscles = muscles_from_args(args)
+    body = body_from_args(args)
+    muscles = muscles_from_args(args, body)
     active, inactive = analyse_both_sides(body, muscles)
     one_sided = args.gastrocnemius == "one-sided"
     stable = active.stable and inactive.stable
     if args.json:
         out = {
             "stiffness": [float(x) for x in muscles.stiffnesses],
-            "viscosity_ratio": float(args.viscosity_ratio),
+            "viscosity": [float(x) for x in muscles.viscosities],
+            "stiffness_fraction_of_mgh": [float(x) for x in
+                                          muscles.stiffnesses / body.load_stiffness],
+            "viscosity_ratio": float(_ratio(args)),
             "poles": [{"re": float(z.real), "im": float(z.imag)} for z in active.poles],
             "stable": bool(stable),
         }
@@ -68,7 +75,7 @@ def run(args: argparse.Namespace) -> int:
         return 0
     label = f"case {args.case} (Table I)" if args.case else "custom stiffness"
     pairs = " ".join(f"{n}={k:g}" for n, k in zip(muscles.names, muscles.stiffnesses, strict=True))
-    print(f"{label}: stiffness [N·m/rad] {pairs}; viscosity = {args.viscosity_ratio:g} × stiffness")
+    print(f"{label}: stiffness [N·m/rad] {pairs}; viscosity = {_ratio(args):g} × stiffness")
     head = "poles [1/s]" + (" (gastrocnemius acting, θ2 >= 0)" if one_sided else "")
     print(head + ":")
     for z in active.poles:
@@ -83,7 +90,7 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _run_all(args: argparse.Namespace) -> int:
-    rows = table2_comparison(viscosity_ratio=args.viscosity_ratio)
+    rows = table2_comparison(viscosity_ratio=_ratio(args))
     if args.json:
         print_json({"table2": [
             {"case": r.case, "stiffness": list(r.stiffness), "stable": r.stable,
@@ -92,7 +99,7 @@ def _run_all(args: argparse.Namespace) -> int:
             for r in rows]})
         return 0
     print("Table II: poles [1/s] of the linearised system, printed | computed "
-          f"(viscosity = {args.viscosity_ratio:g} × stiffness)")
+          f"(viscosity = {_ratio(args):g} × stiffness)")
     print("  '!' marks a printed pole that disagrees beyond its printed digits; "
           "[n] is the erratum.")
     flagged: set[int] = set()

@@ -9,7 +9,6 @@ import sys
 import numpy as np
 
 from ..errors import ParameterError
-from ..model.body import paper_body
 from ..model.options import FOOT_FROM_LITERATURE, BaseOfSupport, FallCriteria, KneeModel
 from ..model.platform import NoDisturbance, VelocityStep, read_profile_csv
 from ..paper.printed import BACKWARD_INITIAL_STATE
@@ -17,10 +16,13 @@ from ..scenarios import Scenario, builtin_scenario, builtin_scenario_names, load
 from . import UsageError
 from ._common import (
     add_muscle_arguments,
+    body_from_args,
     check_writable,
+    feedback_options_from_args,
     muscles_from_args,
     parse_float_list,
     parse_limit_list,
+    parse_tilt,
     print_json,
 )
 
@@ -98,9 +100,13 @@ def add_experiment_arguments(p: argparse.ArgumentParser) -> None:
     src.add_argument("--centre-of-pressure", action="store_true",
                      help="with --foot, also fall when the centre of pressure leaves the foot "
                      "(the foot tips), not only the centre of gravity.")
-    src.add_argument("--feedback-delay", type=float, default=None, metavar="SECONDS",
-                     help="neural delay of the muscle feedback [s]: every pair's torque "
-                     "responds to the state this much earlier (default 0, the paper).")
+    src.add_argument("--tilt", metavar="SPEC",
+                     help="support-surface tilt α, positive toes-up, about the ankle: "
+                     "sine:AMPLITUDE_RAD:FREQUENCY_HZ[:PHASE_RAD], "
+                     "raised-cosine:AMPLITUDE_RAD:DURATION_S[:START_S] (a smooth ramp, then "
+                     "held), prts:AMPLITUDE_RAD[:STATE_DURATION_S] (peak to peak; Peterka's "
+                     "80-state, 20 s sequence). A tilt column [rad] in --platform-profile "
+                     "does the same from data.")
     src.add_argument("--torque-limits", metavar="ANKLE,KNEE,HIP",
                      help="largest net muscle moment at each joint [N·m] ('inf' for none).")
     src.add_argument("--max-link-angle", type=float, default=None, metavar="RAD",
@@ -115,7 +121,8 @@ def add_experiment_arguments(p: argparse.ArgumentParser) -> None:
 
 
 MODEL_OPTIONS = ("case", "stiffness", "disturbance", "platform_profile", "initial_posture",
-                 "initial_rates")
+                 "initial_rates", "controller", "body", "height", "mass", "viscosity",
+                 "active_stiffness", "active_viscosity", "active_viscosity_ratio")
 
 
 def scenario_from_args(args: argparse.Namespace, command: str = "simulate") -> Scenario:
@@ -145,11 +152,15 @@ def scenario_from_args(args: argparse.Namespace, command: str = "simulate") -> S
             args.max_link_angle if args.max_link_angle is not None else sc.fall.max_link_angle,
             _foot(args.foot) if args.foot != "none" else sc.fall.base_of_support,
             args.centre_of_pressure or sc.fall.centre_of_pressure))
-    if args.feedback_delay is not None:
-        if not (math.isfinite(args.feedback_delay) and 0 <= args.feedback_delay <= 1):
-            raise ParameterError(
-                f"--feedback-delay [s] must be in [0, 1], got {args.feedback_delay:g}")
-        sc = sc.replace(feedback_delay=args.feedback_delay)
+    feedback = feedback_options_from_args(args)
+    if feedback:
+        sc = sc.replace(**feedback)
+    if args.tilt is not None:
+        if sc.tilt is not None:
+            raise UsageError(f"{command}: the experiment already has a tilt; give --tilt or "
+                             "a tilt column, not both")
+        tilt = parse_tilt(args.tilt)
+        sc = sc.replace(tilt=tilt, description=f"{sc.description}, {tilt.describe()}")
     if args.torque_limits:
         sc = sc.replace(torque_limits=tuple(
             parse_limit_list(args.torque_limits, "--torque-limits [N·m]", sc.body.n_links)))
@@ -174,21 +185,22 @@ def _foot(text: str) -> BaseOfSupport:
 
 
 def _scenario_from_options(args: argparse.Namespace, command: str) -> Scenario:
-    if args.case is None and args.stiffness is None:
-        raise UsageError(f"{command}: give --case or --stiffness (or --scenario / "
-                         "--builtin)")
+    if args.case is None and args.stiffness is None and args.controller is None:
+        raise UsageError(f"{command}: give --case, --stiffness or --controller (or "
+                         "--scenario / --builtin)")
     if args.disturbance not in (None, "none") and args.platform_profile:
         raise UsageError(f"{command}: give --disturbance or --platform-profile, not both")
-    body = paper_body()
-    muscles = muscles_from_args(args)
+    body = body_from_args(args)
+    muscles = muscles_from_args(args, body)
     n = body.n_links
+    tilt = None
     if args.platform_profile:
-        disturbance = read_profile_csv(args.platform_profile)
+        disturbance, tilt = _read_platform_file(args.platform_profile)
         default_posture = [0.0] * n
     elif args.disturbance in ("backward", "forward"):
         step = VelocityStep.backward if args.disturbance == "backward" else VelocityStep.forward
         disturbance = step(args.speed)
-        default_posture = list(BACKWARD_INITIAL_STATE[:n])
+        default_posture = list(BACKWARD_INITIAL_STATE[:n]) if n == 3 else [0.0] * n
     else:
         disturbance = NoDisturbance()
         default_posture = [0.0] * n
@@ -196,13 +208,40 @@ def _scenario_from_options(args: argparse.Namespace, command: str) -> Scenario:
                if args.initial_posture else default_posture)
     rates = (parse_float_list(args.initial_rates, "--initial-rates [rad/s]", n)
              if args.initial_rates else [0.0] * n)
-    label = f"case {args.case}" if args.case else "custom stiffness"
+    label = (f"case {args.case}" if args.case else f"controller {args.controller}"
+             if args.controller else "custom stiffness")
+    what = disturbance.describe() + (f", {tilt.describe()}" if tilt is not None else "")
     return Scenario(
-        name="cli", description=f"{label}, {disturbance.describe()}", source="command line",
+        name="cli", description=f"{label}, {what}", source="command line",
         body=body, muscles=muscles, disturbance=disturbance, duration=5.0,
         initial_state=np.array(posture + rates), rates_from="upright", knee=KneeModel(),
-        fall=FallCriteria(), case=args.case,
+        fall=FallCriteria(), case=args.case, tilt=tilt,
     )
+
+
+def _read_platform_file(path: str):
+    """A measured profile: the translation (x_acceleration, y_acceleration) and the tilt
+    (tilt [rad]) columns it has, at least one."""
+    import csv
+
+    from ..errors import DataFileError
+    from ..model.tilt import read_tilt_csv
+
+    try:
+        with open(path, newline="", encoding="utf-8-sig") as fh:
+            header = next(csv.reader(fh), [])
+    except (OSError, UnicodeDecodeError):
+        header = []  # read_profile_csv says what is wrong
+    names = {h.split("[")[0].strip().lower() for h in header}
+    translation = names & {"x_acceleration", "ax", "xdd"}
+    if "tilt" in names and not translation:
+        return NoDisturbance(), read_tilt_csv(path)
+    if "tilt" in names:
+        return read_profile_csv(path), read_tilt_csv(path)
+    try:
+        return read_profile_csv(path), None
+    except DataFileError as exc:
+        raise DataFileError(f"{exc} (or a tilt [rad] column)") from None
 
 
 def run(args: argparse.Namespace) -> int:

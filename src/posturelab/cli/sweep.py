@@ -89,15 +89,15 @@ def run(args: argparse.Namespace) -> int:
     table_format(args.out)
     check_writable([args.out])
     if not (args.scenario or args.builtin or args.case is not None
-            or args.stiffness is not None):
-        raise UsageError("sweep: give the base experiment: --case or --stiffness (with "
-                         "--disturbance), or --scenario FILE.toml / --builtin NAME")
+            or args.stiffness is not None or args.controller is not None):
+        raise UsageError("sweep: give the base experiment: --case, --stiffness or --controller "
+                         "(with --disturbance), or --scenario FILE.toml / --builtin NAME")
     if args.workers is not None and args.workers < 1:
         raise ParameterError(f"--workers must be >= 1, got {args.workers}")
     if args.chunk_size is not None and args.chunk_size < 1:
         raise ParameterError(f"--chunk-size must be >= 1, got {args.chunk_size}")
     ratio = args.viscosity_ratio
-    if ratio is None and not (args.scenario or args.builtin):
+    if ratio is None and not (args.scenario or args.builtin or args.controller):
         args.viscosity_ratio = DEFAULT_VISCOSITY_RATIO  # what --case / --stiffness build with
     scenario = scenario_from_args(args, "sweep")
     tolerances = {}

@@ -54,6 +54,8 @@ __all__ = [
     "moments_to_link_torques",
     "feedback_gains",
     "feedback_pair_torques",
+    "joint_pair_names",
+    "muscles_for",
 ]
 
 #: Viscosity as a fraction of stiffness used throughout the paper (Appendix C). [s]
@@ -579,6 +581,82 @@ def paper_muscles(
     else:
         va = (np.zeros(5) if active_viscosity is None
               else _five("active viscosity [N·m·s/rad]", active_viscosity))
+    return muscles.with_active_feedback(ka, va)
+
+
+def joint_pair_names(n_links: int) -> tuple[str, ...]:
+    """Names of the single-joint pairs of an N-link chain (not the paper's three links):
+    ``ankle`` for N = 1; ``ankle, hip`` for N = 2 (the ankle–hip model); ``ankle, knee,
+    hip, joint4, …`` beyond."""
+    if n_links == 1:
+        return ("ankle",)
+    if n_links == 2:
+        return ("ankle", "hip")
+    return ("ankle", "knee", "hip") + tuple(f"joint{j}" for j in range(4, n_links + 1))
+
+
+def muscles_for(n_links: int, stiffness: Sequence[float], viscosity: Sequence[float] | None = None,
+                *, viscosity_ratio: float = DEFAULT_VISCOSITY_RATIO,
+                active_stiffness: Sequence[float] | None = None,
+                active_viscosity: Sequence[float] | None = None,
+                active_viscosity_ratio: float | None = None,
+                gastrocnemius: Gastrocnemius = "two-sided") -> MuscleSet:
+    """The standard pair layout of an N-link body with these gains: the paper's five pairs
+    for N = 3, one pair per joint otherwise (:func:`joint_pair_names`), in that order.
+
+    Parameters
+    ----------
+    n_links : int
+        N. [-]
+    stiffness, viscosity : sequence of float, shape (P,)
+        Intrinsic (or, without active gains, whole) pair gains; viscosity = ratio ×
+        stiffness when not given. [N·m/rad], [N·m·s/rad]
+    viscosity_ratio : float
+        [s]
+    active_stiffness, active_viscosity, active_viscosity_ratio
+        As for :func:`paper_muscles`. [N·m/rad], [N·m·s/rad], [s]
+    gastrocnemius : {"two-sided", "one-sided"}
+        N = 3 only.
+    """
+    if n_links == 3:
+        return paper_muscles(stiffness=stiffness, viscosity=viscosity,
+                             viscosity_ratio=viscosity_ratio, gastrocnemius=gastrocnemius,
+                             active_stiffness=active_stiffness,
+                             active_viscosity=active_viscosity,
+                             active_viscosity_ratio=active_viscosity_ratio)
+    if gastrocnemius != "two-sided":
+        raise ParameterError(f"gastrocnemius applies to the paper's three-link body, not "
+                             f"{n_links} links")
+    names = joint_pair_names(n_links)
+    P = len(names)
+
+    def gains(label: str, values) -> np.ndarray:
+        arr = np.atleast_1d(finite_array(label, values))
+        if arr.shape != (P,):
+            raise ParameterError(f"{label} must have {P} values ({', '.join(names)}), got "
+                                 f"{arr.size}")
+        if np.any(arr < 0):
+            raise ParameterError(f"{label} must be >= 0, got {arr[arr < 0][0]:g}")
+        return arr
+
+    k = gains("stiffness [N·m/rad]", stiffness)
+    v = (nonnegative_float("viscosity_ratio [s]", viscosity_ratio) * k if viscosity is None
+         else gains("viscosity [N·m·s/rad]", viscosity))
+    muscles = MuscleSet(tuple(MusclePair(name, j, j + 1, float(k[j]), float(v[j]))
+                              for j, name in enumerate(names)), n_links)
+    if active_stiffness is None and active_viscosity is None:
+        if active_viscosity_ratio is not None:
+            raise ParameterError("active_viscosity_ratio needs active_stiffness")
+        return muscles
+    if active_viscosity is not None and active_viscosity_ratio is not None:
+        raise ParameterError("give active_viscosity or active_viscosity_ratio, not both")
+    ka = np.zeros(P) if active_stiffness is None else gains("active stiffness [N·m/rad]",
+                                                             active_stiffness)
+    if active_viscosity_ratio is not None:
+        va = nonnegative_float("active_viscosity_ratio [s]", active_viscosity_ratio) * ka
+    else:
+        va = np.zeros(P) if active_viscosity is None else gains(
+            "active viscosity [N·m·s/rad]", active_viscosity)
     return muscles.with_active_feedback(ka, va)
 
 

@@ -424,7 +424,18 @@ class _Task:
             knee=sc.knee, fall=sc.fall, torque_limits=_rows(grid.torque_limits, lo, hi),
             feedback_delay=grid.feedback_delay[lo:hi], rtol=self.rtol, atol=self.atol,
             sample_rate=sc.sample_rate, settle_tolerance=SETTLE_TOLERANCE, parallel=parallel,
-            disturbance_scale=_rows(grid.disturbance_scale, lo, hi))
+            disturbance_scale=_rows(grid.disturbance_scale, lo, hi),
+            tilt=sc.tilt, proprioceptive_weight=sc.proprioceptive_weight,
+            **_active_rows(sc.muscles, hi - lo))
+
+
+def _active_rows(muscles, rows: int) -> dict:
+    """The base experiment's active gains for ``rows`` runs (a sweep varies the pair gains,
+    which with active gains are the intrinsic part), or nothing without active gains."""
+    if not muscles.has_active_feedback:
+        return {}
+    return {"active_stiffness": np.tile(muscles.active_stiffnesses, (rows, 1)),
+            "active_viscosity": np.tile(muscles.active_viscosities, (rows, 1))}
 
 
 def _run_chunk(task: _Task, grid: SweepGrid, lo: int, hi: int) -> BatchResult:
