@@ -153,3 +153,68 @@ def test_verdicts_and_their_json():
                              "stable_without_delay": True}
     with pytest.raises(ParameterError, match="delay"):
         rightmost_roots(body, intrinsic, -0.1)
+
+
+# ---------------------------------------------------------------------------
+# Batched delayed stability (posturelab.linear.delay_batch)
+# ---------------------------------------------------------------------------
+
+
+def unstable_count(body, muscles, delay):
+    """Roots in the right half-plane at ``delay``: those at τ = 0 plus two for every
+    crossing below ``delay`` into it, minus two for every one out of it (delay_margin's
+    crossings, each a conjugate pair)."""
+    from posturelab.linear.delay import delayed_system
+
+    A0, A1 = delayed_system(body, muscles).first_order()
+    count = int(np.sum(np.linalg.eigvals(A0 + A1).real > 0))
+    out = delay_margin(body, muscles, max_delay=delay)
+    return count + 2 * sum(c.direction for c in out.crossings if c.delay < delay)
+
+
+@pytest.mark.parametrize("delay", [0.003, 0.03, 0.15])
+def test_batched_flags_equal_the_crossing_count(rng, delay):
+    from posturelab.linear.delay_batch import batch_delay_stable
+
+    m = 60
+    k = rng.uniform(0.0, 1200.0, (m, 5))
+    ka = rng.uniform(0.0, 1200.0, (m, 5))
+    flags = batch_delay_stable(pl.paper_body(), pl.paper_muscles("1"), k, 0.25 * k, ka,
+                               0.3 * ka, delay)
+    for i in range(m):
+        muscles = pl.paper_muscles(stiffness=k[i], viscosity=0.25 * k[i],
+                                   active_stiffness=ka[i], active_viscosity=0.3 * ka[i])
+        assert flags[i] == (unstable_count(pl.paper_body(), muscles, delay) == 0), i
+    assert 0 < flags.sum() < m
+
+
+def test_batched_rightmost_root_without_delay_is_the_largest_pole(rng):
+    from posturelab.linear.delay_batch import batch_rightmost_root
+
+    k = rng.uniform(0.0, 1500.0, (30, 5))
+    r = batch_rightmost_root(pl.paper_body(), pl.paper_muscles("1"), k, 0.25 * k)
+    for i in range(30):
+        a = pl.analyse(pl.paper_body(), pl.paper_muscles(stiffness=k[i]))
+        assert r[i].real == pytest.approx(a.max_real_part, rel=1e-9, abs=1e-12)
+
+
+def test_d_subdivision_map_of_the_delayed_pendulum():
+    """Over K_a × L_a at τ = 0.15 s: stable exactly where τ is below the delay margin of the
+    set (and it is stable without delay), for the one-link body with a small intrinsic
+    part; and the stable region lies right of the static line K_a = mgh − K_i."""
+    from posturelab.linear.delay_batch import delay_stability_map
+
+    body = pl.get_body("paper-1link")
+    mgh = body.load_stiffness
+    base = MuscleSet((MusclePair("ankle", 0, 1, 0.05 * mgh, 0.02 * mgh, active_stiffness=0.0,
+                                 active_viscosity=0.0),), 1)
+    out = delay_stability_map(body, base, 0.15, (0.0, 3 * mgh), (0.0, 1.2 * mgh), 13)
+    for iy, la in enumerate(out.active_viscosity):
+        for ix, ka in enumerate(out.active_stiffness):
+            muscles = MuscleSet((MusclePair("ankle", 0, 1, 0.05 * mgh, 0.02 * mgh,
+                                            active_stiffness=ka, active_viscosity=la),), 1)
+            dm = delay_margin(body, muscles)
+            expected = dm.stable_without_delay and 0.15 < dm.delay_margin
+            assert out.stable[iy, ix] == expected, (ka, la)
+    assert out.stable.any() and not out.stable.all()
+    assert not out.stable[:, out.active_stiffness < 0.95 * mgh].any()

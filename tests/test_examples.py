@@ -47,3 +47,23 @@ def test_largest_step_grid_brackets_the_reference_bisection(tmp_path):
         assert lo <= boundary.estimate <= hi
     figure = example.main(tmp_path)
     assert figure.exists() and figure.stat().st_size > 10_000
+
+
+def test_delay_stability_map_example_marks_a_stable_published_controller(tmp_path):
+    """The D-subdivision example: Peterka's round K_P, K_D lie inside the stable region at
+    τ = 0.15 s (the exact delay margin of that set is longer), and the figure is written."""
+    import posturelab as pl
+    from posturelab.model.muscles import MusclePair, MuscleSet
+
+    example = _load("delay_stability_map")
+    dmap = example.compute(resolution=41)
+    mgh = dmap.load_stiffness
+    ix = int(np.argmin(np.abs(dmap.active_stiffness - 1.35 * mgh)))
+    iy = int(np.argmin(np.abs(dmap.active_viscosity - 0.47 * mgh)))
+    assert dmap.stable[iy, ix]
+    body = pl.get_body("paper-1link")
+    muscles = MuscleSet((MusclePair("ankle", 0, 1, 0.05 * mgh, 0.02 * mgh,
+                                    active_stiffness=dmap.active_stiffness[ix],
+                                    active_viscosity=dmap.active_viscosity[iy]),), 1)
+    assert pl.delay_margin(body, muscles).delay_margin > example.DELAY
+    assert example.main(tmp_path).stat().st_size > 10_000

@@ -448,6 +448,47 @@ def plot_run_overview(
     return fig
 
 
+def plot_delay_stability_map(dmap, *, mark=None) -> Figure:
+    """The D-subdivision figure: the rightmost root's real part [1/s] over one pair's active
+    stiffness × active viscosity at a fixed delay, both axes also as fractions of mgh, the
+    stable region outlined.
+
+    Parameters
+    ----------
+    dmap : posturelab.linear.delay_batch.DelayStabilityMap
+    mark : (float, float, str), optional
+        A point (active stiffness [N·m/rad], active viscosity [N·m·s/rad], label) to mark,
+        such as a published controller.
+
+    Returns
+    -------
+    Figure
+    """
+    from matplotlib.colors import TwoSlopeNorm
+
+    fig, ax = new_figure(figsize=(7.0, 5.2))
+    mgh = dmap.load_stiffness
+    x, y = dmap.active_stiffness / mgh, dmap.active_viscosity / mgh
+    values = np.clip(dmap.max_real_part, -20.0, 20.0)
+    low, high = float(values.min()), float(values.max())
+    span = max(abs(low), abs(high), 1e-9)
+    norm = TwoSlopeNorm(vmin=min(low, -1e-9), vcenter=0.0, vmax=max(high, 1e-9)) \
+        if low < 0 < high else TwoSlopeNorm(vmin=-span, vcenter=0.0, vmax=span)
+    image = ax.pcolormesh(x, y, values, cmap="RdBu_r", norm=norm, shading="nearest")
+    fig.colorbar(image, ax=ax, label="real part of the rightmost root [1/s] (clipped at ±20)")
+    if dmap.stable.any() and not dmap.stable.all():
+        ax.contour(x, y, dmap.stable.astype(float), levels=[0.5], colors="k", linewidths=1.5)
+    if mark is not None:
+        ax.plot(mark[0] / mgh, mark[1] / mgh, "o", ms=8, mfc="gold", mec="k")
+        ax.annotate(mark[2], (mark[0] / mgh, mark[1] / mgh), xytext=(6, 6),
+                    textcoords="offset points", fontsize=9)
+    ax.set_xlabel(f"active stiffness of the {dmap.pair} pair / mgh [-] (mgh = {mgh:.0f} N·m/rad)")
+    ax.set_ylabel(f"active viscosity of the {dmap.pair} pair / mgh [s]")
+    ax.set_title(f"Stability with a feedback delay τ = {dmap.delay * 1000:.0f} ms "
+                 f"(outlined: stable, {100 * dmap.stable.mean():.1f}% of the grid)", fontsize=10)
+    return fig
+
+
 def figure_bytes(fig: Figure, fmt: str = "png", dpi: float = 110) -> bytes:
     """Render ``fig`` to bytes (PNG, SVG, PDF, …) without pyplot.
 

@@ -1,0 +1,241 @@
+"""Delayed linear stability of many parameter sets at once (numpy, stacked).
+
+For M gain sets on one body and pair layout, at one feedback delay τ, the rightmost
+characteristic root of each set (posturelab.linear.delay states the equation) is found by
+the spectral discretisation of :func:`posturelab.linear.delay.rightmost_roots`, stacked
+over the sets (one ``numpy.linalg.eigvals`` call on an (M, 2N(n+1), 2N(n+1)) array), then
+polished by a few Newton steps on det Δ(s) = 0, stacked too. A set is stable when that
+root's real part is below −δ (δ = 1e-9 × max(1, |root|)).
+
+:func:`delay_stability_map` evaluates a grid of two active (delayed) gains at a fixed delay:
+the classic D-subdivision figure, whose stable region the tests check against the exact
+crossing count of :func:`posturelab.linear.delay.delay_margin`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .._validation import float_in_range
+from ..errors import ParameterError
+from ..model.body import Body
+from ..model.dynamics import mass_matrix
+from ..model.muscles import MuscleSet, feedback_gains
+from .delay import MAX_DELAY_FOR_ROOTS, _chebyshev
+
+__all__ = ["batch_rightmost_root", "batch_delay_stable", "DelayStabilityMap",
+           "delay_stability_map", "MAX_DELAY_MAP_RESOLUTION"]
+
+#: Largest grid side of :func:`delay_stability_map`. [-]
+MAX_DELAY_MAP_RESOLUTION = 1000
+#: Sets per stacked eigenvalue call (bounds the memory of one call). [-]
+_CHUNK = 1024
+
+
+def _joint(E: np.ndarray, rows: np.ndarray) -> np.ndarray:
+    """Eᵀ diag(rows) E for rows (M, P): (M, N, N)."""
+    return np.einsum("pi,mp,pj->mij", E, rows, E)
+
+
+def _system(body: Body, muscles: MuscleSet, stiffness, viscosity, active_stiffness,
+            active_viscosity):
+    """Stacked matrices: J0 (N, N) and (M, N, N) stiffness − gA, L_i, K_a, L_a."""
+    k = np.atleast_2d(np.asarray(stiffness, dtype=float))
+    g = feedback_gains(k, viscosity, active_stiffness, active_viscosity, np.ones(k.shape[0]))
+    E = muscles.selection_matrix
+    G = body.gravity * np.diag(body.gravity_coefficients)
+    return (mass_matrix(body, np.zeros(body.n_links)), _joint(E, g[:, 0]) - G,
+            _joint(E, g[:, 1]), _joint(E, g[:, 2]), _joint(E, g[:, 3]))
+
+
+def batch_rightmost_root(body: Body, muscles: MuscleSet, stiffness, viscosity,
+                         active_stiffness=None, active_viscosity=None, delay: float = 0.0, *,
+                         nodes: int = 12) -> np.ndarray:
+    """The rightmost characteristic root of each of M gain sets at delay ``delay``.
+
+    Parameters
+    ----------
+    body : Body
+    muscles : MuscleSet
+        The pair layout (its own gains are not used).
+    stiffness, viscosity : array_like, shape (M, P)
+        Pair (intrinsic, or without active gains the whole) gains. [N·m/rad], [N·m·s/rad]
+    active_stiffness, active_viscosity : array_like, shape (M, P), optional
+        Active (delayed) gains; without them the whole feedback is delayed (the rule of
+        :func:`posturelab.model.muscles.feedback_gains`). [N·m/rad], [N·m·s/rad]
+    delay : float
+        τ in [0, MAX_DELAY_FOR_ROOTS]. [s]
+    nodes : int
+        Chebyshev intervals, 4 … 64. [-]
+
+    Returns
+    -------
+    numpy.ndarray of complex, shape (M,)
+        [1/s]
+    """
+    delay = float_in_range("delay [s]", delay, 0.0, MAX_DELAY_FOR_ROOTS, unit="s")
+    if isinstance(nodes, bool) or not isinstance(nodes, int | np.integer) \
+            or not 4 <= nodes <= 64:
+        raise ParameterError(f"nodes must be an integer in [4, 64], got {nodes!r}")
+    J0, S, Li, Ka, La = _system(body, muscles, stiffness, viscosity, active_stiffness,
+                                active_viscosity)
+    M, n = S.shape[0], body.n_links
+    inv = np.linalg.inv(J0)
+    m = 2 * n
+    A0 = np.zeros((M, m, m))
+    A0[:, :n, n:] = np.eye(n)
+    A0[:, n:, :n] = -inv @ S
+    A0[:, n:, n:] = -inv @ Li
+    A1 = np.zeros((M, m, m))
+    A1[:, n:, :n] = -inv @ Ka
+    A1[:, n:, n:] = -inv @ La
+    roots = np.empty(M, dtype=complex)
+    if delay == 0.0:
+        for lo in range(0, M, _CHUNK):
+            lam = np.linalg.eigvals(A0[lo:lo + _CHUNK] + A1[lo:lo + _CHUNK])
+            roots[lo:lo + _CHUNK] = lam[np.arange(lam.shape[0]), np.argmax(lam.real, axis=1)]
+        return roots
+    _, D = _chebyshev(nodes)
+    template = np.kron(D * (2.0 / delay), np.eye(m))
+    template[:m, :] = 0.0
+
+    def chunk(lo: int) -> None:
+        a0, a1 = A0[lo:lo + _CHUNK], A1[lo:lo + _CHUNK]
+        gen = np.broadcast_to(template, (a0.shape[0],) + template.shape).copy()
+        gen[:, :m, :m] = a0
+        gen[:, :m, -m:] = a1
+        lam = np.linalg.eigvals(gen)  # (LAPACK, without the GIL: chunks run in parallel)
+        roots[lo:lo + _CHUNK] = lam[np.arange(lam.shape[0]), np.argmax(lam.real, axis=1)]
+
+    starts = range(0, M, _CHUNK)
+    if len(starts) > 1:
+        from concurrent.futures import ThreadPoolExecutor
+
+        with ThreadPoolExecutor(max_workers=min(len(starts), _threads())) as pool:
+            list(pool.map(chunk, starts))
+    else:
+        chunk(0)
+    return _newton(J0, S, Li, Ka, La, roots, delay)
+
+
+def _threads() -> int:
+    """CPUs this process may run on. [-]"""
+    import os
+
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:  # not on Linux
+        return max(1, os.cpu_count() or 1)
+
+
+def _newton(J0, S, Li, Ka, La, s, delay, steps: int = 8) -> np.ndarray:
+    """A few stacked Newton steps s ← s − f/f' on f(s) = det Δ(s), f' by a central
+    difference (a singular Δ does not stop the stack)."""
+    def f(z):
+        z = z[:, None, None]
+        return np.linalg.det(z * z * J0 + S + z * Li + (Ka + z * La) * np.exp(-z * delay))
+
+    s = s.copy()
+    for _ in range(steps):
+        h = 1e-6 * np.maximum(1.0, np.abs(s))
+        with np.errstate(all="ignore"):
+            step = f(s) / ((f(s + h) - f(s - h)) / (2 * h))
+        ok = np.isfinite(step) & (np.abs(step) < 0.5 * (1.0 + np.abs(s)))
+        s = np.where(ok, s - step, s)  # keep the spectral estimate where Newton wanders off
+    return s
+
+
+def batch_delay_stable(body: Body, muscles: MuscleSet, stiffness, viscosity,
+                       active_stiffness=None, active_viscosity=None, delay: float = 0.0, *,
+                       nodes: int = 12) -> np.ndarray:
+    """Stable flags of M gain sets at delay τ (arguments of :func:`batch_rightmost_root`):
+    the rightmost root's real part < −1e-9 · max(1, |root|)."""
+    r = batch_rightmost_root(body, muscles, stiffness, viscosity, active_stiffness,
+                             active_viscosity, delay, nodes=nodes)
+    return r.real < -1e-9 * np.maximum(1.0, np.abs(r))
+
+
+@dataclass(frozen=True)
+class DelayStabilityMap:
+    """Delayed stability over active stiffness × active viscosity of one pair.
+
+    Attributes
+    ----------
+    pair : str
+        The pair whose active gains vary.
+    active_stiffness : numpy.ndarray, shape (R,)
+        x values. [N·m/rad]
+    active_viscosity : numpy.ndarray, shape (R,)
+        y values. [N·m·s/rad]
+    delay : float
+        τ. [s]
+    max_real_part : numpy.ndarray, shape (R, R)
+        Real part of the rightmost root, [y, x]. [1/s]
+    stable : numpy.ndarray of bool, shape (R, R)
+    load_stiffness : float
+        The body's mgh. [N·m/rad]
+    """
+
+    pair: str
+    active_stiffness: np.ndarray
+    active_viscosity: np.ndarray
+    delay: float
+    max_real_part: np.ndarray
+    stable: np.ndarray
+    load_stiffness: float
+
+
+def delay_stability_map(body: Body, muscles: MuscleSet, delay: float,
+                        stiffness_range: tuple[float, float],
+                        viscosity_range: tuple[float, float], resolution: int = 200, *,
+                        pair: str | None = None, nodes: int = 12) -> DelayStabilityMap:
+    """Rightmost root over a grid of one pair's active stiffness × active viscosity at a
+    fixed delay (the D-subdivision figure); every other gain is ``muscles``' own.
+
+    Parameters
+    ----------
+    body : Body
+    muscles : MuscleSet
+        Intrinsic gains, and the other pairs' active gains (none: zero).
+    delay : float
+        τ. [s]
+    stiffness_range, viscosity_range : (float, float)
+        (low, high) of the axes, >= 0. [N·m/rad], [N·m·s/rad]
+    resolution : int
+        Points per axis, 2 … :data:`MAX_DELAY_MAP_RESOLUTION`. [-]
+    pair : str, optional
+        The pair varied (default: the first, the ankle).
+    """
+    if isinstance(resolution, bool) or not isinstance(resolution, int | np.integer) \
+            or not 2 <= resolution <= MAX_DELAY_MAP_RESOLUTION:
+        raise ParameterError(f"resolution must be an integer in [2, "
+                             f"{MAX_DELAY_MAP_RESOLUTION}], got {resolution!r}")
+    names = muscles.names
+    pair = names[0] if pair is None else pair
+    if pair not in names:
+        raise ParameterError(f"unknown pair {pair!r}; pairs: {', '.join(names)}")
+    j = names.index(pair)
+    axes = []
+    for label, (lo, hi) in (("active stiffness [N·m/rad]", stiffness_range),
+                            ("active viscosity [N·m·s/rad]", viscosity_range)):
+        lo = float_in_range(f"{label} low", lo, 0.0, 1e7)
+        hi = float_in_range(f"{label} high", hi, 0.0, 1e7)
+        if not lo < hi:
+            raise ParameterError(f"{label} range must have low < high, got {lo:g}:{hi:g}")
+        axes.append(np.linspace(lo, hi, resolution))
+    kx, vy = np.meshgrid(axes[0], axes[1])
+    count = kx.size
+    ka = np.tile(muscles.active_stiffnesses, (count, 1))
+    va = np.tile(muscles.active_viscosities, (count, 1))
+    ka[:, j], va[:, j] = kx.ravel(), vy.ravel()
+    k = np.tile(muscles.stiffnesses, (count, 1))
+    v = np.tile(muscles.viscosities, (count, 1))
+    root = batch_rightmost_root(body, muscles.as_two_sided(), k, v, ka, va, delay, nodes=nodes)
+    real = root.real.reshape(kx.shape)
+    stable = real < -1e-9 * np.maximum(1.0, np.abs(root)).reshape(kx.shape)
+    for arr in (real, stable, axes[0], axes[1]):
+        arr.setflags(write=False)
+    return DelayStabilityMap(pair, axes[0], axes[1], float(delay), real, stable,
+                             body.load_stiffness)
