@@ -24,7 +24,9 @@ def test_simulate_csv_and_json(tmp_path, capsys):
                             "--duration", "5", "--out", str(out), "--json")
     assert code == 0, err
     summary = json.loads(stdout)
-    assert set(summary) == {"fell", "fall_time", "status", "max_abs_theta", "final_state"}
+    assert set(summary) == {"fell", "fall_time", "status", "max_abs_theta", "final_state",
+                            "hip_fraction"}
+    assert 0.0 <= summary["hip_fraction"] <= 1.0
     assert summary["fell"] is False and summary["fall_time"] is None
     assert summary["status"] == "completed"
     assert len(summary["max_abs_theta"]) == 3 and len(summary["final_state"]) == 6

@@ -59,7 +59,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     out.add_argument("--animate", metavar="RUN.gif", help="write a stick-figure animation (GIF).")
     out.add_argument("--json", action="store_true",
                      help='print one JSON summary: {"fell", "fall_time", "status", '
-                     '"max_abs_theta", "final_state"}.')
+                     '"max_abs_theta", "final_state", "hip_fraction"}; hip_fraction [-] is the '
+                     'share of the anti-phase (hip) mode of leg and trunk, null for one link.')
     p.add_argument("--engine", choices=["reference", "compiled"], default="reference",
                    help="reference (default): the numpy model integrated by scipy at the "
                    "scenario's solver settings; compiled: the C engine (hundreds of times "
@@ -268,6 +269,8 @@ def run(args: argparse.Namespace) -> int:
         print(f"{sc.description}")
         print(f"status: {result.status} ({result.message})")
         print(f"peak |θ| [rad]: {peaks}")
+        if sc.body.n_links >= 2:
+            print(f"hip fraction (anti-phase leg–trunk mode): {result.hip_fraction:.3f}")
         print("final state [rad, rad/s]: " + ", ".join(f"{x:.4g}" for x in result.final_state))
         for path in outputs:
             print(f"wrote {path}")

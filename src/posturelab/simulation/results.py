@@ -203,6 +203,15 @@ class SimulationResult:
         """Peak |θ_i| over the run, shape (N,). [rad]"""
         return np.abs(self.theta).max(axis=0)
 
+    @property
+    def hip_fraction(self) -> float:
+        """Share of the anti-phase (hip) mode of leg and trunk in the run's motion, in
+        [0, 1]; NaN for a one-link body (:func:`posturelab.studies.strategy.hip_fraction`:
+        the definition, after Creath et al. 2005). [-]"""
+        from ..studies.strategy import hip_fraction
+
+        return hip_fraction(self.theta)
+
     def settling_time(self, tolerance: float = 0.01) -> float | None:
         """Last time any |θ_i| exceeded ``tolerance`` [rad]; None if it never settled. [s]"""
         outside = np.any(np.abs(self.theta) > tolerance, axis=1)
@@ -213,13 +222,15 @@ class SimulationResult:
         return float(self.time[np.nonzero(outside)[0][-1]])
 
     def summary(self) -> dict:
-        """Plain-Python summary (the CLI's ``--json``): angles [rad], times [s]."""
+        """Plain-Python summary (the CLI's ``--json``): angles [rad], times [s], the hip
+        fraction [-] (None for one link)."""
         return {
             "fell": bool(self.fell),
             "fall_time": None if self.fall_time is None else float(self.fall_time),
             "status": self.status,
             "max_abs_theta": [float(x) for x in self.max_abs_theta],
             "final_state": [float(x) for x in self.final_state],
+            "hip_fraction": None if self.n_links < 2 else float(self.hip_fraction),
         }
 
     def columns(self) -> tuple[list[str], np.ndarray]:
