@@ -290,3 +290,23 @@ def test_delay_finding_states_the_margin_and_the_oscillation_above_it():
     assert f"τ = {margin.delay_margin * 1000:.2f} ms (its delay margin)" in found.text
     assert f"{margin.crossing_frequency / (2 * math.pi):.1f} Hz" in found.text
     assert "Not falling within a run is not stability." in found.text
+
+
+def test_literature_controller_and_strategy_findings_state_their_numbers():
+    import posturelab as pl
+    from posturelab.model.controllers import get_controller
+    from posturelab.paper.checks import literature_controller_finding, strategy_finding
+    from posturelab.paper.findings import HUMAN_RECOVERY_YOUNG
+
+    lit = literature_controller_finding(pl.FOOT_FROM_LITERATURE)
+    preset = get_controller("peterka-2002")
+    body = pl.get_body("paper-1link")
+    assert lit.delay_margin == pl.delay_margin(body, preset.muscles(body)).delay_margin
+    assert lit.feedback_delay == preset.feedback_delay < lit.delay_margin
+    assert 0.01 < lit.by_cop < lit.by_cog < 1.0
+    assert f"{lit.by_cop * 100:.1f} cm" in lit.text and f"{lit.by_cog * 100:.1f} cm" in lit.text
+    assert f"{HUMAN_RECOVERY_YOUNG[0] * 100:.1f} ± {HUMAN_RECOVERY_YOUNG[1] * 100:.1f} cm" \
+        in lit.text
+    st = strategy_finding(pl.paper_body(), pl.FOOT_FROM_LITERATURE)
+    assert st.first_fall is not None and st.largest_hip_fraction <= st.linear_hip_fraction + 1e-3
+    assert f"at most {st.largest_hip_fraction:.3f}" in st.text

@@ -31,9 +31,11 @@ from .findings import (
     DelayFinding,
     FootExcursion,
     FootFinding,
+    LiteratureControllerFinding,
     OneSidedFinding,
     Outcome,
     RecoveryFinding,
+    StrategyFinding,
 )
 from .printed import BACKWARD_INITIAL_STATE, FIGURE_CAPTIONS
 from .runs import PaperRuns
@@ -52,7 +54,7 @@ __all__ = [
     "check_fig3", "check_fig4", "check_fig5_6", "check_fig7", "check_fig8", "check_fig9",
     "check_fig10", "erratum_notes", "one_sided_finding", "foot_finding",
     "ramp_and_hold_run", "recovery_finding", "delayed_run", "delay_finding",
-    "with_delay_margin",
+    "with_delay_margin", "literature_controller_finding", "strategy_finding",
 ]
 
 #: |θ_i| below this counts as back upright (the settling criterion). [rad]
@@ -604,3 +606,57 @@ def with_delay_margin(finding: DelayFinding, backward: Scenario) -> DelayFinding
         oscillation = float(np.abs(knee - knee.mean()).max())
     return replace(finding, margin=margin.delay_margin,
                    crossing_frequency=margin.crossing_frequency, oscillation=oscillation)
+
+
+def literature_controller_finding(foot: BaseOfSupport, name: str = "peterka-2002"
+                                  ) -> LiteratureControllerFinding:
+    """The preset ``name`` on ``paper-1link``: delay margin, and the largest backward
+    ramp-and-hold (over :data:`RECOVERY_RAMP_DURATION`, bisection to 1 mm) by the CoP and the
+    CoG criteria, on the compiled engine with the preset's delay."""
+    from ..linear.delay import delay_margin
+    from ..model.body import get_body
+    from ..model.controllers import get_controller
+    from ..model.platform import RampAndHold
+    from ..simulation import simulate
+    from ..studies.recovery import largest_recoverable
+
+    body = get_body("paper-1link")
+    preset = get_controller(name)
+    muscles = preset.muscles(body)
+
+    def search(cop: bool) -> float:
+        fall = FallCriteria(base_of_support=foot, centre_of_pressure=cop)
+
+        def run(d: float) -> SimulationResult:
+            return simulate(body, muscles, RampAndHold(-d, RECOVERY_RAMP_DURATION), 4.0,
+                            fall=fall, sample_rate=50.0, engine="compiled",
+                            **preset.run_options())
+
+        return largest_recoverable(run, 0.01, 1.0, tolerance=1e-3).estimate
+
+    return LiteratureControllerFinding(
+        preset.name, preset.citation, preset.feedback_delay,
+        float(delay_margin(body, muscles).delay_margin), RECOVERY_RAMP_DURATION,
+        search(True), search(False))
+
+
+def strategy_finding(body: Body, foot: BaseOfSupport, ankle_torque_limit: float = 60.0
+                     ) -> StrategyFinding:
+    """Case 1 with the ankle moment limited: hip fraction over backward ramp-and-holds of
+    2–30 cm against the small unlimited runs (:func:`posturelab.studies.strategy.
+    hip_fraction_study`)."""
+    from ..studies.strategy import hip_fraction_study
+
+    muscles = paper_muscles("1")
+    fall = FallCriteria(base_of_support=foot)
+    free = hip_fraction_study(body, muscles, np.linspace(0.01, 0.05, 5),
+                              ankle_torque_limit=1e6, fall=fall,
+                              ramp_duration=RECOVERY_RAMP_DURATION)
+    sizes = np.linspace(0.02, 0.30, 29)
+    limited = hip_fraction_study(body, muscles, sizes, ankle_torque_limit=ankle_torque_limit,
+                                 fall=fall, ramp_duration=RECOVERY_RAMP_DURATION)
+    kept = limited.hip_fraction[~limited.fell]
+    first_fall = float(sizes[limited.fell][0]) if limited.fell.any() else None
+    return StrategyFinding(ankle_torque_limit, float(free.hip_fraction.mean()),
+                           float(kept.max()) if kept.size else float("nan"), first_fall,
+                           RECOVERY_RAMP_DURATION)

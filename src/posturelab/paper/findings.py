@@ -15,7 +15,18 @@ from ..model.options import BaseOfSupport
 from ..simulation.results import SimulationResult
 
 __all__ = ["Outcome", "FootExcursion", "OneSidedFinding", "FOOT_RUN_LABELS", "FootFinding",
-           "RecoveryFinding", "DelayFinding"]
+           "RecoveryFinding", "DelayFinding", "LiteratureControllerFinding", "StrategyFinding",
+           "HUMAN_RECOVERY_CITATION", "HUMAN_RECOVERY_YOUNG", "HUMAN_RECOVERY_OLDER"]
+
+#: Largest backward platform displacement recovered without stepping (PMC6338353): young
+#: adults (20–30 years, n = 5) and community-dwelling older adults (70–80, n = 6), mean and
+#: standard deviation. [m]
+HUMAN_RECOVERY_YOUNG = (0.162, 0.026)
+HUMAN_RECOVERY_OLDER = (0.118, 0.021)
+HUMAN_RECOVERY_CITATION = (
+    "Maximal backward support-surface displacement recovered without stepping: 16.2 ± 2.6 cm "
+    "(young, 20–30 years) and 11.8 ± 2.1 cm (older, 70–80 years); PMC6338353"
+)
 
 
 @dataclass(frozen=True)
@@ -295,4 +306,99 @@ class DelayFinding:
             "perturbation (Section III.A), so its gains, whose fast modes (poles near −554 and "
             "−89 1/s) come from large viscosity acting on light links, can only be read as "
             "instantaneous, intrinsic (muscle) impedance, not as reflexes."
+        )
+
+
+@dataclass(frozen=True)
+class LiteratureControllerFinding:
+    """A published delayed controller on the paper's body (as one link): its delay margin
+    and the largest backward translation it recovers, against the human range.
+
+    Attributes
+    ----------
+    controller : str
+        Preset name (:mod:`posturelab.model.controllers`).
+    citation : str
+    feedback_delay : float
+        The preset's τ. [s]
+    delay_margin : float
+        Of the linearised model. [s]
+    ramp_duration : float
+        The backward ramp-and-hold's duration. [s]
+    by_cop : float
+        Largest recoverable displacement before the foot tips. [m]
+    by_cog : float
+        Largest before the centre of gravity leaves the foot. [m]
+    """
+
+    controller: str
+    citation: str
+    feedback_delay: float
+    delay_margin: float
+    ramp_duration: float
+    by_cop: float
+    by_cog: float
+
+    @property
+    def text(self) -> str:
+        """The finding in words, with its numbers."""
+        young, older = HUMAN_RECOVERY_YOUNG, HUMAN_RECOVERY_OLDER
+        return (
+            f"A delayed controller from the literature ({self.controller}: {self.citation}) on "
+            "the paper's body lumped into one link (paper-1link): intrinsic ankle impedance "
+            f"none, neural feedback delayed by τ = {self.feedback_delay * 1000:.0f} ms. Its "
+            f"delay margin is {self.delay_margin * 1000:.0f} ms, so τ leaves "
+            f"{(self.delay_margin - self.feedback_delay) * 1000:.0f} ms to spare. On a "
+            f"backward ramp-and-hold of the platform over {self.ramp_duration:g} s (one sine "
+            "cycle of acceleration, peak speed twice the mean) with the typical foot, it "
+            f"recovers up to {self.by_cop * 100:.1f} cm before the centre of pressure passes "
+            f"the toe, and up to {self.by_cog * 100:.1f} cm before the centre of gravity "
+            f"leaves the foot. People recover {young[0] * 100:.1f} ± {young[1] * 100:.1f} cm "
+            f"(young) and {older[0] * 100:.1f} ± {older[1] * 100:.1f} cm (older) without "
+            "stepping (PMC6338353): the centre-of-gravity bound lies in the young range, the "
+            "centre-of-pressure bound far below both, so people recover by more than a linear "
+            "ankle controller whose foot stays flat can."
+        )
+
+
+@dataclass(frozen=True)
+class StrategyFinding:
+    """Whether limiting the ankle torque switches the paper's model to the hip strategy.
+
+    Attributes
+    ----------
+    ankle_torque_limit : float
+        [N·m]
+    linear_hip_fraction : float
+        Hip fraction of the small, unlimited runs (independent of size there). [-]
+    largest_hip_fraction : float
+        Largest hip fraction of a limited run that did not fall. [-]
+    first_fall : float or None
+        Smallest displacement at which the limited run fell. [m]
+    ramp_duration : float
+        [s]
+    """
+
+    ankle_torque_limit: float
+    linear_hip_fraction: float
+    largest_hip_fraction: float
+    first_fall: float | None
+    ramp_duration: float
+
+    @property
+    def text(self) -> str:
+        """The finding in words, with its numbers."""
+        fall = ("" if self.first_fall is None else
+                f"; beyond {self.first_fall * 100:.0f} cm it falls, toppling as one pendulum")
+        return (
+            "Ankle to hip strategy (posturelab.studies.strategy, after Creath et al. 2005: the "
+            "hip fraction is the share of the anti-phase leg–trunk mode in the motion). The "
+            "paper proposes the hip strategy for when the ankle torque is limited. With its "
+            "case 1 impedance and the net ankle moment limited to "
+            f"{self.ankle_torque_limit:g} N·m, backward ramp-and-holds of growing size (over "
+            f"{self.ramp_duration:g} s, the typical foot) keep a hip fraction of at most "
+            f"{self.largest_hip_fraction:.3f}, against {self.linear_hip_fraction:.3f} for the "
+            f"small unlimited runs{fall}. Impedance alone does not switch strategy: the hip "
+            "pairs only resist the trunk's motion. A hip strategy, which people show at the "
+            "faster backward translations (Runge et al. 1999), needs active hip control."
         )

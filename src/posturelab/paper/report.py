@@ -77,9 +77,9 @@ ProgressCallback = Callable[[int, int, str], None]
 #: The report page's template, in ``templates/`` beside this module.
 TEMPLATE = "report.html.j2"
 
-#: Steps :func:`reproduce_paper` reports: Table II, the runs, the figures, the two searches,
+#: Steps :func:`reproduce_paper` reports: Table II, the runs, the figures, the three searches,
 #: the writing. [-]
-_TOTAL_STEPS = 1 + RUN_STEPS + len(_figures.FIGURE_STEPS) + 2 + 1
+_TOTAL_STEPS = 1 + RUN_STEPS + len(_figures.FIGURE_STEPS) + 3 + 1
 
 
 @dataclass(frozen=True)
@@ -397,6 +397,9 @@ def _build(tmp: Path, progress: ProgressCallback | None) -> tuple[PaperChecks, l
     tick("neural delay the paper's case 1 gains tolerate (beyond the paper)")
     backward = runs.scenarios["backward"]
     findings.append(_checks.with_delay_margin(_checks.delay_finding(backward), backward))
+    tick("a delayed controller from the literature, and the hip strategy (beyond the paper)")
+    findings.append(_checks.literature_controller_finding(runs.foot))
+    findings.append(_checks.strategy_finding(body, runs.foot))
 
     tick("write table2.csv and index.html")
     paper = PaperChecks(body, table2, sensitivity, figure_checks, tuple(findings),
