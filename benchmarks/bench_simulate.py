@@ -11,7 +11,9 @@ Run it as a script (not a test): ``python benchmarks/bench_simulate.py``. It pri
 3. delayed feedback: case 1 with τ = 10 ms for 5 s (it survives, oscillating near
    90 Hz) on the reference engine and on the compiled engine at the same tolerances,
    and a delayed batch (1,000 runs, τ from 0 to 50 ms) against the reference engine's
-   time per run measured on a sample;
+   time per run measured on a sample; 3b. a tilt experiment (one link, intrinsic and
+   delayed active gains, Peterka's PRTS for 40 s) on both engines, and a batch of 1,000
+   over the active stiffness against the reference per run;
 4. start-up and whole commands in fresh processes (median of 3, warm): ``import
    posturelab``, ``posturelab --help``, ``stability-map`` at resolution 1000, the
    README's ``sweep`` of 10,000 runs and ``reproduce``;
@@ -304,6 +306,44 @@ def main() -> int:
         delayed("reference", float(delays[r]), k_delayed[r])
     t_ref_per_run = (time.perf_counter() - t0) / ref_sample.size
 
+    # ---- 3b. a tilt experiment: intrinsic + delayed active feedback under a PRTS tilt --------
+    from posturelab.model.controllers import get_controller
+    from posturelab.model.tilt import PRTSTilt
+
+    body1 = pl.get_body("paper-1link")
+    preset = get_controller("icm-pmc5664365")
+    m1 = preset.muscles(body1)
+    prts = PRTSTilt.peterka_2002(0.035)
+    tilt_duration = 20.0 if QUICK else 40.0
+
+    def tilted(engine, ka=None):
+        mus = m1 if ka is None else m1.with_active_feedback([ka], m1.active_viscosities)
+        return pl.simulate(body1, mus, None, tilt_duration, tilt=prts, engine=engine,
+                           sample_rate=100.0, **tol, **preset.run_options())
+
+    t0 = time.perf_counter()
+    ref_tilted = tilted("reference")
+    t_ref_tilted = time.perf_counter() - t0
+    t_fast_tilted = median_time(lambda: tilted("compiled"), REPEATS_FAST // 4)
+    fast_tilted = tilted("compiled")
+    d_tilted = float(np.max(np.abs(ref_tilted.theta - fast_tilted.theta)))
+    n_tilted = N_DELAYED_BATCH
+    ka_tilted = rng.uniform(0.9, 1.9, n_tilted) * body1.load_stiffness
+
+    def tilted_batch():
+        k1 = np.tile(m1.stiffnesses, (n_tilted, 1))
+        return simulate_batch(body1, k1, np.tile(m1.viscosities, (n_tilted, 1)), None,
+                              tilt_duration, muscles=m1, active_stiffness=ka_tilted[:, None],
+                              active_viscosity=np.tile(m1.active_viscosities, (n_tilted, 1)),
+                              tilt=prts, sample_rate=100.0, **tol, **preset.run_options())
+
+    t_tilted_batch = median_time(tilted_batch, REPEATS_BATCH)
+    t0 = time.perf_counter()
+    tilt_sample = rng.choice(n_tilted, size=2 if QUICK else 4, replace=False)
+    for r in tilt_sample:
+        tilted("reference", float(ka_tilted[r]))
+    t_ref_tilt_run = (time.perf_counter() - t0) / tilt_sample.size
+
     # ---- 4. start-up and whole commands -------------------------------------------------------
     startup = {}
     for label, code in (("import posturelab", "import posturelab"),
@@ -372,6 +412,17 @@ def main() -> int:
     print(f"   compiled batch, {N_DELAYED_BATCH} runs, τ 0–50 ms       "
           f"{t_delayed_batch:9.3f} s    {t_ref_per_run * N_DELAYED_BATCH / t_delayed_batch:7.0f}× "
           f"(reference {t_ref_per_run:.2f} s per run on {ref_sample.size} of them)")
+    print()
+    print(f"3b. tilt experiment: one link ({preset.name}: intrinsic + active gains, τ = "
+          f"{preset.feedback_delay:g} s, W = {preset.proprioceptive_weight:g}), Peterka's PRTS "
+          f"0.035 rad peak to peak, {tilt_duration:g} s ({fast_tilted.status} / "
+          f"{ref_tilted.status}; engines differ by {d_tilted:.1e} rad)")
+    print(f"   reference engine                                    {t_ref_tilted:9.3f} s")
+    print(f"   compiled engine                                     {t_fast_tilted * 1e3:9.3f} ms"
+          f"   {t_ref_tilted / t_fast_tilted:7.0f}×")
+    print(f"   compiled batch, {n_tilted} runs, K_a 0.9–1.9 mgh     {t_tilted_batch:9.3f} s    "
+          f"{t_ref_tilt_run * n_tilted / t_tilted_batch:7.0f}× (reference "
+          f"{t_ref_tilt_run:.2f} s per run on {tilt_sample.size} of them)")
     print()
     print("4. start-up and whole commands (fresh processes, warm, medians)")
     for label, t in {**startup, **commands}.items():
