@@ -254,3 +254,44 @@ def test_sweep_over_a_joint_torque_limit_equals_single_runs(tmp_path):
                  "--out", str(tmp_path / "limits.csv")]) == 0
     header = (tmp_path / "limits.csv").read_text().splitlines()[0]
     assert header.startswith("knee_torque_limit,fell")
+
+
+def test_a_one_link_sweep_over_delay_active_gain_and_weight_equals_single_runs(tmp_path,
+                                                                                capsys):
+    """--controller on one link, a tilt, and a grid over feedback_delay × active_ankle ×
+    proprioceptive_weight: every row is the single compiled run of its values."""
+    import csv
+
+    import posturelab as pl
+    from posturelab.model.controllers import get_controller
+    from posturelab.model.tilt import SineTilt
+
+    out = tmp_path / "one.csv"
+    code = main(["sweep", "--controller", "peterka-2002", "--tilt", "sine:0.02:0.5",
+                 "--duration", "4", "--vary", "feedback_delay=0.1:0.3:3",
+                 "--vary", "active_ankle=600:900:2", "--vary", "proprioceptive_weight=0.5:1:2",
+                 "--out", str(out)])
+    assert code == 0, capsys.readouterr().err
+    rows = list(csv.DictReader(out.open()))
+    assert len(rows) == 12 and set(rows[0]) >= {"peak_theta1", "fell"}
+    assert "peak_theta2" not in rows[0]
+    body = pl.get_body("paper-1link")
+    base = get_controller("peterka-2002").muscles(body)
+    for row in rows:
+        ka = float(row["active_ankle"])
+        muscles = base.with_active_feedback([ka], base.active_viscosities)
+        one = pl.simulate(body, muscles, None, 4.0, tilt=SineTilt(0.02, 0.5),
+                          feedback_delay=float(row["feedback_delay"]),
+                          proprioceptive_weight=float(row["proprioceptive_weight"]),
+                          engine="compiled")
+        assert (row["fell"] == "true") == one.fell
+        assert float(row["peak_theta1"]) == one.max_abs_theta[0]
+    assert {r["fell"] for r in rows} == {"true", "false"}  # τ = 0.3 s is past the margin
+
+
+def test_a_sweep_refuses_a_name_its_experiment_lacks(tmp_path, capsys):
+    code = main(["sweep", "--body", "paper-1link", "--stiffness", "900", "--disturbance",
+                 "backward", "--vary", "knee=0:10:2", "--out", str(tmp_path / "x.csv")])
+    err = capsys.readouterr().err
+    assert code == 2 and "unknown sweep parameter 'knee' for this experiment (1 link," in err
+    assert "known: ankle, viscosity_ratio" in err

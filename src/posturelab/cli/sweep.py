@@ -28,26 +28,30 @@ the first --vary varying slowest) with the compiled engine, and write one row pe
 
 --vary NAME=LO:HI:N takes N evenly spaced values from LO to HI inclusive (N >= 1; N = 1
 needs LO = HI; at most {MAX_RUNS:,} runs in all). NAME is a pair stiffness [N·m/rad]
-({", ".join(PAPER_PAIR_NAMES)}), viscosity_ratio [s], disturbance_scale [-], a factor on
-the base experiment's platform motion (velocity-step speed, pulse peak, ramp
-displacement, sine amplitudes, measured accelerations: --vary disturbance_scale=0.5:3:26
-with a 1 m/s step sweeps 0.5-3 m/s), feedback_delay [s], the neural delay of every
-pair's feedback, or {", ".join(TORQUE_LIMIT_PARAMETERS)} [N·m], the largest net muscle
+({", ".join(PAPER_PAIR_NAMES)} on the paper's body; ankle, or ankle and hip, on one or
+two links): the intrinsic part when the base experiment has active gains, the whole pair
+feedback otherwise; active_PAIR [N·m/rad] and active_viscosity_PAIR [N·m·s/rad], a pair's
+active (delayed) gains; viscosity_ratio [s]; disturbance_scale [-], a factor on the base
+experiment's platform motion (velocity-step speed, pulse peak, ramp displacement, sine
+amplitudes, measured accelerations: --vary disturbance_scale=0.5:3:26 with a 1 m/s step
+sweeps 0.5-3 m/s); feedback_delay [s]; proprioceptive_weight [-]; or JOINT_torque_limit
+[N·m] ({", ".join(TORQUE_LIMIT_PARAMETERS)} on the paper's body), the largest net muscle
 moment at a joint; repeat --vary for each parameter. Every other gain comes from the
-base experiment: --case/--stiffness with --disturbance (as in posturelab simulate),
---scenario FILE.toml or --builtin NAME. A pair's viscosity is the ratio times its
-stiffness: the varied viscosity_ratio, else --viscosity-ratio, else the base experiment's
-(0.25, the paper's, for --case).
+base experiment: --case/--stiffness/--controller with --disturbance or --tilt (as in
+posturelab simulate), --scenario FILE.toml or --builtin NAME. A pair's viscosity is the
+ratio times its stiffness: the varied viscosity_ratio, else --viscosity-ratio, else the
+base experiment's (0.25, the paper's, for --case).
 
-Columns: the varied parameters, then {", ".join(OUTCOME_COLUMNS)}.
-fell is true/false; fall_time [s] is empty if the run did not fall; peak_theta1..3 [rad]
+Columns: the varied parameters, then {", ".join(OUTCOME_COLUMNS)} (one peak_theta
+per link). fell is true/false; fall_time [s] is empty if the run did not fall; peak_thetaI [rad]
 are the largest |θ_i| over the samples; settling_time [s] is the last sample time at which
 some |θ_i| exceeded 0.01 rad (0 if none did; empty if the run fell or had not settled by
 the end). The file type follows the suffix of --out: .csv or .parquet (pyarrow); it is
 written to a temporary file and renamed, so no half-written file is left behind.
 
 Everything of the base experiment carries into every run: --torque-limits, --feedback-delay,
---foot with --centre-of-pressure, the knee model. Parallelism: the runs use every CPU
+active gains, --tilt and --proprioceptive-weight, --foot with --centre-of-pressure, the
+knee model. Parallelism: the runs use every CPU
 available (one thread each). --workers N sends chunks of runs to a Dask LocalCluster of N
 single-threaded worker processes, --scheduler ADDRESS to a running Dask cluster (its
 workers need posturelab installed); the results are identical. Tolerances default to the

@@ -65,18 +65,47 @@ __all__ = [
     "ProgressBar",
 ]
 
-#: The joints whose torque limit a sweep can vary, in joint order.
+#: The joints whose torque limit a sweep can vary on the paper's body, in joint order.
 TORQUE_LIMIT_PARAMETERS: tuple[str, ...] = ("ankle_torque_limit", "knee_torque_limit",
                                             "hip_torque_limit")
-#: Names a sweep can vary: the paper's pair stiffnesses, the viscosity ratio, the scale of
-#: the platform motion, the feedback delay and the joint torque limits.
-SWEEP_PARAMETERS: tuple[str, ...] = (*PAPER_PAIR_NAMES, "viscosity_ratio", "disturbance_scale",
-                                     "feedback_delay", *TORQUE_LIMIT_PARAMETERS)
-#: Unit of each sweep parameter.
-PARAMETER_UNITS: dict[str, str] = {**{n: "N·m/rad" for n in PAPER_PAIR_NAMES},
-                                   "viscosity_ratio": "s", "disturbance_scale": "-",
-                                   "feedback_delay": "s",
-                                   **{n: "N·m" for n in TORQUE_LIMIT_PARAMETERS}}
+#: Parameters of every sweep besides the pairs and the joints.
+COMMON_PARAMETERS: tuple[str, ...] = ("viscosity_ratio", "disturbance_scale", "feedback_delay",
+                                      "proprioceptive_weight")
+#: Names a sweep of the paper's body can vary: each pair's stiffness (intrinsic, or without
+#: active gains the whole), its active stiffness ``active_<pair>`` and active viscosity
+#: ``active_viscosity_<pair>``, the common parameters and the joint torque limits. Another
+#: body's sweep has its own pairs and joints (:func:`sweep_parameters`).
+SWEEP_PARAMETERS: tuple[str, ...] = (
+    *PAPER_PAIR_NAMES, *COMMON_PARAMETERS, *TORQUE_LIMIT_PARAMETERS,
+    *(f"active_{n}" for n in PAPER_PAIR_NAMES),
+    *(f"active_viscosity_{n}" for n in PAPER_PAIR_NAMES))
+_UNITS = {"viscosity_ratio": "s", "disturbance_scale": "-", "feedback_delay": "s",
+          "proprioceptive_weight": "-"}
+
+
+def parameter_unit(name: str) -> str:
+    """The unit of a sweep parameter (its name's form decides)."""
+    if name in _UNITS:
+        return _UNITS[name]
+    if name.endswith("_torque_limit"):
+        return "N·m"
+    if name.startswith("active_viscosity_"):
+        return "N·m·s/rad"
+    return "N·m/rad"
+
+
+def sweep_parameters(muscles, n_links: int) -> tuple[str, ...]:
+    """What a sweep of this pair layout and body can vary (see :data:`SWEEP_PARAMETERS`)."""
+    from ..model.muscles import joint_pair_names
+
+    pairs = tuple(muscles.names)
+    joints = ("ankle", "knee", "hip") if n_links == 3 else joint_pair_names(n_links)
+    return (*pairs, *COMMON_PARAMETERS, *(f"{j}_torque_limit" for j in joints[:n_links]),
+            *(f"active_{n}" for n in pairs), *(f"active_viscosity_{n}" for n in pairs))
+
+
+#: Unit of each parameter of a sweep of the paper's body.
+PARAMETER_UNITS: dict[str, str] = {n: parameter_unit(n) for n in SWEEP_PARAMETERS}
 #: Largest number of runs one sweep may ask for (a bound on the work and memory). [-]
 MAX_RUNS = 10_000_000
 #: Outcome columns of a sweep table (after the varied parameters), for 3 links.
@@ -106,7 +135,8 @@ class VaryRange:
     Parameters
     ----------
     name : str
-        One of :data:`SWEEP_PARAMETERS`.
+        A parameter name (:data:`SWEEP_PARAMETERS` for the paper's body; the base
+        experiment decides which it has: :func:`sweep_parameters`).
     low, high : float
         First and last value, low <= high, both >= 0. [N·m/rad], [s] or [-]
     count : int
@@ -119,10 +149,10 @@ class VaryRange:
     count: int
 
     def __post_init__(self) -> None:
-        if self.name not in SWEEP_PARAMETERS:
+        if not re.fullmatch(r"[a-z][a-z0-9_]*", str(self.name)):
             raise ParameterError(f"unknown sweep parameter {self.name!r}; known: "
                                  f"{', '.join(SWEEP_PARAMETERS)}")
-        unit = PARAMETER_UNITS[self.name]
+        unit = parameter_unit(self.name)
         for label, v in (("LO", self.low), ("HI", self.high)):
             if not (isinstance(v, int | float | np.floating) and math.isfinite(v)):
                 raise ParameterError(f"{self.name} {label} [{unit}] must be a finite number, "
@@ -151,7 +181,7 @@ class VaryRange:
     @property
     def unit(self) -> str:
         """Unit of the parameter."""
-        return PARAMETER_UNITS[self.name]
+        return parameter_unit(self.name)
 
 
 def parse_vary(text: str) -> VaryRange:
@@ -166,7 +196,7 @@ def parse_vary(text: str) -> VaryRange:
     m = _VARY_RE.match(str(text))
     if not m:
         name = str(text).split("=", 1)[0].strip()
-        if "=" in str(text) and name and name not in SWEEP_PARAMETERS:
+        if "=" in str(text) and name and not re.fullmatch(r"[a-z][a-z0-9_]*", name):
             raise ParameterError(f"unknown sweep parameter {name!r} in --vary {text!r}; known: "
                                  f"{', '.join(SWEEP_PARAMETERS)}")
         raise ParameterError(f"--vary must be NAME=LO:HI:N (N evenly spaced values from LO to "
@@ -193,18 +223,23 @@ class SweepGrid:
     values : numpy.ndarray, shape (M, K)
         Row r holds run r's values of the K varied parameters (the cartesian
         product, the first parameter varying slowest). [N·m/rad], [s] or [-]
-    stiffness : numpy.ndarray, shape (M, 5)
-        Pair stiffness of each run (ankle, knee, hip, quadriceps, gastrocnemius). [N·m/rad]
-    viscosity : numpy.ndarray, shape (M, 5)
+    stiffness : numpy.ndarray, shape (M, P)
+        Pair stiffness of each run, in the base experiment's pair order. [N·m/rad]
+    viscosity : numpy.ndarray, shape (M, P)
         Pair viscosity of each run. [N·m·s/rad]
     disturbance_scale : numpy.ndarray, shape (M,), optional
         Factor on the base experiment's platform motion per run; None when not
         varied (every run has the base motion). [-]
     feedback_delay : numpy.ndarray, shape (M,)
         Neural delay of the muscle feedback per run. [s]
-    torque_limits : numpy.ndarray, shape (M, 3), optional
-        Largest net moment at the ankle, knee and hip per run (inf for none); None
-        when no run has a limit. [N·m]
+    torque_limits : numpy.ndarray, shape (M, N), optional
+        Largest net moment at each joint per run (inf for none); None when no run has a
+        limit. [N·m]
+    active_stiffness, active_viscosity : numpy.ndarray, shape (M, P), optional
+        Active (delayed) pair gains per run; None when the base experiment has none and
+        none is varied. [N·m/rad], [N·m·s/rad]
+    proprioceptive_weight : numpy.ndarray, shape (M,), optional
+        W per run; None for the base experiment's. [-]
     """
 
     names: tuple[str, ...]
@@ -214,6 +249,9 @@ class SweepGrid:
     disturbance_scale: np.ndarray | None = None
     feedback_delay: np.ndarray | None = None
     torque_limits: np.ndarray | None = None
+    active_stiffness: np.ndarray | None = None
+    active_viscosity: np.ndarray | None = None
+    proprioceptive_weight: np.ndarray | None = None
 
     @property
     def n_runs(self) -> int:
@@ -231,20 +269,23 @@ def _base_ratios(scenario: Scenario, viscosity_ratio: float | None) -> np.ndarra
     if viscosity_ratio is not None:
         if not (math.isfinite(viscosity_ratio) and viscosity_ratio >= 0):
             raise ParameterError(f"viscosity ratio [s] must be >= 0, got {viscosity_ratio!r}")
-        return np.full(len(PAPER_PAIR_NAMES), float(viscosity_ratio))
+        return np.full(len(scenario.muscles.pairs), float(viscosity_ratio))
     k = np.asarray(scenario.muscles.stiffnesses, dtype=float)
     v = np.asarray(scenario.muscles.viscosities, dtype=float)
     with np.errstate(divide="ignore", invalid="ignore"):
         return np.where(k > 0, v / np.where(k > 0, k, 1.0), DEFAULT_VISCOSITY_RATIO)
 
 
-def check_base(scenario: Scenario) -> None:
-    """The base experiment must have the paper's five pairs on 3 links."""
-    names = tuple(scenario.muscles.names)
-    if names != PAPER_PAIR_NAMES or scenario.body.n_links != 3:
-        raise ParameterError(f"a sweep needs the paper's five pairs ({', '.join(PAPER_PAIR_NAMES)})"
-                             f" on 3 links; the base experiment has {', '.join(names)} on "
-                             f"{scenario.body.n_links} links")
+def check_base(scenario: Scenario, names: Sequence[str] = ()) -> None:
+    """Every varied name must be one the base experiment has (:func:`sweep_parameters`)."""
+    known = sweep_parameters(scenario.muscles, scenario.body.n_links)
+    for name in names:
+        if name not in known:
+            n = scenario.body.n_links
+            raise ParameterError(f"unknown sweep parameter {name!r} for this experiment "
+                                 f"({n} link{'s' if n != 1 else ''}, pairs "
+                                 f"{', '.join(scenario.muscles.names)}); known: "
+                                 f"{', '.join(known)}")
 
 
 def sweep_grid(scenario: Scenario, varies: Sequence[VaryRange],
@@ -261,11 +302,11 @@ def sweep_grid(scenario: Scenario, varies: Sequence[VaryRange],
         Viscosity/stiffness for every pair when ``viscosity_ratio`` is not
         varied; default: the base experiment's ratio per pair. [s]
     """
-    check_base(scenario)
     varies = list(varies)
     if not varies:
         raise ParameterError("give at least one --vary NAME=LO:HI:N")
     names = [v.name for v in varies]
+    check_base(scenario, names)
     dup = sorted({n for n in names if names.count(n) > 1})
     if dup:
         raise ParameterError(f"--vary names a parameter more than once: {', '.join(dup)}")
@@ -283,22 +324,42 @@ def sweep_grid(scenario: Scenario, varies: Sequence[VaryRange],
                              "scenario with a disturbance")
     scale = None
     delay = np.full(m, float(scenario.feedback_delay))
-    base_limits = (np.full(3, math.inf) if scenario.torque_limits is None
+    n = scenario.body.n_links
+    base_limits = (np.full(n, math.inf) if scenario.torque_limits is None
                    else np.asarray(scenario.torque_limits, dtype=float))
     limits = np.tile(base_limits, (m, 1))
+    muscles = scenario.muscles
+    pairs = list(muscles.names)
+    joints = [name.removesuffix("_torque_limit")
+              for name in sweep_parameters(muscles, n) if name.endswith("_torque_limit")]
+    varies_active = any(nm.startswith("active_") for nm in names)
+    ka = va = weight = None
+    if muscles.has_active_feedback or varies_active:
+        ka = np.tile(muscles.active_stiffnesses, (m, 1))
+        va = np.tile(muscles.active_viscosities, (m, 1))
     for k, name in enumerate(names):
+        column = values[:, k]
         if name == "viscosity_ratio":
-            ratios[:] = values[:, k:k + 1]
+            ratios[:] = column[:, None]
         elif name == "disturbance_scale":
-            scale = np.ascontiguousarray(values[:, k])
+            scale = np.ascontiguousarray(column)
         elif name == "feedback_delay":
-            delay = np.ascontiguousarray(values[:, k])
-        elif name in TORQUE_LIMIT_PARAMETERS:
-            limits[:, TORQUE_LIMIT_PARAMETERS.index(name)] = values[:, k]
+            delay = np.ascontiguousarray(column)
+        elif name == "proprioceptive_weight":
+            if np.any(column > 1):
+                raise ParameterError(f"proprioceptive_weight [-] must be in [0, 1], got "
+                                     f"{column.max():g}")
+            weight = np.ascontiguousarray(column)
+        elif name.endswith("_torque_limit"):
+            limits[:, joints.index(name.removesuffix("_torque_limit"))] = column
+        elif name.startswith("active_viscosity_"):
+            va[:, pairs.index(name.removeprefix("active_viscosity_"))] = column
+        elif name.startswith("active_"):
+            ka[:, pairs.index(name.removeprefix("active_"))] = column
         else:
-            stiffness[:, PAPER_PAIR_NAMES.index(name)] = values[:, k]
+            stiffness[:, pairs.index(name)] = column
     return SweepGrid(tuple(names), values, stiffness, ratios * stiffness, scale, delay,
-                     None if np.all(np.isinf(limits)) else limits)
+                     None if np.all(np.isinf(limits)) else limits, ka, va, weight)
 
 
 # ---------------------------------------------------------------------------
@@ -425,17 +486,11 @@ class _Task:
             feedback_delay=grid.feedback_delay[lo:hi], rtol=self.rtol, atol=self.atol,
             sample_rate=sc.sample_rate, settle_tolerance=SETTLE_TOLERANCE, parallel=parallel,
             disturbance_scale=_rows(grid.disturbance_scale, lo, hi),
-            tilt=sc.tilt, proprioceptive_weight=sc.proprioceptive_weight,
-            **_active_rows(sc.muscles, hi - lo))
-
-
-def _active_rows(muscles, rows: int) -> dict:
-    """The base experiment's active gains for ``rows`` runs (a sweep varies the pair gains,
-    which with active gains are the intrinsic part), or nothing without active gains."""
-    if not muscles.has_active_feedback:
-        return {}
-    return {"active_stiffness": np.tile(muscles.active_stiffnesses, (rows, 1)),
-            "active_viscosity": np.tile(muscles.active_viscosities, (rows, 1))}
+            tilt=sc.tilt,
+            proprioceptive_weight=(sc.proprioceptive_weight if grid.proprioceptive_weight is None
+                                   else grid.proprioceptive_weight[lo:hi]),
+            active_stiffness=_rows(grid.active_stiffness, lo, hi),
+            active_viscosity=_rows(grid.active_viscosity, lo, hi))
 
 
 def _run_chunk(task: _Task, grid: SweepGrid, lo: int, hi: int) -> BatchResult:

@@ -412,7 +412,7 @@ def simulate_batch(
     active_stiffness: np.ndarray | None = None,
     active_viscosity: np.ndarray | None = None,
     tilt: Tilt | None = None,
-    proprioceptive_weight: float = 1.0,
+    proprioceptive_weight: float | np.ndarray = 1.0,
     rtol: float = DEFAULT_RTOL,
     atol: float = DEFAULT_ATOL,
     sample_rate: float = 1000.0,
@@ -457,8 +457,9 @@ def simulate_batch(
         (:func:`posturelab.model.muscles.feedback_gains`). [N·m/rad], [N·m·s/rad]
     tilt : Tilt, optional
         The support-surface tilt of every run (:mod:`posturelab.model.tilt`).
-    proprioceptive_weight : float
-        W of the active part's error for pairs that span the foot, in [0, 1]. [-]
+    proprioceptive_weight : float or array_like, shape (M,)
+        W of the active part's error for pairs that span the foot, in [0, 1], for every
+        run or per run. [-]
     rtol : float
         Relative tolerance. [-]
     atol : float
@@ -523,6 +524,7 @@ def simulate_batch(
                 raise ParameterError(f"{label} must have the shape of stiffness, "
                                      f"{kd_all.shape}, got {arr.shape}")
     delays = _per_run("feedback_delay [s]", feedback_delay, M, None)
+    weights = _per_run("proprioceptive_weight [-]", proprioceptive_weight, M, None)
     lims = (np.full((M, n), math.inf) if torque_limits is None
             else _per_run("torque_limits [N·m]", torque_limits, M, n))
     scale = (np.ones(M) if disturbance_scale is None
@@ -534,7 +536,11 @@ def simulate_batch(
                            rates_from=rates_from, knee=knee, fall=fall,
                            torque_limits=limits, feedback_delay=delay, rtol=rtol, atol=atol,
                            sample_rate=sample_rate, max_switches=max_switches, tilt=tilt,
-                           proprioceptive_weight=proprioceptive_weight)
+                           proprioceptive_weight=weight)
+
+    weight = float(weights[0]) if M else 1.0
+    for w in np.unique(weights):  # each checked as a single run's would be
+        prepare_run(body, muscles, None, 1.0, proprioceptive_weight=float(w))
 
     # every run's delay and limits are checked as a single run's would be
     for d in np.unique(delays):
@@ -568,8 +574,7 @@ def simulate_batch(
     tilt_gain_all = enc.readonly(np.zeros((M, 4, n)))
     if base.tilt is not None:  # the tilt's gains follow each run's gains and delay
         split = feedback_gains(kd_all, ld_all, ka_all, la_all, np.ones(M))
-        pair_gains = tilt_pair_gains(split, muscles.spans_foot, delays,
-                                     base.proprioceptive_weight)
+        pair_gains = tilt_pair_gains(split, muscles.spans_foot, delays, weights)
         a0, ad0 = base.tilt.angle_and_rate(0.0)
         ab, adb = base.tilt.angle_and_rate(-delays)  # what the delayed part feels at t = 0
         at_start = (pair_gains[:, 0] * a0 + pair_gains[:, 1] * ad0
