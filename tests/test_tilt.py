@@ -163,3 +163,52 @@ def test_bad_tilt_input_is_refused_naming_the_field():
         pl.simulate(body, muscles, None, 1.0, tilt=0.1)
     with pytest.raises(ParameterError, match="PRTS taps"):
         PRTSTilt(0.05, taps=(1, 0, 0, 0))
+
+
+def test_an_axis_below_the_ankle_is_a_tilt_about_the_ankle_plus_its_translation():
+    """Turning the surface about an axis h below the ankle = the same tilt about the ankle
+    plus the ankle's translation on its circle, given as a measured acceleration profile
+    (x = −h sin α, y = h(cos α − 1), differentiated here by hand; sampled at 10 kHz, so
+    on the compiled engine; the next test checks the reference against it)."""
+    engine = "compiled"
+    body, muscles = pl.paper_body(), split_case_1()
+    tilt, h = RaisedCosineTilt(0.06, 0.4, 0.1), 0.08
+    t = np.arange(0.0, 3.0 + 1e-9, 1e-4)
+    a, ad, add = tilt.kinematics(t)
+    ax = -h * (add * np.cos(a) - ad**2 * np.sin(a))
+    ay = -h * (add * np.sin(a) + ad**2 * np.cos(a))
+    kwargs = dict(feedback_delay=0.03, sample_rate=100, engine=engine)
+    about_axis = pl.simulate(body, muscles, None, 3.0, tilt=tilt, tilt_axis_depth=h, **kwargs)
+    split = pl.simulate(body, muscles, pl.MeasuredProfile(t, ax, ay), 3.0, tilt=tilt,
+                        **kwargs)
+    np.testing.assert_allclose(about_axis.theta, split.theta, rtol=0, atol=2e-6)
+    assert np.abs(about_axis.theta - pl.simulate(body, muscles, None, 3.0, tilt=tilt,
+                                                 **kwargs).theta).max() > 1e-4
+
+
+def test_the_engines_agree_about_an_axis_below_the_ankle_with_a_starting_sine():
+    """A sine starts turning at once: the ankle's velocity jumps at t = 0 (−h α̇(0)), and the
+    rates jump with it (−J⁻¹H Δẋ)."""
+    body, muscles = pl.paper_body(), split_case_1()
+    kwargs = dict(tilt=SineTilt(0.03, 0.7), tilt_axis_depth=0.08, feedback_delay=0.02,
+                  sample_rate=100)
+    fast = pl.simulate(body, muscles, None, 3.0, engine="compiled", rtol=1e-10, atol=1e-13,
+                       **kwargs)
+    ref = pl.simulate(body, muscles, None, 3.0, engine="reference", rtol=1e-10, atol=1e-12,
+                      **kwargs)
+    np.testing.assert_allclose(fast.theta, ref.theta, rtol=0, atol=1e-6)
+    dv = -0.08 * 0.03 * 2 * math.pi * 0.7
+    expected = pl.velocity_step_response(body, dv)
+    np.testing.assert_allclose(ref.omega[0], expected, rtol=1e-12)
+    assert ref.platform_velocity[0, 0] == pytest.approx(dv, rel=1e-12)
+
+
+def test_an_axis_depth_needs_a_smooth_tilt():
+    body, muscles = pendulum()
+    with pytest.raises(ParameterError, match="needs a tilt rate without jumps"):
+        pl.simulate(body, muscles, None, 1.0, tilt=PRTSTilt.peterka_2002(0.02),
+                    tilt_axis_depth=0.05)
+    with pytest.raises(ParameterError, match=r"tilt_axis_depth \[m\] needs a tilt"):
+        pl.simulate(body, muscles, None, 1.0, tilt_axis_depth=0.05)
+    with pytest.raises(ParameterError, match=r"tilt_axis_depth \[m\] must be"):
+        pl.simulate(body, muscles, None, 1.0, tilt=SineTilt(0.01, 1.0), tilt_axis_depth=-1)

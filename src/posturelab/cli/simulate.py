@@ -108,6 +108,10 @@ def add_experiment_arguments(p: argparse.ArgumentParser) -> None:
                      "held), prts:AMPLITUDE_RAD[:STATE_DURATION_S] (peak to peak; Peterka's "
                      "80-state, 20 s sequence). A tilt column [rad] in --platform-profile "
                      "does the same from data.")
+    src.add_argument("--tilt-axis-depth", type=float, default=None, metavar="M",
+                     help="the tilt axis this far below the ankle [m], in [0, 1] (default 0: "
+                     "about the ankle; then the ankle moves with the surface). Needs a tilt "
+                     "without rate jumps (not prts).")
     src.add_argument("--torque-limits", metavar="ANKLE,KNEE,HIP",
                      help="largest net muscle moment at each joint [N·m] ('inf' for none).")
     src.add_argument("--max-link-angle", type=float, default=None, metavar="RAD",
@@ -162,6 +166,11 @@ def scenario_from_args(args: argparse.Namespace, command: str = "simulate") -> S
                              "a tilt column, not both")
         tilt = parse_tilt(args.tilt)
         sc = sc.replace(tilt=tilt, description=f"{sc.description}, {tilt.describe()}")
+    if args.tilt_axis_depth is not None:
+        depth = args.tilt_axis_depth
+        if not (math.isfinite(depth) and 0 <= depth <= 1):
+            raise ParameterError(f"--tilt-axis-depth [m] must be in [0, 1], got {depth:g}")
+        sc = sc.replace(tilt_axis_depth=float(depth))
     if args.torque_limits:
         sc = sc.replace(torque_limits=tuple(
             parse_limit_list(args.torque_limits, "--torque-limits [N·m]", sc.body.n_links)))

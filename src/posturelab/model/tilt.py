@@ -45,12 +45,16 @@ __all__ = [
     "prts_sequence",
     "tilt_pair_gains",
     "read_tilt_csv",
+    "axis_translation",
+    "MAX_AXIS_DEPTH",
     "MAX_TILT",
     "PETERKA_2002_CITATION",
 ]
 
 #: Largest |α| a profile may reach. [rad]
 MAX_TILT = 0.5
+#: Largest distance of the tilt axis below the ankle. [m]
+MAX_AXIS_DEPTH = 1.0
 
 PETERKA_2002_CITATION = (
     "Peterka RJ (2002) Sensorimotor integration in human postural control. "
@@ -99,19 +103,26 @@ class TiltTerm:
 
     def evaluate(self, t) -> tuple[np.ndarray, np.ndarray]:
         """(α, α̇) at ``t`` (any shape). [rad], [rad/s]"""
+        return self.kinematics(t)[:2]
+
+    def kinematics(self, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(α, α̇, α̈) at ``t`` (any shape). [rad], [rad/s], [rad/s²]"""
         t = np.asarray(t, dtype=float)
         if self.kind == "sine":
             w = 2 * math.pi * self.frequency
             tt = np.maximum(t, 0.0)
-            rate = np.where(t >= 0.0, self.amplitude * w * np.cos(w * tt + self.phase), 0.0)
-            return self.amplitude * np.sin(w * tt + self.phase), rate
+            after = t >= 0.0
+            rate = np.where(after, self.amplitude * w * np.cos(w * tt + self.phase), 0.0)
+            accel = np.where(after, -self.amplitude * w * w * np.sin(w * tt + self.phase), 0.0)
+            return self.amplitude * np.sin(w * tt + self.phase), rate, accel
         if self.kind == "raised-cosine":
             s = np.clip((t - self.start) / self.duration, 0.0, 1.0)
             inside = (t > self.start) & (t < self.start + self.duration)
             angle = self.amplitude * 0.5 * (1.0 - np.cos(math.pi * s))
-            rate = np.where(inside, self.amplitude * 0.5 * math.pi / self.duration
-                            * np.sin(math.pi * s), 0.0)
-            return angle, rate
+            k = math.pi / self.duration
+            rate = np.where(inside, self.amplitude * 0.5 * k * np.sin(math.pi * s), 0.0)
+            accel = np.where(inside, self.amplitude * 0.5 * k * k * np.cos(math.pi * s), 0.0)
+            return angle, rate, accel
         # piecewise cubic
         x, c = self.knots, self.coefficients
         tt = t
@@ -124,7 +135,8 @@ class TiltTerm:
         ck = c[k]
         angle = ck[..., 0] + u * (ck[..., 1] + u * (ck[..., 2] + u * ck[..., 3]))
         rate = ck[..., 1] + u * (2 * ck[..., 2] + u * 3 * ck[..., 3])
-        return angle, np.where(inside, rate, 0.0)
+        accel = 2 * ck[..., 2] + 6 * u * ck[..., 3]
+        return angle, np.where(inside, rate, 0.0), np.where(inside, accel, 0.0)
 
 
 class Tilt:
@@ -142,6 +154,20 @@ class Tilt:
             a, r = term.evaluate(t)
             angle, rate = angle + a, rate + r
         return angle, rate
+
+    def kinematics(self, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(α, α̇, α̈) at ``t``, the shape of ``t``. [rad], [rad/s], [rad/s²]"""
+        t = np.asarray(t, dtype=float)
+        out = [np.zeros(t.shape), np.zeros(t.shape), np.zeros(t.shape)]
+        for term in self.terms():
+            for k, v in enumerate(term.kinematics(t)):
+                out[k] = out[k] + v
+        return out[0], out[1], out[2]
+
+    @property
+    def rate_is_continuous(self) -> bool:
+        """α̇ has no jumps after t = 0 (needed to turn about an axis off the ankle)."""
+        return True
 
     def angle(self, t) -> np.ndarray:
         """α(t). [rad]"""
@@ -342,6 +368,10 @@ class PRTSTilt(Tilt):
         object.__setattr__(self, "_term", TiltTerm(
             "ppoly", knots=knots, coefficients=coefficients, period=knots[-1]))
 
+    @property
+    def rate_is_continuous(self) -> bool:
+        return False
+
     @classmethod
     def peterka_2002(cls, amplitude: float) -> PRTSTilt:
         """Peterka's 80-state PRTS with 0.25 s per state (a 20 s cycle), peak-to-peak
@@ -517,6 +547,25 @@ def tilt_pair_gains(split_gains: np.ndarray, spans_foot: np.ndarray, delay,
         np.where(delayed, active_k, zero),
         np.where(delayed, active_l, zero),
     ], axis=-2)
+
+
+def axis_translation(tilt: Tilt, depth: float, t) -> tuple[np.ndarray, np.ndarray]:
+    """The ankle's acceleration and velocity when the surface turns about an axis ``depth``
+    [m] below the ankle: the ankle sits at (−h sin α, h (cos α − 1)) from its level place, so
+
+        ẍ = −h (α̈ cos α − α̇² sin α),   ÿ = −h (α̈ sin α + α̇² cos α)
+        ẋ = −h α̇ cos α,                 ẏ = −h α̇ sin α.
+
+    Returns
+    -------
+    (numpy.ndarray, numpy.ndarray), shapes t.shape + (2,)
+        Acceleration [m/s²] and velocity [m/s], (x, y).
+    """
+    a, ad, add = tilt.kinematics(t)
+    c, s = np.cos(a), np.sin(a)
+    acc = np.stack([-depth * (add * c - ad * ad * s), -depth * (add * s + ad * ad * c)], axis=-1)
+    vel = np.stack([-depth * ad * c, -depth * ad * s], axis=-1)
+    return acc, vel
 
 
 def check_proprioceptive_weight(value) -> float:

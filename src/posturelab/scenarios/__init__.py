@@ -35,6 +35,7 @@ Schema (every table optional except where noted; units in brackets)::
     # prts: amplitude [rad] peak to peak; state_duration [s], registers, taps, seed
     #       (default: Peterka 2002's 80-state, 20 s sequence)
     # profile: file = "tilt.csv" with columns time [s] and tilt [rad]
+    axis_depth = 0.0                     # the tilt axis this far below the ankle [m]
 
     [disturbance]                        # or [[disturbance]] several, summed
     type = "velocity-step"               # velocity-step | half-sine | ramp-and-hold |
@@ -156,6 +157,8 @@ class Scenario:
         Support-surface tilt (:mod:`posturelab.model.tilt`).
     proprioceptive_weight : float
         W of the active part's error for pairs that span the foot. [-]
+    tilt_axis_depth : float
+        Distance of the tilt axis below the ankle. [m]
     """
 
     name: str
@@ -178,6 +181,7 @@ class Scenario:
     feedback_delay: float = 0.0
     tilt: Tilt | None = None
     proprioceptive_weight: float = 1.0
+    tilt_axis_depth: float = 0.0
 
     def run(self, *, engine: str = "reference", **overrides: Any) -> SimulationResult:
         """Simulate this scenario; keyword ``overrides`` replace fields first.
@@ -196,7 +200,7 @@ class Scenario:
             feedback_delay=sc.feedback_delay, rtol=sc.rtol, atol=sc.atol,
             sample_rate=sc.sample_rate, description=sc.description,
             method=sc.method if name == "reference" else None, engine=name, tilt=sc.tilt,
-            proprioceptive_weight=sc.proprioceptive_weight,
+            proprioceptive_weight=sc.proprioceptive_weight, tilt_axis_depth=sc.tilt_axis_depth,
         )
 
     def replace(self, **changes: Any) -> Scenario:
@@ -282,7 +286,9 @@ def _parse(data: dict, base_dir: Path, origin: str) -> Scenario:
         raise ScenarioError(f"{origin}: muscles.proprioceptive_weight [-] must be in [0, 1], "
                             f"got {weight:g}")
     muscles, case = _parse_muscles(mt, body, origin)
-    tilt = _parse_tilt(_table(data, "tilt", TILT_KEYS, origin), base_dir, origin)
+    tilt_table = _table(data, "tilt", TILT_KEYS, origin)
+    tilt = _parse_tilt(tilt_table, base_dir, origin)
+    depth = finite_float("tilt.axis_depth [m]", tilt_table.get("axis_depth", 0.0))
     disturbance = _parse_disturbances(data.get("disturbance"), base_dir, origin)
 
     it = _table(data, "initial", ("posture", "rates", "rates_from"), origin)
@@ -341,12 +347,12 @@ def _parse(data: dict, base_dir: Path, origin: str) -> Scenario:
         atol=finite_float("solver.atol", st.get("atol", 1e-10)),
         sample_rate=finite_float("solver.sample_rate [Hz]", st.get("sample_rate", 1000.0)),
         method=method, case=case, torque_limits=torque_limits, feedback_delay=delay,
-        tilt=tilt, proprioceptive_weight=weight,
+        tilt=tilt, proprioceptive_weight=weight, tilt_axis_depth=depth,
     )
 
 
 TILT_KEYS = ("type", "amplitude", "frequency", "phase", "duration", "start", "state_duration",
-             "registers", "taps", "seed", "file")
+             "registers", "taps", "seed", "file", "axis_depth")
 
 
 def _parse_tilt(tt: dict, base_dir: Path, origin: str) -> Tilt | None:
@@ -361,7 +367,7 @@ def _parse_tilt(tt: dict, base_dir: Path, origin: str) -> Tilt | None:
     if kind not in allowed:
         raise ScenarioError(f"{origin}: tilt.type must be one of {', '.join(allowed)}; "
                             f"got {kind!r}")
-    _reject(tt, ("type", *allowed[kind]), f"tilt (type {kind})", origin)
+    _reject(tt, ("type", "axis_depth", *allowed[kind]), f"tilt (type {kind})", origin)
     try:
         if kind == "sine":
             return SineTilt(tt.get("amplitude"), tt.get("frequency"), tt.get("phase", 0.0))

@@ -18,7 +18,7 @@ from ..model.kinematics import (
 )
 from ..model.muscles import feedback_pair_torques, moments_to_link_torques
 from .results import DerivedSeries
-from .setup import RunSetup, tilt_torques
+from .setup import RunSetup, platform_acceleration, tilt_torques
 
 __all__ = ["derived_series"]
 
@@ -48,7 +48,7 @@ def derived_series(setup: RunSetup, time: np.ndarray, state: np.ndarray,
         Pair torques are zero while a one-sided pair's fed-back stretch is negative;
         joint moments are clipped to the torque limits.
     """
-    body, muscles, disturbance = setup.body, setup.muscles, setup.disturbance
+    body, muscles = setup.body, setup.muscles
     n = body.n_links
     time = np.asarray(time, dtype=float)
     state = np.asarray(state, dtype=float).reshape(-1, 2 * n)
@@ -66,7 +66,7 @@ def derived_series(setup: RunSetup, time: np.ndarray, state: np.ndarray,
         U = moments_to_link_torques(moments)
     else:
         U = -M @ muscles.selection_matrix
-    acc = disturbance.acceleration(time)
+    acc = platform_acceleration(setup, time)
     alpha = (angular_acceleration(body, theta, omega, U, acc[:, 0], acc[:, 1]) if time.size
              else np.zeros((0, n)))
     if locked is not None and setup.knee_row is not None and np.any(locked):
@@ -81,10 +81,10 @@ def derived_series(setup: RunSetup, time: np.ndarray, state: np.ndarray,
     if time.size > 1:
         dt = np.diff(time)[:, None]
         vel[1:] = np.cumsum(0.5 * (acc[1:] + acc[:-1]) * dt, axis=0)
-        vel += np.array(disturbance.velocity_change)
+        vel += np.array(setup.velocity_jump)
         pos[1:] = np.cumsum(0.5 * (vel[1:] + vel[:-1]) * dt, axis=0)
     elif time.size == 1:
-        vel[:] = disturbance.velocity_change
+        vel[:] = setup.velocity_jump
     alpha.setflags(write=False)
     return DerivedSeries(
         pair_torques=M, joint_torques=U, joint_moments=moments,

@@ -63,6 +63,7 @@ def simulate(
     engine: str = "reference",
     tilt: Tilt | None = None,
     proprioceptive_weight: float = 1.0,
+    tilt_axis_depth: float = 0.0,
 ) -> SimulationResult:
     """Simulate the nonlinear chain.
 
@@ -118,6 +119,11 @@ def simulate(
     proprioceptive_weight : float
         W in [0, 1]: the active part's error for pairs that span the foot is
         θ_hi + W·α (1: relative to the foot; 0: to the vertical). [-]
+    tilt_axis_depth : float
+        Distance of the tilt axis below the ankle, in [0, 1] [m]; 0 (the default) turns
+        the surface about the ankle itself, otherwise the ankle moves on a circle about
+        the axis (:func:`posturelab.model.tilt.axis_translation`). Needs a tilt whose rate
+        has no jumps.
 
     Returns
     -------
@@ -134,7 +140,7 @@ def simulate(
         feedback_delay=feedback_delay, rtol=d_rtol if rtol is None else rtol,
         atol=d_atol if atol is None else atol, sample_rate=sample_rate,
         max_switches=max_switches, description=description, tilt=tilt,
-        proprioceptive_weight=proprioceptive_weight)
+        proprioceptive_weight=proprioceptive_weight, tilt_axis_depth=tilt_axis_depth)
     method = d_method if method is None else method
     if name == "reference":
         from .reference import integrate_reference

@@ -39,7 +39,13 @@ from ..model.muscles import (
 )
 from ..model.options import FallCriteria, KneeModel, torque_limit_array
 from ..model.platform import Disturbance, NoDisturbance
-from ..model.tilt import Tilt, check_proprioceptive_weight, tilt_pair_gains
+from ..model.tilt import (
+    MAX_AXIS_DEPTH,
+    Tilt,
+    axis_translation,
+    check_proprioceptive_weight,
+    tilt_pair_gains,
+)
 
 __all__ = [
     "RunSetup",
@@ -127,6 +133,11 @@ class RunSetup:
         Pair gains on α(t), α̇(t), α(t − τ), α̇(t − τ)
         (:func:`posturelab.model.tilt.tilt_pair_gains`); None without a tilt.
         [N·m/rad], [N·m·s/rad], [N·m/rad], [N·m·s/rad]
+    tilt_axis_depth : float
+        Distance of the tilt axis below the ankle (0: the ankle's own axis). [m]
+    velocity_jump : (float, float)
+        The ankle's velocity change at t = 0: the disturbance's step and the start of a
+        tilt about an axis below the ankle. [m/s]
     """
 
     body: Body
@@ -158,6 +169,8 @@ class RunSetup:
     tilt: Tilt | None = None
     proprioceptive_weight: float = 1.0
     tilt_gains: np.ndarray | None = None
+    tilt_axis_depth: float = 0.0
+    velocity_jump: tuple[float, float] = (0.0, 0.0)
 
     @property
     def n_links(self) -> int:
@@ -193,6 +206,7 @@ def initial_state_for(
     disturbance: Disturbance,
     initial_state: np.ndarray | None = None,
     rates_from: Literal["upright", "posture"] = "upright",
+    extra_velocity: tuple[float, float] = (0.0, 0.0),
 ) -> np.ndarray:
     """Initial state after the disturbance's velocity step at t = 0.
 
@@ -204,11 +218,15 @@ def initial_state_for(
     ----------
     initial_state : array_like, shape (2N,), optional
         ``[Θ, Θ̇]`` before the step; upright at rest by default. [rad], [rad/s]
+    extra_velocity : (float, float)
+        A further jump of the ankle's velocity at t = 0 (a tilt about an axis below the
+        ankle that starts turning at once). [m/s]
     """
     n = body.n_links
     x0 = (np.zeros(2 * n) if initial_state is None
           else finite_array("initial_state [rad, rad/s]", initial_state, (2 * n,)).copy())
-    dv = disturbance.velocity_change
+    dv = tuple(float(a + b) for a, b in zip(disturbance.velocity_change, extra_velocity,
+                                             strict=True))
     if dv != (0.0, 0.0):
         if rates_from not in ("upright", "posture"):
             raise ParameterError(
@@ -233,7 +251,7 @@ RUN_OPTIONS: dict[str, object] = {
     "initial_state": None, "rates_from": "upright", "knee": None, "fall": None,
     "torque_limits": None, "feedback_delay": 0.0, "rtol": 1e-8, "atol": 1e-10,
     "sample_rate": 1000.0, "max_switches": 10_000, "description": "", "tilt": None,
-    "proprioceptive_weight": 1.0,
+    "proprioceptive_weight": 1.0, "tilt_axis_depth": 0.0,
 }
 
 
@@ -288,11 +306,19 @@ def _prepare(body: Body, muscles: MuscleSet, disturbance: Disturbance | None = N
     max_switches, description = o["max_switches"], o["description"]
     tilt = o["tilt"]
     weight = check_proprioceptive_weight(o["proprioceptive_weight"])
+    depth = float_in_range("tilt_axis_depth [m]", o["tilt_axis_depth"], 0.0, MAX_AXIS_DEPTH,
+                           unit="m")
     if tilt is not None:
         _expect("tilt", tilt, Tilt)
         if muscles.one_sided_mask.any():
             raise ParameterError("a platform tilt cannot be combined with one-sided pairs "
                                  "(make them two-sided)")
+        if depth > 0 and not tilt.rate_is_continuous:
+            raise ParameterError("a tilt about an axis below the ankle needs a tilt rate "
+                                 "without jumps (sine, raised cosine or measured), not "
+                                 f"{type(tilt).__name__}")
+    elif depth > 0:
+        raise ParameterError("tilt_axis_depth [m] needs a tilt")
     _expect("body", body, Body)
     _expect("muscles", muscles, MuscleSet)
     disturbance = NoDisturbance() if disturbance is None else disturbance
@@ -320,7 +346,10 @@ def _prepare(body: Body, muscles: MuscleSet, disturbance: Disturbance | None = N
     limits = torque_limit_array(torque_limits, n)
     before = (np.zeros(2 * n) if initial_state is None
               else finite_array("initial_state [rad, rad/s]", initial_state, (2 * n,)).copy())
-    x0 = initial_state_for(body, disturbance, initial_state, rates_from)
+    jump = (0.0, 0.0)
+    if tilt is not None and depth > 0:  # the ankle starts moving with the surface's rate
+        jump = tuple(float(v) for v in axis_translation(tilt, depth, 0.0)[1])
+    x0 = initial_state_for(body, disturbance, initial_state, rates_from, jump)
     knee_row = knee_constraint_row(n) if knee.mode != "free" else None
     locked0 = knee.mode == "locked"
     if knee.mode == "stop":
@@ -365,6 +394,8 @@ def _prepare(body: Body, muscles: MuscleSet, disturbance: Disturbance | None = N
         grid=output_grid(duration, sample_rate), breakpoints=breakpoints,
         delay_breakpoints=delay_bps, max_step=max_step, fall_at_start=None, knee_row=knee_row,
         rates_from=rates_from, tilt=tilt, proprioceptive_weight=weight, tilt_gains=tilt_gains,
+        tilt_axis_depth=depth, velocity_jump=tuple(
+            float(a + b) for a, b in zip(disturbance.velocity_change, jump, strict=True)),
     )
     object.__setattr__(setup, "fall_at_start", _fall_at_start(setup))
     return setup
@@ -411,7 +442,7 @@ def start_centre_of_pressure(setup: RunSetup, moments: np.ndarray, limits, satur
     if limits is not None:
         bound = np.where(np.isfinite(limits), limits, 0.0)
         tau = np.where(saturation != 0, saturation * bound, tau)
-    a = setup.disturbance.acceleration(0.0)
+    a = platform_acceleration(setup, 0.0)
     theta = np.broadcast_to(x[:n], tau.shape)
     omega = np.broadcast_to(x[n:], tau.shape)
     acc = angular_acceleration(setup.body, theta, omega, moments_to_link_torques(tau), a[0],
@@ -458,7 +489,7 @@ def model_response(setup: RunSetup, t: float, x: np.ndarray, feedback: np.ndarra
     if saturation is not None and setup.torque_limits is not None:
         bound = np.where(np.isfinite(setup.torque_limits), setup.torque_limits, 0.0)
         tau = np.where(saturation != 0, saturation * bound, tau)
-    a = setup.disturbance.acceleration(t)
+    a = platform_acceleration(setup, t)
     acc = angular_acceleration(setup.body, x[:n], x[n:], moments_to_link_torques(tau),
                                a[0], a[1])
     if locked:
@@ -474,6 +505,16 @@ def raw_moments(setup: RunSetup, t: float, x: np.ndarray, feedback: np.ndarray,
     if setup.tilt is not None:
         M = M + tilt_torques(setup.tilt, setup.tilt_gains, setup.feedback_delay, t)
     return M @ setup.muscles.crossing_matrix
+
+
+def platform_acceleration(setup: RunSetup, t) -> np.ndarray:
+    """The ankle's acceleration (ẍ_d, ÿ_d) at ``t``, shape t.shape + (2,): the disturbance's,
+    plus that of a tilt about an axis below the ankle
+    (:func:`posturelab.model.tilt.axis_translation`). [m/s²]"""
+    a = setup.disturbance.acceleration(t)
+    if setup.tilt is not None and setup.tilt_axis_depth > 0:
+        a = a + axis_translation(setup.tilt, setup.tilt_axis_depth, t)[0]
+    return a
 
 
 def tilt_torques(tilt: Tilt, tilt_gains: np.ndarray, delay: float, t) -> np.ndarray:
@@ -493,7 +534,7 @@ def cop_at(setup: RunSetup, t: float, x: np.ndarray, feedback: np.ndarray, activ
     """Centre of pressure x_p at one state, relative to the ankle. [m]"""
     n = setup.n_links
     tau, acc = model_response(setup, t, x, feedback, active, locked, saturation)
-    fy = ground_reaction(setup.body, x[:n], x[n:], acc, setup.disturbance.acceleration(t))[1]
+    fy = ground_reaction(setup.body, x[:n], x[n:], acc, platform_acceleration(setup, t))[1]
     return float(centre_of_pressure(tau[0], fy))
 
 

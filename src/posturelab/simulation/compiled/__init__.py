@@ -152,6 +152,7 @@ def _packed(setup: RunSetup) -> dict:
         "tilt_gain": enc.readonly(np.ascontiguousarray(
             setup.tilt_gains @ muscles.crossing_matrix if setup.tilt_gains is not None
             else np.zeros((4, n)))),
+        "tilt_depth": float(setup.tilt_axis_depth),
         "bps": enc.readonly(setup.breakpoints.astype(float)), "fpar": fpar, "ipar": ipar,
         "active0": enc.readonly(setup.active0), "slots": slots,
         "ev_offset": ev.EVENT_OFFSET, "ev_direction": ev.EVENT_DIRECTION,
@@ -179,7 +180,7 @@ def _base_run_struct(a: dict, method: str) -> Run:
     n = a["n"]
     run = Run(n=n, p=a["E"].shape[0], n_grid=a["grid"].size, n_bps=a["bps"].size,
               n_slots=len(a["slots"]), method=METHOD_RADAU if tab is None else METHOD_EXPLICIT,
-              delay_multiples=DELAY_BREAKPOINT_MULTIPLES)
+              delay_multiples=DELAY_BREAKPOINT_MULTIPLES, tilt_depth=a["tilt_depth"])
     for name in ("x0", "before", "grid", "bp", "E", "C", "dp", "bps", "fpar", "active0",
                  "ev_offset", "tp", "tilt_gain"):
         setattr(run, name, pointer(a[name]))
@@ -413,6 +414,7 @@ def simulate_batch(
     active_viscosity: np.ndarray | None = None,
     tilt: Tilt | None = None,
     proprioceptive_weight: float | np.ndarray = 1.0,
+    tilt_axis_depth: float = 0.0,
     rtol: float = DEFAULT_RTOL,
     atol: float = DEFAULT_ATOL,
     sample_rate: float = 1000.0,
@@ -460,6 +462,8 @@ def simulate_batch(
     proprioceptive_weight : float or array_like, shape (M,)
         W of the active part's error for pairs that span the foot, in [0, 1], for every
         run or per run. [-]
+    tilt_axis_depth : float
+        Distance of the tilt axis below the ankle (0: the ankle's own). [m]
     rtol : float
         Relative tolerance. [-]
     atol : float
@@ -536,7 +540,7 @@ def simulate_batch(
                            rates_from=rates_from, knee=knee, fall=fall,
                            torque_limits=limits, feedback_delay=delay, rtol=rtol, atol=atol,
                            sample_rate=sample_rate, max_switches=max_switches, tilt=tilt,
-                           proprioceptive_weight=weight)
+                           proprioceptive_weight=weight, tilt_axis_depth=tilt_axis_depth)
 
     weight = float(weights[0]) if M else 1.0
     for w in np.unique(weights):  # each checked as a single run's would be

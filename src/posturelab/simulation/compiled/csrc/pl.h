@@ -70,6 +70,7 @@ typedef struct {
     int64_t delay_multiples;            /* land on k·delay for k = 1 … this */
     const double *tp;                   /* packed tilt (tp[0] = 0: none) */
     const double *tilt_gain;            /* (4, n) joint moments per α(t), α̇(t), α(t−τ), α̇(t−τ) */
+    double tilt_depth;                  /* tilt axis below the ankle [m] (0: the ankle's) */
 } pl_run;
 
 /* Outputs of one run (any pointer may be NULL where noted). */
@@ -138,7 +139,7 @@ void pl_inverse3_complex(const double *ar, const double *ai, double *outr, doubl
 
 /* platform (pl_platform.c) */
 void pl_platform_acceleration(double t, const double *dp, double *ax, double *ay);
-void pl_tilt(double t, const double *tp, double *angle, double *rate);
+void pl_tilt(double t, const double *tp, double *angle, double *rate, double *accel);
 
 /* history of a delayed run (pl_history.c) */
 typedef struct {

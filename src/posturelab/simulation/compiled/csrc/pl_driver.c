@@ -136,7 +136,7 @@ int64_t pl_integrate(const pl_run *run, pl_out *out)
     memcpy(b.x, run->x0, sizeof(double) * m);
     pl_model md = {n, run->bp, b.tm, run->lim, b.sat, b.base, b.work, b.tau};
     pl_ctx cx = {&md, run->E, run->dp, fpar, run->before, run->ev_offset, &hist, delay,
-                 run->tp, run->tilt_gain, b.sc_out, b.sc_inp, b.sc_x, b.ys};
+                 run->tp, run->tilt_gain, run->tilt_depth, b.sc_out, b.sc_inp, b.sc_x, b.ys};
     double *x = b.x, *y = b.y, *Q = b.Q, *inp = b.inp;
     for (int64_t i = 0; i < n; i++)
         out->peak[i] = 0.0;

@@ -17,6 +17,14 @@ void pl_inputs_at(const pl_ctx *cx, double t, double *out)
     double ax = 0.0, ay = 0.0;
     if (cx->dp[0] > 0.0)
         pl_platform_acceleration(t, cx->dp, &ax, &ay);
+    double a = 0.0, ad = 0.0, add = 0.0;
+    if (cx->tp[0] > 0.0)
+        pl_tilt(t, cx->tp, &a, &ad, &add);
+    if (cx->tilt_depth > 0.0) {  /* the ankle moves on a circle about the tilt axis */
+        const double c = cos(a), s = sin(a), h = cx->tilt_depth;
+        ax -= h * (add * c - ad * ad * s);
+        ay -= h * (add * s + ad * ad * c);
+    }
     out[0] = ax;
     out[1] = ay;
     if (cx->delay > 0.0) {
@@ -34,12 +42,10 @@ void pl_inputs_at(const pl_ctx *cx, double t, double *out)
     }
     if (cx->tp[0] > 0.0) {  /* the tilt's moments: now, and as the delayed part felt it */
         const double *g = cx->tilt_gain;
-        double a, ad;
-        pl_tilt(t, cx->tp, &a, &ad);
         for (int64_t j = 0; j < n; j++)
             out[2 + j] += g[j] * a + g[n + j] * ad;
         if (cx->delay > 0.0) {
-            pl_tilt(t - cx->delay, cx->tp, &a, &ad);
+            pl_tilt(t - cx->delay, cx->tp, &a, &ad, &add);
             for (int64_t j = 0; j < n; j++)
                 out[2 + j] += g[2 * n + j] * a + g[3 * n + j] * ad;
         }

@@ -11,6 +11,7 @@ typedef struct {
     const pl_history *hist;
     double delay;
     const double *tp, *tilt_gain;          /* packed tilt, (4, n) joint gains on it */
+    double tilt_depth;                     /* tilt axis below the ankle [m] */
     double *sc_out, *sc_inp, *sc_x, *ys;   /* scratch (2n), (2 + n), (2n), (2n) */
 } pl_ctx;
 

@@ -58,7 +58,7 @@ void pl_platform_acceleration(double t, const double *dp, double *ax, double *ay
 
 /* α and α̇ of one piecewise cubic: knots x[0..K], coefficients c[4k .. 4k+3] */
 static void ppoly(double t, const double *x, const double *c, int64_t K, double period,
-                  double *angle, double *rate)
+                  double *angle, double *rate, double *accel)
 {
     if (period > 0.0 && t >= x[0])
         t = x[0] + fmod(t - x[0], period);
@@ -78,11 +78,12 @@ static void ppoly(double t, const double *x, const double *c, int64_t K, double 
     const double u = t - x[lo], *q = c + 4 * lo;
     *angle = q[0] + u * (q[1] + u * (q[2] + u * q[3]));
     *rate = inside ? q[1] + u * (2.0 * q[2] + u * 3.0 * q[3]) : 0.0;
+    *accel = inside ? 2.0 * q[2] + 6.0 * u * q[3] : 0.0;
 }
 
-void pl_tilt(double t, const double *tp, double *angle, double *rate)
+void pl_tilt(double t, const double *tp, double *angle, double *rate, double *accel)
 {
-    double a = 0.0, ad = 0.0;
+    double a = 0.0, ad = 0.0, add = 0.0;
     const int64_t nq = (int64_t)tp[0];
     for (int64_t q = 0; q < nq; q++) {
         const double *r = tp + 1 + TILT_ROW * q;
@@ -90,23 +91,30 @@ void pl_tilt(double t, const double *tp, double *angle, double *rate)
         if (kind == TILT_SINE) {
             const double w = 2.0 * PI * r[2], tt = t > 0.0 ? t : 0.0;
             a += r[1] * sin(w * tt + r[3]);
-            if (t >= 0.0)
+            if (t >= 0.0) {
                 ad += r[1] * w * cos(w * tt + r[3]);
+                add -= r[1] * w * w * sin(w * tt + r[3]);
+            }
         } else if (kind == TILT_RAISED_COSINE) {
             double s = (t - r[2]) / r[3];
             const int inside = t > r[2] && t < r[2] + r[3];
             s = s < 0.0 ? 0.0 : (s > 1.0 ? 1.0 : s);
             a += r[1] * 0.5 * (1.0 - cos(PI * s));
-            if (inside)
-                ad += r[1] * 0.5 * PI / r[3] * sin(PI * s);
+            if (inside) {
+                const double k = PI / r[3];
+                ad += r[1] * 0.5 * k * sin(PI * s);
+                add += r[1] * 0.5 * k * k * cos(PI * s);
+            }
         } else if (kind == TILT_PPOLY) {
             const int64_t off = (int64_t)r[1], K = (int64_t)r[2];
-            double pa, pr;
-            ppoly(t, tp + off, tp + off + K + 1, K, r[3], &pa, &pr);
+            double pa, pr, pq;
+            ppoly(t, tp + off, tp + off + K + 1, K, r[3], &pa, &pr, &pq);
             a += pa;
             ad += pr;
+            add += pq;
         }
     }
     *angle = a;
     *rate = ad;
+    *accel = add;
 }
