@@ -135,3 +135,37 @@ def test_bad_input_is_one_line_and_exit_2(capsys, argv, needle):
     code, out, err = run(capsys, *argv)
     assert code == 2 and out == ""
     assert err.count("\n") == 1 and needle in err, err
+
+
+def test_stability_map_with_a_delay_is_the_d_subdivision_map(capsys, tmp_path):
+    """The CLI's delayed map writes what delay_stability_map computes, CSV row by row."""
+    import csv
+
+    from posturelab.linear.delay_batch import delay_stability_map
+
+    out = tmp_path / "d.png"
+    code, stdout, err = run(capsys, "stability-map", "--body", "paper-1link", "--stiffness",
+                            "28", "--viscosity", "11", "--x", "active_stiffness:0:1700",
+                            "--y", "active_viscosity:0:680", "--feedback-delay", "0.15",
+                            "--resolution", "12", "--out", str(out))
+    assert code == 0, err
+    assert out.stat().st_size > 5_000 and "12 × 12 sets of the ankle pair" in stdout
+    rows = list(csv.DictReader((tmp_path / "d.csv").open()))
+    body = pl.get_body("paper-1link")
+    api = delay_stability_map(body, pl.model.muscles.muscles_for(1, [28.0], [11.0]), 0.15,
+                              (0, 1700), (0, 680), 12)
+    assert len(rows) == 144
+    assert [int(r["stable"]) for r in rows] == api.stable.ravel().astype(int).tolist()
+    assert [float(r["max_real_part"]) for r in rows] == api.max_real_part.ravel().tolist()
+
+
+@pytest.mark.parametrize("argv,needle", [
+    (["--x", "active_stiffness:0:1", "--y", "active_viscosity:0:1"], "needs --feedback-delay"),
+    (["--x", "ankle:0:1", "--y", "hip:0:1", "--feedback-delay", "0.1"],
+     "--feedback-delay is for the delayed map"),
+    (["--x", "active_stiffness:0:1", "--y", "hip:0:1", "--feedback-delay", "0.1"],
+     "both axes are active_stiffness and active_viscosity"),
+])
+def test_bad_delayed_maps(capsys, tmp_path, argv, needle):
+    code, out, err = run(capsys, "stability-map", *argv, "--out", str(tmp_path / "e.png"))
+    assert code == 2 and needle in err and err.count("\n") == 1

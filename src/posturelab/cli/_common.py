@@ -53,10 +53,12 @@ def parse_limit_list(text: str, field: str, n: int) -> list[float]:
     return out
 
 
-def add_muscle_arguments(p: argparse.ArgumentParser, *, require: bool = False) -> None:
+def add_muscle_arguments(p: argparse.ArgumentParser, *, require: bool = False,
+                         own_case: bool = False) -> None:
     """The body and its feedback: --body / --height --mass, --case / --stiffness /
     --controller, --viscosity / --viscosity-ratio, --gastrocnemius, the active gains,
-    --feedback-delay and --proprioceptive-weight."""
+    --feedback-delay and --proprioceptive-weight (``own_case``: the command defines --case
+    and --viscosity-ratio itself)."""
     from ..model.body import BODY_PRESETS
     from ..model.controllers import CONTROLLERS
 
@@ -69,8 +71,9 @@ def add_muscle_arguments(p: argparse.ArgumentParser, *, require: bool = False) -
     body.add_argument("--mass", type=str, metavar="KG", help="subject mass [kg], with --height.")
     fb = p.add_argument_group("feedback (muscle pairs)")
     g = fb.add_mutually_exclusive_group(required=require)
-    g.add_argument("--case", metavar="CASE",
-                   help=f"Table I stiffness set (three links): {', '.join(STIFFNESS_CASES)}.")
+    if not own_case:
+        g.add_argument("--case", metavar="CASE", help="Table I stiffness set (three links): "
+                       f"{', '.join(STIFFNESS_CASES)}.")
     g.add_argument("--stiffness", metavar="LIST",
                    help="pair stiffnesses [N·m/rad], one per pair: five for three links ("
                    + ", ".join(PAPER_PAIR_NAMES) + "), one per joint otherwise (one for a "
@@ -80,8 +83,10 @@ def add_muscle_arguments(p: argparse.ArgumentParser, *, require: bool = False) -
                    f"fractions of mgh, delay, weight): {', '.join(CONTROLLERS)}.")
     fb.add_argument("--viscosity", metavar="LIST",
                     help="pair viscosities [N·m·s/rad], one per pair (instead of a ratio).")
-    fb.add_argument("--viscosity-ratio", type=float, default=None, metavar="R",
-                    help="pair viscosity = R × pair stiffness [s] (default 0.25, the paper's).")
+    if not own_case:
+        fb.add_argument("--viscosity-ratio", type=float, default=None, metavar="R",
+                        help="pair viscosity = R × pair stiffness [s] (default 0.25, the "
+                        "paper's).")
     fb.add_argument("--gastrocnemius", choices=["two-sided", "one-sided"], default="two-sided",
                     help=GASTROCNEMIUS_HELP)
     fb.add_argument("--active-stiffness", metavar="LIST",

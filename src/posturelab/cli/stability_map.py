@@ -36,9 +36,23 @@ pole has real part < -δ, δ = 1e-9 × the poles' magnitude scale [1/s] (a set w
 undamped poles on the imaginary axis is not stable; see posturelab.batch_linear).
 
 Example: posturelab stability-map --x ankle:0:2000 --y gastrocnemius:0:1000 --out map.png
+
+With a feedback delay, the D-subdivision map: --x active_stiffness:LO:HI --y
+active_viscosity:LO:HI [N·m/rad, N·m·s/rad] of one pair (--pair, default the ankle) at
+--feedback-delay S, for any body and gains (--body, --height/--mass, --stiffness,
+--controller, ...: the other gains as in posturelab simulate). Colour is the real part of the
+rightmost characteristic root; the CSV has active_stiffness, active_viscosity,
+max_real_part [1/s], stable [1 or 0].
+
+Example: posturelab stability-map --body paper-1link --stiffness 28 --viscosity 11 \
+             --x active_stiffness:0:1700 --y active_viscosity:0:680 --feedback-delay 0.15 \
+             --out dmap.png
 """
 
 MAX_RESOLUTION = 5000
+#: Axes of the delayed (D-subdivision) map: one pair's active stiffness [N·m/rad] and
+#: active viscosity [N·m·s/rad].
+DELAYED_AXES = ("active_stiffness", "active_viscosity")
 
 
 def add_parser(sub, name: str) -> argparse.ArgumentParser:
@@ -63,6 +77,12 @@ def add_parser(sub, name: str) -> argparse.ArgumentParser:
                    "an axis (default 0.25, as in the paper).")
     p.add_argument("--progress", action="store_true",
                    help="show a progress bar on standard error even when it is not a terminal.")
+    p.add_argument("--pair", metavar="NAME",
+                   help="with active_stiffness × active_viscosity axes: the pair whose active "
+                   "gains vary (default the first, the ankle).")
+    from ._common import add_muscle_arguments
+
+    add_muscle_arguments(p, own_case=True)
     return p
 
 
@@ -303,6 +323,20 @@ def _write_csv(smap, path: Path, show: bool) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    names = {str(a).split(":")[0].strip().lower() for a in (args.x, args.y)}
+    if names & set(DELAYED_AXES):
+        from ._delay_map import run_delay_map
+
+        return run_delay_map(args)
+    model = [f for f in ("body", "height", "mass", "stiffness", "controller", "viscosity",
+                         "active_stiffness", "active_viscosity", "active_viscosity_ratio",
+                         "feedback_delay", "proprioceptive_weight", "pair")
+             if getattr(args, f, None) is not None]
+    if model:
+        raise ParameterError(
+            f"--{model[0].replace('_', '-')} is for the delayed map (axes "
+            "active_stiffness:LO:HI and active_viscosity:LO:HI with --feedback-delay); the map "
+            "over pair stiffnesses is of the paper's body with --case and --viscosity-ratio")
     x = parse_axis(args.x, "--x")
     y = parse_axis(args.y, "--y")
     if x.name == y.name:
