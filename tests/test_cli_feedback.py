@@ -169,3 +169,17 @@ def test_stability_map_with_a_delay_is_the_d_subdivision_map(capsys, tmp_path):
 def test_bad_delayed_maps(capsys, tmp_path, argv, needle):
     code, out, err = run(capsys, "stability-map", *argv, "--out", str(tmp_path / "e.png"))
     assert code == 2 and needle in err and err.count("\n") == 1
+
+
+def test_poles_with_a_delay_give_the_rightmost_roots(capsys):
+    code, out, _ = run(capsys, "poles", "--case", "1", "--feedback-delay", "0.01", "--json")
+    obj = json.loads(out)
+    assert code == 0 and obj["stable"] is True and obj["stable_with_delay"] is False
+    roots = [complex(r["re"], r["im"]) for r in obj["rightmost_roots"]]
+    np.testing.assert_allclose(roots, pl.rightmost_roots(pl.paper_body(), pl.paper_muscles("1"),
+                                                         0.01, 6), rtol=1e-12)
+    code, out, _ = run(capsys, "poles", "--controller", "peterka-2002", "--json")
+    obj = json.loads(out)
+    mgh = pl.get_body("paper-1link").load_stiffness
+    assert obj["active_stiffness"] == [pytest.approx(1.35 * mgh)]
+    assert obj["viscosity_ratio"] is None

@@ -14,6 +14,9 @@ stance (Θ = 0, Θ̇ = 0), with the five muscle pairs acting as stiffness K [N·
 and viscosity L = R·K [N·m·s/rad]. The system is stable when every pole has a
 negative real part.
 
+With --feedback-delay the rightmost characteristic roots at that delay are printed too
+('rightmost_roots' and 'stable_with_delay' in JSON).
+
 A one-sided gastrocnemius (--gastrocnemius one-sided) has no derivative at upright,
 where its stretch θ2 is exactly 0. It is linearised on both sides of its switch:
 the side θ2 >= 0 where it acts (the poles printed, identical to two-sided) and the
@@ -56,6 +59,14 @@ def run(args: argparse.Namespace) -> int:
     active, inactive = analyse_both_sides(body, muscles)
     one_sided = args.gastrocnemius == "one-sided"
     stable = active.stable and inactive.stable
+    from ._common import feedback_options_from_args
+
+    delay = feedback_options_from_args(args).get("feedback_delay")
+    delayed = None
+    if delay is not None:
+        from ..linear.delay import rightmost_roots
+
+        delayed = rightmost_roots(body, muscles, delay, 2 * body.n_links)
     if args.json:
         out = {
             "stiffness": [float(x) for x in muscles.stiffnesses],
@@ -71,6 +82,16 @@ def run(args: argparse.Namespace) -> int:
             out["inactive_side_poles"] = [
                 {"re": float(z.real), "im": float(z.imag)} for z in inactive.poles
             ]
+        if muscles.has_active_feedback:
+            out["active_stiffness"] = [float(x) for x in muscles.active_stiffnesses]
+            out["active_viscosity"] = [float(x) for x in muscles.active_viscosities]
+        if args.controller is not None:
+            out["viscosity_ratio"] = None  # (the preset gives every gain)
+        if delayed is not None:
+            out["feedback_delay"] = float(delay)
+            out["rightmost_roots"] = [{"re": float(z.real), "im": float(z.imag)}
+                                      for z in delayed]
+            out["stable_with_delay"] = bool(delayed[0].real < 0)
         print_json(out)
         return 0
     label = f"case {args.case} (Table I)" if args.case else "custom stiffness"
@@ -86,6 +107,12 @@ def run(args: argparse.Namespace) -> int:
             print(f"  {_fmt_pole(z)}")
     worst = max(active.max_real_part, inactive.max_real_part)
     print(f"stable: {'yes' if stable else 'no'} (largest real part {worst:.3f} 1/s)")
+    if delayed is not None:
+        print(f"with the feedback delay τ = {delay:g} s, rightmost roots [1/s]:")
+        for z in delayed:
+            print(f"  {_fmt_pole(z)}")
+        print(f"stable with the delay: {'yes' if delayed[0].real < 0 else 'no'} "
+              "(posturelab delay-margin gives the delay at which it changes)")
     return 0
 
 
