@@ -567,21 +567,8 @@ def paper_muscles(
                    one_sided=(name == "gastrocnemius" and gastrocnemius == "one-sided"))
         for i, (name, (lo, hi, _)) in enumerate(PAPER_PAIRS.items())
     )
-    muscles = MuscleSet(pairs, 3)
-    if active_stiffness is None and active_viscosity is None:
-        if active_viscosity_ratio is not None:
-            raise ParameterError("active_viscosity_ratio needs active_stiffness")
-        return muscles
-    if active_viscosity is not None and active_viscosity_ratio is not None:
-        raise ParameterError("give active_viscosity or active_viscosity_ratio, not both")
-    ka = (np.zeros(5) if active_stiffness is None
-          else _five("active stiffness [N·m/rad]", active_stiffness))
-    if active_viscosity_ratio is not None:
-        va = nonnegative_float("active_viscosity_ratio [s]", active_viscosity_ratio) * ka
-    else:
-        va = (np.zeros(5) if active_viscosity is None
-              else _five("active viscosity [N·m·s/rad]", active_viscosity))
-    return muscles.with_active_feedback(ka, va)
+    return _with_active(MuscleSet(pairs, 3), active_stiffness, active_viscosity,
+                        active_viscosity_ratio, _five)
 
 
 def joint_pair_names(n_links: int) -> tuple[str, ...]:
@@ -644,19 +631,28 @@ def muscles_for(n_links: int, stiffness: Sequence[float], viscosity: Sequence[fl
          else gains("viscosity [N·m·s/rad]", viscosity))
     muscles = MuscleSet(tuple(MusclePair(name, j, j + 1, float(k[j]), float(v[j]))
                               for j, name in enumerate(names)), n_links)
+    return _with_active(muscles, active_stiffness, active_viscosity, active_viscosity_ratio,
+                        gains)
+
+
+def _with_active(muscles: MuscleSet, active_stiffness, active_viscosity,
+                 active_viscosity_ratio, check) -> MuscleSet:
+    """``muscles`` with the active gains given (none: as it is); ``check(label, values)``
+    validates a list of one value per pair."""
     if active_stiffness is None and active_viscosity is None:
         if active_viscosity_ratio is not None:
             raise ParameterError("active_viscosity_ratio needs active_stiffness")
         return muscles
     if active_viscosity is not None and active_viscosity_ratio is not None:
         raise ParameterError("give active_viscosity or active_viscosity_ratio, not both")
-    ka = np.zeros(P) if active_stiffness is None else gains("active stiffness [N·m/rad]",
-                                                             active_stiffness)
+    P = len(muscles.pairs)
+    ka = (np.zeros(P) if active_stiffness is None
+          else check("active stiffness [N·m/rad]", active_stiffness))
     if active_viscosity_ratio is not None:
         va = nonnegative_float("active_viscosity_ratio [s]", active_viscosity_ratio) * ka
     else:
-        va = np.zeros(P) if active_viscosity is None else gains(
-            "active viscosity [N·m·s/rad]", active_viscosity)
+        va = (np.zeros(P) if active_viscosity is None
+              else check("active viscosity [N·m·s/rad]", active_viscosity))
     return muscles.with_active_feedback(ka, va)
 
 

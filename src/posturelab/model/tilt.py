@@ -139,6 +139,13 @@ class TiltTerm:
         return angle, np.where(inside, rate, 0.0), np.where(inside, accel, 0.0)
 
 
+def _check(obj, *fields: tuple[str, str, float, float, str]) -> None:
+    """Set each (field, label, low, high, unit) of a frozen profile to its checked float."""
+    for field_name, label, low, high, unit in fields:
+        object.__setattr__(obj, field_name, float_in_range(
+            f"{label} [{unit}]", getattr(obj, field_name), low, high, unit=unit))
+
+
 class Tilt:
     """A support-surface tilt profile α(t) (base class; see the module notes)."""
 
@@ -210,10 +217,8 @@ class SineTilt(Tilt):
     phase: float = 0.0
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "amplitude", float_in_range(
-            "tilt amplitude [rad]", self.amplitude, -MAX_TILT, MAX_TILT, unit="rad"))
-        object.__setattr__(self, "frequency", float_in_range(
-            "tilt frequency [Hz]", self.frequency, 1e-6, 1000.0, unit="Hz"))
+        _check(self, ("amplitude", "tilt amplitude", -MAX_TILT, MAX_TILT, "rad"),
+               ("frequency", "tilt frequency", 1e-6, 1000.0, "Hz"))
         object.__setattr__(self, "phase", finite_float("tilt phase [rad]", self.phase))
 
     def terms(self) -> tuple[TiltTerm, ...]:
@@ -249,12 +254,9 @@ class RaisedCosineTilt(Tilt):
     start: float = 0.0
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "amplitude", float_in_range(
-            "tilt amplitude [rad]", self.amplitude, -MAX_TILT, MAX_TILT, unit="rad"))
-        object.__setattr__(self, "duration", float_in_range(
-            "tilt duration [s]", self.duration, 1e-4, 1e4, unit="s"))
-        object.__setattr__(self, "start", float_in_range(
-            "tilt start [s]", self.start, 0.0, 1e4, unit="s"))
+        _check(self, ("amplitude", "tilt amplitude", -MAX_TILT, MAX_TILT, "rad"),
+               ("duration", "tilt duration", 1e-4, 1e4, "s"),
+               ("start", "tilt start", 0.0, 1e4, "s"))
 
     def terms(self) -> tuple[TiltTerm, ...]:
         return (TiltTerm("raised-cosine", amplitude=self.amplitude, start=self.start,
@@ -345,11 +347,8 @@ class PRTSTilt(Tilt):
     _term: TiltTerm = field(init=False, repr=False, compare=False, default=None)
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "amplitude", float_in_range(
-            "PRTS amplitude (peak to peak) [rad]", self.amplitude, 1e-9, 2 * MAX_TILT,
-            unit="rad"))
-        object.__setattr__(self, "state_duration", float_in_range(
-            "PRTS state duration [s]", self.state_duration, 1e-3, 100.0, unit="s"))
+        _check(self, ("amplitude", "PRTS amplitude (peak to peak)", 1e-9, 2 * MAX_TILT, "rad"),
+               ("state_duration", "PRTS state duration", 1e-3, 100.0, "s"))
         object.__setattr__(self, "taps", tuple(int(t) for t in self.taps))
         object.__setattr__(self, "seed", tuple(int(s) for s in self.seed))
         velocity = prts_sequence(self.registers, self.taps, self.seed)
