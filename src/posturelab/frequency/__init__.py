@@ -1,0 +1,13 @@
+"""Frequency-domain identification: PRTS stimuli analysed as frequency response functions.
+
+:mod:`.bands` states the stimulus harmonics and Peterka's frequency bands, :mod:`.estimate`
+estimates an FRF with coherence and 95 % bounds from measured series, :mod:`.model` computes
+the linearised model's FRF exactly (the delay as e^{−sτ}).
+"""
+
+from .bands import PETERKA_BAND_HARMONICS, band_frequencies, harmonic_bands, peterka_bands
+from .estimate import FRFEstimate, estimate_frf
+from .model import model_frf
+
+__all__ = ["PETERKA_BAND_HARMONICS", "band_frequencies", "harmonic_bands", "peterka_bands",
+           "FRFEstimate", "estimate_frf", "model_frf"]

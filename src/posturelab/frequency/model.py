@@ -1,0 +1,150 @@
+"""The linearised model's frequency response, exact (the delay as e^{−sτ}, no Padé).
+
+About upright with the platform at rest, for s = 2πi f (conventions.md, and the equation of
+:mod:`posturelab.linear.delay`):
+
+    Δ(s) Θ(s) = b(s) u(s),   Δ(s) = s² J0 − g A + K_i + s L_i + (K_a + s L_a) e^{−sτ}
+
+with the input u either
+
+* the surface tilt α [rad]: b(s) = −Eᵀ[f ∘ (k_i + s l_i) + W f ∘ (k_a + s l_a) e^{−sτ}],
+  f the pairs that span the foot, W the proprioceptive weight; or
+* the platform displacement x_d [m]: b(s) = −a s² (a the gravity coefficients: the
+  horizontal platform acceleration ẍ_d a).
+
+The output is y = c·Θ: the centre-of-mass angle Σ a_i θ_i / Σ a_i (``com_angle``), a link
+angle (``theta1`` …) or a joint angle (``ankle_angle`` = θ1, ``knee_angle`` = θ2 − θ1, …).
+Tilt FRFs are reported in the literature's sign, H = −y/α, so that a body that follows the
+surface (θ = −α: perpendicular to it) has H = 1; translation FRFs are H = y/x_d [rad/m].
+The gains split as :func:`posturelab.model.muscles.feedback_gains` states (without active
+gains the whole feedback is delayed, and W applies to it).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .._validation import finite_array, float_in_range
+from ..errors import ParameterError, UnknownNameError
+from ..model.body import Body
+from ..model.dynamics import mass_matrix
+from ..model.muscles import MuscleSet, feedback_gains
+
+__all__ = ["model_frf", "model_frf_batch", "output_vector", "output_names", "INPUTS"]
+
+#: Inputs of a model FRF.
+INPUTS = ("tilt", "translation")
+
+
+def output_names(n_links: int) -> tuple[str, ...]:
+    """The outputs a body of ``n_links`` has."""
+    from ..model.muscles import joint_pair_names
+
+    joints = ("ankle", "knee", "hip") if n_links == 3 else joint_pair_names(n_links)
+    return ("com_angle", *(f"theta{i + 1}" for i in range(n_links)),
+            *(f"{j}_angle" for j in joints[:n_links]))
+
+
+def output_vector(body: Body, output: str) -> np.ndarray:
+    """c with y = c·Θ for the output named (module notes). [-]"""
+    n = body.n_links
+    names = output_names(n)
+    if output not in names:
+        raise UnknownNameError(f"unknown output {output!r}; known outputs: {', '.join(names)}")
+    c = np.zeros(n)
+    if output == "com_angle":
+        a = body.gravity_coefficients
+        return a / a.sum()
+    if output.startswith("theta"):
+        c[int(output[5:]) - 1] = 1.0
+        return c
+    j = names.index(output) - 1 - n  # joint j lies between links j and j + 1
+    c[j] = 1.0
+    if j > 0:
+        c[j - 1] = -1.0
+    return c
+
+
+def model_frf_batch(body: Body, muscles: MuscleSet, frequencies, stiffness, viscosity,
+                    active_stiffness=None, active_viscosity=None, feedback_delay=0.0,
+                    proprioceptive_weight=1.0, *, input: str = "tilt",
+                    output: str = "com_angle") -> np.ndarray:
+    """Model FRFs of M parameter sets at F frequencies (module notes).
+
+    Parameters
+    ----------
+    body : Body
+    muscles : MuscleSet
+        The pair layout (its gains are not used).
+    frequencies : array_like, shape (F,)
+        > 0. [Hz]
+    stiffness, viscosity : array_like, shape (M, P)
+        Pair (intrinsic, or without active gains the whole) gains. [N·m/rad], [N·m·s/rad]
+    active_stiffness, active_viscosity : array_like, shape (M, P), optional
+        Active (delayed) gains. [N·m/rad], [N·m·s/rad]
+    feedback_delay : float or array_like, shape (M,)
+        τ. [s]
+    proprioceptive_weight : float or array_like, shape (M,)
+        W. [-]
+    input : {"tilt", "translation"}
+    output : str
+        :func:`output_names`.
+
+    Returns
+    -------
+    numpy.ndarray of complex, shape (M, F)
+        [-] for tilt, [rad/m] for translation.
+    """
+    if input not in INPUTS:
+        raise ParameterError(f"input must be one of {', '.join(INPUTS)}, got {input!r}")
+    f = finite_array("frequencies [Hz]", frequencies, (None,))
+    if f.size == 0 or np.any(f <= 0):
+        raise ParameterError("frequencies [Hz] must be > 0")
+    c = output_vector(body, output)
+    k = np.atleast_2d(np.asarray(stiffness, dtype=float))
+    M = k.shape[0]
+    tau = np.broadcast_to(np.asarray(feedback_delay, dtype=float), (M,))
+    w = np.broadcast_to(np.asarray(proprioceptive_weight, dtype=float), (M,))
+    if np.any(tau < 0) or np.any(~np.isfinite(tau)):
+        raise ParameterError("feedback_delay [s] must be finite and >= 0")
+    if np.any((w < 0) | (w > 1)):
+        raise ParameterError("proprioceptive_weight [-] must be in [0, 1]")
+    g = feedback_gains(k, viscosity, active_stiffness, active_viscosity, np.ones(M))
+    E = muscles.selection_matrix
+    n = body.n_links
+
+    def joint(rows):  # Eᵀ diag(rows) E, (M, N, N)
+        return np.einsum("pi,mp,pj->mij", E, rows, E)
+
+    J0 = mass_matrix(body, np.zeros(n))
+    S = joint(g[:, 0]) - body.gravity * np.diag(body.gravity_coefficients)
+    Li, Ka, La = joint(g[:, 1]), joint(g[:, 2]), joint(g[:, 3])
+    s = (2j * np.pi * f)[None, :, None, None]
+    ex = np.exp(-s * tau[:, None, None, None])
+    D = s * s * J0 + S[:, None] + s * Li[:, None] + (Ka[:, None] + s * La[:, None]) * ex
+    s1 = s[..., 0]  # (1, F, 1)
+    if input == "tilt":
+        foot = muscles.spans_foot.astype(float)
+        immediate = (g[:, 0][:, None] + s1 * g[:, 1][:, None]) * foot          # (M, F, P)
+        delayed = w[:, None, None] * (g[:, 2][:, None] + s1 * g[:, 3][:, None]) * foot * ex[..., 0]
+        b = -(immediate + delayed) @ E                                  # (M, F, N)
+    else:
+        b = np.broadcast_to(-(s1 * s1) * body.gravity_coefficients, (M, f.size, n))
+    theta = np.linalg.solve(D, b[..., None])[..., 0]
+    y = theta @ c
+    return -y if input == "tilt" else y
+
+
+def model_frf(body: Body, muscles: MuscleSet, frequencies, *, input: str = "tilt",
+              output: str = "com_angle", feedback_delay: float = 0.0,
+              proprioceptive_weight: float = 1.0) -> np.ndarray:
+    """The model FRF of one body and muscle set (its own intrinsic and active gains) at
+    ``frequencies`` [Hz]; shape (F,). See :func:`model_frf_batch`."""
+    float_in_range("feedback_delay [s]", feedback_delay, 0.0, 10.0, unit="s")
+    float_in_range("proprioceptive_weight [-]", proprioceptive_weight, 0.0, 1.0)
+    active = muscles.has_active_feedback
+    return model_frf_batch(
+        body, muscles, frequencies, muscles.stiffnesses[None], muscles.viscosities[None],
+        muscles.active_stiffnesses[None] if active else None,
+        muscles.active_viscosities[None] if active else None, feedback_delay,
+        proprioceptive_weight, input=input, output=output)[0]
