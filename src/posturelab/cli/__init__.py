@@ -24,6 +24,8 @@ SUBCOMMANDS: dict[str, str] = {
     "sweep": "sweep",
     "fit": "fit",
     "delay-margin": "delay_margin",
+    "frf": "frf",
+    "frf-model": "frf_model",
 }
 
 

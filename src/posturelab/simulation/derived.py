@@ -92,4 +92,6 @@ def derived_series(setup: RunSetup, time: np.ndarray, state: np.ndarray,
         cog_velocity=centre_of_gravity_velocity(body, theta, omega),
         platform_acceleration=acc, platform_velocity=vel, platform_position=pos,
         angular_acceleration=alpha, ground_reaction=ground, centre_of_pressure=cop,
+        com_angle=theta @ body.gravity_coefficients / body.gravity_coefficients.sum(),
+        tilt=None if setup.tilt is None else setup.tilt.angle(time),
     )

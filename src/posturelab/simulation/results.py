@@ -47,6 +47,10 @@ class DerivedSeries:
         Force of the platform on the foot. [N]
     centre_of_pressure : numpy.ndarray, shape (T,), optional
         Centre of pressure relative to the ankle. [m]
+    com_angle : numpy.ndarray, shape (T,), optional
+        Centre-of-mass angle Σ a_i θ_i / Σ a_i. [rad]
+    tilt : numpy.ndarray, shape (T,), optional
+        The support-surface tilt α, None without one. [rad]
     """
 
     pair_torques: np.ndarray
@@ -60,6 +64,8 @@ class DerivedSeries:
     angular_acceleration: np.ndarray | None = None
     ground_reaction: np.ndarray | None = None
     centre_of_pressure: np.ndarray | None = None
+    com_angle: np.ndarray | None = None
+    tilt: np.ndarray | None = None
 
 
 def _derived(name: str, doc: str) -> property:
@@ -177,6 +183,8 @@ class SimulationResult:
                                "Force of the platform on the foot (F_x, F_y), (T, 2). [N]")
     centre_of_pressure = _derived("centre_of_pressure",
                                   "Centre of pressure relative to the ankle, (T,). [m]")
+    com_angle = _derived("com_angle", "Centre-of-mass angle Σ a_i θ_i / Σ a_i, (T,). [rad]")
+    tilt = _derived("tilt", "Support-surface tilt α (positive toes-up), (T,), or None. [rad]")
 
     @property
     def n_links(self) -> int:
@@ -252,6 +260,9 @@ class SimulationResult:
         if self.centre_of_pressure is not None:
             names += ["cop_x", "ground_fx", "ground_fy"]
             cols += [self.centre_of_pressure[:, None], self.ground_reaction]
+        if self.tilt is not None:  # (a tilt experiment: the columns an FRF is made of)
+            names += ["tilt", "com_angle"]
+            cols += [self.tilt[:, None], self.com_angle[:, None]]
         return names, np.concatenate(cols, axis=1)
 
     def to_csv_text(self) -> str:

@@ -489,6 +489,49 @@ def plot_delay_stability_map(dmap, *, mark=None) -> Figure:
     return fig
 
 
+def plot_bode(estimates, labels=None, model=None) -> Figure:
+    """Gain, phase [deg] and coherence against frequency [Hz] of FRF estimates, with their 95 %
+    bounds as bands, and optionally model curves.
+
+    Parameters
+    ----------
+    estimates : sequence of posturelab.frequency.FRFEstimate
+        One or several conditions.
+    labels : sequence of str, optional
+    model : sequence of (frequency [Hz], complex FRF, label), optional
+        Curves to overlay.
+
+    Returns
+    -------
+    Figure
+    """
+    fig, (ax_g, ax_p, ax_c) = new_figure(3, 1, figsize=(6.5, 7.5), sharex=True)
+    labels = list(labels or [f"condition {i + 1}" for i in range(len(estimates))])
+    for est, label in zip(estimates, labels, strict=True):
+        line, = ax_g.loglog(est.frequency, est.gain, "o-", ms=4, label=label)
+        ok = np.all(np.isfinite(est.gain_ci95), axis=1)
+        if ok.any():
+            ax_g.fill_between(est.frequency[ok], np.maximum(est.gain_ci95[ok, 0], 1e-6),
+                              est.gain_ci95[ok, 1], color=line.get_color(), alpha=0.2)
+            ax_p.fill_between(est.frequency[ok], est.phase_ci95_deg[ok, 0],
+                              est.phase_ci95_deg[ok, 1], color=line.get_color(), alpha=0.2)
+        ax_p.semilogx(est.frequency, est.phase_deg, "o-", ms=4, color=line.get_color())
+        ax_c.semilogx(est.frequency, est.coherence, "o-", ms=4, color=line.get_color())
+    for f, h, label in model or ():
+        f, h = np.asarray(f), np.asarray(h)
+        ax_g.loglog(f, np.abs(h), "k--", lw=1.2, label=label)
+        ax_p.semilogx(f, np.degrees(np.unwrap(np.angle(h))), "k--", lw=1.2)
+    ax_g.set_ylabel("gain")
+    ax_p.set_ylabel("phase [deg]")
+    ax_c.set_ylabel("coherence")
+    ax_c.set_ylim(0, 1.05)
+    ax_c.set_xlabel("frequency [Hz]")
+    ax_g.legend(fontsize=8)
+    for ax in (ax_g, ax_p, ax_c):
+        ax.grid(True, which="both", alpha=0.3)
+    return fig
+
+
 def figure_bytes(fig: Figure, fmt: str = "png", dpi: float = 110) -> bytes:
     """Render ``fig`` to bytes (PNG, SVG, PDF, …) without pyplot.
 

@@ -1,0 +1,111 @@
+"""``posturelab frf``: a frequency response function from a measured (or simulated) trial."""
+
+from __future__ import annotations
+
+import argparse
+
+from ..errors import ParameterError
+from ._common import check_writable, print_json
+
+HELP = "frequency response function of a periodic-stimulus (PRTS) trial, from a CSV"
+
+DESCRIPTION = """\
+Estimate the frequency response function (FRF) of one column to another in a CSV trial with a
+periodic stimulus (a PRTS), as Peterka (2002) did: the record is cut into cycles of
+--cycle-length s (--discard-cycles leading ones dropped), the DFT cross- and auto-spectra are
+averaged over cycles at the stimulus's odd harmonics and then over frequency bands, and the
+FRF is G_xy/G_xx, with the coherence and 95 % bounds on gain and phase.
+
+The file has a header row and a uniform time column [s] (the sample rate comes from it).
+--bands peterka (default) averages Peterka's 11 bands (for a 20 s cycle 0.05 … 2.20 Hz; for
+another cycle length the same harmonic numbers); --bands harmonics gives every odd harmonic.
+
+Sign: a tilt FRF is reported so that a body that follows the surface has gain 1 and phase 0.
+posturelab's angles are positive leaning forward and its tilt positive toes-up, so with
+--response-sign auto (default) a response named com_angle or thetaN against a stimulus named
+tilt is negated; otherwise the ratio is as it is. --response-sign 1 or -1 forces it.
+
+--json prints one object: {"frequency": [Hz], "frf": [{"re", "im"}], "gain", "phase_deg",
+"coherence", "gain_ci95": [[low, high]], "phase_ci95_deg": [[low, high]]}.
+--ci periodic (default) gives bounds exact for a periodic stimulus; --ci otnes-enochson the
+form Peterka used (wider).
+
+Example: posturelab simulate --controller peterka-2002 --tilt prts:0.035 --duration 120 \\
+             --engine compiled --sample-rate 100 --out trial.csv
+         posturelab frf --data trial.csv --stimulus tilt --response com_angle \\
+             --cycle-length 20 --discard-cycles 1 --plot bode.png
+"""
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    """The options of ``posturelab frf``."""
+    p.add_argument("--data", required=True, metavar="FILE.csv", help="the trial.")
+    p.add_argument("--stimulus", required=True, metavar="COLUMN", help="stimulus column.")
+    p.add_argument("--response", required=True, metavar="COLUMN", help="response column.")
+    p.add_argument("--cycle-length", required=True, type=float, metavar="SECONDS",
+                   help="stimulus cycle [s] (20 for Peterka's PRTS).")
+    p.add_argument("--discard-cycles", type=int, default=0, metavar="N",
+                   help="leading cycles to drop (the transient; default 0).")
+    p.add_argument("--bands", choices=["peterka", "harmonics"], default="peterka",
+                   help="frequency bands (default peterka).")
+    p.add_argument("--response-sign", choices=["auto", "1", "-1"], default="auto",
+                   help="multiply the response (default auto: see above).")
+    p.add_argument("--ci", choices=["periodic", "otnes-enochson"], default="periodic",
+                   help="form of the 95 %% bounds (default periodic).")
+    p.add_argument("--json", action="store_true", help="print one JSON object.")
+    p.add_argument("--plot", metavar="BODE.png", help="write a Bode plot (PNG/SVG/PDF).")
+
+
+def response_sign(stimulus: str, response: str, choice: str) -> int:
+    """The sign the response is taken with (``--response-sign``)."""
+    if choice != "auto":
+        return int(choice)
+    angle = response == "com_angle" or (response.startswith("theta") and response[5:].isdigit())
+    return -1 if stimulus == "tilt" and angle else 1
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..frequency.data import read_series_csv
+    from ..frequency.estimate import estimate_frf
+
+    if args.plot:
+        from pathlib import Path
+
+        if Path(args.plot).suffix.lower() not in (".png", ".svg", ".pdf"):
+            raise ParameterError(f"--plot must end in .png, .svg or .pdf, got {args.plot!r}")
+        check_writable([args.plot])
+    stim, resp = args.stimulus.strip().lower(), args.response.strip().lower()
+    fs, cols = read_series_csv(args.data, [stim, resp])
+    sign = response_sign(stim, resp, args.response_sign)
+    x, y = cols[stim], cols[resp]
+    per_cycle = fs * args.cycle_length
+    trimmed = False
+    if per_cycle > 0 and abs(per_cycle - round(per_cycle)) < 1e-6 * per_cycle \
+            and x.size % round(per_cycle) == 1:
+        x, y, trimmed = x[:-1], y[:-1], True  # a record that includes its end point
+    est = estimate_frf(x, y, fs, args.cycle_length,
+                       discard_cycles=args.discard_cycles, bands=args.bands,
+                       response_sign=sign, ci=args.ci)
+    if args.plot:
+        from ..viz.plots import plot_bode, save_figure
+
+        save_figure(plot_bode([est], [f"{resp} / {stim}"]), args.plot)
+    if args.json:
+        print_json(est.to_dict())
+        return 0
+    print(f"FRF of {resp}{' (negated)' if sign < 0 else ''} to {stim}: {est.n_cycles} cycles "
+          f"of {est.cycle_length:g} s at {fs:g} Hz, {len(est.bands)} bands"
+          + (" (the record's end point, one sample past the last cycle, left out)"
+             if trimmed else ""))
+    print(f"{'f [Hz]':>8} {'gain':>10} {'phase [deg]':>12} {'coherence':>10}  gain 95 %")
+    for k in range(est.frequency.size):
+        lo, hi = est.gain_ci95[k]
+        print(f"{est.frequency[k]:8.3f} {est.gain[k]:10.4g} {est.phase_deg[k]:12.1f} "
+              f"{est.coherence[k]:10.3f}  {lo:.4g} … {hi:.4g}")
+    low = est.coherence < 0.5
+    if low.any():
+        print(f"warning: coherence below 0.5 at {int(low.sum())} band(s): those estimates are "
+              "noisy")
+    if args.plot:
+        print(f"wrote {args.plot}")
+    return 0

@@ -1,0 +1,103 @@
+"""``posturelab frf`` and ``posturelab frf-model``: the API's numbers, one-line errors."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+import posturelab as pl
+from posturelab.cli import main
+from posturelab.frequency import estimate_frf, model_frf
+from posturelab.frequency.bands import PETERKA_BAND_FREQUENCIES
+from posturelab.model.controllers import get_controller
+from posturelab.model.tilt import PRTSTilt
+
+KEYS = {"frequency", "frf", "gain", "phase_deg", "coherence", "gain_ci95", "phase_ci95_deg"}
+
+
+def run(capsys, *argv):
+    code = main(list(argv))
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+@pytest.fixture(scope="module")
+def trial(tmp_path_factory):
+    """A simulated PRTS trial written by posturelab simulate (3 cycles of 20 s at 50 Hz)."""
+    path = tmp_path_factory.mktemp("frf") / "trial.csv"
+    assert main(["simulate", "--controller", "peterka-2002", "--tilt", "prts:0.035",
+                 "--duration", "60", "--engine", "compiled", "--sample-rate", "50",
+                 "--out", str(path)]) == 0
+    return path
+
+
+def test_frf_json_is_the_estimate_of_the_simulated_trial(capsys, trial):
+    code, out, err = run(capsys, "frf", "--data", str(trial), "--stimulus", "tilt",
+                         "--response", "com_angle", "--cycle-length", "20",
+                         "--discard-cycles", "1", "--json")
+    assert code == 0, err
+    obj = json.loads(out)
+    assert set(obj) == KEYS and len(obj["frequency"]) == 11
+    body = pl.get_body("paper-1link")
+    preset = get_controller("peterka-2002")
+    r = pl.simulate(body, preset.muscles(body), None, 60.0, tilt=PRTSTilt.peterka_2002(0.035),
+                    engine="compiled", sample_rate=50.0, rtol=1e-8, atol=1e-10,
+                    **preset.run_options())
+    est = estimate_frf(r.tilt[:-1], r.com_angle[:-1], 50.0, 20.0, discard_cycles=1,
+                       response_sign=-1)
+    np.testing.assert_allclose(obj["gain"], est.gain, rtol=1e-9)
+    np.testing.assert_allclose(obj["frequency"], PETERKA_BAND_FREQUENCIES, atol=0.005)
+    # the model explains the noise-free trial closely (band averaging aside)
+    model = model_frf(body, preset.muscles(body), obj["frequency"], **preset.run_options())
+    np.testing.assert_allclose(obj["gain"], np.abs(model), rtol=0.1)
+
+
+def test_frf_model_json_is_model_frf(capsys):
+    code, out, _ = run(capsys, "frf-model", "--controller", "icm-pmc5664365", "--bands",
+                       "peterka", "--json")
+    obj = json.loads(out)
+    assert code == 0 and set(obj) == {"frequency", "frf", "gain", "phase_deg"}
+    body = pl.get_body("paper-1link")
+    preset = get_controller("icm-pmc5664365")
+    H = model_frf(body, preset.muscles(body), obj["frequency"], **preset.run_options())
+    np.testing.assert_allclose([complex(z["re"], z["im"]) for z in obj["frf"]], H, rtol=1e-12)
+    code, out, _ = run(capsys, "frf-model", "--case", "1", "--input", "translation",
+                       "--output", "hip_angle", "--frequencies", "0.1,1,3", "--json")
+    H = model_frf(pl.paper_body(), pl.paper_muscles("1"), [0.1, 1, 3], input="translation",
+                  output="hip_angle")
+    np.testing.assert_allclose(json.loads(out)["gain"], np.abs(H), rtol=1e-12)
+
+
+def write(path, rows, header="time,tilt,com_angle"):
+    path.write_text(header + "\n" + "".join(",".join(map(str, r)) + "\n" for r in rows))
+    return path
+
+
+@pytest.mark.parametrize("case,needle", [
+    ("nonuniform", "the time column is not uniform"),
+    ("not-whole", "not a whole number of cycles"),
+    ("unknown", "has no column 'sway'"),
+    ("nan", "NaN and inf are not allowed"),
+    ("one-cycle", "at least 2 cycles"),
+])
+def test_bad_frf_input_is_one_line_and_exit_2(capsys, tmp_path, case, needle):
+    t = np.arange(0, 40, 0.1)
+    x = np.sin(2 * np.pi * t / 20)
+    rows = [[a, b, 0.5 * b] for a, b in zip(t, x, strict=True)]
+    response, cycle = "com_angle", "20"
+    if case == "nonuniform":
+        rows[10][0] += 0.03
+    elif case == "not-whole":
+        cycle = "15"
+    elif case == "unknown":
+        response = "sway"
+    elif case == "nan":
+        rows[5][2] = "nan"
+    elif case == "one-cycle":
+        rows = rows[:200]
+    path = write(tmp_path / "t.csv", rows)
+    code, out, err = run(capsys, "frf", "--data", str(path), "--stimulus", "tilt",
+                         "--response", response, "--cycle-length", cycle)
+    assert code == 2 and out == "" and err.count("\n") == 1 and needle in err, err
