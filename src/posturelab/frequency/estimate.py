@@ -78,6 +78,11 @@ class FRFEstimate:
         [s]
     cycle_stimulus, cycle_response : numpy.ndarray, shape (L,)
         The time-domain averages over the cycles used (the response with its sign).
+    harmonic_frequency : tuple of numpy.ndarray
+        Per band, the frequencies of its harmonics. [Hz]
+    harmonic_weight : tuple of numpy.ndarray
+        Per band, the stimulus auto-spectrum at them: a noise-free linear system's band FRF
+        is Σ w H(f) / Σ w over them (:meth:`band_average`). [stimulus unit²]
     """
 
     frequency: np.ndarray
@@ -93,6 +98,20 @@ class FRFEstimate:
     cycle_length: float
     cycle_stimulus: np.ndarray = field(repr=False)
     cycle_response: np.ndarray = field(repr=False)
+    harmonic_frequency: tuple = field(default=(), repr=False)
+    harmonic_weight: tuple = field(default=(), repr=False)
+
+    def band_average(self, frf_at) -> np.ndarray:
+        """The band FRF a noise-free linear system with FRF ``frf_at(f)`` [f in Hz, vectorised]
+        would give with this stimulus: Σ w H / Σ w over each band's harmonics."""
+        f = np.concatenate(self.harmonic_frequency)
+        values = np.asarray(frf_at(f))
+        out, start = [], 0
+        for w in self.harmonic_weight:
+            v = values[start:start + w.size]
+            out.append(np.sum(w * v) / np.sum(w))
+            start += w.size
+        return np.array(out)
 
     def to_dict(self) -> dict:
         """The JSON of ``posturelab frf`` (frequency [Hz], FRF as {re, im}, gain, phase [deg],
@@ -247,4 +266,5 @@ def estimate_frf(stimulus, response, sample_rate: float, cycle_length: float, *,
     phase_ci = np.stack([phase - half, phase + half], axis=1)
     return FRFEstimate(band_frequencies(chosen, T), H, gain, phase, coh, gain_ci, phase_ci,
                        averages, chosen, int(n_cycles), T,
-                       np.concatenate(cx).mean(axis=0), np.concatenate(cy).mean(axis=0))
+                       np.concatenate(cx).mean(axis=0), np.concatenate(cy).mean(axis=0),
+                       tuple(b / T for b in bins), tuple(Gxx_h[b] for b in bins))

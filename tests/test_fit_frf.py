@@ -1,0 +1,101 @@
+"""Fitting a controller to FRFs (posturelab.frequency.fit): parameters come back inside their
+95 % intervals at about the nominal rate; bad requests are refused naming the parameter."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import posturelab as pl
+from posturelab.errors import ParameterError
+from posturelab.frequency import estimate_frf, model_frf
+from posturelab.frequency.fit import fit_frf
+from posturelab.model.controllers import get_controller
+from posturelab.model.tilt import PRTSTilt
+
+BODY = pl.get_body("paper-1link")
+PRESET = get_controller("icm-pmc5664365")
+TRUE = PRESET.muscles(BODY)
+TRUTH = {"active_stiffness": TRUE.active_stiffnesses[0],
+         "active_viscosity": TRUE.active_viscosities[0],
+         "feedback_delay": PRESET.feedback_delay,
+         "proprioceptive_weight": PRESET.proprioceptive_weight}
+L, T = 1000, 20.0
+
+
+def steady_cycle(muscles, delay, weight, amplitude=0.035, input="tilt"):
+    """One cycle of Peterka's PRTS and the model's periodic steady response (the sway in the
+    surface's sense), through the exact FRF at every harmonic."""
+    x = PRTSTilt.peterka_2002(amplitude).angle(np.arange(L) * T / L)
+    X = np.fft.rfft(x)
+    f = np.arange(X.size) / T
+    H = np.zeros(X.size, complex)
+    H[1:] = model_frf(BODY, muscles, f[1:], feedback_delay=delay, proprioceptive_weight=weight,
+                      input=input)
+    return x, np.fft.irfft(H * X, L)
+
+
+def test_fits_recover_the_parameters_inside_their_intervals(rng):
+    """40 seeded experiments (6 cycles, white sensor noise in the sway, coherence 0.2–1),
+    four parameters fitted from 20 % off: the truth lies inside the 95 % interval in at least
+    90 % of the 160 parameter estimates (measured 95 %), and every fit is determined."""
+    x1, y1 = steady_cycle(TRUE, PRESET.feedback_delay, PRESET.proprioceptive_weight)
+    start = TRUE.with_active_feedback([0.8 * TRUTH["active_stiffness"]],
+                                      [1.2 * TRUTH["active_viscosity"]])
+    inside = total = 0
+    for _ in range(40):
+        y = np.tile(y1, 6) + rng.normal(0.0, 0.002, 6 * L)
+        est = estimate_frf(np.tile(x1, 6), y, L / T, T)
+        fit = fit_frf(BODY, start, est, list(TRUTH), feedback_delay=0.12,
+                      proprioceptive_weight=0.6)
+        assert fit.success and fit.determined.all()
+        for (lo, hi), true in zip(fit.confidence_intervals, TRUTH.values(), strict=True):
+            inside += int(lo <= true <= hi)
+            total += 1
+    assert inside / total >= 0.9, inside / total
+
+
+def test_shared_and_per_condition_parameters():
+    """Two tilt amplitudes with different weights W (Peterka's re-weighting): the gains and
+    delay are shared, W per condition; noise-free, everything comes back to 1e-6."""
+    conditions = []
+    for w in (0.9, 0.5):
+        x1, y1 = steady_cycle(TRUE, PRESET.feedback_delay, w)
+        conditions.append(estimate_frf(np.tile(x1, 3), np.tile(y1, 3), L / T, T))
+    start = TRUE.with_active_feedback([700.0], [250.0])
+    fit = fit_frf(BODY, start, conditions, ["active_stiffness", "active_viscosity",
+                                            "feedback_delay"],
+                  per_condition=["proprioceptive_weight"], feedback_delay=0.12,
+                  proprioceptive_weight=0.7)
+    assert fit.names == ("active_stiffness", "active_viscosity", "feedback_delay",
+                         "proprioceptive_weight#1", "proprioceptive_weight#2")
+    np.testing.assert_allclose(fit.estimates, [TRUTH["active_stiffness"],
+                                               TRUTH["active_viscosity"],
+                                               PRESET.feedback_delay, 0.9, 0.5], rtol=1e-6)
+
+
+def test_a_parameter_the_data_cannot_determine_is_reported():
+    """A translation FRF of the CoM does not see W at all (a PRTS translation of the
+    platform, 3.5 cm peak to peak)."""
+    x1, y1 = steady_cycle(TRUE, PRESET.feedback_delay, PRESET.proprioceptive_weight,
+                          input="translation")
+    est = estimate_frf(np.tile(x1, 3), np.tile(y1, 3) + 1e-6 * np.sin(np.arange(3 * L)), L / T, T)
+    fit = fit_frf(BODY, TRUE.with_active_feedback([800.0], TRUE.active_viscosities), est,
+                  ["active_stiffness", "proprioceptive_weight"], input="translation",
+                  feedback_delay=PRESET.feedback_delay)
+    assert fit.determined.tolist() == [True, False]
+    assert fit.estimates[0] == pytest.approx(TRUTH["active_stiffness"], rel=1e-3)
+    assert np.isinf(fit.standard_errors[1])
+
+
+@pytest.mark.parametrize("kwargs,needle", [
+    (dict(free=["elbow"]), "unknown FRF fit parameter 'elbow'"),
+    (dict(free=["stiffness:knee"]), "unknown pair 'knee'"),
+    (dict(free=[]), "at least one parameter"),
+    (dict(free=["feedback_delay"], per_condition=["feedback_delay"]), "both shared"),
+])
+def test_bad_fit_requests(kwargs, needle):
+    x1, y1 = steady_cycle(TRUE, PRESET.feedback_delay, PRESET.proprioceptive_weight)
+    est = estimate_frf(np.tile(x1, 3), np.tile(y1, 3), L / T, T)
+    with pytest.raises(ParameterError, match=needle):
+        fit_frf(BODY, TRUE, est, **kwargs)
