@@ -101,3 +101,48 @@ def test_bad_frf_input_is_one_line_and_exit_2(capsys, tmp_path, case, needle):
     code, out, err = run(capsys, "frf", "--data", str(path), "--stimulus", "tilt",
                          "--response", response, "--cycle-length", cycle)
     assert code == 2 and out == "" and err.count("\n") == 1 and needle in err, err
+
+
+def test_fit_frf_recovers_the_preset_from_a_simulated_trial(capsys, trial, tmp_path):
+    """From the trial CSV, and from its FRF JSON, the active gains and the delay of the
+    simulated preset come back within 1 % (starting 20–40 % off)."""
+    start = ["--body", "paper-1link", "--stiffness", "0", "--viscosity", "0",
+             "--active-stiffness", "600", "--active-viscosity", "200", "--feedback-delay",
+             "0.12"]
+    code, out, err = run(capsys, "fit-frf", "--data", str(trial), "--stimulus", "tilt",
+                         "--response", "com_angle", "--cycle-length", "20",
+                         "--discard-cycles", "1", *start, "--free",
+                         "active_stiffness,active_viscosity,feedback_delay", "--json")
+    assert code == 0, err
+    got = {p["name"]: p["estimate"] for p in json.loads(out)["parameters"]}
+    mgh = pl.get_body("paper-1link").load_stiffness
+    assert got["active_stiffness"] == pytest.approx(1.35 * mgh, rel=0.01)
+    assert got["active_viscosity"] == pytest.approx(0.47 * mgh, rel=0.01)
+    assert got["feedback_delay"] == pytest.approx(0.15, rel=0.01)
+    frf_json = tmp_path / "frf.json"
+    frf_json.write_text(_frf_json(trial))
+    code, out, err = run(capsys, "fit-frf", "--data", str(frf_json), *start, "--free",
+                         "active_stiffness,feedback_delay")
+    assert code == 0, err
+    assert "active_stiffness" in out and "feedback_delay" in out
+
+
+def _frf_json(trial) -> str:
+    import contextlib
+    import io
+
+    buf = io.StringIO()
+    with contextlib.redirect_stdout(buf):
+        main(["frf", "--data", str(trial), "--stimulus", "tilt", "--response", "com_angle",
+              "--cycle-length", "20", "--discard-cycles", "1", "--json"])
+    return buf.getvalue()
+
+
+def test_bad_fit_frf_requests_are_one_line(capsys, trial):
+    code, out, err = run(capsys, "fit-frf", "--data", str(trial), "--free", "active_stiffness",
+                         "--controller", "peterka-2002")
+    assert code == 2 and "needs --stimulus, --response and --cycle-length" in err
+    code, out, err = run(capsys, "fit-frf", "--data", str(trial), "--stimulus", "tilt",
+                         "--response", "com_angle", "--cycle-length", "20",
+                         "--controller", "peterka-2002", "--free", "elbow")
+    assert code == 2 and err.count("\n") == 1 and "unknown FRF fit parameter 'elbow'" in err

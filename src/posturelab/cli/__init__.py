@@ -26,6 +26,7 @@ SUBCOMMANDS: dict[str, str] = {
     "delay-margin": "delay_margin",
     "frf": "frf",
     "frf-model": "frf_model",
+    "fit-frf": "fit_frf",
 }
 
 
