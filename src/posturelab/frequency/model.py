@@ -110,6 +110,20 @@ def model_frf_batch(body: Body, muscles: MuscleSet, frequencies, stiffness, visc
     if np.any((w < 0) | (w > 1)):
         raise ParameterError("proprioceptive_weight [-] must be in [0, 1]")
     g = feedback_gains(k, viscosity, active_stiffness, active_viscosity, np.ones(M))
+    if M > _CHUNK:  # bound the memory of one evaluation
+        return np.concatenate([
+            _frf(body, muscles, f, g[lo:lo + _CHUNK], tau[lo:lo + _CHUNK], w[lo:lo + _CHUNK],
+                 input, c) for lo in range(0, M, _CHUNK)])
+    return _frf(body, muscles, f, g, tau, w, input, c)
+
+
+#: Parameter sets per evaluation of :func:`_frf`. [-]
+_CHUNK = 32_768
+
+
+def _frf(body, muscles, f, g, tau, w, input, c) -> np.ndarray:
+    """The FRFs of the gain rows ``g`` (M, 4, P) (module notes), shape (M, F)."""
+    M = g.shape[0]
     E = muscles.selection_matrix
     n = body.n_links
 
@@ -130,7 +144,10 @@ def model_frf_batch(body: Body, muscles: MuscleSet, frequencies, stiffness, visc
         b = -(immediate + delayed) @ E                                  # (M, F, N)
     else:
         b = np.broadcast_to(-(s1 * s1) * body.gravity_coefficients, (M, f.size, n))
-    theta = np.linalg.solve(D, b[..., None])[..., 0]
+    if n == 1:  # a scalar equation: no solve
+        theta = b / D[..., 0]
+    else:
+        theta = np.linalg.solve(D, b[..., None])[..., 0]
     y = theta @ c
     return -y if input == "tilt" else y
 
