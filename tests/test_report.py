@@ -310,3 +310,20 @@ def test_literature_controller_and_strategy_findings_state_their_numbers():
     st = strategy_finding(pl.paper_body(), pl.FOOT_FROM_LITERATURE)
     assert st.first_fall is not None and st.largest_hip_fraction <= st.linear_hip_fraction + 1e-3
     assert f"at most {st.largest_hip_fraction:.3f}" in st.text
+
+
+def test_frf_finding_states_its_numbers():
+    """The report's FRF finding: model FRFs as posturelab.frequency computes them, and a
+    simulated PRTS experiment whose fit lands within 0.5 % of the truth."""
+    import numpy as np
+
+    import posturelab as pl
+    from posturelab.frequency import model_frf
+    from posturelab.paper.checks import frf_finding
+
+    f = frf_finding()
+    paper = model_frf(pl.paper_body(), pl.paper_muscles("1"), list(f.frequency))
+    np.testing.assert_allclose(f.paper_gain, np.abs(paper), rtol=1e-12)
+    np.testing.assert_allclose(f.fitted, f.true, rtol=5e-3)
+    assert f.delayed_phase[-1] < -180 < f.paper_phase[-1]
+    assert f"{f.paper_gain[0]:.2f} ({f.paper_phase[0]:.0f}°)" in f.text

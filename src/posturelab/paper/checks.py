@@ -31,6 +31,7 @@ from .findings import (
     DelayFinding,
     FootExcursion,
     FootFinding,
+    FRFFinding,
     LiteratureControllerFinding,
     OneSidedFinding,
     Outcome,
@@ -54,7 +55,7 @@ __all__ = [
     "check_fig3", "check_fig4", "check_fig5_6", "check_fig7", "check_fig8", "check_fig9",
     "check_fig10", "erratum_notes", "one_sided_finding", "foot_finding",
     "ramp_and_hold_run", "recovery_finding", "delayed_run", "delay_finding",
-    "with_delay_margin", "literature_controller_finding", "strategy_finding",
+    "with_delay_margin", "literature_controller_finding", "strategy_finding", "frf_finding",
 ]
 
 #: |θ_i| below this counts as back upright (the settling criterion). [rad]
@@ -660,3 +661,43 @@ def strategy_finding(body: Body, foot: BaseOfSupport, ankle_torque_limit: float 
     return StrategyFinding(ankle_torque_limit, float(free.hip_fraction.mean()),
                            float(kept.max()) if kept.size else float("nan"), first_fall,
                            RECOVERY_RAMP_DURATION)
+
+
+def frf_finding(seed: int = 20261201) -> FRFFinding:
+    """The tilt FRFs of case 1 and of ``peterka-2002`` on ``paper-1link`` at 0.05, 0.55 and
+    2.2 Hz, and a simulated PRTS experiment (compiled engine, 6 cycles at 100 Hz, the first
+    discarded, seeded sensor noise) fitted for K_P, K_D and τ from 20 % off."""
+    from ..frequency import estimate_frf, model_frf
+    from ..frequency.fit import fit_frf
+    from ..model.body import get_body, paper_body
+    from ..model.controllers import get_controller
+    from ..model.tilt import PRTSTilt
+    from ..simulation import simulate
+
+    f = np.array([0.05, 0.55, 2.2])
+    paper = model_frf(paper_body(), paper_muscles("1"), f)
+    body = get_body("paper-1link")
+    preset = get_controller("peterka-2002")
+    muscles = preset.muscles(body)
+    delayed = model_frf(body, muscles, f, **preset.run_options())
+    cycles, noise, fs = 5, 0.001, 100.0
+    tilt = PRTSTilt.peterka_2002(0.035)
+    r = simulate(body, muscles, None, 20.0 * (cycles + 1), tilt=tilt, sample_rate=fs,
+                 engine="compiled", **preset.run_options())
+    rng = np.random.default_rng(seed)
+    sway = r.theta[:-1, 0] + rng.normal(0.0, noise, r.time.size - 1)
+    est = estimate_frf(tilt.angle(r.time[:-1]), sway, fs, 20.0, discard_cycles=1,
+                       response_sign=-1)
+    true = (muscles.active_stiffnesses[0], muscles.active_viscosities[0], preset.feedback_delay)
+    start = muscles.with_active_feedback([0.8 * true[0]], [1.2 * true[1]])
+    fit = fit_frf(body, start, est, ["active_stiffness", "active_viscosity", "feedback_delay"],
+                  feedback_delay=0.8 * true[2])
+
+    def phase(h):
+        return tuple(float(p) for p in np.degrees(np.unwrap(np.angle(h))))
+
+    return FRFFinding(tuple(float(v) for v in f), tuple(float(v) for v in np.abs(paper)),
+                      phase(paper), tuple(float(v) for v in np.abs(delayed)), phase(delayed),
+                      tuple(float(v) for v in true), tuple(float(v) for v in fit.estimates),
+                      tuple(float(v) for v in fit.standard_errors), cycles, noise,
+                      float(fit.fit_error))

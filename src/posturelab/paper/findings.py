@@ -16,7 +16,8 @@ from ..simulation.results import SimulationResult
 
 __all__ = ["Outcome", "FootExcursion", "OneSidedFinding", "FOOT_RUN_LABELS", "FootFinding",
            "RecoveryFinding", "DelayFinding", "LiteratureControllerFinding", "StrategyFinding",
-           "HUMAN_RECOVERY_CITATION", "HUMAN_RECOVERY_YOUNG", "HUMAN_RECOVERY_OLDER"]
+           "HUMAN_RECOVERY_CITATION", "HUMAN_RECOVERY_YOUNG", "HUMAN_RECOVERY_OLDER",
+           "FRFFinding"]
 
 #: Largest backward platform displacement recovered without stepping (PMC6338353): young
 #: adults (20–30 years, n = 5) and community-dwelling older adults (70–80, n = 6), mean and
@@ -401,4 +402,70 @@ class StrategyFinding:
             f"small unlimited runs{fall}. Impedance alone does not switch strategy: the hip "
             "pairs only resist the trunk's motion. A hip strategy, which people show at the "
             "faster backward translations (Runge et al. 1999), needs active hip control."
+        )
+
+
+@dataclass(frozen=True)
+class FRFFinding:
+    """The independent-channel model's tilt FRF beside the paper's instantaneous model, and a
+    simulated PRTS experiment recovered by the fit.
+
+    Attributes
+    ----------
+    frequency : tuple of float
+        Band frequencies shown. [Hz]
+    paper_gain, paper_phase : tuple of float
+        Tilt FRF of the paper's case 1 (three links, W = 1). [-], [deg]
+    delayed_gain, delayed_phase : tuple of float
+        Tilt FRF of the ``peterka-2002`` preset on ``paper-1link``. [-], [deg]
+    true, fitted, standard_error : tuple of float
+        K_P [N·m/rad], K_D [N·m·s/rad], τ [s] of the simulated experiment and their fit.
+    cycles : int
+        PRTS cycles used (20 s each, one more discarded). [-]
+    noise : float
+        Standard deviation of the white sensor noise added to the sway. [rad]
+    """
+
+    frequency: tuple
+    paper_gain: tuple
+    paper_phase: tuple
+    delayed_gain: tuple
+    delayed_phase: tuple
+    true: tuple
+    fitted: tuple
+    standard_error: tuple
+    cycles: int
+    noise: float
+    fit_error: float = float("nan")
+
+    @property
+    def text(self) -> str:
+        """The finding in words, with its numbers."""
+        def row(gain, phase):
+            return ", ".join(f"{g:.2f} ({p:.0f}°)" for g, p in zip(gain, phase, strict=True))
+
+        freqs = ", ".join(f"{f:g}" for f in self.frequency)
+        names = ("K_P", "K_D", "τ")
+        units = ("N·m/rad", "N·m·s/rad", "s")
+        fit = "; ".join(f"{n} {f:.4g} ± {s:.2g} {u} (true {t:.4g})" for n, f, s, u, t in zip(
+            names, self.fitted, self.standard_error, units, self.true, strict=True))
+        paper = row(self.paper_gain, self.paper_phase)
+        delayed = row(self.delayed_gain, self.delayed_phase)
+        return (
+            "Frequency response to surface tilt (posturelab.frequency; a body that follows the "
+            f"surface has gain 1, phase 0). At {freqs} Hz the paper's case 1, whose impedance "
+            f"acts at once and relative to the foot, has gain (phase) {paper}; the "
+            "independent-channel controller of Peterka 2002 (peterka-2002, 150 ms delay) on "
+            f"the same body as one link has {delayed}. Both over-follow the surface at low "
+            "frequency (a stiffness relative to the foot only a little above mgh), but only the "
+            "delayed controller's phase keeps falling past −180° with frequency, the shape "
+            "people's FRFs have; the paper's instantaneous impedance stays near −90°. A "
+            "simulated PRTS "
+            f"experiment with it ({self.cycles} cycles of Peterka's 80-state sequence, "
+            f"{self.noise * 1000:.1f} mrad of white sensor noise on the sway, seeded) gives, "
+            f"fitted to its 11-band FRF: {fit}; fit error {self.fit_error:.2g} (the weighted "
+            "RMS residual). Each estimate is within 0.5 % of the truth; the few-SE offsets of "
+            "K_P are the sway's small nonlinearity at this amplitude, which the linear FRF "
+            "leaves out (noise-free, it is 0.04 % at 0.035 rad and vanishes at 0.0035 rad), a "
+            "bias that noise-based intervals do not include."
         )

@@ -77,9 +77,9 @@ ProgressCallback = Callable[[int, int, str], None]
 #: The report page's template, in ``templates/`` beside this module.
 TEMPLATE = "report.html.j2"
 
-#: Steps :func:`reproduce_paper` reports: Table II, the runs, the figures, the three searches,
+#: Steps :func:`reproduce_paper` reports: Table II, the runs, the figures, the four searches,
 #: the writing. [-]
-_TOTAL_STEPS = 1 + RUN_STEPS + len(_figures.FIGURE_STEPS) + 3 + 1
+_TOTAL_STEPS = 1 + RUN_STEPS + len(_figures.FIGURE_STEPS) + 4 + 1
 
 
 @dataclass(frozen=True)
@@ -400,6 +400,8 @@ def _build(tmp: Path, progress: ProgressCallback | None) -> tuple[PaperChecks, l
     tick("a delayed controller from the literature, and the hip strategy (beyond the paper)")
     findings.append(_checks.literature_controller_finding(runs.foot))
     findings.append(_checks.strategy_finding(body, runs.foot))
+    tick("frequency responses to tilt, and a simulated PRTS experiment fitted (beyond the paper)")
+    findings.append(_checks.frf_finding())
 
     tick("write table2.csv and index.html")
     paper = PaperChecks(body, table2, sensitivity, figure_checks, tuple(findings),
