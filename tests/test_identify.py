@@ -113,3 +113,32 @@ def test_cli_fit_bad_input_one_line(tmp_path, capsys):
                  "--free", "ankle"])
     err = capsys.readouterr().err
     assert code == 2 and "theta3" in err and len(err.strip().splitlines()) == 1
+
+
+def test_the_time_domain_fit_learns_delay_active_gain_and_weight(rng):
+    """A tilted one-link run with intrinsic and delayed active gains, seeded noise on the
+    angle: the active stiffness, the delay and W come back inside their 95 % intervals."""
+    import posturelab as pl
+    from posturelab.model.controllers import get_controller
+    from posturelab.model.tilt import SineTilt
+    from posturelab.scenarios import Scenario
+    from posturelab.studies.identification import fit_stiffness
+
+    body = pl.get_body("paper-1link")
+    preset = get_controller("icm-pmc5664365")
+    true = preset.muscles(body)
+    sc = Scenario(name="t", description="", source="test", body=body, muscles=true,
+                  disturbance=pl.NoDisturbance(), duration=12.0, initial_state=None,
+                  rates_from="upright", knee=pl.KneeModel(), fall=pl.FallCriteria(1.5),
+                  sample_rate=50.0, tilt=SineTilt(0.03, 0.4), feedback_delay=0.097,
+                  proprioceptive_weight=0.8)
+    r = sc.run(engine="compiled")
+    theta = r.theta + rng.normal(0.0, 2e-4, r.theta.shape)
+    start = sc.replace(muscles=true.with_active_feedback([700.0], true.active_viscosities),
+                       feedback_delay=0.12, proprioceptive_weight=0.6)
+    fit = fit_stiffness(start, r.time, theta, ["active_ankle", "feedback_delay",
+                                               "proprioceptive_weight"],
+                        viscosity_ratio=true.viscosities[0] / true.stiffnesses[0])
+    truth = [true.active_stiffnesses[0], 0.097, 0.8]
+    for (lo, hi), value in zip(fit.confidence_intervals, truth, strict=True):
+        assert lo <= value <= hi, (fit.estimates, truth)

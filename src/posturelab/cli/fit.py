@@ -61,7 +61,9 @@ def run(args: argparse.Namespace) -> int:
           f"{fit.n_simulations} simulations; residual RMS {fit.residual_rms:.3g} rad")
     for name, e, se, (lo, hi) in zip(fit.parameter_names, fit.estimates, fit.standard_errors,
                                      fit.confidence_intervals, strict=True):
-        unit = "s" if name == VISCOSITY_RATIO else "N·m/rad"
+        unit = ("s" if name in (VISCOSITY_RATIO, "feedback_delay") else "-"
+                if name == "proprioceptive_weight" else "N·m·s/rad"
+                if name.startswith("active_viscosity_") else "N·m/rad")
         print(f"  {name:<16} {e:10.4g} ± {se:.3g} {unit}   (95 % CI {lo:.4g} … {hi:.4g})")
     if not fit.success:
         print(f"warning: the optimiser did not converge: {fit.message}")

@@ -138,8 +138,10 @@ def fit_stiffness(
     theta : array_like, shape (S, N)
         Measured link angles. [rad]
     free : sequence of str
-        Pair names whose stiffness is fitted, and optionally
-        ``"viscosity_ratio"``.
+        Pair names whose stiffness (intrinsic, with active gains) is fitted, and
+        optionally ``"viscosity_ratio"``, ``"feedback_delay"`` [s],
+        ``"proprioceptive_weight"`` [-], ``"active_<pair>"`` [N·m/rad] and
+        ``"active_viscosity_<pair>"`` [N·m·s/rad].
     viscosity_ratio : float
         Viscosity / stiffness for every pair when the ratio is not fitted,
         and its starting value when it is. [s]
@@ -166,7 +168,9 @@ def fit_stiffness(
     names = list(free)
     if not names:
         raise ParameterError("free must name at least one pair or 'viscosity_ratio'")
-    known = scenario.muscles.names + [VISCOSITY_RATIO]
+    pairs = scenario.muscles.names
+    known = pairs + [VISCOSITY_RATIO, "feedback_delay", "proprioceptive_weight",
+                     *(f"active_{p}" for p in pairs), *(f"active_viscosity_{p}" for p in pairs)]
     for name in names:
         if name not in known:
             raise UnknownNameError(f"unknown parameter {name!r}; known: {', '.join(known)}")
@@ -184,24 +188,38 @@ def fit_stiffness(
             f"time [s] must lie within [0, duration={scenario.duration:g}], got "
             f"[{t[0]:g}, {t[-1]:g}]"
         )
-    current = dict(zip(scenario.muscles.names, scenario.muscles.stiffnesses, strict=True))
+    m0 = scenario.muscles
+    current = {**dict(zip(pairs, m0.stiffnesses, strict=True)),
+               **{f"active_{p}": v for p, v in zip(pairs, m0.active_stiffnesses, strict=True)},
+               **{f"active_viscosity_{p}": v
+                  for p, v in zip(pairs, m0.active_viscosities, strict=True)}}
+    special = {VISCOSITY_RATIO: (viscosity_ratio, 5.0),
+               "feedback_delay": (scenario.feedback_delay or 0.1, 1.0),
+               "proprioceptive_weight": (scenario.proprioceptive_weight, 1.0)}
     if initial_guess is None:
-        x0 = [viscosity_ratio if nm == VISCOSITY_RATIO else (current[nm] or 500.0)
-              for nm in names]
+        x0 = [special[nm][0] if nm in special else (current[nm] or 500.0) for nm in names]
     else:
         x0 = list(finite_array("initial_guess", initial_guess, (len(names),)))
     lower = np.zeros(len(names))
-    upper = np.array([5.0 if nm == VISCOSITY_RATIO else upper_bound for nm in names])
+    upper = np.array([special[nm][1] if nm in special else upper_bound for nm in names])
     x0 = np.clip(np.asarray(x0, dtype=float), lower + 1e-9, upper)
     sc = scenario.replace(duration=float(t[-1]) if t[-1] > 0 else scenario.duration)
     count = [0]
 
     def run(params: np.ndarray) -> SimulationResult:
         count[0] += 1
-        stiff = {nm: v for nm, v in zip(names, params, strict=True) if nm != VISCOSITY_RATIO}
-        ratio = (params[names.index(VISCOSITY_RATIO)] if VISCOSITY_RATIO in names
-                 else viscosity_ratio)
-        return sc.run(engine=engine, muscles=_muscles_with(scenario.muscles, stiff, ratio))
+        value = dict(zip(names, params, strict=True))
+        stiff = {nm: v for nm, v in value.items() if nm in pairs}
+        ratio = value.get(VISCOSITY_RATIO, viscosity_ratio)
+        muscles = _muscles_with(scenario.muscles, stiff, ratio)
+        if any(nm.startswith("active_") for nm in names):
+            ka = [value.get(f"active_{p}", current[f"active_{p}"]) for p in pairs]
+            va = [value.get(f"active_viscosity_{p}", current[f"active_viscosity_{p}"])
+                  for p in pairs]
+            muscles = muscles.with_active_feedback(ka, va)
+        options = {k: value[k] for k in ("feedback_delay", "proprioceptive_weight")
+                   if k in value}
+        return sc.run(engine=engine, muscles=muscles, **options)
 
     def residuals(params: np.ndarray) -> np.ndarray:
         r = run(params)
