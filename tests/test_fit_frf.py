@@ -99,3 +99,23 @@ def test_bad_fit_requests(kwargs, needle):
     est = estimate_frf(np.tile(x1, 3), np.tile(y1, 3), L / T, T)
     with pytest.raises(ParameterError, match=needle):
         fit_frf(BODY, TRUE, est, **kwargs)
+
+
+def test_a_seeded_in_silico_prts_experiment_and_its_fit():
+    """simulate → seeded sensor noise → estimate → fit: the same seed gives the same FRF,
+    the fit comes back within 1 % (the remaining bias is the sway's nonlinearity)."""
+    from posturelab.frequency.experiment import prts_experiment
+
+    preset = get_controller("peterka-2002")
+    muscles = preset.muscles(BODY)
+    a = prts_experiment(BODY, muscles, sensor_noise=1e-3, seed=3, **preset.run_options())
+    b = prts_experiment(BODY, muscles, sensor_noise=1e-3, seed=3, **preset.run_options())
+    np.testing.assert_array_equal(a.estimate.frf, b.estimate.frf)
+    assert a.estimate.n_cycles == 5 and not a.fell
+    start = muscles.with_active_feedback([600.0], [200.0])
+    fit = fit_frf(BODY, start, a.estimate, ["active_stiffness", "active_viscosity",
+                                            "feedback_delay"], feedback_delay=0.12)
+    true = [muscles.active_stiffnesses[0], muscles.active_viscosities[0], 0.15]
+    np.testing.assert_allclose(fit.estimates, true, rtol=0.01)
+    with pytest.raises(ParameterError, match="cycles must be an integer >= 2"):
+        prts_experiment(BODY, muscles, cycles=1)

@@ -1,0 +1,103 @@
+"""A PRTS identification experiment in silico: simulate, add seeded sensor noise, estimate.
+
+:func:`prts_experiment` applies a periodic tilt (by default Peterka's 80-state PRTS) to the
+nonlinear model on the compiled engine for ``discard + cycles`` cycles, adds white sensor
+noise of a given standard deviation [rad] to the measured angle (seeded), and estimates the
+FRF of that angle to the tilt in the literature's sign (:func:`posturelab.frequency.
+estimate_frf`). Motor noise (a random torque) is not modelled yet.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import ParameterError
+from .estimate import FRFEstimate, estimate_frf
+
+__all__ = ["PRTSExperiment", "prts_experiment"]
+
+
+@dataclass(frozen=True)
+class PRTSExperiment:
+    """What :func:`prts_experiment` measured.
+
+    Attributes
+    ----------
+    estimate : FRFEstimate
+    time : numpy.ndarray, shape (S,)
+        [s]
+    stimulus : numpy.ndarray, shape (S,)
+        The tilt α. [rad]
+    response : numpy.ndarray, shape (S,)
+        The measured angle, noise included (posturelab's sign: forward positive). [rad]
+    fell : bool
+        The body fell: the record is not usable (``estimate`` is then None).
+    """
+
+    estimate: FRFEstimate | None
+    time: np.ndarray
+    stimulus: np.ndarray
+    response: np.ndarray
+    fell: bool
+
+
+def prts_experiment(body, muscles, *, tilt=None, cycles: int = 5, discard: int = 1,
+                    sensor_noise: float = 0.0, seed: int = 0, sample_rate: float = 100.0,
+                    output: str = "com_angle", bands="peterka", **run_options
+                    ) -> PRTSExperiment:
+    """Run one seeded PRTS experiment (module notes).
+
+    Parameters
+    ----------
+    body, muscles
+        The model.
+    tilt : PRTSTilt, optional
+        Default: Peterka's 80-state sequence, 0.035 rad peak to peak.
+    cycles, discard : int
+        Cycles analysed, and cycles run before them (dropped). [-]
+    sensor_noise : float
+        Standard deviation of the white noise on the measured angle, >= 0. [rad]
+    seed : int
+        Of the noise generator.
+    sample_rate : float
+        [Hz]
+    output : {"com_angle", "thetaN"}
+        The angle measured.
+    bands
+        As for :func:`posturelab.frequency.estimate_frf`.
+    **run_options
+        For :func:`posturelab.simulate` (``feedback_delay``, ``proprioceptive_weight``, …).
+    """
+    from ..model.tilt import PRTSTilt
+    from ..simulation.engines import simulate
+
+    tilt = PRTSTilt.peterka_2002(0.035) if tilt is None else tilt
+    if not isinstance(tilt, PRTSTilt):
+        raise ParameterError("tilt must be a PRTSTilt (a periodic stimulus)")
+    for name, value, least in (("cycles", cycles, 2), ("discard", discard, 0)):
+        if isinstance(value, bool) or not isinstance(value, int) or value < least:
+            raise ParameterError(f"{name} must be an integer >= {least}, got {value!r}")
+    if not (np.isfinite(sensor_noise) and sensor_noise >= 0):
+        raise ParameterError(f"sensor_noise [rad] must be >= 0, got {sensor_noise!r}")
+    total = tilt.cycle * (cycles + discard)
+    r = simulate(body, muscles, None, total, tilt=tilt, sample_rate=sample_rate,
+                 engine="compiled", **run_options)
+    t = r.time[:-1] if r.time.size > 1 else r.time
+    if output == "com_angle":
+        angle = r.com_angle
+    elif output.startswith("theta") and output[5:].isdigit() \
+            and 1 <= int(output[5:]) <= body.n_links:
+        angle = r.theta[:, int(output[5:]) - 1]
+    else:
+        raise ParameterError(f"output must be com_angle or theta1 … theta{body.n_links}, got "
+                             f"{output!r}")
+    rng = np.random.default_rng(seed)
+    measured = angle[:t.size] + rng.normal(0.0, sensor_noise, t.size)
+    stimulus = tilt.angle(t)
+    if r.fell:
+        return PRTSExperiment(None, t, stimulus, measured, True)
+    est = estimate_frf(stimulus, measured, sample_rate, tilt.cycle, discard_cycles=discard,
+                       bands=bands, response_sign=-1)
+    return PRTSExperiment(est, t, stimulus, measured, False)
