@@ -146,3 +146,32 @@ def test_bad_fit_frf_requests_are_one_line(capsys, trial):
                          "--response", "com_angle", "--cycle-length", "20",
                          "--controller", "peterka-2002", "--free", "elbow")
     assert code == 2 and err.count("\n") == 1 and "unknown FRF fit parameter 'elbow'" in err
+
+
+def test_the_text_tables_print_the_json_numbers(capsys, trial):
+    """The text of frf and frf-model shows, band by band, the numbers their JSON gives."""
+    argv = ["frf", "--data", str(trial), "--stimulus", "tilt", "--response", "com_angle",
+            "--cycle-length", "20", "--discard-cycles", "1"]
+    _, text, _ = run(capsys, *argv)
+    _, out, _ = run(capsys, *argv, "--json")
+    obj = json.loads(out)
+    rows = [line.split() for line in text.splitlines()[2:13]]
+    for row, f, g, p, c in zip(rows, obj["frequency"], obj["gain"], obj["phase_deg"],
+                               obj["coherence"], strict=True):
+        assert row[:4] == [f"{f:.3f}", f"{g:.4g}", f"{p:.1f}", f"{c:.3f}"]
+    argv = ["frf-model", "--controller", "peterka-2002", "--bands", "peterka"]
+    _, text, _ = run(capsys, *argv)
+    _, out, _ = run(capsys, *argv, "--json")
+    obj = json.loads(out)
+    rows = [line.split() for line in text.splitlines()[2:]]
+    assert [r[1] for r in rows] == [f"{g:.4g}" for g in obj["gain"]]
+    assert [r[2] for r in rows] == [f"{p:.1f}" for p in obj["phase_deg"]]
+
+
+def test_simulate_prints_the_hip_fraction_of_its_json(capsys):
+    argv = ["simulate", "--case", "1", "--disturbance", "backward", "--duration", "2",
+            "--engine", "compiled"]
+    _, text, _ = run(capsys, *argv)
+    _, out, _ = run(capsys, *argv, "--json")
+    assert f"hip fraction (anti-phase leg–trunk mode): {json.loads(out)['hip_fraction']:.3f}" \
+        in text

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import io
 import math
 
 from ..errors import ParameterError
@@ -33,7 +34,7 @@ def run_delay_map(args: argparse.Namespace) -> int:
     from ..linear.delay_batch import delay_stability_map
     from ..simulation.results import atomic_write_text
     from ..viz.plots import plot_delay_stability_map, save_figure
-    from .stability_map import output_paths, parse_resolution
+    from .stability_map import output_paths, parse_resolution, parse_viscosity_ratio
 
     axes = {name: (low, high) for name, low, high in
             (_axis(a, f) for a, f in ((args.x, "--x"), (args.y, "--y")))}
@@ -51,28 +52,23 @@ def run_delay_map(args: argparse.Namespace) -> int:
                                  "this body")
     else:
         args.case = None  # (--case has a default: the paper's Table I case 1)
-    args.viscosity_ratio = parse_float(args.viscosity_ratio)
+    args.viscosity_ratio = parse_viscosity_ratio(args.viscosity_ratio)
     muscles = muscles_from_args(args, body)
     dmap = delay_stability_map(body, muscles, delay, axes["active_stiffness"],
                                axes["active_viscosity"], resolution, pair=args.pair)
     x_first = str(args.x).split(":")[0].strip().lower() == "active_stiffness"
     fig = plot_delay_stability_map(dmap)
-    rows = ["active_stiffness,active_viscosity,max_real_part,stable"]
-    for iy, v in enumerate(dmap.active_viscosity):
-        for ix, k in enumerate(dmap.active_stiffness):
-            rows.append(f"{float(k)!r},{float(v)!r},{float(dmap.max_real_part[iy, ix])!r},"
-                        f"{int(dmap.stable[iy, ix])}")
+    kx, vy = np.meshgrid(dmap.active_stiffness, dmap.active_viscosity)
+    table = np.column_stack([kx.ravel(), vy.ravel(), dmap.max_real_part.ravel(),
+                             dmap.stable.ravel()])
+    buf = io.StringIO()
+    np.savetxt(buf, table, delimiter=",", fmt=["%.17g", "%.17g", "%.17g", "%d"],
+               header="active_stiffness,active_viscosity,max_real_part,stable", comments="")
     save_figure(fig, figure_path)
-    atomic_write_text(csv_path, "\n".join(rows) + "\n")
+    atomic_write_text(csv_path, buf.getvalue())
     print(f"wrote {figure_path} and {csv_path}: {resolution} × {resolution} sets of the "
           f"{dmap.pair} pair's active gains at τ = {delay:g} s, "
           f"{100 * float(np.mean(dmap.stable)):.1f}% stable"
           + ("" if x_first else " (x is always the active stiffness)"))
     return 0
 
-
-def parse_float(text) -> float | None:
-    """--viscosity-ratio given as text, or None. [s]"""
-    from .stability_map import parse_viscosity_ratio
-
-    return parse_viscosity_ratio(text)

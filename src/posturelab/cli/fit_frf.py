@@ -84,16 +84,13 @@ def _condition(path: str, args: argparse.Namespace):
                            np.zeros(f.size, int), (), 0, 0.0, np.zeros(0), np.zeros(0))
     from ..frequency.data import read_series_csv
     from ..frequency.estimate import estimate_frf
-    from .frf import response_sign
+    from .frf import response_sign, whole_cycles
 
     if args.stimulus is None or args.response is None or args.cycle_length is None:
         raise ParameterError("a trial CSV needs --stimulus, --response and --cycle-length")
     stim, resp = args.stimulus.strip().lower(), args.response.strip().lower()
     fs, cols = read_series_csv(path, [stim, resp])
-    x, y = cols[stim], cols[resp]
-    per_cycle = round(fs * args.cycle_length)
-    if per_cycle > 0 and x.size % per_cycle == 1:
-        x, y = x[:-1], y[:-1]  # a record that includes its end point
+    x, y, _ = whole_cycles(cols[stim], cols[resp], fs, args.cycle_length)
     return estimate_frf(x, y, fs, args.cycle_length, discard_cycles=args.discard_cycles,
                         response_sign=response_sign(stim, resp, "auto"))
 

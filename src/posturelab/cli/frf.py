@@ -64,6 +64,16 @@ def response_sign(stimulus: str, response: str, choice: str) -> int:
     return -1 if stimulus == "tilt" and angle else 1
 
 
+def whole_cycles(x, y, sample_rate: float, cycle_length: float):
+    """``x, y`` without a last sample one past whole cycles (a record that includes its end
+    point, as posturelab simulate writes), and whether it was dropped."""
+    per_cycle = sample_rate * cycle_length
+    if per_cycle > 0 and abs(per_cycle - round(per_cycle)) < 1e-6 * per_cycle \
+            and x.size % round(per_cycle) == 1:
+        return x[:-1], y[:-1], True
+    return x, y, False
+
+
 def run(args: argparse.Namespace) -> int:
     from ..frequency.data import read_series_csv
     from ..frequency.estimate import estimate_frf
@@ -77,12 +87,7 @@ def run(args: argparse.Namespace) -> int:
     stim, resp = args.stimulus.strip().lower(), args.response.strip().lower()
     fs, cols = read_series_csv(args.data, [stim, resp])
     sign = response_sign(stim, resp, args.response_sign)
-    x, y = cols[stim], cols[resp]
-    per_cycle = fs * args.cycle_length
-    trimmed = False
-    if per_cycle > 0 and abs(per_cycle - round(per_cycle)) < 1e-6 * per_cycle \
-            and x.size % round(per_cycle) == 1:
-        x, y, trimmed = x[:-1], y[:-1], True  # a record that includes its end point
+    x, y, trimmed = whole_cycles(cols[stim], cols[resp], fs, args.cycle_length)
     est = estimate_frf(x, y, fs, args.cycle_length,
                        discard_cycles=args.discard_cycles, bands=args.bands,
                        response_sign=sign, ci=args.ci)

@@ -6,7 +6,13 @@ import argparse
 
 from ..linear.analysis import analyse_both_sides
 from ..paper.compare import erratum, table2_comparison
-from ._common import add_muscle_arguments, body_from_args, muscles_from_args, print_json
+from ._common import (
+    add_muscle_arguments,
+    body_from_args,
+    feedback_options_from_args,
+    muscles_from_args,
+    print_json,
+)
 
 DESCRIPTION = """\
 Poles [1/s] of the paper's three-link biped (Appendix A) linearised about upright
@@ -59,8 +65,6 @@ def run(args: argparse.Namespace) -> int:
     active, inactive = analyse_both_sides(body, muscles)
     one_sided = args.gastrocnemius == "one-sided"
     stable = active.stable and inactive.stable
-    from ._common import feedback_options_from_args
-
     delay = feedback_options_from_args(args).get("feedback_delay")
     delayed = None
     if delay is not None:

@@ -232,7 +232,7 @@ def estimate_frf(stimulus, response, sample_rate: float, cycle_length: float, *,
     if n_cycles < 2:
         raise ParameterError(f"an FRF needs at least 2 cycles; the record has {n_cycles} "
                              "after discarding")
-    n_odd = (L // 2 - 1 + 1) // 2  # odd bins 1, 3, … below Nyquist
+    n_odd = L // 4  # odd bins 1, 3, … below the Nyquist bin L/2
     if isinstance(bands, str):
         if bands == "peterka":
             chosen = peterka_bands()

@@ -155,12 +155,7 @@ class Tilt:
 
     def angle_and_rate(self, t) -> tuple[np.ndarray, np.ndarray]:
         """(α, α̇) at ``t``, the shape of ``t``. [rad], [rad/s]"""
-        t = np.asarray(t, dtype=float)
-        angle, rate = np.zeros(t.shape), np.zeros(t.shape)
-        for term in self.terms():
-            a, r = term.evaluate(t)
-            angle, rate = angle + a, rate + r
-        return angle, rate
+        return self.kinematics(t)[:2]
 
     def kinematics(self, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(α, α̇, α̈) at ``t``, the shape of ``t``. [rad], [rad/s], [rad/s²]"""

@@ -42,7 +42,7 @@ from ...model.events import fall_message
 from ...model.muscles import MuscleSet, feedback_gains, muscle_set_gains, paper_muscles
 from ...model.options import FallCriteria, KneeModel
 from ...model.platform import Disturbance
-from ...model.tilt import Tilt, tilt_pair_gains
+from ...model.tilt import Tilt, check_proprioceptive_weight, tilt_pair_gains
 from ..derived import derived_series
 from ..engines import simulate
 from ..results import SimulationResult
@@ -544,7 +544,7 @@ def simulate_batch(
 
     weight = float(weights[0]) if M else 1.0
     for w in np.unique(weights):  # each checked as a single run's would be
-        prepare_run(body, muscles, None, 1.0, proprioceptive_weight=float(w))
+        check_proprioceptive_weight(float(w))
 
     # every run's delay and limits are checked as a single run's would be
     for d in np.unique(delays):
