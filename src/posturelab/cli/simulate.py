@@ -112,6 +112,15 @@ def add_experiment_arguments(p: argparse.ArgumentParser) -> None:
                      help="the tilt axis this far below the ankle [m], in [0, 1] (default 0: "
                      "about the ankle; then the ankle moves with the surface). Needs a tilt "
                      "without rate jumps (not prts).")
+    src.add_argument("--motor-noise", metavar="SIGMA[,SIGMA...]",
+                     help="motor noise: a seeded random torque added to each joint's net "
+                     "moment, standard deviation per joint [N·m], ankle first (one value: "
+                     "the ankle only).")
+    src.add_argument("--motor-noise-cutoff", type=float, default=None, metavar="HZ",
+                     help="low-pass the motor noise at HZ (first order; default: white at "
+                     "100 Hz samples).")
+    src.add_argument("--seed", type=int, default=None, metavar="N",
+                     help="seed of the motor noise (default 0).")
     src.add_argument("--torque-limits", metavar="ANKLE,KNEE,HIP",
                      help="largest net muscle moment at each joint [N·m] ('inf' for none).")
     src.add_argument("--max-link-angle", type=float, default=None, metavar="RAD",
@@ -174,12 +183,35 @@ def scenario_from_args(args: argparse.Namespace, command: str = "simulate") -> S
     if args.torque_limits:
         sc = sc.replace(torque_limits=tuple(
             parse_limit_list(args.torque_limits, "--torque-limits [N·m]", sc.body.n_links)))
+    noise = motor_noise_from_args(args, sc.body.n_links)
+    if noise is not None:
+        if sc.motor_noise is not None:
+            raise UsageError(f"{command}: the experiment already has motor noise; give "
+                             "--motor-noise or [motor_noise], not both")
+        sc = sc.replace(motor_noise=noise, description=f"{sc.description}, {noise.describe()}")
     if args.knee != "free":
         sc = sc.replace(knee=KneeModel(args.knee))
     if args.rates_from != "upright":
         sc = sc.replace(rates_from=args.rates_from)
     _check_numbers(sc)
     return sc
+
+
+def motor_noise_from_args(args: argparse.Namespace, n_joints: int):
+    """The MotorNoise of --motor-noise, --motor-noise-cutoff and --seed (None without
+    --motor-noise; the other two need it)."""
+    from ..model.noise import MotorNoise
+
+    if args.motor_noise is None:
+        for flag in ("motor_noise_cutoff", "seed"):
+            if getattr(args, flag) is not None:
+                raise UsageError(f"--{flag.replace('_', '-')} needs --motor-noise")
+        return None
+    sigma = parse_float_list(args.motor_noise, "--motor-noise [N·m]")
+    if len(sigma) > n_joints:
+        raise ParameterError(f"--motor-noise [N·m] takes at most {n_joints} values (one per "
+                             f"joint), got {len(sigma)}")
+    return MotorNoise(tuple(sigma), args.motor_noise_cutoff, seed=args.seed or 0)
 
 
 def _check_numbers(sc: Scenario) -> None:

@@ -4,7 +4,9 @@
 nonlinear model on the compiled engine for ``discard + cycles`` cycles, adds white sensor
 noise of a given standard deviation [rad] to the measured angle (seeded), and estimates the
 FRF of that angle to the tilt in the literature's sign (:func:`posturelab.frequency.
-estimate_frf`). Motor noise (a random torque) is not modelled yet.
+estimate_frf`). Motor noise, a seeded random torque inside the loop that adds sway the
+stimulus does not explain, is a run option: ``motor_noise=MotorNoise(...)``
+(:mod:`posturelab.model.noise`).
 """
 
 from __future__ import annotations
@@ -68,7 +70,8 @@ def prts_experiment(body, muscles, *, tilt=None, cycles: int = 5, discard: int =
     bands
         As for :func:`posturelab.frequency.estimate_frf`.
     **run_options
-        For :func:`posturelab.simulate` (``feedback_delay``, ``proprioceptive_weight``, …).
+        For :func:`posturelab.simulate` (``feedback_delay``, ``proprioceptive_weight``,
+        ``motor_noise``, …).
     """
     from ..model.tilt import PRTSTilt
     from ..simulation.engines import simulate

@@ -37,6 +37,12 @@ Schema (every table optional except where noted; units in brackets)::
     # profile: file = "tilt.csv" with columns time [s] and tilt [rad]
     axis_depth = 0.0                     # the tilt axis this far below the ankle [m]
 
+    [motor_noise]                        # a seeded random torque on each joint's moment
+    standard_deviation = [2.0]           # σ per joint, ankle first [N·m]
+    cutoff = 1.0                         # first-order low-pass corner [Hz] (omit: white)
+    sample_rate = 100.0                  # [Hz]
+    seed = 0
+
     [disturbance]                        # or [[disturbance]] several, summed
     type = "velocity-step"               # velocity-step | half-sine | ramp-and-hold |
                                          # sum-of-sines | profile | none
@@ -87,6 +93,7 @@ from .._validation import finite_array, finite_float, reject_unknown_keys
 from ..errors import ParameterError, PostureLabError, ScenarioError
 from ..model.body import Body, Segment, get_body
 from ..model.muscles import MusclePair, MuscleSet, paper_muscles
+from ..model.noise import MotorNoise
 from ..model.options import FOOT_FROM_LITERATURE, BaseOfSupport, FallCriteria, KneeModel
 from ..model.platform import (
     Disturbance,
@@ -159,6 +166,8 @@ class Scenario:
         W of the active part's error for pairs that span the foot. [-]
     tilt_axis_depth : float
         Distance of the tilt axis below the ankle. [m]
+    motor_noise : MotorNoise or None
+        A seeded random joint torque (:mod:`posturelab.model.noise`). [N·m]
     """
 
     name: str
@@ -182,6 +191,7 @@ class Scenario:
     tilt: Tilt | None = None
     proprioceptive_weight: float = 1.0
     tilt_axis_depth: float = 0.0
+    motor_noise: MotorNoise | None = None
 
     def run(self, *, engine: str = "reference", **overrides: Any) -> SimulationResult:
         """Simulate this scenario; keyword ``overrides`` replace fields first.
@@ -201,6 +211,7 @@ class Scenario:
             sample_rate=sc.sample_rate, description=sc.description,
             method=sc.method if name == "reference" else None, engine=name, tilt=sc.tilt,
             proprioceptive_weight=sc.proprioceptive_weight, tilt_axis_depth=sc.tilt_axis_depth,
+            motor_noise=sc.motor_noise,
         )
 
     def replace(self, **changes: Any) -> Scenario:
@@ -211,7 +222,7 @@ class Scenario:
 
 
 TOP_KEYS = ("name", "description", "source", "duration", "body", "muscles", "disturbance",
-            "initial", "knee", "fall", "limits", "solver", "tilt")
+            "initial", "knee", "fall", "limits", "solver", "tilt", "motor_noise")
 
 
 def load_scenario(path: str | Path) -> Scenario:
@@ -290,6 +301,14 @@ def _parse(data: dict, base_dir: Path, origin: str) -> Scenario:
     tilt = _parse_tilt(tilt_table, base_dir, origin)
     depth = finite_float("tilt.axis_depth [m]", tilt_table.get("axis_depth", 0.0))
     disturbance = _parse_disturbances(data.get("disturbance"), base_dir, origin)
+    nt = _table(data, "motor_noise", ("standard_deviation", "cutoff", "sample_rate", "seed"),
+                origin)
+    noise = None
+    if nt:
+        if "standard_deviation" not in nt:
+            raise ScenarioError(f"{origin}: [motor_noise] needs standard_deviation [N·m]")
+        noise = MotorNoise(nt["standard_deviation"], nt.get("cutoff"),
+                           nt.get("sample_rate", 100.0), nt.get("seed", 0))
 
     it = _table(data, "initial", ("posture", "rates", "rates_from"), origin)
     n = body.n_links
@@ -347,7 +366,7 @@ def _parse(data: dict, base_dir: Path, origin: str) -> Scenario:
         atol=finite_float("solver.atol", st.get("atol", 1e-10)),
         sample_rate=finite_float("solver.sample_rate [Hz]", st.get("sample_rate", 1000.0)),
         method=method, case=case, torque_limits=torque_limits, feedback_delay=delay,
-        tilt=tilt, proprioceptive_weight=weight, tilt_axis_depth=depth,
+        tilt=tilt, proprioceptive_weight=weight, tilt_axis_depth=depth, motor_noise=noise,
     )
 
 

@@ -17,6 +17,7 @@ from ..model.kinematics import (
     ground_reaction,
 )
 from ..model.muscles import feedback_pair_torques, moments_to_link_torques
+from ..model.noise import torque_at
 from .results import DerivedSeries
 from .setup import RunSetup, platform_acceleration, tilt_torques
 
@@ -61,8 +62,11 @@ def derived_series(setup: RunSetup, time: np.ndarray, state: np.ndarray,
     if setup.tilt is not None:
         M = M + tilt_torques(setup.tilt, setup.tilt_gains, setup.feedback_delay, time)
     moments = M @ muscles.crossing_matrix
+    if setup.motor_torque is not None:
+        moments = moments + torque_at(setup.motor_torque, time)
     if setup.torque_limits is not None:
         moments = np.clip(moments, -setup.torque_limits, setup.torque_limits)
+    if setup.torque_limits is not None or setup.motor_torque is not None:
         U = moments_to_link_torques(moments)
     else:
         U = -M @ muscles.selection_matrix

@@ -14,6 +14,7 @@ import numpy as np
 from ..errors import ParameterError
 from ..model.body import Body
 from ..model.muscles import MuscleSet
+from ..model.noise import MotorNoise
 from ..model.options import FallCriteria, KneeModel
 from ..model.platform import Disturbance
 from ..model.tilt import Tilt
@@ -64,6 +65,7 @@ def simulate(
     tilt: Tilt | None = None,
     proprioceptive_weight: float = 1.0,
     tilt_axis_depth: float = 0.0,
+    motor_noise: MotorNoise | None = None,
 ) -> SimulationResult:
     """Simulate the nonlinear chain.
 
@@ -124,6 +126,9 @@ def simulate(
         the surface about the ankle itself, otherwise the ankle moves on a circle about
         the axis (:func:`posturelab.model.tilt.axis_translation`). Needs a tilt whose rate
         has no jumps.
+    motor_noise : MotorNoise, optional
+        A seeded random torque added to each joint's net muscle moment, before the torque
+        limits (:mod:`posturelab.model.noise`); none by default. [N·m]
 
     Returns
     -------
@@ -140,7 +145,8 @@ def simulate(
         feedback_delay=feedback_delay, rtol=d_rtol if rtol is None else rtol,
         atol=d_atol if atol is None else atol, sample_rate=sample_rate,
         max_switches=max_switches, description=description, tilt=tilt,
-        proprioceptive_weight=proprioceptive_weight, tilt_axis_depth=tilt_axis_depth)
+        proprioceptive_weight=proprioceptive_weight, tilt_axis_depth=tilt_axis_depth,
+        motor_noise=motor_noise)
     method = d_method if method is None else method
     if name == "reference":
         from .reference import integrate_reference

@@ -37,6 +37,7 @@ from ..model.muscles import (
     moments_to_link_torques,
     muscle_set_gains,
 )
+from ..model.noise import MotorNoise, TorqueSeries, motor_noise_series, torque_at
 from ..model.options import FallCriteria, KneeModel, torque_limit_array
 from ..model.platform import Disturbance, NoDisturbance
 from ..model.tilt import (
@@ -138,6 +139,10 @@ class RunSetup:
     velocity_jump : (float, float)
         The ankle's velocity change at t = 0: the disturbance's step and the start of a
         tilt about an axis below the ankle. [m/s]
+    motor_noise : MotorNoise or None
+        The motor noise of the run (:mod:`posturelab.model.noise`), None for none.
+    motor_torque : TorqueSeries or None
+        Its realisation over the run: added to each joint's moment before the limits. [N·m]
     """
 
     body: Body
@@ -171,6 +176,8 @@ class RunSetup:
     tilt_gains: np.ndarray | None = None
     tilt_axis_depth: float = 0.0
     velocity_jump: tuple[float, float] = (0.0, 0.0)
+    motor_noise: MotorNoise | None = None
+    motor_torque: TorqueSeries | None = None
 
     @property
     def n_links(self) -> int:
@@ -251,7 +258,7 @@ RUN_OPTIONS: dict[str, object] = {
     "initial_state": None, "rates_from": "upright", "knee": None, "fall": None,
     "torque_limits": None, "feedback_delay": 0.0, "rtol": 1e-8, "atol": 1e-10,
     "sample_rate": 1000.0, "max_switches": 10_000, "description": "", "tilt": None,
-    "proprioceptive_weight": 1.0, "tilt_axis_depth": 0.0,
+    "proprioceptive_weight": 1.0, "tilt_axis_depth": 0.0, "motor_noise": None,
 }
 
 
@@ -332,6 +339,11 @@ def _prepare(body: Body, muscles: MuscleSet, disturbance: Disturbance | None = N
             f"muscle set is for {muscles.n_links} links but the body has {body.n_links}"
         )
     duration = positive_float("duration [s]", duration)
+    noise = o["motor_noise"]
+    motor_torque = None
+    if noise is not None:
+        _expect("motor_noise", noise, MotorNoise)
+        motor_torque = motor_noise_series(noise, duration, body.n_links)
     rtol = float_in_range("rtol", rtol, 1e-14, 1e-1)
     atol = float_in_range("atol", atol, 1e-16, 1e-1)
     sample_rate = float_in_range("sample_rate [Hz]", sample_rate, 1.0, 1e6, unit="Hz")
@@ -373,6 +385,8 @@ def _prepare(body: Body, muscles: MuscleSet, disturbance: Disturbance | None = N
     moments0 = start_moments(muscles, x0, before, active0, gains)
     if tilt is not None:
         moments0 = moments0 + tilt_torques(tilt, tilt_gains, delay, 0.0) @ muscles.crossing_matrix
+    if motor_torque is not None:
+        moments0 = moments0 + torque_at(motor_torque, 0.0)
     saturation0 = start_saturation(moments0, limits)
     corners = set(disturbance.breakpoints)
     if tilt is not None:  # the tilt's corners, and where the delayed part feels them
@@ -382,7 +396,8 @@ def _prepare(body: Body, muscles: MuscleSet, disturbance: Disturbance | None = N
     delay_bps = np.array([k * delay for k in range(1, DELAY_BREAKPOINT_MULTIPLES + 1)
                           if delay > 0 and k * delay < duration])
     max_step = min(disturbance.max_step, duration, delay if delay > 0 else math.inf,
-                   tilt.max_step if tilt is not None else math.inf)
+                   tilt.max_step if tilt is not None else math.inf,
+                   noise.max_step if noise is not None else math.inf)
     for arr in (before, x0, active0, saturation0, breakpoints, delay_bps, gains):
         arr.setflags(write=False)
     setup = RunSetup(
@@ -396,6 +411,7 @@ def _prepare(body: Body, muscles: MuscleSet, disturbance: Disturbance | None = N
         rates_from=rates_from, tilt=tilt, proprioceptive_weight=weight, tilt_gains=tilt_gains,
         tilt_axis_depth=depth, velocity_jump=tuple(
             float(a + b) for a, b in zip(disturbance.velocity_change, jump, strict=True)),
+        motor_noise=noise, motor_torque=motor_torque,
     )
     object.__setattr__(setup, "fall_at_start", _fall_at_start(setup))
     return setup
@@ -500,11 +516,15 @@ def model_response(setup: RunSetup, t: float, x: np.ndarray, feedback: np.ndarra
 def raw_moments(setup: RunSetup, t: float, x: np.ndarray, feedback: np.ndarray,
                 active: np.ndarray) -> np.ndarray:
     """Unsaturated net muscle moment per joint at time ``t`` [s]: the immediate part on the
-    state ``x``, the delayed part on ``feedback`` (x(t − τ)), and the tilt's part. [N·m]"""
+    state ``x``, the delayed part on ``feedback`` (x(t − τ)), the tilt's part and the motor
+    noise. [N·m]"""
     M = feedback_pair_torques(setup.muscles, setup.gains, x, feedback, active)
     if setup.tilt is not None:
         M = M + tilt_torques(setup.tilt, setup.tilt_gains, setup.feedback_delay, t)
-    return M @ setup.muscles.crossing_matrix
+    tau = M @ setup.muscles.crossing_matrix
+    if setup.motor_torque is not None:
+        tau = tau + torque_at(setup.motor_torque, t)
+    return tau
 
 
 def platform_acceleration(setup: RunSetup, t) -> np.ndarray:

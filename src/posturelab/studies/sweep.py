@@ -486,7 +486,7 @@ class _Task:
             feedback_delay=grid.feedback_delay[lo:hi], rtol=self.rtol, atol=self.atol,
             sample_rate=sc.sample_rate, settle_tolerance=SETTLE_TOLERANCE, parallel=parallel,
             disturbance_scale=_rows(grid.disturbance_scale, lo, hi),
-            tilt=sc.tilt, tilt_axis_depth=sc.tilt_axis_depth,
+            tilt=sc.tilt, tilt_axis_depth=sc.tilt_axis_depth, motor_noise=sc.motor_noise,
             proprioceptive_weight=(sc.proprioceptive_weight if grid.proprioceptive_weight is None
                                    else grid.proprioceptive_weight[lo:hi]),
             active_stiffness=_rows(grid.active_stiffness, lo, hi),

@@ -40,6 +40,7 @@ from ...errors import ParameterError
 from ...model.body import Body
 from ...model.events import fall_message
 from ...model.muscles import MuscleSet, feedback_gains, muscle_set_gains, paper_muscles
+from ...model.noise import MotorNoise, torque_at
 from ...model.options import FallCriteria, KneeModel
 from ...model.platform import Disturbance
 from ...model.tilt import Tilt, check_proprioceptive_weight, tilt_pair_gains
@@ -153,6 +154,7 @@ def _packed(setup: RunSetup) -> dict:
             setup.tilt_gains @ muscles.crossing_matrix if setup.tilt_gains is not None
             else np.zeros((4, n)))),
         "tilt_depth": float(setup.tilt_axis_depth),
+        "mp": enc.encode_motor_noise(setup.motor_torque),
         "bps": enc.readonly(setup.breakpoints.astype(float)), "fpar": fpar, "ipar": ipar,
         "active0": enc.readonly(setup.active0), "slots": slots,
         "ev_offset": ev.EVENT_OFFSET, "ev_direction": ev.EVENT_DIRECTION,
@@ -182,7 +184,7 @@ def _base_run_struct(a: dict, method: str) -> Run:
               n_slots=len(a["slots"]), method=METHOD_RADAU if tab is None else METHOD_EXPLICIT,
               delay_multiples=DELAY_BREAKPOINT_MULTIPLES, tilt_depth=a["tilt_depth"])
     for name in ("x0", "before", "grid", "bp", "E", "C", "dp", "bps", "fpar", "active0",
-                 "ev_offset", "tp", "tilt_gain"):
+                 "ev_offset", "tp", "tilt_gain", "mp"):
         setattr(run, name, pointer(a[name]))
     for name in ("one_sided", "ipar", "ev_direction", "ev_ends"):
         setattr(run, name, pointer(a[name], ctypes_int64))
@@ -415,6 +417,7 @@ def simulate_batch(
     tilt: Tilt | None = None,
     proprioceptive_weight: float | np.ndarray = 1.0,
     tilt_axis_depth: float = 0.0,
+    motor_noise: MotorNoise | None = None,
     rtol: float = DEFAULT_RTOL,
     atol: float = DEFAULT_ATOL,
     sample_rate: float = 1000.0,
@@ -464,6 +467,9 @@ def simulate_batch(
         run or per run. [-]
     tilt_axis_depth : float
         Distance of the tilt axis below the ankle (0: the ankle's own). [m]
+    motor_noise : MotorNoise, optional
+        The motor noise of every run: the same realisation in each
+        (:mod:`posturelab.model.noise`). [N·m]
     rtol : float
         Relative tolerance. [-]
     atol : float
@@ -540,7 +546,8 @@ def simulate_batch(
                            rates_from=rates_from, knee=knee, fall=fall,
                            torque_limits=limits, feedback_delay=delay, rtol=rtol, atol=atol,
                            sample_rate=sample_rate, max_switches=max_switches, tilt=tilt,
-                           proprioceptive_weight=weight, tilt_axis_depth=tilt_axis_depth)
+                           proprioceptive_weight=weight, tilt_axis_depth=tilt_axis_depth,
+                           motor_noise=motor_noise)
 
     weight = float(weights[0]) if M else 1.0
     for w in np.unique(weights):  # each checked as a single run's would be
@@ -585,6 +592,8 @@ def simulate_batch(
                     + pair_gains[:, 2] * ab[:, None] + pair_gains[:, 3] * adb[:, None])
         moments0 = moments0 + at_start @ muscles.crossing_matrix
         tilt_gain_all = enc.readonly(np.ascontiguousarray(pair_gains @ muscles.crossing_matrix))
+    if base.motor_torque is not None:
+        moments0 = moments0 + torque_at(base.motor_torque, 0.0)
     sat0_all = enc.readonly(start_saturation(moments0, lims))
     lim_all = enc.readonly(lims)
     delay_all = enc.readonly(delays)

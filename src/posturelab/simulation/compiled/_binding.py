@@ -31,7 +31,7 @@ class Run(ctypes.Structure):
         ("ev_offset", _d), ("ev_direction", _i), ("ev_ends", _i),
         ("tab_A", _d), ("tab_c", _d), ("tab_e", _d), ("tab_P", _d),
         ("tab_error_order", ctypes.c_int64), ("delay_multiples", ctypes.c_int64),
-        ("tp", _d), ("tilt_gain", _d), ("tilt_depth", ctypes.c_double),
+        ("tp", _d), ("tilt_gain", _d), ("tilt_depth", ctypes.c_double), ("mp", _d),
     ]
 
 

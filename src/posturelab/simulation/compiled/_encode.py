@@ -115,6 +115,14 @@ def encode_tilt(tilt) -> np.ndarray:
     return readonly(packed)
 
 
+def encode_motor_noise(series) -> np.ndarray:
+    """``mp``: a :class:`~posturelab.model.noise.TorqueSeries` packed ([0] for none)."""
+    if series is None:
+        return readonly(np.zeros(1))
+    K = series.coefficients.shape[0]
+    return readonly(np.concatenate([[float(K)], series.knots, series.coefficients.ravel()]))
+
+
 def body_array(body: Body) -> np.ndarray:
     """``bp``: a_i [kg·m], J_ii [kg·m²], c_ij row-major [kg·m²], g [m/s²], Σm [kg]."""
     n = body.n_links
@@ -138,7 +146,10 @@ def options(setup: RunSetup, settle_tolerance: float = 0.01) -> tuple[np.ndarray
     fpar[F_STOP_ANGLE] = knee.stop_angle
     fpar[F_RTOL] = setup.rtol
     fpar[F_ATOL] = setup.atol
-    fpar[F_MAX_STEP] = min(setup.disturbance.max_step, setup.duration)
+    fpar[F_MAX_STEP] = min(  # the C driver caps it at the run's delay itself
+        setup.disturbance.max_step, setup.duration,
+        setup.tilt.max_step if setup.tilt is not None else math.inf,
+        setup.motor_noise.max_step if setup.motor_noise is not None else math.inf)
     fpar[F_DURATION] = setup.duration
     fpar[F_SETTLE_TOL] = settle_tolerance
     ipar = np.zeros(N_IPAR, dtype=np.int64)

@@ -38,6 +38,10 @@ enum { DIST_ROW = 6, DIST_WINDOWED_SINE = 1, DIST_SINE = 2, DIST_SAMPLES = 3 };
  * tp[offset] K + 1 knots, then K rows of 4 coefficients in ascending powers of t − knot. */
 enum { TILT_ROW = 7, TILT_SINE = 1, TILT_RAISED_COSINE = 2, TILT_PPOLY = 3 };
 
+/* Packed motor noise (posturelab.model.noise.TorqueSeries): mp[0] = K intervals (0: none),
+ * then K + 1 knots, then K·4·n coefficients, interval-major, ascending powers of t − knot,
+ * joint fastest. */
+
 /* Event kinds (posturelab.model.events) and the conditions of the segment's event slots */
 enum { EV_LINK_ANGLE = 0, EV_COG_TOE, EV_COG_HEEL, EV_COP_TOE, EV_COP_HEEL, EV_SATURATES,
        EV_LETS_GO, EV_PAIR_SLACKENS, EV_PAIR_ENGAGES, EV_KNEE_HITS_STOP, EV_KNEE_LEAVES_STOP };
@@ -71,6 +75,7 @@ typedef struct {
     const double *tp;                   /* packed tilt (tp[0] = 0: none) */
     const double *tilt_gain;            /* (4, n) joint moments per α(t), α̇(t), α(t−τ), α̇(t−τ) */
     double tilt_depth;                  /* tilt axis below the ankle [m] (0: the ankle's) */
+    const double *mp;                   /* packed motor noise (mp[0] = 0: none) */
 } pl_run;
 
 /* Outputs of one run (any pointer may be NULL where noted). */
@@ -140,6 +145,7 @@ void pl_inverse3_complex(const double *ar, const double *ai, double *outr, doubl
 /* platform (pl_platform.c) */
 void pl_platform_acceleration(double t, const double *dp, double *ax, double *ay);
 void pl_tilt(double t, const double *tp, double *angle, double *rate, double *accel);
+void pl_motor_noise_add(double t, const double *mp, int64_t n, double *tau);
 
 /* history of a delayed run (pl_history.c) */
 typedef struct {

@@ -110,7 +110,8 @@ int64_t pl_integrate(const pl_run *run, pl_out *out)
         max_step = fmin(max_step, delay);  /* the method of steps: the past is computed */
     const int64_t max_switches = run->ipar[I_MAX_SWITCHES];
     int locked = run->ipar[I_LOCKED0] != 0;
-    const int has_inputs = run->dp[0] > 0.0 || delay > 0.0 || run->tp[0] > 0.0;
+    const int has_inputs = run->dp[0] > 0.0 || delay > 0.0 || run->tp[0] > 0.0
+                           || run->mp[0] > 0.0;
     double *res = out->res;
     for (int64_t k = 0; k < N_RESULT; k++)
         res[k] = 0.0;
@@ -136,7 +137,8 @@ int64_t pl_integrate(const pl_run *run, pl_out *out)
     memcpy(b.x, run->x0, sizeof(double) * m);
     pl_model md = {n, run->bp, b.tm, run->lim, b.sat, b.base, b.work, b.tau};
     pl_ctx cx = {&md, run->E, run->dp, fpar, run->before, run->ev_offset, &hist, delay,
-                 run->tp, run->tilt_gain, run->tilt_depth, b.sc_out, b.sc_inp, b.sc_x, b.ys};
+                 run->tp, run->tilt_gain, run->tilt_depth, run->mp, b.sc_out, b.sc_inp, b.sc_x,
+                 b.ys};
     double *x = b.x, *y = b.y, *Q = b.Q, *inp = b.inp;
     for (int64_t i = 0; i < n; i++)
         out->peak[i] = 0.0;

@@ -50,6 +50,8 @@ void pl_inputs_at(const pl_ctx *cx, double t, double *out)
                 out[2 + j] += g[2 * n + j] * a + g[3 * n + j] * ad;
         }
     }
+    if (cx->mp[0] > 0.0)  /* the motor noise, on the motor command */
+        pl_motor_noise_add(t, cx->mp, n, out + 2);
 }
 
 double pl_event_value(const pl_ctx *cx, int64_t kind, int64_t idx, double side, double t,

@@ -12,6 +12,7 @@ typedef struct {
     double delay;
     const double *tp, *tilt_gain;          /* packed tilt, (4, n) joint gains on it */
     double tilt_depth;                     /* tilt axis below the ankle [m] */
+    const double *mp;                      /* packed motor noise */
     double *sc_out, *sc_inp, *sc_x, *ys;   /* scratch (2n), (2 + n), (2n), (2n) */
 } pl_ctx;
 

@@ -1,6 +1,7 @@
 /* Platform acceleration from a packed disturbance (the terms of
- * posturelab.model.platform.Primitive) and the tilt angle and rate from a packed tilt (the
- * terms of posturelab.model.tilt.TiltTerm); layouts in pl.h. */
+ * posturelab.model.platform.Primitive), the tilt angle and rate from a packed tilt (the
+ * terms of posturelab.model.tilt.TiltTerm) and the motor-noise torque from a packed
+ * posturelab.model.noise.TorqueSeries; layouts in pl.h. */
 #include <math.h>
 #include "pl.h"
 
@@ -117,4 +118,26 @@ void pl_tilt(double t, const double *tp, double *angle, double *rate, double *ac
     *angle = a;
     *rate = ad;
     *accel = add;
+}
+
+/* tau[j] += the motor noise at joint j (posturelab.model.noise.torque_at: the interval whose
+ * knot is the last at or before t, the end intervals carried on outside the knots) */
+void pl_motor_noise_add(double t, const double *mp, int64_t n, double *tau)
+{
+    const int64_t K = (int64_t)mp[0];
+    const double *x = mp + 1, *c = mp + 2 + K;
+    int64_t lo = 0, hi = K;  /* the largest k in [0, K - 1] with x[k] <= t */
+    if (t >= x[K - 1])
+        lo = K - 1;
+    else
+        while (hi - lo > 1) {
+            const int64_t mid = (lo + hi) >> 1;
+            if (x[mid] <= t)
+                lo = mid;
+            else
+                hi = mid;
+        }
+    const double u = t - x[lo], *q = c + lo * 4 * n;
+    for (int64_t j = 0; j < n; j++)
+        tau[j] += q[j] + u * (q[n + j] + u * (q[2 * n + j] + u * q[3 * n + j]));
 }
