@@ -120,7 +120,8 @@ def add_experiment_arguments(p: argparse.ArgumentParser) -> None:
                      help="low-pass the motor noise at HZ (first order; default: white at "
                      "100 Hz samples).")
     src.add_argument("--seed", type=int, default=None, metavar="N",
-                     help="seed of the motor noise (default 0).")
+                     help="seed of the motor noise (default 0); with sweep --experiment prts, "
+                     "of the measurement noise too.")
     src.add_argument("--torque-limits", metavar="ANKLE,KNEE,HIP",
                      help="largest net muscle moment at each joint [N·m] ('inf' for none).")
     src.add_argument("--max-link-angle", type=float, default=None, metavar="RAD",
@@ -203,7 +204,10 @@ def motor_noise_from_args(args: argparse.Namespace, n_joints: int):
     from ..model.noise import MotorNoise
 
     if args.motor_noise is None:
-        for flag in ("motor_noise_cutoff", "seed"):
+        # (sweep --experiment prts seeds its measurement noise with --seed too)
+        flags = ("motor_noise_cutoff",) if getattr(args, "experiment", "") == "prts" else (
+            "motor_noise_cutoff", "seed")
+        for flag in flags:
             if getattr(args, flag) is not None:
                 raise UsageError(f"--{flag.replace('_', '-')} needs --motor-noise")
         return None

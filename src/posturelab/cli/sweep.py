@@ -51,7 +51,18 @@ written to a temporary file and renamed, so no half-written file is left behind.
 
 Everything of the base experiment carries into every run: --torque-limits, --feedback-delay,
 active gains, --tilt and --proprioceptive-weight, --foot with --centre-of-pressure, the
-knee model. Parallelism: the runs use every CPU
+knee model.
+
+--experiment prts runs, for every parameter set, the in-silico PRTS identification
+experiment instead of one simulation: the base experiment's --tilt prts:… for
+--discard-cycles + --cycles cycles, recorded at --record-rate with --sensor-noise [rad] of
+white measurement noise (seeded per run from --seed), --motor-noise in the loop (seeded per
+run), the FRF of --output at Peterka's bands, and with --fit NAMES the FRF fit of those
+parameters (posturelab fit-frf's names) started from the base experiment's values. Its
+columns: the varied parameters, fell, gain_B, phase_deg_B [deg], coherence_B per band, then
+fit_NAME and se_NAME per fitted parameter and fit_error.
+
+Parallelism: the runs use every CPU
 available (one thread each). --workers N sends chunks of runs to a Dask LocalCluster of N
 single-threaded worker processes, --scheduler ADDRESS to a running Dask cluster (its
 workers need posturelab installed); the results are identical. Tolerances default to the
@@ -80,6 +91,24 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="runs per chunk (progress step / Dask task).")
     g.add_argument("--progress", action="store_true",
                    help="draw a progress bar on standard error even when it is not a terminal.")
+    e = p.add_argument_group("PRTS experiments (--experiment prts)")
+    e.add_argument("--experiment", choices=["simulation", "prts"], default="simulation",
+                   help="what each run is: one simulation (default) or a PRTS "
+                   "identification experiment.")
+    e.add_argument("--cycles", type=int, default=5, metavar="N",
+                   help="cycles analysed per experiment (default 5).")
+    e.add_argument("--discard-cycles", type=int, default=1, metavar="N",
+                   help="cycles run first and dropped (default 1).")
+    e.add_argument("--sensor-noise", type=float, default=0.0, metavar="RAD",
+                   help="standard deviation of the measurement noise on the recorded angle "
+                   "[rad] (default 0).")
+    e.add_argument("--record-rate", type=float, default=100.0, metavar="HZ",
+                   help="samples per second of the recording [Hz] (default 100).")
+    e.add_argument("--output", default="com_angle", metavar="ANGLE",
+                   help="the angle recorded: com_angle (default) or thetaI.")
+    e.add_argument("--fit", metavar="NAMES",
+                   help="fit these parameters to each experiment's FRF (comma-separated, "
+                   "as for posturelab fit-frf --free).")
     add_experiment_arguments(p)
     # None means "not given": a scenario then keeps its own ratio
     p.set_defaults(viscosity_ratio=None)
@@ -104,6 +133,8 @@ def run(args: argparse.Namespace) -> int:
     if ratio is None and not (args.scenario or args.builtin or args.controller):
         args.viscosity_ratio = DEFAULT_VISCOSITY_RATIO  # what --case / --stiffness build with
     scenario = scenario_from_args(args, "sweep")
+    if args.experiment == "prts":
+        return _run_experiments(args, scenario, varies, ratio)
     tolerances = {}
     if args.rtol is not None:
         tolerances["rtol"] = scenario.rtol
@@ -135,4 +166,33 @@ def run(args: argparse.Namespace) -> int:
     if failed:
         print(f"posturelab: warning: {failed} runs failed to integrate (fell = false, "
               "outcomes up to the failure)", file=sys.stderr)
+    return 0
+
+
+def _run_experiments(args: argparse.Namespace, scenario, varies, ratio) -> int:
+    """``--experiment prts``: a PRTS identification experiment per parameter set."""
+    from ..frequency.population import PRTSProtocol, prts_sweep
+
+    fit = tuple(s.strip() for s in (args.fit or "").split(",") if s.strip())
+    protocol = PRTSProtocol(cycles=args.cycles, discard=args.discard_cycles,
+                            sensor_noise=args.sensor_noise, seed=args.seed or 0,
+                            sample_rate=args.record_rate, output=args.output, fit=fit)
+    total = 1
+    for v in varies:
+        total *= v.count
+    bar = ProgressBar(total) if args.progress or sys.stderr.isatty() else None
+    t0 = time.perf_counter()
+    try:
+        result = prts_sweep(scenario, varies, protocol, viscosity_ratio=ratio,
+                            workers=args.workers, scheduler=args.scheduler,
+                            chunk_size=args.chunk_size,
+                            progress=None if bar is None else (lambda done, _: bar.update(done)))
+    finally:
+        if bar is not None:
+            bar.close()
+    elapsed = time.perf_counter() - t0
+    result.write(args.out)
+    fitted = f", fitted {', '.join(fit)}" if fit else ""
+    print(f"wrote {args.out}: {result.fell.size} PRTS experiments ({', '.join(result.grid.names)}"
+          f"), {int(result.fell.sum())} fell{fitted}, in {elapsed:.2f} s")
     return 0

@@ -61,6 +61,20 @@ def check_bands(bands, n_available: int) -> tuple[tuple[int, ...], ...]:
     return tuple(out)
 
 
+def resolve_bands(bands, n_available: int) -> tuple[tuple[int, ...], ...]:
+    """The bands ``"peterka"``, ``"harmonics"`` (one per odd harmonic below the Nyquist
+    frequency: the first ``n_available``) or a given list, checked (:func:`check_bands`)."""
+    if isinstance(bands, str):
+        if bands == "peterka":
+            bands = peterka_bands()
+        elif bands == "harmonics":
+            bands = harmonic_bands(n_available)
+        else:
+            raise ParameterError(f"bands must be 'peterka', 'harmonics' or a list of bands, "
+                                 f"got {bands!r}")
+    return check_bands(bands, n_available)
+
+
 def band_frequencies(bands, cycle_length: float) -> np.ndarray:
     """Mean frequency of each band's harmonics. [Hz]"""
     return np.array([odd_harmonic_frequency(np.array(b), cycle_length).mean() for b in bands])

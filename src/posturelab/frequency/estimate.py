@@ -40,7 +40,7 @@ import numpy as np
 
 from .._validation import finite_array, float_in_range
 from ..errors import ParameterError
-from .bands import band_frequencies, check_bands, harmonic_bands, peterka_bands
+from .bands import band_frequencies, resolve_bands
 
 __all__ = ["FRFEstimate", "estimate_frf", "confidence_radius", "BOUNDS", "MAX_SAMPLES"]
 
@@ -233,17 +233,7 @@ def estimate_frf(stimulus, response, sample_rate: float, cycle_length: float, *,
         raise ParameterError(f"an FRF needs at least 2 cycles; the record has {n_cycles} "
                              "after discarding")
     n_odd = L // 4  # odd bins 1, 3, … below the Nyquist bin L/2
-    if isinstance(bands, str):
-        if bands == "peterka":
-            chosen = peterka_bands()
-        elif bands == "harmonics":
-            chosen = harmonic_bands(n_odd)
-        else:
-            raise ParameterError(f"bands must be 'peterka', 'harmonics' or a list of bands, "
-                                 f"got {bands!r}")
-    else:
-        chosen = bands
-    chosen = check_bands(chosen, n_odd)
+    chosen = resolve_bands(bands, n_odd)
     bins = [np.array([2 * k - 1 for k in band]) for band in chosen]
     Gxx_h = np.mean(np.abs(X) ** 2, axis=0)
     Gyy_h = np.mean(np.abs(Y) ** 2, axis=0)

@@ -394,50 +394,75 @@ class SweepResult:
         cols.append(("settling_time", o.settling_time))
         return cols
 
+    def units(self) -> dict[str, str]:
+        """The unit of each column that has one."""
+        return {name: PARAMETER_UNITS.get(name, OUTCOME_UNITS.get(name, ""))
+                for name, _ in self.columns()}
+
     def to_csv_text(self) -> str:
         """CSV: a header row, then one row per run; ``fell`` is true/false, a missing fall or
         settling time is an empty cell, numbers have 17 significant digits (exact)."""
-        cols = self.columns()
-        buf = io.StringIO()
-        buf.write(",".join(name for name, _ in cols) + "\n")
-        text_cols = []
-        for name, values in cols:
-            if name == "fell":
-                text_cols.append(np.where(values, "true", "false"))
-            else:
-                text_cols.append(np.array([_number(v) for v in values.tolist()], dtype=object))
-        for row in zip(*text_cols, strict=True):
-            buf.write(",".join(row) + "\n")
-        return buf.getvalue()
+        return table_csv_text(self.columns())
 
     def to_parquet_bytes(self) -> bytes:
         """The table as Parquet (pyarrow): float64 columns (NaN as null), ``fell`` boolean;
         each field's unit in its metadata."""
-        pa, pq = _pyarrow()
-        fields, arrays = [], []
-        for name, values in self.columns():
-            unit = PARAMETER_UNITS.get(name, OUTCOME_UNITS.get(name, ""))
-            if name == "fell":
-                arr = pa.array(np.asarray(values, dtype=bool))
-                typ = pa.bool_()
-            else:
-                values = np.asarray(values, dtype=float)
-                arr = pa.array(values, mask=np.isnan(values), type=pa.float64())
-                typ = pa.float64()
-            fields.append(pa.field(name, typ, metadata={"unit": unit} if unit else None))
-            arrays.append(arr)
-        table = pa.Table.from_arrays(arrays, schema=pa.schema(fields))
-        sink = io.BytesIO()
-        pq.write_table(table, sink)
-        return sink.getvalue()
+        return table_parquet_bytes(self.columns(), self.units())
 
     def write(self, path: str | Path) -> None:
         """Write the table to ``path`` (.csv or .parquet by its suffix), atomically."""
-        kind = table_format(path)
-        if kind == "csv":
-            atomic_write_text(path, self.to_csv_text())
+        write_table(path, self.columns(), self.units())
+
+
+def table_csv_text(columns: Sequence[tuple[str, np.ndarray]]) -> str:
+    """A table as CSV: a header row, then one row per entry; boolean columns are true/false,
+    NaN an empty cell, numbers with 17 significant digits (exact)."""
+    buf = io.StringIO()
+    buf.write(",".join(name for name, _ in columns) + "\n")
+    text_cols = []
+    for _, values in columns:
+        values = np.asarray(values)
+        if values.dtype == bool:
+            text_cols.append(np.where(values, "true", "false"))
         else:
-            atomic_write_bytes(path, self.to_parquet_bytes())
+            text_cols.append(np.array([_number(v) for v in values.tolist()], dtype=object))
+    for row in zip(*text_cols, strict=True):
+        buf.write(",".join(row) + "\n")
+    return buf.getvalue()
+
+
+def table_parquet_bytes(columns: Sequence[tuple[str, np.ndarray]], units: dict[str, str]
+                        ) -> bytes:
+    """A table as Parquet (pyarrow): float64 columns (NaN as null), boolean columns boolean;
+    each field's unit (``units``) in its metadata."""
+    pa, pq = _pyarrow()
+    fields, arrays = [], []
+    for name, values in columns:
+        unit = units.get(name, "")
+        if np.asarray(values).dtype == bool:
+            arr = pa.array(np.asarray(values, dtype=bool))
+            typ = pa.bool_()
+        else:
+            values = np.asarray(values, dtype=float)
+            arr = pa.array(values, mask=np.isnan(values), type=pa.float64())
+            typ = pa.float64()
+        fields.append(pa.field(name, typ, metadata={"unit": unit} if unit else None))
+        arrays.append(arr)
+    table = pa.Table.from_arrays(arrays, schema=pa.schema(fields))
+    sink = io.BytesIO()
+    pq.write_table(table, sink)
+    return sink.getvalue()
+
+
+def write_table(path: str | Path, columns: Sequence[tuple[str, np.ndarray]],
+                units: dict[str, str]) -> None:
+    """Write a table to ``path``, .csv or .parquet by its suffix, atomically (a temporary
+    file renamed: nothing half-written is left)."""
+    kind = table_format(path)
+    if kind == "csv":
+        atomic_write_text(path, table_csv_text(columns))
+    else:
+        atomic_write_bytes(path, table_parquet_bytes(columns, units))
 
 
 def _number(v: float) -> str:
@@ -600,29 +625,55 @@ def run_sweep(
         The same numbers whichever way the runs were spread.
     """
     grid = sweep_grid(scenario, varies, viscosity_ratio)
-    task = _Task(scenario, rtol, atol)
+    parts = run_chunks(_Task(scenario, rtol, atol), grid, workers=workers, scheduler=scheduler,
+                       client=client, chunk_size=chunk_size, progress=progress)
+    return SweepResult(grid, _concatenate(parts))
+
+
+def run_chunks(task, grid: SweepGrid, *, workers: int | None = None, scheduler: str | None = None,
+               client: Any = None, chunk_size: int | None = None,
+               progress: Callable[[int, int], None] | None = None, largest_chunk: int = 2048,
+               threads: int = 1) -> list:
+    """Run the rows of ``grid`` in chunks: ``task.run(grid, lo, hi, parallel)`` for each, here
+    (``parallel=True``; ``threads`` chunks at a time) or on Dask (``parallel=False``, one
+    chunk per single-threaded worker task); the parts in row order.
+
+    ``progress(done, total)`` after each finished chunk. The same parts whichever way.
+    """
     m = grid.n_runs
     distributed_run = client is not None or scheduler is not None or workers is not None
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int)
                                 or workers < 1):
         raise ParameterError(f"--workers must be an integer >= 1, got {workers!r}")
     if chunk_size is None:
-        chunk_size = 2048 if not distributed_run else max(64, min(2048, -(-m // (8 * (
-            workers or 4)))))
+        chunk_size = largest_chunk if not distributed_run else max(
+            min(64, largest_chunk), min(largest_chunk, -(-m // (8 * (workers or 4)))))
     if chunk_size < 1:
         raise ParameterError(f"chunk size must be >= 1, got {chunk_size}")
     bounds = [(lo, min(m, lo + chunk_size)) for lo in range(0, m, chunk_size)]
-    if not distributed_run:
-        parts = []
-        done = 0
-        for lo, hi in bounds:
-            parts.append(task.run(grid, lo, hi, parallel=True))
+    if distributed_run:
+        return _run_on_dask(task, grid, bounds, workers, scheduler, client, progress)
+    parts: list = [None] * len(bounds)
+    done = 0
+    if threads <= 1:
+        for k, (lo, hi) in enumerate(bounds):
+            parts[k] = task.run(grid, lo, hi, parallel=True)
             done += hi - lo
             if progress is not None:
                 progress(done, m)
-        return SweepResult(grid, _concatenate(parts))
-    parts = _run_on_dask(task, grid, bounds, workers, scheduler, client, progress)
-    return SweepResult(grid, _concatenate(parts))
+        return parts
+    from concurrent.futures import ThreadPoolExecutor, as_completed
+
+    with ThreadPoolExecutor(threads) as pool:
+        futures = {pool.submit(task.run, grid, lo, hi, True): k
+                   for k, (lo, hi) in enumerate(bounds)}
+        for fut in as_completed(futures):
+            k = futures[fut]
+            parts[k] = fut.result()
+            done += bounds[k][1] - bounds[k][0]
+            if progress is not None:
+                progress(done, m)
+    return parts
 
 
 def _run_on_dask(task, grid, bounds, workers, scheduler, client, progress) -> list[BatchResult]:
