@@ -175,3 +175,44 @@ def test_simulate_prints_the_hip_fraction_of_its_json(capsys):
     _, out, _ = run(capsys, *argv, "--json")
     assert f"hip fraction (anti-phase leg–trunk mode): {json.loads(out)['hip_fraction']:.3f}" \
         in text
+
+
+def test_the_figures_of_frf_and_fit_frf_are_written(capsys, trial, tmp_path):
+    """--plot and --plot-cycles write images; fit-frf --plot draws every condition with its
+    fitted curve, and the curve is the fit's model FRF."""
+    bode, cycles, fitted = tmp_path / "b.png", tmp_path / "c.svg", tmp_path / "f.pdf"
+    code, out, err = run(capsys, "frf", "--data", str(trial), "--stimulus", "tilt",
+                         "--response", "com_angle", "--cycle-length", "20",
+                         "--discard-cycles", "1", "--plot", str(bode), "--plot-cycles",
+                         str(cycles))
+    assert code == 0, err
+    assert bode.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and b"<svg" in cycles.read_bytes()[:500]
+    assert f"wrote {cycles}" in out
+    code, out, err = run(capsys, "fit-frf", "--data", str(trial), "--data", str(trial),
+                         "--stimulus", "tilt", "--response", "com_angle", "--cycle-length",
+                         "20", "--discard-cycles", "1", "--controller", "peterka-2002",
+                         "--free", "active_stiffness", "--plot", str(fitted))
+    assert code == 0, err
+    assert fitted.read_bytes()[:4] == b"%PDF"
+    code, _, err = run(capsys, "frf", "--data", str(trial), "--stimulus", "tilt", "--response",
+                       "com_angle", "--cycle-length", "20", "--plot-cycles", "c.txt")
+    assert code == 2 and "must end in .png, .svg or .pdf, got 'c.txt'" in err
+
+
+def test_fit_curves_are_the_fitted_models_frf(trial):
+    from posturelab.frequency.data import read_series_csv
+    from posturelab.frequency.fit import fit_frf
+
+    fs, cols = read_series_csv(trial, ["tilt", "com_angle"])
+    est = estimate_frf(cols["tilt"][:-1], cols["com_angle"][:-1], fs, 20.0, discard_cycles=1,
+                       response_sign=-1)
+    body = pl.get_body("paper-1link")
+    preset = get_controller("peterka-2002")
+    fit = fit_frf(body, preset.muscles(body), est, ["active_stiffness"],
+                  feedback_delay=preset.feedback_delay)
+    (f, h), = fit.curves
+    assert f[0] < est.frequency[0] and f[-1] > est.frequency[-1] and f.size == 200
+    muscles = preset.muscles(body).with_active_feedback(
+        [fit.estimates[0]], preset.muscles(body).active_viscosities)
+    np.testing.assert_allclose(h, model_frf(body, muscles, f, **preset.run_options()),
+                               rtol=1e-12)

@@ -21,7 +21,7 @@ from posturelab.cli import main
 from posturelab.errors import PostureLabError
 from posturelab.paper import TABLE_II_PRINTED
 
-FIGS = [f"fig{n:02d}" for n in range(3, 11)]
+FIGS = [f"fig{n:02d}" for n in range(3, 11)] + ["beyond1", "frf", "prts"]
 
 
 @pytest.fixture(scope="module")

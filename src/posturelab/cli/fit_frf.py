@@ -54,6 +54,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="parameters with one value per condition.")
     p.add_argument("--bounds", default="", metavar="NAME=LO:HI,...")
     p.add_argument("--json", action="store_true", help="print one JSON object.")
+    p.add_argument("--plot", metavar="BODE.png",
+                   help="write a Bode plot of every condition with its fitted model (PNG/SVG/"
+                   "PDF).")
     add_muscle_arguments(p)
 
 
@@ -114,7 +117,9 @@ def _bounds(text: str) -> dict:
 
 def run(args: argparse.Namespace) -> int:
     from ..frequency.fit import fit_frf
+    from .frf import check_plot_path
 
+    check_plot_path(args.plot)
     body = body_from_args(args)
     muscles = muscles_from_args(args, body)
     options = feedback_options_from_args(args)
@@ -124,6 +129,15 @@ def run(args: argparse.Namespace) -> int:
                   feedback_delay=options.get("feedback_delay", 0.0),
                   proprioceptive_weight=options.get("proprioceptive_weight", 1.0),
                   per_condition=_names(args.per_condition), bounds=_bounds(args.bounds))
+    if args.plot:
+        from pathlib import Path
+
+        from ..viz.plots import plot_bode, save_figure
+
+        labels = [Path(p).name for p in args.data]
+        curves = [(f, h, f"fit: {label}") for (f, h), label in zip(fit.curves, labels,
+                                                                     strict=True)]
+        save_figure(plot_bode(conditions, labels, model=curves), args.plot)
     if args.json:
         print_json(fit.to_dict())
         return 0
@@ -139,4 +153,6 @@ def run(args: argparse.Namespace) -> int:
         print(f"warning: {w}")
     if not fit.success:
         print(f"warning: the optimiser did not converge: {fit.message}")
+    if args.plot:
+        print(f"wrote {args.plot}")
     return 0

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 
 from ..errors import ParameterError
 from ._common import check_writable, print_json
@@ -54,6 +55,20 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="form of the 95 %% bounds (default periodic).")
     p.add_argument("--json", action="store_true", help="print one JSON object.")
     p.add_argument("--plot", metavar="BODE.png", help="write a Bode plot (PNG/SVG/PDF).")
+    p.add_argument("--plot-cycles", metavar="CYCLES.png",
+                   help="write the stimulus over one cycle and the cycle-averaged response "
+                   "(PNG/SVG/PDF).")
+
+
+def check_plot_path(*paths: str | None) -> None:
+    """Each given figure path ends in .png, .svg or .pdf and can be written."""
+    from pathlib import Path
+
+    given = [p for p in paths if p]
+    for path in given:
+        if Path(path).suffix.lower() not in (".png", ".svg", ".pdf"):
+            raise ParameterError(f"a figure must end in .png, .svg or .pdf, got {path!r}")
+    check_writable(given)
 
 
 def response_sign(stimulus: str, response: str, choice: str) -> int:
@@ -78,12 +93,7 @@ def run(args: argparse.Namespace) -> int:
     from ..frequency.data import read_series_csv
     from ..frequency.estimate import estimate_frf
 
-    if args.plot:
-        from pathlib import Path
-
-        if Path(args.plot).suffix.lower() not in (".png", ".svg", ".pdf"):
-            raise ParameterError(f"--plot must end in .png, .svg or .pdf, got {args.plot!r}")
-        check_writable([args.plot])
+    check_plot_path(args.plot, args.plot_cycles)
     stim, resp = args.stimulus.strip().lower(), args.response.strip().lower()
     fs, cols = read_series_csv(args.data, [stim, resp])
     sign = response_sign(stim, resp, args.response_sign)
@@ -95,6 +105,17 @@ def run(args: argparse.Namespace) -> int:
         from ..viz.plots import plot_bode, save_figure
 
         save_figure(plot_bode([est], [f"{resp} / {stim}"]), args.plot)
+    if args.plot_cycles:
+        from ..viz.plots import plot_prts_cycles, save_figure
+
+        def unit(column: str) -> tuple[str, float]:  # angles in degrees, the rest as read
+            angle = column in ("tilt", "com_angle") or column.startswith("theta")
+            return ("deg", 180 / math.pi) if angle else ("file unit", 1.0)
+
+        save_figure(plot_prts_cycles(est, stimulus_label=stim,
+                                     response_label=("−" if sign < 0 else "") + resp,
+                                     stimulus_unit=unit(stim), response_unit=unit(resp)),
+                    args.plot_cycles)
     if args.json:
         print_json(est.to_dict())
         return 0
@@ -111,6 +132,7 @@ def run(args: argparse.Namespace) -> int:
     if low.any():
         print(f"warning: coherence below 0.5 at {int(low.sum())} band(s): those estimates are "
               "noisy")
-    if args.plot:
-        print(f"wrote {args.plot}")
+    for path in (args.plot, args.plot_cycles):
+        if path:
+            print(f"wrote {path}")
     return 0

@@ -32,7 +32,7 @@ warning in ``warnings``.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -72,6 +72,9 @@ class FRFFit:
     success : bool
     message : str
     warnings : tuple of str
+    curves : tuple of (numpy.ndarray, numpy.ndarray)
+        Per condition, the fitted model's FRF (complex) on 200 log-spaced frequencies [Hz]
+        from a third below the lowest band to a half above the highest (for plots).
     """
 
     names: tuple[str, ...]
@@ -83,6 +86,7 @@ class FRFFit:
     success: bool
     message: str
     warnings: tuple[str, ...] = ()
+    curves: tuple = field(default=(), repr=False)
 
     def unit(self, name: str) -> str:
         """Unit of a fitted parameter."""
@@ -186,7 +190,7 @@ def fit_frf(body: Body, muscles: MuscleSet, data, free, *, input: str = "tilt",
     warnings = tuple(f"condition {k + 1}: coherence below 0.5 at {int(np.sum(c.coherence < 0.5))}"
                      " band(s)" for k, c in enumerate(conditions) if np.any(c.coherence < 0.5))
 
-    def model(p: np.ndarray) -> list[np.ndarray]:
+    def model(p: np.ndarray, dense: bool = False) -> list:
         out = []
         for k, c in enumerate(conditions):
             gains = base.copy()
@@ -210,7 +214,12 @@ def fit_frf(body: Body, muscles: MuscleSet, data, free, *, input: str = "tilt",
                                        gains[3][None] if active else None, tau, w,
                                        input=input, output=output)[0]
 
-            out.append(c.band_average(frf_at) if c.harmonic_weight else frf_at(c.frequency))
+            if dense:
+                f = np.geomspace(c.frequency.min() / 1.5, c.frequency.max() * 1.5, 200)
+                out.append((f, frf_at(f)))
+            else:
+                out.append(c.band_average(frf_at) if c.harmonic_weight
+                           else frf_at(c.frequency))
         return out
 
     def residuals(z: np.ndarray) -> np.ndarray:
@@ -243,4 +252,4 @@ def fit_frf(body: Body, muscles: MuscleSet, data, free, *, input: str = "tilt",
     ci = np.stack([p - q * se, p + q * se], axis=1)
     determined = seen & np.isfinite(se) & (se <= np.abs(p)) & (cond < 1e10)
     return FRFFit(tuple(labels), p, se, ci, determined, float(np.sqrt(s2)), bool(sol.success),
-                  str(sol.message), warnings)
+                  str(sol.message), warnings, tuple(model(p, dense=True)))

@@ -14,9 +14,10 @@ their simulation runner as one parameter (:func:`ramp_and_hold_run`,
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, NamedTuple
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 
@@ -56,6 +57,7 @@ __all__ = [
     "check_fig10", "erratum_notes", "one_sided_finding", "foot_finding",
     "ramp_and_hold_run", "recovery_finding", "delayed_run", "delay_finding",
     "with_delay_margin", "literature_controller_finding", "strategy_finding", "frf_finding",
+    "FRFExperiment", "frf_experiment",
 ]
 
 #: |θ_i| below this counts as back upright (the settling criterion). [rad]
@@ -663,23 +665,48 @@ def strategy_finding(body: Body, foot: BaseOfSupport, ankle_torque_limit: float 
                            RECOVERY_RAMP_DURATION)
 
 
-def frf_finding(seed: int = 20261201) -> FRFFinding:
-    """The tilt FRFs of case 1 and of ``peterka-2002`` on ``paper-1link`` at 0.05, 0.55 and
-    2.2 Hz, and a simulated PRTS experiment (compiled engine, 6 cycles at 100 Hz, the first
-    discarded, seeded sensor noise) fitted for K_P, K_D and τ from 20 % off."""
-    from ..frequency import estimate_frf, model_frf
+@dataclass(frozen=True)
+class FRFExperiment:
+    """The report's simulated PRTS experiment (:func:`frf_experiment`).
+
+    Attributes
+    ----------
+    estimate : FRFEstimate
+        The 11-band estimate of the sway (tilt FRF, the literature's sign).
+    true, fitted, standard_error : tuple of float
+        K_P [N·m/rad], K_D [N·m·s/rad], τ [s]: simulated, fitted, and its standard errors.
+    fit_error : float
+        RMS weighted residual of the fit. [-]
+    cycles : int
+        Cycles analysed (one more ran first and was dropped). [-]
+    noise : float
+        Standard deviation of the white sensor noise on the sway. [rad]
+    """
+
+    estimate: Any
+    true: tuple
+    fitted: tuple
+    standard_error: tuple
+    fit_error: float
+    cycles: int
+    noise: float
+
+
+@functools.lru_cache(maxsize=2)
+def frf_experiment(seed: int = 20261201) -> FRFExperiment:
+    """The ``peterka-2002`` preset on ``paper-1link`` under Peterka's PRTS (0.035 rad peak to
+    peak; compiled engine, 6 cycles at 100 Hz, the first discarded, seeded sensor noise of
+    1 mrad), estimated at the 11 bands and fitted for K_P, K_D and τ from 20 % off."""
+    from ..frequency import estimate_frf
     from ..frequency.fit import fit_frf
-    from ..model.body import get_body, paper_body
+    from ..model.body import get_body
     from ..model.controllers import get_controller
     from ..model.tilt import PRTSTilt
     from ..simulation import simulate
 
-    f = np.array([0.05, 0.55, 2.2])
-    paper = model_frf(paper_body(), paper_muscles("1"), f)
     body = get_body("paper-1link")
     preset = get_controller("peterka-2002")
     muscles = preset.muscles(body)
-    delayed = model_frf(body, muscles, f, **preset.run_options())
     cycles, noise, fs = 5, 0.001, 100.0
     tilt = PRTSTilt.peterka_2002(0.035)
     r = simulate(body, muscles, None, 20.0 * (cycles + 1), tilt=tilt, sample_rate=fs,
@@ -692,12 +719,30 @@ def frf_finding(seed: int = 20261201) -> FRFFinding:
     start = muscles.with_active_feedback([0.8 * true[0]], [1.2 * true[1]])
     fit = fit_frf(body, start, est, ["active_stiffness", "active_viscosity", "feedback_delay"],
                   feedback_delay=0.8 * true[2])
+    return FRFExperiment(est, tuple(float(v) for v in true),
+                         tuple(float(v) for v in fit.estimates),
+                         tuple(float(v) for v in fit.standard_errors), float(fit.fit_error),
+                         cycles, noise)
+
+
+def frf_finding(seed: int = 20261201) -> FRFFinding:
+    """The tilt FRFs of case 1 and of ``peterka-2002`` on ``paper-1link`` at 0.05, 0.55 and
+    2.2 Hz, and the simulated PRTS experiment of :func:`frf_experiment` fitted."""
+    from ..frequency import model_frf
+    from ..model.body import get_body, paper_body
+    from ..model.controllers import get_controller
+
+    f = np.array([0.05, 0.55, 2.2])
+    paper = model_frf(paper_body(), paper_muscles("1"), f)
+    body = get_body("paper-1link")
+    preset = get_controller("peterka-2002")
+    delayed = model_frf(body, preset.muscles(body), f, **preset.run_options())
+    exp = frf_experiment(seed)
 
     def phase(h):
         return tuple(float(p) for p in np.degrees(np.unwrap(np.angle(h))))
 
     return FRFFinding(tuple(float(v) for v in f), tuple(float(v) for v in np.abs(paper)),
                       phase(paper), tuple(float(v) for v in np.abs(delayed)), phase(delayed),
-                      tuple(float(v) for v in true), tuple(float(v) for v in fit.estimates),
-                      tuple(float(v) for v in fit.standard_errors), cycles, noise,
-                      float(fit.fit_error))
+                      exp.true, exp.fitted, exp.standard_error, exp.cycles, exp.noise,
+                      exp.fit_error)

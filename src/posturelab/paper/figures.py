@@ -34,6 +34,8 @@ FIGURE_STEPS: dict[str, str] = {
     "fig09": "Fig. 9: centre-of-gravity phase plane",
     "fig10": "Fig. 10: centre-of-gravity phase plane",
     "beyond1": "Beyond the paper: the real one-sided gastrocnemius in the forward case 1",
+    "frf": "Beyond the paper: tilt FRFs (Bode) of the models and of a simulated PRTS experiment",
+    "prts": "Beyond the paper: the PRTS stimulus and the cycle-averaged sway",
 }
 
 _PHASE_TITLES = {
@@ -157,10 +159,49 @@ def _beyond1(runs: PaperRuns, names: list[str]) -> Figure:
     return fig
 
 
+def _frf(runs: PaperRuns, names: list[str]) -> Figure:
+    """Bode plot: the simulated experiment's estimate with its 95 % bounds, and the model
+    FRFs of the paper's case 1, of the peterka-2002 preset and of the fit."""
+    from ..frequency import model_frf
+    from ..model.body import get_body, paper_body
+    from ..model.controllers import get_controller
+    from ..model.muscles import paper_muscles
+    from ..viz.plots import plot_bode
+    from .checks import frf_experiment
+
+    exp = frf_experiment()
+    f = np.geomspace(0.03, 3.0, 200)
+    body = get_body("paper-1link")
+    preset = get_controller("peterka-2002")
+    muscles = preset.muscles(body)
+    kp, kd, tau = exp.fitted
+    fitted = muscles.with_active_feedback([kp], [kd])
+    curves = [
+        (f, model_frf(paper_body(), paper_muscles("1"), f),
+         "paper case 1, 3 links (instantaneous impedance)"),
+        (f, model_frf(body, muscles, f, **preset.run_options()),
+         "peterka-2002 on one link (150 ms delay)"),
+        (f, model_frf(body, fitted, f, feedback_delay=tau), "fitted to the simulated experiment"),
+    ]
+    fig = plot_bode([exp.estimate], [f"simulated PRTS experiment ({exp.cycles} cycles, "
+                                     f"{exp.noise * 1000:g} mrad sensor noise)"], model=curves)
+    fig.suptitle("Tilt FRF of the centre-of-mass sway (gain 1, phase 0: following the surface)",
+                 fontsize=10)
+    return fig
+
+
+def _prts(runs: PaperRuns, names: list[str]) -> Figure:
+    from ..viz.plots import plot_prts_cycles
+    from .checks import frf_experiment
+
+    return plot_prts_cycles(frf_experiment().estimate, stimulus_label="tilt α",
+                            response_label="−sway θ")
+
+
 _DRAW: dict[str, Callable[[PaperRuns, list[str]], Figure]] = {
     "fig03": _fig3, "fig04": _fig4, "fig05": _fig5, "fig06": _fig6,
     "fig07": _phase(7), "fig08": _phase(8), "fig09": _phase(9), "fig10": _phase(10),
-    "beyond1": _beyond1,
+    "beyond1": _beyond1, "frf": _frf, "prts": _prts,
 }
 
 

@@ -14,7 +14,8 @@ Figs. 3–10 (:mod:`.figures`), and writes into a directory:
   and the numbers behind it, the errata, and findings beyond the paper;
 * ``table2.csv`` — one row per printed pole (54): case, column, printed,
   computed_re, computed_im, agrees, erratum;
-* ``fig03.png`` … ``fig10.png`` and ``.svg``, and ``beyond1.png/.svg``.
+* ``fig03.png`` … ``fig10.png`` and ``.svg``, and ``beyond1``, ``frf`` (tilt FRFs) and
+  ``prts`` (the PRTS cycle averages) ``.png/.svg``.
 
 Everything is built in a hidden temporary directory inside the output
 directory and then renamed into place file by file, so a failure (or an
@@ -196,7 +197,8 @@ def render_index(paper: PaperChecks, images: Mapping[str, bytes],
     paper : PaperChecks
         Everything computed.
     images : mapping of str to bytes
-        PNG of each figure, by stem (``"fig03"`` … ``"fig10"``, ``"beyond1"``).
+        PNG of each figure, by stem (``"fig03"`` … ``"fig10"``, ``"beyond1"``, ``"frf"``,
+        ``"prts"``).
     version : str, optional
         The posturelab version named on the page; the installed one by default.
 

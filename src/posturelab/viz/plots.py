@@ -45,6 +45,9 @@ __all__ = [
     "plot_run_overview",
     "figure_bytes",
     "save_figure",
+    "plot_delay_stability_map",
+    "plot_bode",
+    "plot_prts_cycles",
     "LINK_COLORS",
     "PAIR_COLORS",
 ]
@@ -517,10 +520,18 @@ def plot_bode(estimates, labels=None, model=None) -> Figure:
                               est.phase_ci95_deg[ok, 1], color=line.get_color(), alpha=0.2)
         ax_p.semilogx(est.frequency, est.phase_deg, "o-", ms=4, color=line.get_color())
         ax_c.semilogx(est.frequency, est.coherence, "o-", ms=4, color=line.get_color())
-    for f, h, label in model or ():
+    styles = [("k", "--"), ("#d62728", "-."), ("#2ca02c", ":"), ("#9467bd", "--")]
+    for k, (f, h, label) in enumerate(model or ()):
         f, h = np.asarray(f), np.asarray(h)
-        ax_g.loglog(f, np.abs(h), "k--", lw=1.2, label=label)
-        ax_p.semilogx(f, np.degrees(np.unwrap(np.angle(h))), "k--", lw=1.2)
+        color, ls = styles[k % len(styles)]
+        ax_g.loglog(f, np.abs(h), color=color, ls=ls, lw=1.3, label=label)
+        ax_p.semilogx(f, np.degrees(np.unwrap(np.angle(h))), color=color, ls=ls, lw=1.3)
+    from matplotlib.ticker import FormatStrFormatter, LogLocator, NullFormatter
+
+    ax_g.yaxis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0)))
+    ax_g.yaxis.set_major_formatter(FormatStrFormatter("%g"))
+    ax_g.yaxis.set_minor_formatter(NullFormatter())
+    ax_c.xaxis.set_major_formatter(FormatStrFormatter("%g"))
     ax_g.set_ylabel("gain")
     ax_p.set_ylabel("phase [deg]")
     ax_c.set_ylabel("coherence")
@@ -529,6 +540,43 @@ def plot_bode(estimates, labels=None, model=None) -> Figure:
     ax_g.legend(fontsize=8)
     for ax in (ax_g, ax_p, ax_c):
         ax.grid(True, which="both", alpha=0.3)
+    return fig
+
+
+def plot_prts_cycles(estimate, *, stimulus_label: str = "tilt",
+                     response_label: str = "response",
+                     stimulus_unit: tuple[str, float] = ("deg", 180.0 / np.pi),
+                     response_unit: tuple[str, float] = ("deg", 180.0 / np.pi)) -> Figure:
+    """The stimulus over one cycle and the response averaged over the cycles used (the
+    time-domain cycle averages of an FRF estimate), against time within the cycle [s].
+
+    Parameters
+    ----------
+    estimate : posturelab.frequency.FRFEstimate
+    stimulus_label, response_label : str
+        Axis words.
+    stimulus_unit, response_unit : (str, float)
+        The plotted unit and the factor from the series' unit to it (radians to degrees by
+        default).
+
+    Returns
+    -------
+    Figure
+    """
+    x = np.asarray(estimate.cycle_stimulus) * stimulus_unit[1]
+    y = np.asarray(estimate.cycle_response) * response_unit[1]
+    t = np.arange(x.size) * estimate.cycle_length / x.size
+    fig, (ax_x, ax_y) = new_figure(2, 1, figsize=(6.5, 5.0), sharex=True)
+    ax_x.plot(t, x, color="0.25", lw=1.2, drawstyle="default")
+    ax_x.set_ylabel(f"{stimulus_label} [{stimulus_unit[0]}]")
+    ax_x.set_title(f"One {estimate.cycle_length:g} s cycle of the stimulus, and the response "
+                   f"averaged over {estimate.n_cycles} cycles", fontsize=10)
+    ax_y.plot(t, y, color="#1f77b4", lw=1.2)
+    ax_y.set_ylabel(f"{response_label} [{response_unit[0]}]")
+    ax_y.set_xlabel("time within the cycle [s]")
+    for ax in (ax_x, ax_y):
+        ax.grid(True, alpha=0.3)
+        ax.axhline(0.0, color="0.6", lw=0.6)
     return fig
 
 
