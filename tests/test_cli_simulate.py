@@ -24,8 +24,12 @@ def test_simulate_csv_and_json(tmp_path, capsys):
                             "--duration", "5", "--out", str(out), "--json")
     assert code == 0, err
     summary = json.loads(stdout)
-    assert set(summary) == {"fell", "fall_time", "status", "max_abs_theta", "final_state",
-                            "hip_fraction"}
+    assert set(summary) == {"outcome", "settling_time", "fall_time", "fall_reason",
+                            "final_lean", "final_rate", "outcome_message", "fell", "status",
+                            "message", "max_abs_theta", "final_state", "hip_fraction",
+                            "linear_stability"}
+    assert summary["outcome"] == "recovered" and 0 < summary["settling_time"] < 5
+    assert summary["linear_stability"]["stable"] is True
     assert 0.0 <= summary["hip_fraction"] <= 1.0
     assert summary["fell"] is False and summary["fall_time"] is None
     assert summary["status"] == "completed"

@@ -58,10 +58,18 @@ def test_cli_sweep_csv_equals_batch_and_single_runs(tmp_path, capsys):
     k[:, 0] = values[:, 0]
     k[:, 4] = values[:, 1]
     batch = simulate_batch(paper_body(), k, 0.25 * k, VelocityStep.backward(1.0), 2.0, POSTURE)
-    assert [r[2] for r in rows] == ["true" if f else "false" for f in batch.fell]
-    got = np.array([[cell(x) for x in r[3:]] for r in rows])
-    want = np.column_stack([batch.fall_time, batch.peak_theta, batch.settling_time])
+    assert [r[2] for r in rows] == list(batch.outcome)
+    assert [r[3] for r in rows] == ["true" if f else "false" for f in batch.fell]
+    got = np.array([[cell(x) for x in r[4:]] for r in rows])
+    n = 3
+    want = np.column_stack([batch.fall_time, batch.peak_theta, batch.settling_time,
+                            np.abs(batch.final_state[:, :n]).max(axis=1),
+                            np.abs(batch.final_state[:, n:]).max(axis=1)])
     np.testing.assert_array_equal(got, want)
+    # the words follow the rule of posturelab.simulation.outcome, as the single run's
+    assert rows[0][2] == "fell" and rows[-1][2] == simulate_fast(
+        paper_body(), paper_muscles(stiffness=k[-1], viscosity=0.25 * k[-1]),
+        VelocityStep.backward(1.0), 2.0, initial_state=POSTURE).outcome.kind
     assert batch.fell[0] and not batch.fell[-1]
     one = simulate_fast(paper_body(), paper_muscles(stiffness=k[-1], viscosity=0.25 * k[-1]),
                         VelocityStep.backward(1.0), 2.0, initial_state=POSTURE)
@@ -82,7 +90,7 @@ def test_parquet_round_trip(tmp_path):
     assert table.schema.field("ankle").metadata[b"unit"] == "N·m/rad".encode()
     for name, values in result.columns():
         col = table.column(name).to_numpy(zero_copy_only=False)
-        if name == "fell":
+        if name in ("fell", "outcome"):
             np.testing.assert_array_equal(col, values)
         else:
             np.testing.assert_array_equal(np.asarray(col, dtype=float), values)
@@ -162,8 +170,9 @@ def test_cli_scenario_base_and_progress_bar(tmp_path, capsys):
     m = paper_muscles("1", gastrocnemius="one-sided", viscosity_ratio=0.3)
     one = simulate_fast(paper_body(), m.with_stiffness(knee=300.0), VelocityStep(-0.5), 1.0,
                         initial_state=POSTURE)
-    np.testing.assert_allclose([cell(x) for x in rows[1][3:6]], one.max_abs_theta, rtol=0,
-                               atol=0)
+    first = header.index("peak_theta1")
+    np.testing.assert_allclose([cell(x) for x in rows[1][first:first + 3]], one.max_abs_theta,
+                               rtol=0, atol=0)
 
 
 @pytest.mark.parametrize("vary, words", [
@@ -253,7 +262,7 @@ def test_sweep_over_a_joint_torque_limit_equals_single_runs(tmp_path):
                  "--vary", "knee_torque_limit=20:60:3", "--torque-limits", "inf,inf,30",
                  "--out", str(tmp_path / "limits.csv")]) == 0
     header = (tmp_path / "limits.csv").read_text().splitlines()[0]
-    assert header.startswith("knee_torque_limit,fell")
+    assert header.startswith("knee_torque_limit,outcome,fell")
 
 
 def test_a_one_link_sweep_over_delay_active_gain_and_weight_equals_single_runs(tmp_path,

@@ -58,9 +58,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     out.add_argument("--plot", metavar="RUN.png", help="write a 2×2 summary figure (PNG/SVG/PDF).")
     out.add_argument("--animate", metavar="RUN.gif", help="write a stick-figure animation (GIF).")
     out.add_argument("--json", action="store_true",
-                     help='print one JSON summary: {"fell", "fall_time", "status", '
-                     '"max_abs_theta", "final_state", "hip_fraction"}; hip_fraction [-] is the '
-                     'share of the anti-phase (hip) mode of leg and trunk, null for one link.')
+                     help='print one JSON summary: {"outcome" (recovered, not recovered, fell, '
+                     'failed), "settling_time", "fall_time", "fall_reason", "final_lean", '
+                     '"final_rate", "outcome_message", "fell", "status", "message", '
+                     '"max_abs_theta", "final_state", "hip_fraction", "linear_stability" '
+                     '({"stable", "rightmost_root", "feedback_delay"})}; hip_fraction [-] is '
+                     'the share of the anti-phase (hip) mode of leg and trunk, null for one '
+                     'link.')
     p.add_argument("--engine", choices=["reference", "compiled"], default="reference",
                    help="reference (default): the numpy model integrated by scipy at the "
                    "scenario's solver settings; compiled: the C engine (hundreds of times "
@@ -307,18 +311,27 @@ def run(args: argparse.Namespace) -> int:
         from ..viz.animation import animate
 
         animate(result, sc.body, args.animate)
+    from ..linear.delay import upright_stability
+
+    verdict = upright_stability(sc.body, sc.muscles, sc.feedback_delay)
+    outcome = result.outcome
     if args.json:
-        print_json(result.summary())
+        print_json({**result.summary(), "linear_stability": verdict.to_dict()})
     else:
         peaks = ", ".join(f"{x:.4f}" for x in result.max_abs_theta)
         print(f"{sc.description}")
+        print(f"outcome: {outcome.message}")
         print(f"status: {result.status} ({result.message})")
+        print(f"linear model: {verdict.describe()}")
         print(f"peak |θ| [rad]: {peaks}")
         if sc.body.n_links >= 2:
             print(f"hip fraction (anti-phase leg–trunk mode): {result.hip_fraction:.3f}")
         print("final state [rad, rad/s]: " + ", ".join(f"{x:.4g}" for x in result.final_state))
         for path in outputs:
             print(f"wrote {path}")
+    if not verdict.stable:
+        print(f"posturelab: warning: these gains are {verdict.describe()} for this body",
+              file=sys.stderr)
     if result.status == "failed":
         print(f"posturelab: warning: {result.message}", file=sys.stderr)
         return 1

@@ -43,10 +43,13 @@ ratio times its stiffness: the varied viscosity_ratio, else --viscosity-ratio, e
 base experiment's (0.25, the paper's, for --case).
 
 Columns: the varied parameters, then {", ".join(OUTCOME_COLUMNS)} (one peak_theta
-per link). fell is true/false; fall_time [s] is empty if the run did not fall; peak_thetaI [rad]
+per link). outcome is recovered (completed, ending within ±0.01 rad of upright and below
+0.05 rad/s), not recovered (completed but ending farther or still moving), fell or failed;
+fell is true/false; fall_time [s] is empty if the run did not fall; peak_thetaI [rad]
 are the largest |θ_i| over the samples; settling_time [s] is the last sample time at which
 some |θ_i| exceeded 0.01 rad (0 if none did; empty if the run fell or had not settled by
-the end). The file type follows the suffix of --out: .csv or .parquet (pyarrow); it is
+the end); final_lean [rad] and final_rate [rad/s] are the largest |θ_i| and |θ̇_i| at the
+last sample. The file type follows the suffix of --out: .csv or .parquet (pyarrow); it is
 written to a temporary file and renamed, so no half-written file is left behind.
 
 Everything of the base experiment carries into every run: --torque-limits, --feedback-delay,
@@ -160,9 +163,11 @@ def run(args: argparse.Namespace) -> int:
     o = result.outcomes
     shape = " × ".join(str(v.count) for v in varies)
     failed = int((o.status_code >= 2).sum())
-    print(f"wrote {args.out}: {o.n_runs} runs ({shape}: {', '.join(result.grid.names)}), "
-          f"{int(o.fell.sum())} fell" + (f", {failed} failed" if failed else "")
-          + f", in {elapsed:.2f} s")
+    kinds = o.outcome
+    counts = ", ".join(f"{int((kinds == k).sum())} {k}" for k in
+                       ("recovered", "not recovered", "fell", "failed") if (kinds == k).any())
+    print(f"wrote {args.out}: {o.n_runs} runs ({shape}: {', '.join(result.grid.names)}): "
+          f"{counts}, in {elapsed:.2f} s")
     if failed:
         print(f"posturelab: warning: {failed} runs failed to integrate (fell = false, "
               "outcomes up to the failure)", file=sys.stderr)

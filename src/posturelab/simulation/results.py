@@ -229,13 +229,28 @@ class SimulationResult:
             return 0.0
         return float(self.time[np.nonzero(outside)[0][-1]])
 
+    @property
+    def outcome(self):
+        """What happened: recovered, not recovered, fell or failed, with the settling time,
+        the fall's reason and time, the final lean and rate
+        (:class:`posturelab.simulation.outcome.Outcome`; the bands there)."""
+        from .outcome import UPRIGHT_BAND, classify
+
+        return classify(self.status, self.settling_time(UPRIGHT_BAND), self.final_state,
+                        fall_time=self.fall_time, fall_reason=self.fall_reason,
+                        message=self.message)
+
     def summary(self) -> dict:
-        """Plain-Python summary (the CLI's ``--json``): angles [rad], times [s], the hip
-        fraction [-] (None for one link)."""
+        """Plain-Python summary (the CLI's ``--json``): the outcome (``outcome``,
+        ``settling_time``, ``fall_time``, ``fall_reason``, ``final_lean``, ``final_rate``,
+        ``outcome_message``), angles [rad], rates [rad/s], times [s], the hip fraction [-]
+        (None for one link)."""
         return {
+            **self.outcome.to_dict(),
             "fell": bool(self.fell),
             "fall_time": None if self.fall_time is None else float(self.fall_time),
             "status": self.status,
+            "message": self.message,
             "max_abs_theta": [float(x) for x in self.max_abs_theta],
             "final_state": [float(x) for x in self.final_state],
             "hip_fraction": None if self.n_links < 2 else float(self.hip_fraction),

@@ -49,6 +49,7 @@ from ..model.muscles import DEFAULT_VISCOSITY_RATIO, PAPER_PAIR_NAMES
 from ..model.platform import NoDisturbance
 from ..scenarios import Scenario
 from ..simulation.compiled import DEFAULT_ATOL, DEFAULT_RTOL, BatchResult, simulate_batch
+from ..simulation.outcome import UPRIGHT_BAND
 from ..simulation.results import atomic_write_bytes, atomic_write_text
 
 __all__ = [
@@ -109,14 +110,16 @@ PARAMETER_UNITS: dict[str, str] = {n: parameter_unit(n) for n in SWEEP_PARAMETER
 #: Largest number of runs one sweep may ask for (a bound on the work and memory). [-]
 MAX_RUNS = 10_000_000
 #: Outcome columns of a sweep table (after the varied parameters), for 3 links.
-OUTCOME_COLUMNS: tuple[str, ...] = ("fell", "fall_time", "peak_theta1", "peak_theta2",
-                                    "peak_theta3", "settling_time")
+OUTCOME_COLUMNS: tuple[str, ...] = ("outcome", "fell", "fall_time", "peak_theta1",
+                                    "peak_theta2", "peak_theta3", "settling_time",
+                                    "final_lean", "final_rate")
 #: Unit of each outcome column ('' for the flag).
-OUTCOME_UNITS: dict[str, str] = {"fell": "", "fall_time": "s", "peak_theta1": "rad",
-                                 "peak_theta2": "rad", "peak_theta3": "rad",
-                                 "settling_time": "s"}
+OUTCOME_UNITS: dict[str, str] = {"outcome": "", "fell": "", "fall_time": "s",
+                                 "peak_theta1": "rad", "peak_theta2": "rad",
+                                 "peak_theta3": "rad", "settling_time": "s",
+                                 "final_lean": "rad", "final_rate": "rad/s"}
 #: Angle threshold of the settling time. [rad]
-SETTLE_TOLERANCE = 0.01
+SETTLE_TOLERANCE = UPRIGHT_BAND
 
 _NUMBER = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
 _VARY_RE = re.compile(rf"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*=\s*({_NUMBER})\s*:\s*({_NUMBER})"
@@ -387,11 +390,15 @@ class SweepResult:
         :data:`OUTCOME_UNITS`)."""
         cols = [(name, self.grid.values[:, k]) for k, name in enumerate(self.grid.names)]
         o = self.outcomes
+        n = o.final_state.shape[1] // 2
+        cols.append(("outcome", o.outcome))
         cols.append(("fell", o.fell))
         cols.append(("fall_time", o.fall_time))
         for i in range(o.peak_theta.shape[1]):
             cols.append((f"peak_theta{i + 1}", o.peak_theta[:, i]))
         cols.append(("settling_time", o.settling_time))
+        cols.append(("final_lean", np.abs(o.final_state[:, :n]).max(axis=1)))
+        cols.append(("final_rate", np.abs(o.final_state[:, n:]).max(axis=1)))
         return cols
 
     def units(self) -> dict[str, str]:
@@ -424,6 +431,8 @@ def table_csv_text(columns: Sequence[tuple[str, np.ndarray]]) -> str:
         values = np.asarray(values)
         if values.dtype == bool:
             text_cols.append(np.where(values, "true", "false"))
+        elif values.dtype.kind in "US":
+            text_cols.append(values.astype(str))
         else:
             text_cols.append(np.array([_number(v) for v in values.tolist()], dtype=object))
     for row in zip(*text_cols, strict=True):
@@ -442,6 +451,9 @@ def table_parquet_bytes(columns: Sequence[tuple[str, np.ndarray]], units: dict[s
         if np.asarray(values).dtype == bool:
             arr = pa.array(np.asarray(values, dtype=bool))
             typ = pa.bool_()
+        elif np.asarray(values).dtype.kind in "US":
+            arr = pa.array(np.asarray(values).astype(str).tolist(), type=pa.string())
+            typ = pa.string()
         else:
             values = np.asarray(values, dtype=float)
             arr = pa.array(values, mask=np.isnan(values), type=pa.float64())

@@ -372,6 +372,14 @@ class BatchResult:
         """"completed", "fell" or "failed" per run (as ``SimulationResult.status``)."""
         return np.array(STATUS_NAMES)[self.status_code]
 
+    @property
+    def outcome(self) -> np.ndarray:
+        """"recovered", "not recovered", "fell" or "failed" per run
+        (:mod:`posturelab.simulation.outcome`, as ``SimulationResult.outcome``)."""
+        from ..outcome import classify_rows
+
+        return classify_rows(self.status, self.settling_time, self.final_state)
+
 
 def _per_run(name: str, value, m: int, width: int | None) -> np.ndarray:
     """A scalar/row broadcast to every run, or one value/row per run."""
