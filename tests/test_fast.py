@@ -33,6 +33,7 @@ from posturelab.simulate import (
     simulate,
 )
 
+import posturelab as pl
 from posturelab.errors import ParameterError
 from posturelab.scenarios import builtin_scenario, builtin_scenario_names
 from posturelab.simulation.derived import derived_series
@@ -502,3 +503,20 @@ def test_batch_disturbance_scale_with_a_knee_stop_starts_each_level_as_its_singl
     empty = simulate_batch(paper_body(), np.zeros((0, 5)), np.zeros((0, 5)), step, 1.0,
                            disturbance_scale=np.zeros(0))
     assert empty.n_runs == 0
+
+
+@pytest.mark.parametrize("engine", ["reference", "compiled"])
+def test_a_knee_at_its_stop_that_the_muscles_pull_off_is_released_at_once(engine):
+    """Upright at rest with the knee at its stop (κ = 0) and a forward step: the free knee
+    acceleration is negative from t = 0, so the knee flexes instead of being held by the
+    stop (before, it stayed locked: the stop pulled)."""
+    body, muscles = pl.paper_body(), pl.paper_muscles("1")
+    r = pl.simulate(body, muscles, pl.VelocityStep.forward(0.5), 3.0,
+                    knee=pl.KneeModel("stop"), engine=engine)
+    kappa = r.theta[:, 1] - r.theta[:, 0]
+    assert kappa.min() < -0.01 and kappa.max() <= 1e-9
+    assert np.all(np.diff(kappa[:50]) < 0)  # it leaves the stop from the first sample
+    other = pl.simulate(body, muscles, pl.VelocityStep.forward(0.5), 3.0,
+                        knee=pl.KneeModel("stop"),
+                        engine="compiled" if engine == "reference" else "reference")
+    np.testing.assert_allclose(r.theta, other.theta, atol=1e-6)

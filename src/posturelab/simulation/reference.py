@@ -133,6 +133,10 @@ def integrate_reference(setup: RunSetup, method: str = "DOP853") -> SimulationRe
             return acc[1] - acc[0] + offset
         return release
 
+    if locked and knee.mode == "stop" and event_function(
+            ev.KNEE_LEAVES_STOP, 1, 0.0, active, False, saturation)(0.0, x) < 0.0:
+        locked = False  # at its stop, but the muscles pull the knee off it at once
+
     grid = setup.grid
     stops = setup.stops
     max_step = setup.max_step

@@ -106,7 +106,9 @@ class RunSetup:
         The state the integration starts from (after the step, on the knee constraint
         if the knee starts locked). [rad], [rad/s]
     locked0 : bool
-        The knee starts locked (mode ``locked``, or at its stop and not flexing).
+        The knee starts locked (mode ``locked``, or at its stop and not flexing); with a
+        stop, both engines release it at t = 0 when the free knee acceleration already
+        points away from the stop (the knee-leaves-stop event is then past its root).
     active0 : numpy.ndarray, shape (P,)
         1 for each pair that acts at the start, 0 for a slack one-sided pair. [-]
     saturation0 : numpy.ndarray, shape (N,)

@@ -161,6 +161,9 @@ int64_t pl_integrate(const pl_run *run, pl_out *out)
             pl_moment_gains(run->E, run->C, run->gains + 2 * run->p, run->gains + 3 * run->p,
                             b.active, run->p, n, b.tm + 2 * n * n, b.tm + 3 * n * n);
             pl_set_base(x, b.base, n);
+            if (t == 0.0 && locked && run->ipar[I_KNEE_MODE] == KNEE_STOP
+                && pl_event_value(&cx, EV_KNEE_LEAVES_STOP, 1, 0.0, t, x, locked) < 0.0)
+                locked = 0;  /* at its stop, but the muscles pull the knee off it at once */
             n_ev = segment_events(run, b.sat, b.active, locked, b.ev_kind, b.ev_index,
                                   b.ev_side);
             for (int64_t e = 0; e < n_ev; e++)
