@@ -65,12 +65,12 @@ def _condition(path: str, args: argparse.Namespace):
 
     import numpy as np
 
+    from .._files import read_text
     from ..frequency.estimate import FRFEstimate
 
     if path.lower().endswith(".json"):
         try:
-            with open(path, encoding="utf-8") as fh:
-                obj = json.load(fh)
+            obj = json.loads(read_text(path, "FRF JSON"))
             f = np.array(obj["frequency"], dtype=float)
             H = np.array([complex(z["re"], z["im"]) for z in obj["frf"]])
             coh = np.array(obj["coherence"], dtype=float)

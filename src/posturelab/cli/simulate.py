@@ -272,16 +272,13 @@ def _scenario_from_options(args: argparse.Namespace, command: str) -> Scenario:
 def _read_platform_file(path: str):
     """A measured profile: the translation (x_acceleration, y_acceleration) and the tilt
     (tilt [rad]) columns it has, at least one."""
-    import csv
 
+    from .._files import csv_rows, read_text
     from ..errors import DataFileError
     from ..model.tilt import read_tilt_csv
 
-    try:
-        with open(path, newline="", encoding="utf-8-sig") as fh:
-            header = next(csv.reader(fh), [])
-    except (OSError, UnicodeDecodeError):
-        header = []  # read_profile_csv says what is wrong
+    first = next(csv_rows(read_text(path, "platform profile"), repr(path)), None)
+    header = first[1] if first is not None else []
     names = {h.split("[")[0].strip().lower() for h in header}
     translation = names & {"x_acceleration", "ax", "xdd"}
     if "tilt" in names and not translation:

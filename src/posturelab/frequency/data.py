@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import csv
 import math
 from pathlib import Path
 
@@ -13,7 +12,7 @@ from ..errors import DataFileError
 __all__ = ["read_series_csv", "MAX_ROWS"]
 
 #: Most data rows a series file may have. [-]
-MAX_ROWS = 20_000_000
+MAX_ROWS = 2_000_000  # posturelab._files.MAX_DATA_ROWS
 
 
 def _name(header: str) -> str:
@@ -36,49 +35,36 @@ def read_series_csv(path: str | Path, columns: list[str]) -> tuple[float, dict[s
         Unreadable file, a missing or unknown column (the known ones are listed), a cell that
         is not a finite number (line and column named), a non-uniform time column.
     """
+    from .._files import csv_rows, header_words, read_text
+
     path = Path(path)
-    if not path.is_file():
-        raise DataFileError(f"cannot read {str(path)!r}: not a regular file")
-    try:
-        with path.open(newline="", encoding="utf-8-sig") as fh:
-            reader = csv.reader(fh)
-            header = next(reader, None)
-            if header is None:
-                raise DataFileError(f"{str(path)!r} is empty")
-            names = [_name(h) for h in header]
-            if "time" not in names:
-                raise DataFileError(f"{str(path)!r} has no time column; columns: "
-                                    f"{', '.join(names)}")
-            for c in columns:
-                if c not in names:
-                    raise DataFileError(f"{str(path)!r} has no column {c!r}; columns: "
-                                        f"{', '.join(names)}")
-            wanted = ["time", *columns]
-            index = [names.index(c) for c in wanted]
-            rows = []
-            for lineno, row in enumerate(reader, start=2):
-                if not row or not any(cell.strip() for cell in row):
-                    continue
-                if len(rows) >= MAX_ROWS:
-                    raise DataFileError(f"{str(path)!r} has more than {MAX_ROWS:,} rows")
-                values = []
-                for c, j in zip(wanted, index, strict=True):
-                    try:
-                        v = float(row[j])
-                    except (IndexError, ValueError):
-                        raise DataFileError(f"{str(path)!r} line {lineno}: column {c!r} is not "
-                                            "a number") from None
-                    if not math.isfinite(v):
-                        raise DataFileError(f"{str(path)!r} line {lineno}: column {c!r} is "
-                                            f"{v}; NaN and inf are not allowed")
-                    values.append(v)
-                rows.append(values)
-    except UnicodeDecodeError:
-        raise DataFileError(f"{str(path)!r} is not a UTF-8 CSV file") from None
-    except OSError as exc:
-        raise DataFileError(f"cannot read {str(path)!r}: {exc.strerror or exc}") from None
-    except csv.Error as exc:
-        raise DataFileError(f"{str(path)!r} is not a readable CSV file: {exc}") from None
+    what = repr(str(path))
+    rows_in = csv_rows(read_text(path, "data file"), what, max_rows=MAX_ROWS)
+    first = next(rows_in, None)
+    if first is None:
+        raise DataFileError(f"{what} is empty")
+    names = [_name(h) for h in first[1]]
+    if "time" not in names:
+        raise DataFileError(f"{what} has no time column; {header_words(first[1])}")
+    for c in columns:
+        if c not in names:
+            raise DataFileError(f"{what} has no column {c!r}; {header_words(first[1])}")
+    wanted = ["time", *columns]
+    index = [names.index(c) for c in wanted]
+    rows = []
+    for lineno, row in rows_in:
+        values = []
+        for c, j in zip(wanted, index, strict=True):
+            try:
+                v = float(row[j])
+            except (IndexError, ValueError):
+                raise DataFileError(f"{what} line {lineno}: column {c!r} is not a "
+                                    "number") from None
+            if not math.isfinite(v):
+                raise DataFileError(f"{what} line {lineno}: column {c!r} is {v}; NaN and "
+                                    "inf are not allowed")
+            values.append(v)
+        rows.append(values)
     if len(rows) < 8:
         raise DataFileError(f"{str(path)!r} needs at least 8 samples, has {len(rows)}")
     data = np.array(rows)

@@ -20,7 +20,6 @@ Sign conventions: x forward, y up. A *backward* platform motion has
 
 from __future__ import annotations
 
-import csv
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
@@ -521,15 +520,13 @@ def read_profile_csv(path: str | Path) -> MeasuredProfile:
     DataFileError
         With the file name, row and column of the first problem.
     """
+    from .._files import csv_rows, header_words, read_text
+
     path = Path(path)
-    try:
-        with path.open(newline="") as fh:
-            rows = list(csv.reader(fh))
-    except OSError as exc:
-        raise DataFileError(f"cannot read platform profile {str(path)!r}: {exc.strerror}") from None
-    except UnicodeDecodeError:
-        raise DataFileError(f"platform profile {str(path)!r} is not a text CSV file") from None
-    rows = [r for r in rows if r and any(c.strip() for c in r)]
+    what = f"platform profile {str(path)!r}"
+    numbered = list(csv_rows(read_text(path, "platform profile"), what))
+    rows = [r for _, r in numbered]
+    lines = [n for n, _ in numbered]
     if len(rows) < 3:
         raise DataFileError(
             f"platform profile {str(path)!r} needs a header row and at least 2 samples"
@@ -545,19 +542,19 @@ def read_profile_csv(path: str | Path) -> MeasuredProfile:
         raise DataFileError(
             f"platform profile {str(path)!r} lacks column {missing[0]!r}; needs columns "
             f"time [s], x_acceleration [m/s²] and optionally y_acceleration [m/s²]; "
-            f"found {', '.join(rows[0])}"
+            f"{header_words(rows[0])}"
         )
     idx = {name: header.index(name) for name in ("time", "x_acceleration", "y_acceleration")
            if name in header}
     data = {name: [] for name in idx}
-    for lineno, r in enumerate(rows[1:], start=2):
+    for lineno, r in zip(lines[1:], rows[1:], strict=True):
         for name, j in idx.items():
             try:
                 v = float(r[j])
             except (IndexError, ValueError):
                 raise DataFileError(
-                    f"platform profile {str(path)!r} line {lineno}: column {name!r} is not a "
-                    f"number ({r[j] if j < len(r) else 'missing'!r})"
+                    f"platform profile {str(path)!r} line {lineno}: column {name!r} is "
+                    f"{'not a number' if j < len(r) else 'missing'}"
                 ) from None
             if not math.isfinite(v):
                 raise DataFileError(
@@ -570,7 +567,7 @@ def read_profile_csv(path: str | Path) -> MeasuredProfile:
     if bad.size:
         i = int(bad[0])
         raise DataFileError(
-            f"platform profile {str(path)!r} line {i + 3}: time {t[i + 1]:g} s does not "
+            f"platform profile {str(path)!r} line {lines[i + 2]}: time {t[i + 1]:g} s does not "
             f"increase (previous {t[i]:g} s); time must be strictly increasing"
         )
     return MeasuredProfile(

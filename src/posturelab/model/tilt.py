@@ -465,19 +465,15 @@ def read_tilt_csv(path) -> MeasuredTilt:
     DataFileError
         With the file, line and column of the first problem.
     """
-    import csv
     from pathlib import Path
 
+    from .._files import csv_rows, read_text
     from ..errors import DataFileError
 
     path = Path(path)
-    try:
-        with path.open(newline="", encoding="utf-8-sig") as fh:
-            rows = [r for r in csv.reader(fh) if r and any(c.strip() for c in r)]
-    except OSError as exc:
-        raise DataFileError(f"cannot read tilt profile {str(path)!r}: {exc.strerror}") from None
-    except UnicodeDecodeError:
-        raise DataFileError(f"tilt profile {str(path)!r} is not a UTF-8 CSV file") from None
+    numbered = list(csv_rows(read_text(path, "tilt profile"),
+                             f"tilt profile {str(path)!r}"))
+    rows = [r for _, r in numbered]
     if len(rows) < 5:
         raise DataFileError(f"tilt profile {str(path)!r} needs a header row and at least 4 "
                             "samples")
@@ -489,7 +485,7 @@ def read_tilt_csv(path) -> MeasuredTilt:
                                 "time [s] and tilt [rad]")
     it, ia = header.index("time"), header.index("tilt")
     values = np.empty((len(rows) - 1, 2))
-    for lineno, r in enumerate(rows[1:], start=2):
+    for row_index, (lineno, r) in enumerate(numbered[1:]):
         for col, j, name in ((0, it, "time"), (1, ia, "tilt")):
             try:
                 v = float(r[j])
@@ -499,7 +495,7 @@ def read_tilt_csv(path) -> MeasuredTilt:
             if not math.isfinite(v):
                 raise DataFileError(f"tilt profile {str(path)!r} line {lineno}: column "
                                     f"{name!r} is not finite")
-            values[lineno - 2, col] = v
+            values[row_index, col] = v
     try:
         return MeasuredTilt(values[:, 0], values[:, 1], source=path.name)
     except ParameterError as exc:

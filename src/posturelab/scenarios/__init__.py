@@ -233,17 +233,17 @@ def load_scenario(path: str | Path) -> Scenario:
     ScenarioError
         Malformed TOML, an unknown key (named), or a bad value (field named).
     """
+    from .._files import MAX_SCENARIO_BYTES, read_text
+
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise ScenarioError(f"cannot read scenario {str(path)!r}: {exc.strerror}") from None
-    except UnicodeDecodeError:
-        raise ScenarioError(f"scenario {str(path)!r} is not UTF-8 text") from None
+    text = read_text(path, "scenario", max_bytes=MAX_SCENARIO_BYTES, error=ScenarioError)
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ScenarioError(f"scenario {str(path)!r} is not valid TOML: {exc}") from None
+    except RecursionError:
+        raise ScenarioError(f"scenario {str(path)!r} is nested too deeply to be a "
+                            "scenario") from None
     return parse_scenario(data, base_dir=path.parent, origin=str(path))
 
 

@@ -19,7 +19,6 @@ scipy's optimiser and statistics are imported when a fit runs.
 
 from __future__ import annotations
 
-import csv
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
@@ -291,12 +290,10 @@ def read_trajectory_csv(path: str | Path, n_links: int) -> tuple[np.ndarray, np.
     theta : numpy.ndarray, shape (S, N)
         [rad]
     """
+    from .._files import csv_rows, read_text
+
     path = Path(path)
-    try:
-        with path.open(newline="") as fh:
-            rows = [r for r in csv.reader(fh) if r]
-    except OSError as exc:
-        raise DataFileError(f"cannot read {str(path)!r}: {exc.strerror}") from None
+    rows = [r for _, r in csv_rows(read_text(path, "trajectory"), repr(str(path)))]
     if len(rows) < 3:
         raise DataFileError(f"{str(path)!r} needs a header row and at least 2 samples")
     header = [h.split("[")[0].strip() for h in rows[0]]

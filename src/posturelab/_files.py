@@ -1,0 +1,104 @@
+"""Reading input files safely (private): one reader for every text and CSV input.
+
+Every input file is checked the same way before a byte is parsed:
+
+* it must be a regular file (a directory, a device such as ``/dev/zero``, a FIFO or a
+  socket gets one line, never a hang);
+* at most :data:`MAX_INPUT_BYTES` (a scenario at most :data:`MAX_SCENARIO_BYTES`);
+* UTF-8, with or without a byte-order mark; another encoding is named by the offset of its
+  first bad byte;
+* a CSV has at most :data:`MAX_DATA_ROWS` data rows and no field longer than the csv
+  module's limit (:data:`MAX_FIELD_CHARS` characters); errors name the line.
+
+Messages never quote the file's content back.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import os
+import stat
+from collections.abc import Iterator
+from pathlib import Path
+
+from .errors import DataFileError, PostureLabError
+
+__all__ = ["MAX_INPUT_BYTES", "MAX_SCENARIO_BYTES", "MAX_DATA_ROWS", "MAX_FIELD_CHARS",
+           "read_text", "csv_rows"]
+
+#: Largest data file read. [bytes]
+MAX_INPUT_BYTES = 512 * 2**20
+#: Largest scenario file read. [bytes]
+MAX_SCENARIO_BYTES = 2**20
+#: Most data rows a CSV may have (33 min at 1 kHz, 5.6 h at 100 Hz). [-]
+MAX_DATA_ROWS = 2_000_000
+#: Longest CSV field. [characters]
+MAX_FIELD_CHARS = 131_072
+
+
+def read_text(path: str | Path, what: str, *, max_bytes: int = MAX_INPUT_BYTES,
+              error: type[PostureLabError] = DataFileError) -> str:
+    """The text of a regular UTF-8 file (a byte-order mark dropped), or ``error`` in one
+    line naming ``what`` and the file."""
+    path = Path(path)
+    name = f"{what} {str(path)!r}"
+    try:
+        info = os.stat(path)
+    except OSError as exc:
+        raise error(f"cannot read {name}: {exc.strerror or exc}") from None
+    if stat.S_ISDIR(info.st_mode):
+        raise error(f"cannot read {name}: it is a directory")
+    if not stat.S_ISREG(info.st_mode):
+        raise error(f"cannot read {name}: not a regular file (a device, FIFO or socket)")
+    if info.st_size > max_bytes:
+        raise error(f"{name} is {info.st_size:,} bytes; at most {max_bytes:,} are read")
+    try:
+        with open(path, "rb") as fh:
+            data = fh.read(max_bytes + 1)
+    except OSError as exc:
+        raise error(f"cannot read {name}: {exc.strerror or exc}") from None
+    if len(data) > max_bytes:
+        raise error(f"{name} is more than {max_bytes:,} bytes; at most {max_bytes:,} are read")
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        raise error(f"{name} is not UTF-8 text (byte 0x{data[exc.start]:02x} at offset "
+                    f"{exc.start})") from None
+
+
+def csv_rows(text: str, what: str, *, max_rows: int = MAX_DATA_ROWS
+             ) -> Iterator[tuple[int, list[str]]]:
+    """(line number, cells) of each non-blank CSV row of ``text``, the header first; a
+    DataFileError in one line for a malformed row, a field over :data:`MAX_FIELD_CHARS`
+    characters or more than ``max_rows`` data rows."""
+    reader = csv.reader(io.StringIO(text, newline=""))
+    count = 0
+    while True:
+        try:
+            row = next(reader)
+        except StopIteration:
+            return
+        except csv.Error as exc:
+            line = reader.line_num
+            if "field larger than field limit" in str(exc):
+                raise DataFileError(f"{what} line {line}: a field longer than "
+                                    f"{MAX_FIELD_CHARS:,} characters") from None
+            raise DataFileError(f"{what} line {line} is not valid CSV: {exc}") from None
+        if not row or not any(cell.strip() for cell in row):
+            continue
+        count += 1
+        if count > max_rows + 1:
+            raise DataFileError(f"{what} has more than {max_rows:,} data rows; at most "
+                                f"{max_rows:,} are read")
+        yield reader.line_num, row
+
+
+def header_words(cells: list[str]) -> str:
+    """The header's column names for a message, or words saying it is not a header: names
+    are listed only when there are at least two, each at most 32 characters (a line of text
+    or data is not quoted back)."""
+    names = [c.strip() for c in cells]
+    if len(names) >= 2 and all(0 < len(c) <= 32 for c in names):
+        return "found " + ", ".join(names)
+    return "its first line is not a header of column names"
