@@ -248,7 +248,13 @@ def load_scenario(path: str | Path) -> Scenario:
 
 
 def parse_scenario(data: dict, base_dir: Path | None = None, origin: str = "scenario") -> Scenario:
-    """Build a :class:`Scenario` from a parsed TOML mapping (see the module schema)."""
+    """Build a :class:`Scenario` from a parsed TOML mapping (see the module schema; the
+    types of every key are checked first, by :func:`posturelab.scenarios.schema.check_types`)."""
+    from .schema import check_types
+
+    if not isinstance(data, dict):
+        raise ScenarioError(f"{origin}: a scenario is a table, got {type(data).__name__}")
+    check_types(data, origin)
     try:
         return _parse(data, base_dir or Path("."), origin)
     except ScenarioError:
