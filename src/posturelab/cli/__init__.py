@@ -104,8 +104,36 @@ def _join_negative_lists(argv: list[str]) -> list[str]:
     return out
 
 
+class Terminated(KeyboardInterrupt):
+    """SIGTERM, raised where the program is, so that every clean-up that runs on Ctrl-C
+    (temporary files and folders removed) runs on it too."""
+
+
+def _on_sigterm(signum, frame) -> None:
+    raise Terminated()
+
+
 def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point of the ``posturelab`` console script; returns the exit code."""
+    """Entry point of the ``posturelab`` console script; returns the exit code (2 for bad
+    input, 130 when interrupted, 143 when terminated)."""
+    import signal
+    import threading
+
+    if threading.current_thread() is threading.main_thread():
+        previous = signal.signal(signal.SIGTERM, _on_sigterm)
+    else:  # (signals can only be handled on the main thread)
+        previous = None
+    try:
+        return _main(argv)
+    except Terminated:
+        print("posturelab: terminated", file=sys.stderr)
+        return 143
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
+
+
+def _main(argv: Sequence[str] | None) -> int:
     try:
         parser = build_parser()
         argv = _join_negative_lists(list(sys.argv[1:] if argv is None else argv))
@@ -117,6 +145,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     except PostureLabError as exc:
         print(f"posturelab: error: {exc}", file=sys.stderr)
         return 2
+    except Terminated:
+        raise
     except KeyboardInterrupt:
         print("posturelab: interrupted", file=sys.stderr)
         return 130

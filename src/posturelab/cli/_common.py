@@ -235,11 +235,21 @@ def print_json(obj) -> None:
     sys.stdout.write("\n")
 
 
-def check_writable(paths: list[str]) -> None:
-    """Fail early, before any work, when an output's directory is missing or read-only."""
+#: The file types each kind of output may have (suffixes, lower case).
+FIGURE_SUFFIXES = (".png", ".svg", ".pdf")
+
+
+def check_writable(paths: list[str], suffixes: dict[str, tuple[str, ...]] | None = None
+                   ) -> None:
+    """Fail early, before any work and before anything is written, when an output cannot
+    be written: its directory is missing or read-only, it is a directory, it exists and is
+    not a regular file (a device, FIFO or socket: never replaced), its suffix is not one of
+    ``suffixes[path]``, or two outputs are the same file."""
     import os
+    import stat
     from pathlib import Path
 
+    seen: dict[str, str] = {}
     for p in paths:
         d = Path(p).parent if str(Path(p).parent) else Path(".")
         if not d.is_dir():
@@ -248,6 +258,22 @@ def check_writable(paths: list[str]) -> None:
             raise ParameterError(f"cannot write {p!r}: directory {str(d)!r} is not writable")
         if Path(p).is_dir():
             raise ParameterError(f"cannot write {p!r}: it is a directory")
+        try:
+            mode = os.stat(p).st_mode
+        except OSError:
+            mode = None
+        if mode is not None and not stat.S_ISREG(mode):
+            raise ParameterError(f"cannot write {p!r}: it exists and is not a regular file "
+                                 "(a device, FIFO or socket is never replaced)")
+        allowed = (suffixes or {}).get(p)
+        if allowed and Path(p).suffix.lower() not in allowed:
+            choices = (", ".join(allowed[:-1]) + " or " + allowed[-1]) if len(allowed) > 1 \
+                else allowed[0]
+            raise ParameterError(f"an output must end in {choices}, got {p!r}")
+        key = os.path.realpath(p)
+        if key in seen:
+            raise ParameterError(f"{seen[key]!r} and {p!r} are the same file")
+        seen[key] = p
 
 
 def load_compiled(load, what: str, stream=None, notice_after: float = 2.0) -> float:

@@ -7,7 +7,7 @@ import argparse
 from ..model.muscles import PAPER_PAIR_NAMES
 from ..simulation.results import atomic_write_text
 from ..studies.identification import ENGINES, VISCOSITY_RATIO, fit_stiffness, read_trajectory_csv
-from ._common import print_json
+from ._common import check_writable, print_json
 from .simulate import add_experiment_arguments, scenario_from_args
 
 DESCRIPTION = """\
@@ -44,6 +44,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     import json
 
+    if args.report:
+        check_writable([args.report], {args.report: (".json",)})
     sc = scenario_from_args(args, "fit")
     time, theta = read_trajectory_csv(args.data, sc.body.n_links)
     sc = sc.replace(duration=max(float(time[-1]), 1e-3))

@@ -5,8 +5,7 @@ from __future__ import annotations
 import argparse
 import math
 
-from ..errors import ParameterError
-from ._common import check_writable, print_json
+from ._common import FIGURE_SUFFIXES, check_writable, print_json
 
 HELP = "frequency response function of a periodic-stimulus (PRTS) trial, from a CSV"
 
@@ -62,13 +61,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 def check_plot_path(*paths: str | None) -> None:
     """Each given figure path ends in .png, .svg or .pdf and can be written."""
-    from pathlib import Path
-
     given = [p for p in paths if p]
-    for path in given:
-        if Path(path).suffix.lower() not in (".png", ".svg", ".pdf"):
-            raise ParameterError(f"a figure must end in .png, .svg or .pdf, got {path!r}")
-    check_writable(given)
+    check_writable(given, {p: FIGURE_SUFFIXES for p in given})
 
 
 def response_sign(stimulus: str, response: str, choice: str) -> int:

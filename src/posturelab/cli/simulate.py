@@ -15,6 +15,7 @@ from ..paper.printed import BACKWARD_INITIAL_STATE
 from ..scenarios import Scenario, builtin_scenario, builtin_scenario_names, load_scenario
 from . import UsageError
 from ._common import (
+    FIGURE_SUFFIXES,
     add_muscle_arguments,
     body_from_args,
     check_writable,
@@ -294,7 +295,8 @@ def _read_platform_file(path: str):
 def run(args: argparse.Namespace) -> int:
     sc = scenario_from_args(args)
     outputs = [p for p in (args.out, args.plot, args.animate) if p]
-    check_writable(outputs)
+    check_writable(outputs, {args.out: (".csv",), args.plot: FIGURE_SUFFIXES,
+                             args.animate: (".gif",)})
     result = sc.run(engine=args.engine)
     if args.out:
         result.to_csv(args.out)
