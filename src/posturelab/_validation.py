@@ -92,3 +92,25 @@ def reject_unknown_keys(
         raise ParameterError(
             f"unknown key {unknown[0]!r} in {where}; allowed keys: {', '.join(sorted(allowed))}"
         )
+
+
+def expect_type(name: str, value: Any, kind: type | tuple[type, ...]) -> None:
+    """Raise :class:`ParameterError` naming the argument unless ``value`` is a ``kind``."""
+    if not isinstance(value, kind):
+        want = kind.__name__ if isinstance(kind, type) else " or ".join(k.__name__ for k in kind)
+        raise ParameterError(f"{name} must be a {want}, got {type(value).__name__} "
+                             f"{value!r:.60}")
+
+
+def check_model(body: Any, muscles: Any = None) -> None:
+    """The public API's first check: ``body`` is a Body, ``muscles`` (if given) a MuscleSet
+    for as many links."""
+    from .model.body import Body
+    from .model.muscles import MuscleSet
+
+    expect_type("body", body, Body)
+    if muscles is not None:
+        expect_type("muscles", muscles, MuscleSet)
+        if muscles.n_links != body.n_links:
+            raise ParameterError(f"muscle set is for {muscles.n_links} links but the body "
+                                 f"has {body.n_links}")

@@ -95,6 +95,9 @@ def model_frf_batch(body: Body, muscles: MuscleSet, frequencies, stiffness, visc
     numpy.ndarray of complex, shape (M, F)
         [-] for tilt, [rad/m] for translation.
     """
+    from .._validation import check_model
+
+    check_model(body, muscles)
     if input not in INPUTS:
         raise ParameterError(f"input must be one of {', '.join(INPUTS)}, got {input!r}")
     f = finite_array("frequencies [Hz]", frequencies, (None,))

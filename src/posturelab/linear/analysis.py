@@ -243,6 +243,9 @@ def disturbance_sensitivity(body: Body, posture: np.ndarray | None = None) -> np
     numpy.ndarray, shape (N,)
         J⁻¹H. [rad/m] (rate change [rad/s] per platform velocity change [m/s])
     """
+    from .._validation import check_model
+
+    check_model(body)
     if posture is None:
         posture = np.zeros(body.n_links)
     posture = finite_array("posture [rad]", posture, (body.n_links,))
@@ -250,7 +253,6 @@ def disturbance_sensitivity(body: Body, posture: np.ndarray | None = None) -> np
 
 
 def _check_match(body: Body, muscles: MuscleSet) -> None:
-    if muscles.n_links != body.n_links:
-        raise ParameterError(
-            f"muscle set is for {muscles.n_links} links but the body has {body.n_links}"
-        )
+    from .._validation import check_model
+
+    check_model(body, muscles)

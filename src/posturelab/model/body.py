@@ -28,6 +28,11 @@ from ..errors import ParameterError, UnknownNameError
 __all__ = ["Segment", "Body", "BodyPreset", "BODY_PRESETS", "get_body", "paper_body"]
 
 
+#: Most links a body may have (the compiled engine's straight-line code covers 1–3; the
+#: general code is O(N³) per evaluation). [-]
+MAX_LINKS = 12
+
+
 @dataclass(frozen=True)
 class Segment:
     """One rigid link of the chain.
@@ -100,6 +105,8 @@ class Body:
         segs = tuple(self.segments)
         if len(segs) < 1:
             raise ParameterError("segments must hold at least 1 link, got 0")
+        if len(segs) > MAX_LINKS:
+            raise ParameterError(f"a body has at most {MAX_LINKS} links, got {len(segs)}")
         for s in segs:
             if not isinstance(s, Segment):
                 raise ParameterError(f"segments must be Segment objects, got {type(s).__name__}")

@@ -34,7 +34,7 @@ from typing import Literal
 
 import numpy as np
 
-from .._validation import finite_array, nonnegative_float
+from .._validation import finite_array, float_in_range, nonnegative_float
 from ..errors import ParameterError, UnknownNameError
 
 __all__ = [
@@ -62,6 +62,12 @@ __all__ = [
 DEFAULT_VISCOSITY_RATIO = 0.25
 
 Gastrocnemius = Literal["two-sided", "one-sided"]
+
+
+#: Largest pair stiffness, intrinsic or active: 10⁵ times a standing adult's mgh. [N·m/rad]
+MAX_PAIR_STIFFNESS = 1e8
+#: Largest pair viscosity, intrinsic or active. [N·m·s/rad]
+MAX_PAIR_VISCOSITY = 1e7
 
 
 @dataclass(frozen=True)
@@ -109,18 +115,18 @@ class MusclePair:
             )
         object.__setattr__(self, "lo", int(self.lo))
         object.__setattr__(self, "hi", int(self.hi))
-        object.__setattr__(
-            self, "stiffness", nonnegative_float(f"{label} stiffness", self.stiffness, "N·m/rad")
-        )
-        object.__setattr__(
-            self, "viscosity", nonnegative_float(f"{label} viscosity", self.viscosity, "N·m·s/rad")
-        )
+        object.__setattr__(self, "stiffness", float_in_range(
+            f"{label} stiffness", self.stiffness, 0.0, MAX_PAIR_STIFFNESS, unit="N·m/rad"))
+        object.__setattr__(self, "viscosity", float_in_range(
+            f"{label} viscosity", self.viscosity, 0.0, MAX_PAIR_VISCOSITY, unit="N·m·s/rad"))
         object.__setattr__(self, "one_sided", bool(self.one_sided))
         for field, unit in (("active_stiffness", "N·m/rad"), ("active_viscosity", "N·m·s/rad")):
             value = getattr(self, field)
             if value is not None:
-                object.__setattr__(self, field, nonnegative_float(
-                    f"{label} {field.replace('_', ' ')}", value, unit))
+                object.__setattr__(self, field, float_in_range(
+                    f"{label} {field.replace('_', ' ')}", value, 0.0,
+                    MAX_PAIR_STIFFNESS if field == "active_stiffness" else MAX_PAIR_VISCOSITY,
+                    unit=unit))
 
     @property
     def has_active(self) -> bool:

@@ -28,7 +28,13 @@ from typing import Literal
 
 import numpy as np
 
-from .._validation import finite_array, finite_float, nonnegative_float, positive_float
+from .._validation import (
+    finite_array,
+    finite_float,
+    float_in_range,
+    nonnegative_float,
+    positive_float,
+)
 from ..errors import DataFileError, ParameterError
 
 __all__ = [
@@ -52,6 +58,10 @@ def _axis(axis: str) -> int:
     if axis not in ("x", "y"):
         raise ParameterError(f"axis must be 'x' (horizontal) or 'y' (vertical), got {axis!r}")
     return 0 if axis == "x" else 1
+
+
+#: Largest platform velocity step: ten times the fastest perturbation of the field. [m/s]
+MAX_PLATFORM_SPEED = 20.0
 
 
 @dataclass(frozen=True)
@@ -167,7 +177,8 @@ class VelocityStep(Disturbance):
     axis: Axis = "x"
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "velocity", finite_float("velocity [m/s]", self.velocity))
+        object.__setattr__(self, "velocity", float_in_range(
+            "velocity [m/s]", self.velocity, -MAX_PLATFORM_SPEED, MAX_PLATFORM_SPEED, unit="m/s"))
         _axis(self.axis)
 
     @property

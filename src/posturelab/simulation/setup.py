@@ -18,7 +18,7 @@ from typing import Literal
 
 import numpy as np
 
-from .._validation import finite_array, float_in_range, positive_float
+from .._validation import finite_array, float_in_range
 from ..errors import ParameterError
 from ..model.body import Body
 from ..model.dynamics import (
@@ -58,6 +58,8 @@ __all__ = [
     "outcome_message",
     "DELAY_BREAKPOINT_MULTIPLES",
     "MAX_FEEDBACK_DELAY",
+    "MAX_DURATION",
+    "MAX_OUTPUT_SAMPLES",
 ]
 
 #: With a feedback delay τ the motion is not smooth at t = kτ (the step at t = 0 reaches
@@ -66,6 +68,10 @@ __all__ = [
 DELAY_BREAKPOINT_MULTIPLES = 5
 #: Largest neural feedback delay a run accepts. [s]
 MAX_FEEDBACK_DELAY = 1.0
+#: Longest run (a day). [s]
+MAX_DURATION = 86_400.0
+#: Most output samples of one run (duration × sample_rate + 1). [-]
+MAX_OUTPUT_SAMPLES = 20_000_000
 
 Status = Literal["completed", "fell", "failed"]
 
@@ -340,7 +346,8 @@ def _prepare(body: Body, muscles: MuscleSet, disturbance: Disturbance | None = N
         raise ParameterError(
             f"muscle set is for {muscles.n_links} links but the body has {body.n_links}"
         )
-    duration = positive_float("duration [s]", duration)
+    duration = float_in_range("duration [s]", duration, 0.0, MAX_DURATION, include_low=False,
+                              unit="s")
     noise = o["motor_noise"]
     motor_torque = None
     if noise is not None:
@@ -349,6 +356,11 @@ def _prepare(body: Body, muscles: MuscleSet, disturbance: Disturbance | None = N
     rtol = float_in_range("rtol", rtol, 1e-14, 1e-1)
     atol = float_in_range("atol", atol, 1e-16, 1e-1)
     sample_rate = float_in_range("sample_rate [Hz]", sample_rate, 1.0, 1e6, unit="Hz")
+    samples = math.floor(duration * sample_rate) + 1
+    if samples > MAX_OUTPUT_SAMPLES:
+        raise ParameterError(f"duration [s] × sample_rate [Hz] = {duration:g} × {sample_rate:g} "
+                             f"gives {samples:,} output samples; at most "
+                             f"{MAX_OUTPUT_SAMPLES:,} (lower the sample rate or the duration)")
     if isinstance(max_switches, bool) or not isinstance(max_switches, int | np.integer) \
             or max_switches < 0:
         raise ParameterError(f"max_switches must be an integer >= 0, got {max_switches!r}")

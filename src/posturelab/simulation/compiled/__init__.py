@@ -507,6 +507,9 @@ def simulate_batch(
     -------
     BatchResult
     """
+    from ..._validation import check_model
+
+    check_model(body, muscles)
     if method is not None:
         _check_method(method)
     if muscles is None:
