@@ -67,7 +67,7 @@ def assert_matches_table_ii(case, poles):
         remaining.remove(best)
 
 
-POLE_LINE = re.compile(r"^\s+(-?\d+\.\d+)(?:\s*([+-])\s*(\d+\.\d+)i)?\s*$")
+POLE_LINE = re.compile(r"^\s+(-?\d+\.\d+)(?:\s*([+-])\s*(\d+\.\d+)j)?\s*$")
 
 
 def text_poles(out):
@@ -352,3 +352,28 @@ def test_load_compiled_says_so_only_when_numba_compiles():
     assert len(lines) == 2
     assert lines[0].startswith("posturelab: compiling the simulator")
     assert lines[1].startswith("posturelab: compiled the simulator in")
+
+
+def test_help_and_printed_numbers_say_one_thing(capsys):
+    """sweep --help states one default tolerance per engine, simulate --help lists every CSV
+    column it writes, poles writes complex numbers one way, grid values print short."""
+    import contextlib
+    import io
+
+    def help_of(command):
+        buf = io.StringIO()
+        with contextlib.redirect_stdout(buf), contextlib.suppress(SystemExit):
+            main([command, "--help"])
+        return " ".join(buf.getvalue().split())
+
+    sweep = help_of("sweep")
+    assert "(default 1e-8)" not in sweep and "rtol 1e-6" in sweep
+    simulate = help_of("simulate")
+    for column in ("cop_x", "ground_fx", "ground_fy", "com_angle"):
+        assert column in simulate
+    code, out, _ = run(capsys, "poles", "--all")
+    assert code == 0 and "j" in out and not re.search(r"\d+\.\d+i\b", out)
+    from posturelab.studies.sweep import parse_vary
+
+    assert parse_vary("viscosity_ratio=0.1:1:10").values.tolist()[4] == 0.5
+    assert repr(parse_vary("x=0:1.1:3").values.tolist()[1]) == "0.55"

@@ -50,7 +50,7 @@ def _ratio(args: argparse.Namespace) -> float:
 def _fmt_pole(z: complex) -> str:
     if abs(z.imag) < 1e-12:
         return f"{z.real:.3f}"
-    return f"{z.real:.3f} {'+' if z.imag >= 0 else '-'} {abs(z.imag):.3f}i"
+    return f"{z.real:.3f} {'+' if z.imag >= 0 else '-'} {abs(z.imag):.3f}j"
 
 
 def run(args: argparse.Namespace) -> int:

@@ -44,7 +44,9 @@ A fall is any |θ_i| beyond --max-link-angle (default 1.047 rad = 60°) or, with
 Output CSV columns: t [s], theta1..3 [rad], omega1..3 [rad/s], M_<pair> [N·m],
 U1..3 [N·m], joint_moment1..3 [N·m], cog_x, cog_y [m], cog_vx, cog_vy [m/s],
 platform_ax, platform_ay [m/s²], platform_vx, platform_vy [m/s], platform_x,
-platform_y [m].
+platform_y [m], cop_x [m] (centre of pressure from the ankle), ground_fx, ground_fy [N]
+(force of the platform on the foot), and with a tilt, tilt and com_angle [rad]. The first
+line printed (outcome in --json) is recovered, not recovered, fell or failed.
 """
 
 
@@ -133,9 +135,12 @@ def add_experiment_arguments(p: argparse.ArgumentParser) -> None:
                      help="fall when any |θ_i| exceeds this [rad] (default π/3).")
     run = p.add_argument_group("integration")
     run.add_argument("--duration", type=float, default=None, help="simulated time [s] (default 5).")
-    run.add_argument("--rtol", type=float, default=None, help="relative tolerance (default 1e-8).")
+    run.add_argument("--rtol", type=float, default=None,
+                     help="relative tolerance (default: the engine's, 1e-8 for the reference "
+                     "engine, 1e-6 for the compiled one and for sweeps).")
     run.add_argument("--atol", type=float, default=None,
-                     help="absolute tolerance [rad, rad/s] (default 1e-10).")
+                     help="absolute tolerance [rad, rad/s] (default: 1e-10 reference, 1e-9 "
+                     "compiled and sweeps).")
     run.add_argument("--sample-rate", type=float, default=None,
                      help="output samples per second [Hz] (default 1000).")
 

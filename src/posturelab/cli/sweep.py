@@ -78,6 +78,10 @@ HELP = ("simulate a grid of gains, delays, torque limits and perturbation sizes;
         "to CSV or Parquet")
 
 
+#: Below this many runs a local sweep is faster than starting a Dask cluster. [-]
+SMALL_FOR_DASK = 20_000
+
+
 def add_arguments(p: argparse.ArgumentParser) -> None:
     """The options of ``posturelab sweep``."""
     g = p.add_argument_group("sweep")
@@ -143,12 +147,10 @@ def run(args: argparse.Namespace) -> int:
         tolerances["rtol"] = scenario.rtol
     if args.atol is not None:
         tolerances["atol"] = scenario.atol
-    bar = None
-    if args.progress or sys.stderr.isatty():
-        total = 1
-        for v in varies:
-            total *= v.count
-        bar = ProgressBar(total)
+    total = 1
+    for v in varies:
+        total *= v.count
+    bar = ProgressBar(total) if args.progress or sys.stderr.isatty() else None
     t0 = time.perf_counter()
     try:
         result = run_sweep(scenario, varies, viscosity_ratio=ratio, workers=args.workers,
@@ -168,6 +170,10 @@ def run(args: argparse.Namespace) -> int:
                        ("recovered", "not recovered", "fell", "failed") if (kinds == k).any())
     print(f"wrote {args.out}: {o.n_runs} runs ({shape}: {', '.join(result.grid.names)}): "
           f"{counts}, in {elapsed:.2f} s")
+    if args.workers is not None and total < SMALL_FOR_DASK:
+        print(f"posturelab: note: {total} runs take well under a second without Dask; "
+              f"starting a cluster of {args.workers} workers took most of the "
+              f"{elapsed:.1f} s (leave out --workers for small sweeps)", file=sys.stderr)
     if failed:
         print(f"posturelab: warning: {failed} runs failed to integrate (fell = false, "
               "outcomes up to the failure)", file=sys.stderr)

@@ -179,7 +179,11 @@ class VaryRange:
     @property
     def values(self) -> np.ndarray:
         """The ``count`` values, ``low`` and ``high`` included. [N·m/rad], [s] or [-]"""
-        return np.linspace(self.low, self.high, self.count)
+        # 15 significant digits: 0.55, not linspace's 0.5499999999999999 (the ends exact)
+        values = np.array([float(f"{v:.15g}") for v in np.linspace(self.low, self.high,
+                                                                        self.count)])
+        values[0], values[-1] = self.low, self.high
+        return values
 
     @property
     def unit(self) -> str:
