@@ -27,6 +27,7 @@ SUBCOMMANDS: dict[str, str] = {
     "frf": "frf",
     "frf-model": "frf_model",
     "fit-frf": "fit_frf",
+    "compare": "compare",
 }
 
 

@@ -16,7 +16,7 @@ import numpy as np
 from ..errors import PostureLabError
 
 __all__ = ["SimulationResult", "DerivedSeries", "atomic_write_text", "atomic_write_bytes",
-           "new_file_mode"]
+           "new_file_mode", "read_run_csv"]
 
 
 @dataclass(frozen=True)
@@ -280,6 +280,18 @@ class SimulationResult:
             cols += [self.tilt[:, None], self.com_angle[:, None]]
         return names, np.concatenate(cols, axis=1)
 
+    def to_dataframe(self):
+        """The CSV's columns as a pandas DataFrame, indexed by time ``t`` [s] (units as in
+        the README's table). Needs pandas: ``pip install 'posturelab[pandas]'``."""
+        try:
+            import pandas as pd
+        except ImportError:
+            raise PostureLabError("to_dataframe needs pandas: pip install pandas (or "
+                                  "'posturelab[pandas]')") from None
+        names, table = self.columns()
+        return pd.DataFrame(table[:, 1:], columns=names[1:],
+                            index=pd.Index(table[:, 0], name=names[0]))
+
     def to_csv_text(self) -> str:
         """The CSV as text: a header row, then one row per output sample."""
         names, table = self.columns()
@@ -293,6 +305,46 @@ class SimulationResult:
     def to_csv(self, path: str | Path) -> None:
         """Write the CSV atomically (temporary file, then rename)."""
         atomic_write_text(path, self.to_csv_text())
+
+
+def read_run_csv(path: str | Path) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A run saved by ``posturelab simulate --out``: time ``t`` [s], ``theta1..N`` [rad] and
+    ``omega1..N`` [rad/s] (other columns ignored; N from the header).
+
+    Returns
+    -------
+    (time (T,), theta (T, N), omega (T, N))
+
+    Raises
+    ------
+    DataFileError
+        Not such a file (the file and the problem named).
+    """
+    from .._files import csv_rows, read_text
+    from ..errors import DataFileError
+
+    what = f"run {str(path)!r}"
+    rows = list(csv_rows(read_text(path, "run"), what))
+    if len(rows) < 3:
+        raise DataFileError(f"{what} needs a header row and at least 2 samples")
+    header = [h.split("[")[0].strip() for h in rows[0][1]]
+    n = 0
+    while f"theta{n + 1}" in header and f"omega{n + 1}" in header:
+        n += 1
+    if "t" not in header or n == 0:
+        raise DataFileError(f"{what} is not a run written by posturelab simulate --out (it "
+                            "needs the columns t, theta1, omega1, …)")
+    idx = [header.index(c) for c in ["t", *(f"theta{i + 1}" for i in range(n)),
+                                     *(f"omega{i + 1}" for i in range(n))]]
+    data = np.empty((len(rows) - 1, len(idx)))
+    for r, (line, cells) in enumerate(rows[1:]):
+        try:
+            data[r] = [float(cells[j]) for j in idx]
+        except (IndexError, ValueError):
+            raise DataFileError(f"{what} line {line}: a missing or non-numeric value") from None
+    if not np.all(np.isfinite(data)) or np.any(np.diff(data[:, 0]) < 0):
+        raise DataFileError(f"{what}: values must be finite and t must not decrease")
+    return data[:, 0], data[:, 1:1 + n], data[:, 1 + n:]
 
 
 def new_file_mode() -> int:

@@ -48,6 +48,7 @@ __all__ = [
     "plot_delay_stability_map",
     "plot_bode",
     "plot_prts_cycles",
+    "plot_compare",
     "LINK_COLORS",
     "PAIR_COLORS",
 ]
@@ -448,6 +449,64 @@ def plot_run_overview(
     head = title or result.description or "posturelab run"
     outcome = result.message or result.status
     fig.suptitle(textwrap.fill(f"{head} — {outcome}", 110), fontsize="medium")
+    return fig
+
+
+def plot_compare(runs, labels: Sequence[str] | None = None, *,
+                 link_names: Sequence[str] | None = None, rates: bool = False) -> Figure:
+    """Several runs overlaid: one panel per link angle [rad] (or rate [rad/s]) against
+    time [s], one colour per run, one legend entry per run, a cross at each fall.
+
+    Parameters
+    ----------
+    runs : sequence of SimulationResult, or of (time [s], theta [rad] (T, N), omega
+        [rad/s] (T, N)) tuples (saved runs, :func:`posturelab.simulation.results.read_run_csv`)
+    labels : sequence of str, optional
+        One per run; "run 1", "run 2", … by default.
+    link_names : sequence of str, optional
+        Panel titles.
+    rates : bool
+        Plot the rates instead of the angles.
+
+    Returns
+    -------
+    Figure
+    """
+    series = []
+    for run in runs:
+        if isinstance(run, SimulationResult):
+            _check_result(run)
+            series.append((run.time, run.theta, run.omega, run.fall_time if run.fell else None))
+        else:
+            t, th, om = run[:3]
+            series.append((np.asarray(t), np.asarray(th), np.asarray(om), None))
+    if not series:
+        raise ParameterError("give at least one run to compare")
+    n = {s[1].shape[1] for s in series}
+    if len(n) != 1:
+        raise ParameterError(f"the runs have different numbers of links: {sorted(n)}")
+    n_links = n.pop()
+    labels = list(labels) if labels is not None else [f"run {k + 1}" for k in range(len(series))]
+    if len(labels) != len(series):
+        raise ParameterError(f"give one label per run: {len(series)} runs, {len(labels)} labels")
+    fig, axes = new_figure(n_links, 1, figsize=(7.0, 2.2 + 1.8 * n_links), sharex=True)
+    axes = np.atleast_1d(axes)
+    colors = ["#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b", "#17becf"]
+    for k, ((t, th, om, fall), label) in enumerate(zip(series, labels, strict=True)):
+        y = om if rates else th
+        c = colors[k % len(colors)]
+        for i, ax in enumerate(axes):
+            ax.plot(t, y[:, i], color=c, lw=1.4, label=label if i == 0 else None)
+            if fall is not None:
+                ax.plot(t[-1], y[-1, i], "X", color=c, mec="k", ms=7)
+    for i, ax in enumerate(axes):
+        name = link_names[i] if link_names is not None and i < len(link_names) else f"link {i + 1}"
+        ax.set_ylabel((r"$\dot{\theta}_%d$ [rad/s]" if rates else r"$\theta_%d$ [rad]") % (i + 1))
+        ax.set_title(name, fontsize="medium")
+        ax.axhline(0.0, color="0.6", lw=0.7, zorder=0)
+        ax.grid(True, alpha=0.3)
+    axes[-1].set_xlabel("time t [s]")
+    axes[0].legend(fontsize="small", loc="best")
     return fig
 
 
