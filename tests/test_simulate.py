@@ -107,9 +107,14 @@ def test_trajectories_converge_as_tolerances_tighten():
 
 
 def test_one_sided_gastrocnemius_switches_exactly_at_theta2_zero():
-    """The real gastrocnemius engages / goes slack as θ2 crosses 0, located as an event."""
+    """The real gastrocnemius, switching on its stretch only (pull_only=False), engages /
+    goes slack as θ2 crosses 0, located as an event (tests/test_pull_only.py: the default,
+    which also lets go when its torque would push)."""
+    from dataclasses import replace
+
     body = pl.paper_body()
     muscles = pl.paper_muscles("1", gastrocnemius="one-sided")
+    muscles = pl.MuscleSet(tuple(replace(p, pull_only=False) for p in muscles.pairs), 3)
     r = simulate(body, muscles, VelocityStep.backward(1.0), 5.0,
                  initial_state=PAPER_POSTURE + [0, 0, 0])
     assert len(r.switch_times) >= 1

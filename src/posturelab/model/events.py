@@ -26,6 +26,12 @@ knee angle [rad], κ̈_free the knee acceleration with the knee free [rad/s²]):
     PAIR_ENGAGES      s_p − h                        rising    (a slack one-sided pair)
     KNEE_HITS_STOP    κ − stop_angle − h             rising    (a free knee locks)
     KNEE_LEAVES_STOP  κ̈_free + h_release             falling   (a locked knee lets go)
+    PAIR_PUSHES       M_p + h_M                      falling   (a pull-only pair would push)
+    PAIR_PULLS        min(M_p, k_p s_p) − h_M        rising    (a slack pull-only pair pulls)
+
+M_p = k_p s_p + l_p ṡ_p is the torque pair p would have, on the state the muscles respond
+to (k_p its stiffness). After PAIR_SLACKENS or PAIR_ENGAGES a pair acts if its stretch is
+growing; after PAIR_PUSHES it is slack; after PAIR_PULLS (stretched, and pulling) it acts.
 
 h = :data:`SWITCH_HYSTERESIS` keeps a pair, joint or knee resting exactly at its
 switch point from switching back and forth; h_release =
@@ -42,6 +48,7 @@ import numpy as np
 __all__ = [
     "SWITCH_HYSTERESIS",
     "RELEASE_HYSTERESIS",
+    "TORQUE_HYSTERESIS",
     "EventKind",
     "EVENT_KINDS",
     "EVENT_DIRECTION",
@@ -58,6 +65,10 @@ __all__ = [
 #: saturates when it passes its limit by this much and lets go this far inside it, and the
 #: knee stop engages this far past its angle: far below any physical resolution. [rad], [N·m]
 SWITCH_HYSTERESIS = 1e-12
+#: A pull-only pair goes slack when its torque falls this far below 0 and acts again this far
+#: above: wider than the integrators' noise on a torque of tens of N·m (rtol 1e-8), so that
+#: a torque grazing 0 does not chatter. [N·m]
+TORQUE_HYSTERESIS = 1e-6
 #: The knee stop lets go when the free knee acceleration pulls away by more than this. [rad/s²]
 RELEASE_HYSTERESIS = 1e-9
 
@@ -73,6 +84,8 @@ PAIR_SLACKENS = 7
 PAIR_ENGAGES = 8
 KNEE_HITS_STOP = 9
 KNEE_LEAVES_STOP = 10
+PAIR_PUSHES = 11
+PAIR_PULLS = 12
 
 
 @dataclass(frozen=True)
@@ -127,6 +140,10 @@ EVENT_KINDS: tuple[EventKind, ...] = (
               "the knee reached its hyper-extension stop"),
     EventKind(KNEE_LEAVES_STOP, "knee-leaves-stop", False, -1, RELEASE_HYSTERESIS,
               "the knee left its stop"),
+    EventKind(PAIR_PUSHES, "pair-pushes", False, -1, TORQUE_HYSTERESIS,
+              "a pull-only pair would have pushed: it went slack"),
+    EventKind(PAIR_PULLS, "pair-pulls", False, 1, -TORQUE_HYSTERESIS,
+              "a slack pull-only pair pulls again"),
 )
 
 #: Direction of each kind, by code (+1 rising, −1 falling). [-]
@@ -183,7 +200,8 @@ class EventSlots:
 
 
 def event_slots(n_links: int, base_of_support: bool, centre_of_pressure: bool,
-                limited: np.ndarray, one_sided: np.ndarray, knee_stop: bool) -> EventSlots:
+                limited: np.ndarray, one_sided: np.ndarray, knee_stop: bool,
+                pull_only: np.ndarray | None = None) -> EventSlots:
     """The event slots of a run, in tie-breaking order.
 
     Falls first (every link angle, then the centre of gravity past the toe and the heel,
@@ -203,6 +221,8 @@ def event_slots(n_links: int, base_of_support: bool, centre_of_pressure: bool,
         One-sided pairs.
     knee_stop : bool
         The knee has a hyper-extension stop.
+    pull_only : array_like of bool, shape (P,), optional
+        One-sided pairs that also switch on the sign of their torque (none by default).
     """
     rows: list[tuple[int, int, float, int]] = [(LINK_ANGLE, i, 0.0, ALWAYS)
                                                for i in range(n_links)]
@@ -213,9 +233,15 @@ def event_slots(n_links: int, base_of_support: bool, centre_of_pressure: bool,
     for j in np.nonzero(np.asarray(limited, dtype=bool))[0]:
         rows += [(SATURATES, int(j), 1.0, JOINT_FREE), (SATURATES, int(j), -1.0, JOINT_FREE),
                  (LETS_GO, int(j), 0.0, JOINT_SATURATED)]
-    for p in np.nonzero(np.asarray(one_sided, dtype=bool))[0]:
+    one_sided = np.asarray(one_sided, dtype=bool)
+    pull = (np.zeros(one_sided.shape, bool) if pull_only is None
+            else np.asarray(pull_only, dtype=bool) & one_sided)
+    for p in np.nonzero(one_sided)[0]:
         rows += [(PAIR_SLACKENS, int(p), 0.0, PAIR_ACTIVE),
                  (PAIR_ENGAGES, int(p), 0.0, PAIR_SLACK)]
+        if pull[p]:
+            rows += [(PAIR_PUSHES, int(p), 0.0, PAIR_ACTIVE),
+                     (PAIR_PULLS, int(p), 0.0, PAIR_SLACK)]
     if knee_stop:
         rows += [(KNEE_HITS_STOP, 1, 0.0, KNEE_FREE), (KNEE_LEAVES_STOP, 1, 0.0, KNEE_LOCKED)]
     kind, index, side, cond = zip(*rows, strict=True)

@@ -92,6 +92,11 @@ class MusclePair:
     active_viscosity : float, optional
         Active (neural, delayed) viscosity; None for none (0 if only the active
         stiffness is given). [N·m·s/rad]
+    pull_only : bool
+        For a one-sided pair: it also goes slack while its torque k s + l ṡ would be
+        negative (a muscle pulls, it cannot push), not only while its stretch is. True by
+        default; False is the stretch-only switch of earlier versions. Ignored for a
+        two-sided pair.
     """
 
     name: str
@@ -102,6 +107,7 @@ class MusclePair:
     one_sided: bool = False
     active_stiffness: float | None = None
     active_viscosity: float | None = None
+    pull_only: bool = True
 
     def __post_init__(self) -> None:
         label = f"muscle pair {self.name!r}"
@@ -120,6 +126,10 @@ class MusclePair:
         object.__setattr__(self, "viscosity", float_in_range(
             f"{label} viscosity", self.viscosity, 0.0, MAX_PAIR_VISCOSITY, unit="N·m·s/rad"))
         object.__setattr__(self, "one_sided", bool(self.one_sided))
+        if not isinstance(self.pull_only, bool | np.bool_):
+            raise ParameterError(f"{label} pull_only must be true or false, got "
+                                 f"{self.pull_only!r}")
+        object.__setattr__(self, "pull_only", bool(self.pull_only))
         for field, unit in (("active_stiffness", "N·m/rad"), ("active_viscosity", "N·m·s/rad")):
             value = getattr(self, field)
             if value is not None:
@@ -235,6 +245,11 @@ class MuscleSet:
     def one_sided_mask(self) -> np.ndarray:
         """True for pairs that act only while their stretch is >= 0."""
         return np.array([p.one_sided for p in self.pairs], dtype=bool)
+
+    @property
+    def pull_only_mask(self) -> np.ndarray:
+        """True for one-sided pairs that also go slack while their torque would push."""
+        return np.array([p.one_sided and p.pull_only for p in self.pairs], dtype=bool)
 
     def stiffness_matrix(self, active: np.ndarray | None = None) -> np.ndarray:
         """Joint-space stiffness K = Eᵀ K_d E (paper eq. 5). [N·m/rad]

@@ -153,7 +153,8 @@ def _beyond1(runs: PaperRuns, names: list[str]) -> Figure:
                    foot_label=_foot_label(runs),
                    label="two-sided gastrocnemius (the paper's artificial antagonist)",
                    color="#1f77b4")
-    plot_cog_phase(runs.one_sided, ax, label="one-sided gastrocnemius (acts only while θ2 ≥ 0)",
+    plot_cog_phase(runs.one_sided, ax,
+                   label="one-sided gastrocnemius (acts only while θ2 ≥ 0 and pulling)",
                    color="#d62728")
     fig.suptitle("Forward platform motion, case 1: artificial vs real gastrocnemius")
     return fig

@@ -144,8 +144,8 @@ class OneSidedFinding:
     def text(self) -> str:
         """The finding in words, with its numbers."""
         return (
-            "The real gastrocnemius pulls one way only (it acts while θ2 ≥ 0). In the forward "
-            "case 1 run with it, "
+            "The real gastrocnemius pulls one way only (it acts while θ2 ≥ 0 and its torque "
+            "pulls). In the forward case 1 run with it, "
             + (f"θ2 reaches {self.theta2_max:+.3f} rad, so the pair acts at times, "
                if self.theta2_max >= 0.0 else
                f"θ2 stays negative (max θ2 = {self.theta2_max:+.3f} rad), so the pair never "

@@ -464,7 +464,7 @@ def _parse_muscles(mt: dict, body: Body, origin: str) -> tuple[MuscleSet, str | 
             if not isinstance(p, dict):
                 raise ScenarioError(f"{origin}: muscles.pairs[{i}] must be a table")
             keys = ("name", "lo", "hi", "stiffness", "viscosity", "one_sided",
-                    "active_stiffness", "active_viscosity")
+                    "active_stiffness", "active_viscosity", "pull_only")
             _reject(p, keys, f"muscles.pairs[{i}]", origin)
             for k in ("lo", "hi", "stiffness"):
                 if k not in p:
@@ -473,7 +473,8 @@ def _parse_muscles(mt: dict, body: Body, origin: str) -> tuple[MuscleSet, str | 
             visc = p.get("viscosity", ratio * finite_float("stiffness", p["stiffness"]))
             pairs.append(MusclePair(str(p.get("name", f"pair{i + 1}")), p["lo"], p["hi"],
                                     p["stiffness"], visc, bool(p.get("one_sided", False)),
-                                    p.get("active_stiffness"), p.get("active_viscosity")))
+                                    p.get("active_stiffness"), p.get("active_viscosity"),
+                                    bool(p.get("pull_only", True))))
         return MuscleSet(tuple(pairs), body.n_links), None
     if body.n_links != 3:
         raise ScenarioError(f"{origin}: muscles.case / muscles.stiffness are the paper's five "

@@ -55,6 +55,7 @@ class PairTable(_Table):
     name: str | None = None
     viscosity: float | None = None
     one_sided: bool | None = None
+    pull_only: bool | None = None
     active_stiffness: float | None = None
     active_viscosity: float | None = None
 

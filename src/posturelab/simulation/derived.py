@@ -58,6 +58,7 @@ def derived_series(setup: RunSetup, time: np.ndarray, state: np.ndarray,
     M = feedback_pair_torques(muscles, setup.gains, state, fb)
     if muscles.one_sided_mask.any():  # (such pairs are all-immediate or all-delayed)
         slack = muscles.one_sided_mask & (fb[:, :n] @ muscles.selection_matrix.T < 0.0)
+        slack |= muscles.pull_only_mask & (M < 0.0)  # a pull-only pair does not push
         M = np.where(slack, 0.0, M)
     if setup.tilt is not None:
         M = M + tilt_torques(setup.tilt, setup.tilt_gains, setup.feedback_delay, time)

@@ -33,7 +33,15 @@ import numpy as np
 from ..model import events as ev
 from .derived import derived_series
 from .results import SimulationResult
-from .setup import RunSetup, cop_at, model_response, outcome_message, raw_moments
+from .setup import (
+    RunSetup,
+    cop_at,
+    model_response,
+    outcome_message,
+    pair_pulls_value,
+    pair_torque_if_acting,
+    raw_moments,
+)
 
 __all__ = ["integrate_reference", "REFERENCE_METHODS"]
 
@@ -103,7 +111,7 @@ def integrate_reference(setup: RunSetup, method: str = "DOP853") -> SimulationRe
     mtot = body.total_mass
     E = muscles.selection_matrix
     slots = ev.event_slots(n, bos is not None, fall.centre_of_pressure, limited,
-                           muscles.one_sided_mask, knee.mode == "stop")
+                           muscles.one_sided_mask, knee.mode == "stop", muscles.pull_only_mask)
 
     def event_function(k: int, j: int, sd: float, _active, _locked, _sat):
         """The event function g(t, x) of event kind k (index j, side sd) in this segment."""
@@ -125,6 +133,10 @@ def integrate_reference(setup: RunSetup, method: str = "DOP853") -> SimulationRe
                 - limits[j] + offset
         if k in (ev.PAIR_SLACKENS, ev.PAIR_ENGAGES):
             return lambda t, y: E[j] @ feedback(t, y)[:n] + offset
+        if k == ev.PAIR_PUSHES:
+            return lambda t, y: pair_torque_if_acting(setup, j, feedback(t, y)) + offset
+        if k == ev.PAIR_PULLS:
+            return lambda t, y: pair_pulls_value(setup, j, feedback(t, y)) + offset
         if k == ev.KNEE_HITS_STOP:
             return lambda t, y: (y[1] - y[0]) - knee.stop_angle + offset
         # KNEE_LEAVES_STOP: the free knee acceleration
@@ -240,10 +252,17 @@ def integrate_reference(setup: RunSetup, method: str = "DOP853") -> SimulationRe
             status = "failed"
             message = outcome_message("chattering", seg_end, setup)
             break
-        if kind in (ev.PAIR_SLACKENS, ev.PAIR_ENGAGES):
-            # the pair engages if its stretch is now growing, goes slack otherwise
+        if kind in (ev.PAIR_SLACKENS, ev.PAIR_ENGAGES, ev.PAIR_PUSHES, ev.PAIR_PULLS):
+            # stretch events: the pair acts if its stretch is now growing; a pull-only pair
+            # goes slack when it would push, and acts again when it pulls while stretched
+            fb = feedback(seg_end, x)
             active = active.copy()
-            active[j] = 1.0 if E[j] @ feedback(seg_end, x)[n:] >= 0 else 0.0
+            if kind == ev.PAIR_PUSHES:
+                active[j] = 0.0
+            elif kind == ev.PAIR_PULLS:
+                active[j] = 1.0
+            else:
+                active[j] = 1.0 if E[j] @ fb[n:] >= 0 else 0.0
         elif kind == ev.KNEE_HITS_STOP:
             from ..model.dynamics import constrained_velocity
 

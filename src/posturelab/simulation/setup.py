@@ -389,7 +389,7 @@ def _prepare(body: Body, muscles: MuscleSet, disturbance: Disturbance | None = N
     if locked0:
         x0[n:] = constrained_velocity(body, x0[:n], x0[n:], knee_row)
     gains = muscle_set_gains(muscles, delay)
-    active0 = start_activity(muscles, before if delay > 0 else x0)  # (one-sided pairs have
+    active0 = start_activity(muscles, before if delay > 0 else x0, gains)  # (one-sided pairs have
     # no active gains: their whole feedback is delayed or none is)
     tilt_gains = None
     if tilt is not None:
@@ -431,15 +431,43 @@ def _prepare(body: Body, muscles: MuscleSet, disturbance: Disturbance | None = N
     return setup
 
 
-def start_activity(muscles: MuscleSet, state: np.ndarray) -> np.ndarray:
+def start_activity(muscles: MuscleSet, state: np.ndarray, gains: np.ndarray | None = None
+                   ) -> np.ndarray:
     """Which pairs act at the start: one-sided pairs if stretched, or at zero stretch and
-    stretching, in the state the muscles respond to, ``state`` (..., 2N). Returns (..., P)."""
+    stretching, in the state the muscles respond to, ``state`` (..., 2N); a pull-only pair
+    also only if its torque k s + l ṡ is >= 0, with the run's ``gains`` (..., 4, P) (the
+    muscles' own by default; :func:`posturelab.model.muscles.feedback_gains`). Returns
+    (..., P)."""
     n = muscles.n_links
     E = muscles.selection_matrix
     state = np.asarray(state, dtype=float)
     s, sd = state[..., :n] @ E.T, state[..., n:] @ E.T
     act = np.where(muscles.one_sided_mask, (s > 0) | ((s == 0) & (sd >= 0)), True)
+    pull = muscles.pull_only_mask
+    if pull.any():
+        g = muscle_set_gains(muscles, 0.0) if gains is None else np.asarray(gains, float)
+        torque = (g[..., 0, :] + g[..., 2, :]) * s + (g[..., 1, :] + g[..., 3, :]) * sd
+        act = act & np.where(pull, torque >= 0, True)
     return act.astype(float)
+
+
+def pair_torque_if_acting(setup: RunSetup, j: int, feedback: np.ndarray) -> float:
+    """M_j = k s + l ṡ of pair j on the state the muscles respond to, ``feedback`` (2N,)
+    (what a pull-only pair's switch looks at; one-sided pairs are wholly immediate or
+    wholly delayed). [N·m]"""
+    n = setup.n_links
+    E, g = setup.muscles.selection_matrix, setup.gains
+    return float((g[0, j] + g[2, j]) * (E[j] @ feedback[:n])
+                 + (g[1, j] + g[3, j]) * (E[j] @ feedback[n:]))
+
+
+def pair_pulls_value(setup: RunSetup, j: int, feedback: np.ndarray) -> float:
+    """min(M_j, k_j s_j) of a slack pull-only pair: positive once it is stretched and its
+    torque pulls (k_j its stiffness, 1 N·m/rad if it has none). [N·m]"""
+    n = setup.n_links
+    k = setup.gains[0, j] + setup.gains[2, j]
+    stretch = float(setup.muscles.selection_matrix[j] @ feedback[:n])
+    return min(pair_torque_if_acting(setup, j, feedback), (k if k > 0 else 1.0) * stretch)
 
 
 def start_moments(muscles: MuscleSet, state: np.ndarray, before: np.ndarray,

@@ -143,7 +143,7 @@ def _packed(setup: RunSetup) -> dict:
                else np.zeros(n, bool))
     slots = ev.event_slots(n, setup.fall.base_of_support is not None,
                            setup.fall.centre_of_pressure, limited, muscles.one_sided_mask,
-                           setup.knee.mode == "stop")
+                           setup.knee.mode == "stop", muscles.pull_only_mask)
     return {
         "x0": enc.readonly(setup.x0), "before": enc.readonly(setup.before),
         "grid": enc.readonly(setup.grid), "bp": enc.body_array(setup.body),
@@ -570,14 +570,24 @@ def simulate_batch(
     any_limit = bool(np.isfinite(lims).any())
     for row in (np.unique(lims, axis=0) if M and any_limit else []):
         level_setup(1.0, 0.0, None if np.all(np.isinf(row)) else row)
-    # one level per distinct (scale, delayed or not): start state, disturbance, knee, pairs
+    # one level per distinct (scale, delayed or not, pairs acting at the start): start
+    # state, disturbance, knee, pairs (a pull-only pair's start depends on the run's gains)
     delayed = delays > 0
+    slot_limits = np.where(np.isfinite(lims).any(axis=0), 1.0, math.inf) if any_limit else None
+    # (a level's limits only decide which event slots exist: the finite ones of any run)
+    gains_all = enc.readonly(np.ascontiguousarray(
+        feedback_gains(kd_all, ld_all, ka_all, la_all, delays)))
     keys = np.stack([scale, delayed.astype(float)], axis=1)
+    if M and muscles.one_sided_mask.any():
+        first, where = np.unique(keys, axis=0, return_inverse=True)
+        starts = [level_setup(float(f), 1.0 if dl else 0.0, slot_limits) for f, dl in first]
+        state = np.stack([lv.before if dl else lv.x0
+                          for lv, (_, dl) in zip(starts, first, strict=True)])
+        acting = start_activity(muscles, state[np.asarray(where).ravel()], gains_all)
+        keys = np.concatenate([keys, acting], axis=1)
     values, which = np.unique(keys, axis=0, return_inverse=True) if M else (keys, [])
     which = np.ascontiguousarray(np.asarray(which).ravel(), dtype=np.int64)
-    # a level's limits only decide which event slots exist: the finite ones of any run
-    slot_limits = np.where(np.isfinite(lims).any(axis=0), 1.0, math.inf) if any_limit else None
-    levels = [level_setup(float(f), 1.0 if dl else 0.0, slot_limits) for f, dl in values]
+    levels = [level_setup(float(row[0]), 1.0 if row[1] else 0.0, slot_limits) for row in values]
     base = levels[0] if levels else level_setup(1.0, 0.0, slot_limits)
     packed = [_packed(lv) for lv in levels] or [_packed(base)]
     stack = lambda key: enc.readonly(np.stack([p[key] for p in packed]))  # noqa: E731
@@ -586,11 +596,9 @@ def simulate_batch(
     dp_all = enc.readonly(np.stack([np.pad(p["dp"], (0, dp_len - p["dp"].size))
                                     for p in packed]))
     active_all = enc.readonly(np.stack(
-        [start_activity(muscles, lv.before if dl else lv.x0)
-         for lv, (_, dl) in zip(levels, values, strict=True)] or [packed[0]["active0"]]))
-    # per run: the gains by when they act, the saturation at the start
-    gains_all = enc.readonly(np.ascontiguousarray(
-        feedback_gains(kd_all, ld_all, ka_all, la_all, delays)))
+        [row[2:] if row.size > 2 else start_activity(muscles, lv.before if row[1] else lv.x0)
+         for lv, row in zip(levels, values, strict=True)] or [packed[0]["active0"]]))
+    # per run: the saturation at the start
     moments0 = start_moments(muscles, x0_all[which], before_all[which], active_all[which],
                              gains_all)
     tilt_gain_all = enc.readonly(np.zeros((M, 4, n)))

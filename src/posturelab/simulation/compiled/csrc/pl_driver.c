@@ -137,8 +137,8 @@ int64_t pl_integrate(const pl_run *run, pl_out *out)
     memcpy(b.x, run->x0, sizeof(double) * m);
     pl_model md = {n, run->bp, b.tm, run->lim, b.sat, b.base, b.work, b.tau};
     pl_ctx cx = {&md, run->E, run->dp, fpar, run->before, run->ev_offset, &hist, delay,
-                 run->tp, run->tilt_gain, run->tilt_depth, run->mp, b.sc_out, b.sc_inp, b.sc_x,
-                 b.ys};
+                 run->tp, run->tilt_gain, run->tilt_depth, run->mp, run->gains, run->p,
+                 b.sc_out, b.sc_inp, b.sc_x, b.ys};
     double *x = b.x, *y = b.y, *Q = b.Q, *inp = b.inp;
     for (int64_t i = 0; i < n; i++)
         out->peak[i] = 0.0;
@@ -341,17 +341,27 @@ int64_t pl_integrate(const pl_run *run, pl_out *out)
                 status = PL_CHATTERING;
                 break;
             }
-            if (kind == EV_PAIR_SLACKENS || kind == EV_PAIR_ENGAGES) {
-                /* the pair engages if its (fed-back) stretch is now growing, else goes slack */
+            if (kind == EV_PAIR_SLACKENS || kind == EV_PAIR_ENGAGES || kind == EV_PAIR_PUSHES
+                || kind == EV_PAIR_PULLS) {
+                /* stretch events: the pair acts if its (fed-back) stretch is now growing; a
+                 * pull-only pair goes slack when it would push, and acts again when it pulls
+                 * while stretched */
                 const double *s = x;
                 if (delay > 0.0) {
                     pl_history_at(&hist, run->before, t_ev - delay, b.sc_x);
                     s = b.sc_x;
                 }
-                double sd = 0.0;
-                for (int64_t k = 0; k < n; k++)
+                double st = 0.0, sd = 0.0;
+                for (int64_t k = 0; k < n; k++) {
+                    st += run->E[j * n + k] * s[k];
                     sd += run->E[j * n + k] * s[n + k];
-                b.active[j] = sd >= 0.0 ? 1.0 : 0.0;
+                }
+                if (kind == EV_PAIR_PUSHES)
+                    b.active[j] = 0.0;
+                else if (kind == EV_PAIR_PULLS)
+                    b.active[j] = 1.0;
+                else
+                    b.active[j] = sd >= 0.0 ? 1.0 : 0.0;
             } else if (kind == EV_KNEE_HITS_STOP) {
                 x[1] = x[0] + stop_angle;
                 pl_project_velocity(x, run->bp, b.work, n);

@@ -75,15 +75,29 @@ double pl_event_value(const pl_ctx *cx, int64_t kind, int64_t idx, double side, 
         break;
     }
     case EV_PAIR_SLACKENS:
-    case EV_PAIR_ENGAGES: {
+    case EV_PAIR_ENGAGES:
+    case EV_PAIR_PUSHES:
+    case EV_PAIR_PULLS: {  /* the stretch, or the torque k s + l ṡ, of the fed-back state */
         const double *s = y;
         if (cx->delay > 0.0) {
             pl_history_at(cx->hist, cx->before, t - cx->delay, cx->sc_x);
             s = cx->sc_x;
         }
-        g = 0.0;
-        for (int64_t j = 0; j < n; j++)
-            g += cx->E[idx * n + j] * s[j];
+        double st = 0.0, sd = 0.0;
+        for (int64_t j = 0; j < n; j++) {
+            st += cx->E[idx * n + j] * s[j];
+            sd += cx->E[idx * n + j] * s[n + j];
+        }
+        if (kind == EV_PAIR_PUSHES || kind == EV_PAIR_PULLS) {
+            const double *gn = cx->gains;
+            const int64_t p = cx->p;
+            const double k = gn[idx] + gn[2 * p + idx];
+            g = k * st + (gn[p + idx] + gn[3 * p + idx]) * sd;
+            if (kind == EV_PAIR_PULLS)  /* stretched, and pulling */
+                g = fmin(g, (k > 0.0 ? k : 1.0) * st);
+        } else {
+            g = st;
+        }
         break;
     }
     case EV_KNEE_HITS_STOP:

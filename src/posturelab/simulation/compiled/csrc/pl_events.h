@@ -13,6 +13,8 @@ typedef struct {
     const double *tp, *tilt_gain;          /* packed tilt, (4, n) joint gains on it */
     double tilt_depth;                     /* tilt axis below the ankle [m] */
     const double *mp;                      /* packed motor noise */
+    const double *gains;                   /* (4, p) the run's pair gains */
+    int64_t p;
     double *sc_out, *sc_inp, *sc_x, *ys;   /* scratch (2n), (2 + n), (2n), (2n) */
 } pl_ctx;
 
