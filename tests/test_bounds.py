@@ -70,3 +70,15 @@ def test_the_api_names_an_argument_of_the_wrong_type():
     ]:
         with pytest.raises(ParameterError, match=words.replace("(", r"\(")):
             call()
+
+
+def test_fit_data_spanning_a_million_seconds_is_refused(tmp_path):
+    """The fit sets the run's duration from the data: 1e6 s is refused by the duration
+    bound in one line, instead of running out of memory."""
+    path = tmp_path / "long.csv"
+    path.write_text("t,theta1,theta2,theta3\n0,0.1,-0.1,0.1\n1,0,0,0\n1000000,0,0,0\n")
+    p = cli("fit", "--case", "1", "--disturbance", "backward", "--data", str(path), "--free",
+            "ankle")
+    err = p.stderr.strip()
+    assert p.returncode == 2 and len(err.splitlines()) == 1
+    assert "duration [s] must be in (0, 86400] s, got 1000000.0" in err
