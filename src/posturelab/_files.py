@@ -25,7 +25,7 @@ from pathlib import Path
 from .errors import DataFileError, PostureLabError
 
 __all__ = ["MAX_INPUT_BYTES", "MAX_SCENARIO_BYTES", "MAX_DATA_ROWS", "MAX_FIELD_CHARS",
-           "read_text", "csv_rows"]
+           "read_text", "csv_rows", "refuse_non_regular"]
 
 #: Largest data file read. [bytes]
 MAX_INPUT_BYTES = 512 * 2**20
@@ -102,3 +102,15 @@ def header_words(cells: list[str]) -> str:
     if len(names) >= 2 and all(0 < len(c) <= 32 for c in names):
         return "found " + ", ".join(names)
     return "its first line is not a header of column names"
+
+
+def refuse_non_regular(path: str | Path, error: type[PostureLabError]) -> None:
+    """Raise ``error`` unless ``path`` is missing or a regular file: an output never
+    replaces a device, FIFO or socket."""
+    try:
+        mode = os.stat(path).st_mode
+    except OSError:
+        return
+    if not stat.S_ISREG(mode):
+        raise error(f"cannot write {str(path)!r}: it exists and is not a regular file (a "
+                    "device, FIFO or socket is never replaced)")

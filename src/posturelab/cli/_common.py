@@ -246,8 +246,9 @@ def check_writable(paths: list[str], suffixes: dict[str, tuple[str, ...]] | None
     not a regular file (a device, FIFO or socket: never replaced), its suffix is not one of
     ``suffixes[path]``, or two outputs are the same file."""
     import os
-    import stat
     from pathlib import Path
+
+    from .._files import refuse_non_regular
 
     seen: dict[str, str] = {}
     for p in paths:
@@ -258,13 +259,7 @@ def check_writable(paths: list[str], suffixes: dict[str, tuple[str, ...]] | None
             raise ParameterError(f"cannot write {p!r}: directory {str(d)!r} is not writable")
         if Path(p).is_dir():
             raise ParameterError(f"cannot write {p!r}: it is a directory")
-        try:
-            mode = os.stat(p).st_mode
-        except OSError:
-            mode = None
-        if mode is not None and not stat.S_ISREG(mode):
-            raise ParameterError(f"cannot write {p!r}: it exists and is not a regular file "
-                                 "(a device, FIFO or socket is never replaced)")
+        refuse_non_regular(p, ParameterError)
         allowed = (suffixes or {}).get(p)
         if allowed and Path(p).suffix.lower() not in allowed:
             choices = (", ".join(allowed[:-1]) + " or " + allowed[-1]) if len(allowed) > 1 \

@@ -147,20 +147,11 @@ def run(args: argparse.Namespace) -> int:
         tolerances["rtol"] = scenario.rtol
     if args.atol is not None:
         tolerances["atol"] = scenario.atol
-    total = 1
-    for v in varies:
-        total *= v.count
-    bar = ProgressBar(total) if args.progress or sys.stderr.isatty() else None
-    t0 = time.perf_counter()
-    try:
-        result = run_sweep(scenario, varies, viscosity_ratio=ratio, workers=args.workers,
-                           scheduler=args.scheduler, chunk_size=args.chunk_size,
-                           progress=None if bar is None else (lambda done, _: bar.update(done)),
-                           **tolerances)
-    finally:
-        if bar is not None:
-            bar.close()
-    elapsed = time.perf_counter() - t0
+    total = _runs(varies)
+    result, elapsed = _with_progress(args, total, lambda progress: run_sweep(
+        scenario, varies, viscosity_ratio=ratio, workers=args.workers,
+        scheduler=args.scheduler, chunk_size=args.chunk_size, progress=progress,
+        **tolerances))
     result.write(args.out)
     o = result.outcomes
     shape = " × ".join(str(v.count) for v in varies)
@@ -180,6 +171,27 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
+def _runs(varies) -> int:
+    """Runs in the grid of ``varies``. [-]"""
+    total = 1
+    for v in varies:
+        total *= v.count
+    return total
+
+
+def _with_progress(args: argparse.Namespace, total: int, work):
+    """``work(progress)`` with a progress bar on standard error (a terminal, or
+    --progress); returns its result and the seconds it took."""
+    bar = ProgressBar(total) if args.progress or sys.stderr.isatty() else None
+    t0 = time.perf_counter()
+    try:
+        result = work(None if bar is None else (lambda done, _: bar.update(done)))
+    finally:
+        if bar is not None:
+            bar.close()
+    return result, time.perf_counter() - t0
+
+
 def _run_experiments(args: argparse.Namespace, scenario, varies, ratio) -> int:
     """``--experiment prts``: a PRTS identification experiment per parameter set."""
     from ..frequency.population import PRTSProtocol, prts_sweep
@@ -188,20 +200,9 @@ def _run_experiments(args: argparse.Namespace, scenario, varies, ratio) -> int:
     protocol = PRTSProtocol(cycles=args.cycles, discard=args.discard_cycles,
                             sensor_noise=args.sensor_noise, seed=args.seed or 0,
                             sample_rate=args.record_rate, output=args.output, fit=fit)
-    total = 1
-    for v in varies:
-        total *= v.count
-    bar = ProgressBar(total) if args.progress or sys.stderr.isatty() else None
-    t0 = time.perf_counter()
-    try:
-        result = prts_sweep(scenario, varies, protocol, viscosity_ratio=ratio,
-                            workers=args.workers, scheduler=args.scheduler,
-                            chunk_size=args.chunk_size,
-                            progress=None if bar is None else (lambda done, _: bar.update(done)))
-    finally:
-        if bar is not None:
-            bar.close()
-    elapsed = time.perf_counter() - t0
+    result, elapsed = _with_progress(args, _runs(varies), lambda progress: prts_sweep(
+        scenario, varies, protocol, viscosity_ratio=ratio, workers=args.workers,
+        scheduler=args.scheduler, chunk_size=args.chunk_size, progress=progress))
     result.write(args.out)
     fitted = f", fitted {', '.join(fit)}" if fit else ""
     print(f"wrote {args.out}: {result.fell.size} PRTS experiments ({', '.join(result.grid.names)}"

@@ -358,17 +358,11 @@ def new_file_mode() -> int:
 
 
 def _atomic_write(path: str | Path, data: bytes) -> None:
-    import stat
+    from .._files import refuse_non_regular
 
     path = Path(path)
     directory = path.parent if str(path.parent) else Path(".")
-    try:
-        mode = os.stat(path).st_mode
-    except OSError:
-        mode = None
-    if mode is not None and not stat.S_ISREG(mode):
-        raise PostureLabError(f"cannot write {str(path)!r}: it exists and is not a regular "
-                              "file (a device, FIFO or socket is never replaced)")
+    refuse_non_regular(path, PostureLabError)
     if not directory.is_dir():
         raise PostureLabError(
             f"cannot write {str(path)!r}: directory {str(directory)!r} does not exist"

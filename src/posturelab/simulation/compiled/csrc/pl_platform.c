@@ -7,23 +7,30 @@
 
 static const double PI = 3.14159265358979323846;
 
-/* numpy.interp(t, xp, fp, left=0, right=0), xp = dp[first .. first+count), fp its col-th
- * block of count values after it */
-static double interp0(double t, const double *dp, int64_t first, int64_t count, int64_t col)
+/* the largest k in [lo, hi) with x[k] <= t, by bisection (x increasing; lo if none) */
+static int64_t interval_of(const double *x, int64_t lo, int64_t hi, double t)
 {
-    int64_t lo = first, hi = first + count - 1;
-    if (!(t >= dp[lo] && t <= dp[hi]))
-        return 0.0;
-    const int64_t off = col * count;
-    if (t == dp[hi])
-        return dp[hi + off];
     while (hi - lo > 1) {
-        int64_t mid = (lo + hi) >> 1;
-        if (dp[mid] <= t)
+        const int64_t mid = (lo + hi) >> 1;
+        if (x[mid] <= t)
             lo = mid;
         else
             hi = mid;
     }
+    return lo;
+}
+
+/* numpy.interp(t, xp, fp, left=0, right=0), xp = dp[first .. first+count), fp its col-th
+ * block of count values after it */
+static double interp0(double t, const double *dp, int64_t first, int64_t count, int64_t col)
+{
+    const int64_t hi = first + count - 1;
+    if (!(t >= dp[first] && t <= dp[hi]))
+        return 0.0;
+    const int64_t off = col * count;
+    if (t == dp[hi])
+        return dp[hi + off];
+    const int64_t lo = interval_of(dp, first, hi, t);
     const double slope = (dp[lo + 1 + off] - dp[lo + off]) / (dp[lo + 1] - dp[lo]);
     return slope * (t - dp[lo]) + dp[lo + off];
 }
@@ -68,14 +75,7 @@ static void ppoly(double t, const double *x, const double *c, int64_t K, double 
         t = x[0];
     if (t > x[K])
         t = x[K];
-    int64_t lo = 0, hi = K;
-    while (hi - lo > 1) {
-        const int64_t mid = (lo + hi) >> 1;
-        if (x[mid] <= t)
-            lo = mid;
-        else
-            hi = mid;
-    }
+    const int64_t lo = interval_of(x, 0, K, t);
     const double u = t - x[lo], *q = c + 4 * lo;
     *angle = q[0] + u * (q[1] + u * (q[2] + u * q[3]));
     *rate = inside ? q[1] + u * (2.0 * q[2] + u * 3.0 * q[3]) : 0.0;
@@ -126,17 +126,7 @@ void pl_motor_noise_add(double t, const double *mp, int64_t n, double *tau)
 {
     const int64_t K = (int64_t)mp[0];
     const double *x = mp + 1, *c = mp + 2 + K;
-    int64_t lo = 0, hi = K;  /* the largest k in [0, K - 1] with x[k] <= t */
-    if (t >= x[K - 1])
-        lo = K - 1;
-    else
-        while (hi - lo > 1) {
-            const int64_t mid = (lo + hi) >> 1;
-            if (x[mid] <= t)
-                lo = mid;
-            else
-                hi = mid;
-        }
+    const int64_t lo = interval_of(x, 0, K, t);  /* in [0, K - 1] */
     const double u = t - x[lo], *q = c + lo * 4 * n;
     for (int64_t j = 0; j < n; j++)
         tau[j] += q[j] + u * (q[n + j] + u * (q[2 * n + j] + u * q[3 * n + j]));
