@@ -201,3 +201,65 @@ def test_joint_positions_reach(body):
     tilt = joint_positions(body, np.full((2, 3), 0.3))
     assert tilt.shape == (2, 4, 2)
     assert np.allclose(tilt[0, -1], body.lengths.sum() * np.array([np.sin(0.3), np.cos(0.3)]))
+
+
+# -- several runs on one figure ------------------------------------------------------------
+
+
+def _legend_texts(ax: Axes) -> list[str]:
+    return [t.get_text() for t in ax.get_legend().texts]
+
+
+def test_time_histories_several_runs(backward, falling):
+    """Links keep their colours, each run its own line style; each label appears once."""
+    _, r = backward
+    _, f = falling
+    axes = plot_time_histories([r, f], labels=["backward", "forward, case 2"])
+    for ax in axes:
+        texts = _legend_texts(ax)
+        assert len(texts) == len(set(texts)), texts
+        assert "backward" in texts and "forward, case 2" in texts
+        assert sum(t.startswith("forward, case 2: fall at t = 1.1") for t in texts) == 1
+    data = [line for line in axes[0].get_lines() if len(line.get_xdata()) == f.time.size]
+    assert len(data) >= 3 and np.allclose(data[0].get_ydata(), f.theta[:, 0])
+    styles = {line.get_linestyle() for line in axes[0].get_lines() if np.size(line.get_xdata()) > 2}
+    assert {"-", "--"} <= styles
+    with pytest.raises(ParameterError, match="one label per run"):
+        plot_time_histories([r, f], labels=["only one"])
+    with pytest.raises(ParameterError, match="two Axes"):
+        plot_time_histories([r, f], new_figure()[1])
+    with pytest.raises(ParameterError, match="SimulationResult"):
+        plot_time_histories("run.csv")
+    with pytest.raises(ParameterError, match="at least one"):
+        plot_time_histories([])
+
+
+def test_angle_angle_and_torques_several_runs(backward, falling):
+    _, r = backward
+    _, f = falling
+    ax = plot_angle_angle([r, f], labels=["a", "b"])
+    texts = _legend_texts(ax)
+    assert len(texts) == len(set(texts)) and {"a", "b", "end", "fall"} <= set(texts)
+    ax = plot_pair_torques([r, f], labels=["a", "b"])
+    texts = _legend_texts(ax)
+    assert texts.count("ankle pair") == 1 and {"a", "b"} <= set(texts)
+    ankle = [line for line in ax.get_lines() if line.get_label() == "ankle pair"]
+    assert len(ankle) == 1 and np.allclose(ankle[0].get_ydata(),
+                                           r.pair_torques[:, r.pair_names.index("ankle")])
+
+
+def test_cog_phase_several_runs_shade_foot_once(backward, falling):
+    """A list of runs, or repeated calls on one Axes: the foot shaded once, labels once."""
+    _, r = backward
+    _, f = falling
+    ax = plot_cog_phase([r, f], label=["backward", "forward"],
+                        base_of_support=FOOT_FROM_LITERATURE)
+    plot_cog_phase(r, ax, label="backward again", base_of_support=FOOT_FROM_LITERATURE)
+    assert len(ax.patches) == 1
+    texts = _legend_texts(ax)
+    assert len(texts) == len(set(texts))
+    assert {"backward", "forward", "backward again", "fall", "end"} <= set(texts)
+    colours = {line.get_color() for line in ax.get_lines() if np.size(line.get_xdata()) > 2}
+    assert len(colours) == 3  # the repeated call carries on the colour cycle
+    with pytest.raises(ParameterError, match="one colour per run"):
+        plot_cog_phase([r, f], color="k")
