@@ -83,7 +83,7 @@ def test_a_fall_and_a_failure_say_so():
                          torque_limits=[300.0, np.inf, np.inf],
                          initial_state=np.array([0.1, -0.1, 0.1, 0, 0, 0]))
     assert failed.status == "failed" and failed.outcome.kind == "failed"
-    assert failed.outcome.message == failed.message
+    assert failed.outcome.message == f"failed: {failed.message}"
 
 
 def test_a_recovered_run_and_its_settling_time():

@@ -59,8 +59,9 @@ def test_cli_sweep_csv_equals_batch_and_single_runs(tmp_path, capsys):
     k[:, 4] = values[:, 1]
     batch = simulate_batch(paper_body(), k, 0.25 * k, VelocityStep.backward(1.0), 2.0, POSTURE)
     assert [r[2] for r in rows] == list(batch.outcome)
-    assert [r[3] for r in rows] == ["true" if f else "false" for f in batch.fell]
-    got = np.array([[cell(x) for x in r[4:]] for r in rows])
+    assert [r[3] for r in rows] == [""] * 6  # no run failed: no failure words
+    assert [r[4] for r in rows] == ["true" if f else "false" for f in batch.fell]
+    got = np.array([[cell(x) for x in r[5:]] for r in rows])
     n = 3
     want = np.column_stack([batch.fall_time, batch.peak_theta, batch.settling_time,
                             np.abs(batch.final_state[:, :n]).max(axis=1),
@@ -90,7 +91,7 @@ def test_parquet_round_trip(tmp_path):
     assert table.schema.field("ankle").metadata[b"unit"] == "N·m/rad".encode()
     for name, values in result.columns():
         col = table.column(name).to_numpy(zero_copy_only=False)
-        if name in ("fell", "outcome"):
+        if name in ("fell", "outcome", "failure"):
             np.testing.assert_array_equal(col, values)
         else:
             np.testing.assert_array_equal(np.asarray(col, dtype=float), values)
@@ -262,7 +263,7 @@ def test_sweep_over_a_joint_torque_limit_equals_single_runs(tmp_path):
                  "--vary", "knee_torque_limit=20:60:3", "--torque-limits", "inf,inf,30",
                  "--out", str(tmp_path / "limits.csv")]) == 0
     header = (tmp_path / "limits.csv").read_text().splitlines()[0]
-    assert header.startswith("knee_torque_limit,outcome,fell")
+    assert header.startswith("knee_torque_limit,outcome,failure,fell")
 
 
 def test_a_one_link_sweep_over_delay_active_gain_and_weight_equals_single_runs(tmp_path,

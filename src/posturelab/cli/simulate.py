@@ -51,6 +51,9 @@ line printed (outcome in --json) is recovered, not recovered, fell or failed.
 
 
 HELP = "simulate a platform disturbance (nonlinear model)"
+#: The wall-clock budget of one `simulate` run when neither --time-limit nor the scenario
+#: gives one: nothing legitimate takes this long on either engine. [s]
+DEFAULT_TIME_LIMIT = 600.0
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -143,6 +146,12 @@ def add_experiment_arguments(p: argparse.ArgumentParser) -> None:
                      "compiled and sweeps).")
     run.add_argument("--sample-rate", type=float, default=None,
                      help="output samples per second [Hz] (default 1000).")
+    run.add_argument("--max-steps", type=int, default=None, metavar="N",
+                     help="step budget of each run: after N accepted integrator steps it "
+                     "stops as failed (default 1e6 + 1e4 per simulated second).")
+    run.add_argument("--time-limit", type=float, default=None, metavar="SECONDS",
+                     help="wall-clock budget of each run: past it the run stops as failed "
+                     "(default: 600 for simulate, none for sweep).")
 
 
 MODEL_OPTIONS = ("case", "stiffness", "disturbance", "platform_profile", "initial_posture",
@@ -166,7 +175,7 @@ def scenario_from_args(args: argparse.Namespace, command: str = "simulate") -> S
     else:
         sc = _scenario_from_options(args, command)
     overrides = {}
-    for name in ("duration", "rtol", "atol", "sample_rate"):
+    for name in ("duration", "rtol", "atol", "sample_rate", "max_steps", "time_limit"):
         value = getattr(args, name)
         if value is not None:
             overrides[name] = value
@@ -302,6 +311,8 @@ def run(args: argparse.Namespace) -> int:
     outputs = [p for p in (args.out, args.plot, args.animate) if p]
     check_writable(outputs, {args.out: (".csv",), args.plot: FIGURE_SUFFIXES,
                              args.animate: (".gif",)})
+    if sc.time_limit is None:
+        sc = sc.replace(time_limit=DEFAULT_TIME_LIMIT)
     result = sc.run(engine=args.engine)
     if args.out:
         result.to_csv(args.out)

@@ -168,6 +168,11 @@ class Scenario:
         Distance of the tilt axis below the ankle. [m]
     motor_noise : MotorNoise or None
         A seeded random joint torque (:mod:`posturelab.model.noise`). [N·m]
+    max_steps : int or None
+        The step budget of a run (None: :func:`posturelab.simulation.setup.default_step_budget`).
+        [-]
+    time_limit : float or None
+        The wall-clock budget of a run; None for none. [s]
     """
 
     name: str
@@ -192,6 +197,8 @@ class Scenario:
     proprioceptive_weight: float = 1.0
     tilt_axis_depth: float = 0.0
     motor_noise: MotorNoise | None = None
+    max_steps: int | None = None
+    time_limit: float | None = None
 
     def run(self, *, engine: str = "reference", **overrides: Any) -> SimulationResult:
         """Simulate this scenario; keyword ``overrides`` replace fields first.
@@ -211,7 +218,7 @@ class Scenario:
             sample_rate=sc.sample_rate, description=sc.description,
             method=sc.method if name == "reference" else None, engine=name, tilt=sc.tilt,
             proprioceptive_weight=sc.proprioceptive_weight, tilt_axis_depth=sc.tilt_axis_depth,
-            motor_noise=sc.motor_noise,
+            motor_noise=sc.motor_noise, max_steps=sc.max_steps, time_limit=sc.time_limit,
         )
 
     def replace(self, **changes: Any) -> Scenario:
@@ -357,7 +364,8 @@ def _parse(data: dict, base_dir: Path, origin: str) -> Scenario:
             raise ScenarioError(f"{origin}: limits.torque needs {body.n_links} values "
                                 f"(one per joint), got {len(torque_limits)}")
 
-    st = _table(data, "solver", ("rtol", "atol", "sample_rate", "method"), origin)
+    st = _table(data, "solver", ("rtol", "atol", "sample_rate", "method", "max_steps",
+                                 "time_limit"), origin)
     method = st.get("method", "DOP853")
     if method not in ("DOP853", "RK45", "RK23", "Radau", "BDF", "LSODA"):
         raise ScenarioError(f"{origin}: solver.method must be one of DOP853, RK45, RK23, Radau, "
@@ -373,7 +381,24 @@ def _parse(data: dict, base_dir: Path, origin: str) -> Scenario:
         sample_rate=finite_float("solver.sample_rate [Hz]", st.get("sample_rate", 1000.0)),
         method=method, case=case, torque_limits=torque_limits, feedback_delay=delay,
         tilt=tilt, proprioceptive_weight=weight, tilt_axis_depth=depth, motor_noise=noise,
+        max_steps=_budget(origin, "solver.max_steps", st.get("max_steps"), duration),
+        time_limit=_budget(origin, "solver.time_limit [s]", st.get("time_limit"), duration),
     )
+
+
+def _budget(origin: str, name: str, value, duration: float):
+    """A scenario's step budget or time limit, checked as a run checks it (None: none
+    given)."""
+    if value is None:
+        return None
+    from ..simulation.setup import check_step_budget, check_time_limit
+
+    try:
+        if name.startswith("solver.max_steps"):
+            return check_step_budget(value, duration)
+        return check_time_limit(value)
+    except ParameterError as exc:
+        raise ScenarioError(f"{origin}: solver.{exc}") from None
 
 
 TILT_KEYS = ("type", "amplitude", "frequency", "phase", "duration", "start", "state_duration",

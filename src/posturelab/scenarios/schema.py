@@ -151,12 +151,15 @@ class LimitsTable(_Table):
 
 
 class SolverTable(_Table):
-    """``[solver]``: tolerances [-], [rad, rad/s], output rate [Hz], scipy method."""
+    """``[solver]``: tolerances [-], [rad, rad/s], output rate [Hz], scipy method, step
+    budget [-], wall-clock time limit [s]."""
 
     rtol: float | None = None
     atol: float | None = None
     sample_rate: float | None = None
     method: Literal["DOP853", "RK45", "RK23", "Radau", "BDF", "LSODA"] | None = None
+    max_steps: int | None = None
+    time_limit: float | None = None
 
 
 class MotorNoiseTable(_Table):

@@ -66,6 +66,8 @@ def simulate(
     proprioceptive_weight: float = 1.0,
     tilt_axis_depth: float = 0.0,
     motor_noise: MotorNoise | None = None,
+    max_steps: int | None = None,
+    time_limit: float | None = None,
 ) -> SimulationResult:
     """Simulate the nonlinear chain.
 
@@ -129,6 +131,14 @@ def simulate(
     motor_noise : MotorNoise, optional
         A seeded random torque added to each joint's net muscle moment, before the torque
         limits (:mod:`posturelab.model.noise`); none by default. [N·m]
+    max_steps : int, optional
+        The step budget: after this many accepted integrator steps the run stops as
+        ``failed`` with a message saying so; by default 10⁶ + 10⁴ per simulated
+        second (:func:`~posturelab.simulation.setup.default_step_budget`), far beyond
+        what a legitimate run needs. [-]
+    time_limit : float, optional
+        A wall-clock budget of the integration: past it the run stops as ``failed``
+        (the samples so far kept); none by default. [s]
 
     Returns
     -------
@@ -146,7 +156,7 @@ def simulate(
         atol=d_atol if atol is None else atol, sample_rate=sample_rate,
         max_switches=max_switches, description=description, tilt=tilt,
         proprioceptive_weight=proprioceptive_weight, tilt_axis_depth=tilt_axis_depth,
-        motor_noise=motor_noise)
+        motor_noise=motor_noise, max_steps=max_steps, time_limit=time_limit)
     method = d_method if method is None else method
     if name == "reference":
         from .reference import integrate_reference

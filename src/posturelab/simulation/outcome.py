@@ -99,7 +99,7 @@ def classify(status: str, settling_time: float | None, final_state, *, fall_time
     elif kind == "fell":
         words = message or f"fell at t = {fall_time} s: {fall_reason}"
     else:
-        words = message
+        words = f"failed: {message}" if message else "failed"
     return Outcome(kind, settling_time if kind == "recovered" else None,
                    fall_time if kind == "fell" else None,
                    fall_reason if kind == "fell" else None, lean, rate, words)

@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import bisect
 import math
+import time
 
 import numpy as np
 
@@ -47,6 +48,35 @@ __all__ = ["integrate_reference", "REFERENCE_METHODS"]
 
 #: scipy ``solve_ivp`` methods the reference engine accepts.
 REFERENCE_METHODS = ("DOP853", "RK45", "RK23", "Radau", "BDF", "LSODA")
+
+
+class _Budget:
+    """A run's step and time budgets, shared by the solvers of all its segments."""
+
+    def __init__(self, max_steps: int, time_limit: float):
+        self.max_steps, self.time_limit = max_steps, time_limit
+        self.steps = 0
+        self.started = time.monotonic()
+        self.spent: str | None = None  # "step-budget" or "time-budget" once one runs out
+
+    def solver(self, method: str):
+        """scipy's ``method`` class, counting its accepted steps against the budgets."""
+        import scipy.integrate
+
+        budget = self
+
+        class Budgeted(getattr(scipy.integrate, method)):
+            def _step_impl(self):
+                if budget.steps >= budget.max_steps:
+                    budget.spent = "step-budget"
+                elif time.monotonic() - budget.started > budget.time_limit:
+                    budget.spent = "time-budget"
+                if budget.spent is not None:
+                    return False, budget.spent
+                budget.steps += 1
+                return super()._step_impl()
+
+        return Budgeted
 
 
 class _History:
@@ -96,6 +126,8 @@ def integrate_reference(setup: RunSetup, method: str = "DOP853") -> SimulationRe
     body, muscles, fall, knee = setup.body, setup.muscles, setup.fall, setup.knee
     delay = setup.feedback_delay
     history = _History(setup.before) if delay > 0 else None
+    budget = _Budget(setup.max_steps, setup.time_limit)
+    solver = budget.solver(method)
 
     def feedback(t: float, x: np.ndarray) -> np.ndarray:
         return x if history is None else history(t - delay)
@@ -192,7 +224,7 @@ def integrate_reference(setup: RunSetup, method: str = "DOP853") -> SimulationRe
             events.append(g)
 
         try:
-            sol = solve_ivp(rhs, (t, t_end), x, method=method, rtol=setup.rtol,
+            sol = solve_ivp(rhs, (t, t_end), x, method=solver, rtol=setup.rtol,
                             atol=setup.atol, dense_output=True, events=events,
                             max_step=max_step)
         except (ValueError, np.linalg.LinAlgError, FloatingPointError) as exc:
@@ -215,7 +247,7 @@ def integrate_reference(setup: RunSetup, method: str = "DOP853") -> SimulationRe
         if sol.status == -1:
             status = "failed"
             message = outcome_message(
-                "failed", seg_end, setup,
+                budget.spent or "failed", seg_end, setup,
                 detail=f"integrator failed at t = {seg_end:.6g} s: {sol.message}")
             break
         x = sol.y[:, -1].copy()

@@ -60,6 +60,9 @@ __all__ = [
     "MAX_FEEDBACK_DELAY",
     "MAX_DURATION",
     "MAX_OUTPUT_SAMPLES",
+    "MAX_STEP_BUDGET",
+    "MAX_TIME_LIMIT",
+    "default_step_budget",
 ]
 
 #: With a feedback delay τ the motion is not smooth at t = kτ (the step at t = 0 reaches
@@ -72,6 +75,24 @@ MAX_FEEDBACK_DELAY = 1.0
 MAX_DURATION = 86_400.0
 #: Most output samples of one run (duration × sample_rate + 1). [-]
 MAX_OUTPUT_SAMPLES = 20_000_000
+#: The step budget of a run when none is given: this many accepted integrator steps … [-]
+BASE_STEP_BUDGET = 1_000_000
+#: … and this many more per simulated second. [1/s]
+STEP_BUDGET_PER_SECOND = 10_000
+#: The largest step budget a run may ask for. [-]
+MAX_STEP_BUDGET = 10_000_000_000
+#: The longest wall-clock time limit a run may ask for (a week). [s]
+MAX_TIME_LIMIT = 604_800.0
+
+
+def default_step_budget(duration: float) -> int:
+    """The step budget of a run of ``duration`` [s] when none is given. [-]
+
+    10⁶ accepted steps plus 10⁴ per simulated second: a hundred times what the
+    stiffest legitimate runs need (delayed feedback and motor noise cap the
+    step near 1 ms), so that only a runaway integration meets it.
+    """
+    return int(BASE_STEP_BUDGET + STEP_BUDGET_PER_SECOND * math.ceil(duration))
 
 Status = Literal["completed", "fell", "failed"]
 
@@ -103,6 +124,11 @@ class RunSetup:
         Output samples per second. [Hz]
     max_switches : int
         More switches than this fail the run (chattering). [-]
+    max_steps : int
+        The step budget: more accepted integrator steps than this end the run as
+        failed. [-]
+    time_limit : float
+        The wall-clock budget of the integration; ``inf`` for none. [s]
     description : str
         The run in words.
     before : numpy.ndarray, shape (2N,)
@@ -186,6 +212,8 @@ class RunSetup:
     velocity_jump: tuple[float, float] = (0.0, 0.0)
     motor_noise: MotorNoise | None = None
     motor_torque: TorqueSeries | None = None
+    max_steps: int = BASE_STEP_BUDGET
+    time_limit: float = math.inf
 
     @property
     def n_links(self) -> int:
@@ -254,6 +282,26 @@ def initial_state_for(
     return x0
 
 
+def check_step_budget(max_steps, duration: float) -> int:
+    """A run's step budget: an integer in [1, :data:`MAX_STEP_BUDGET`], or None for
+    :func:`default_step_budget`. [-]"""
+    if max_steps is None:
+        return default_step_budget(duration)
+    if isinstance(max_steps, bool) or not isinstance(max_steps, int | np.integer) \
+            or not 1 <= max_steps <= MAX_STEP_BUDGET:
+        raise ParameterError(f"max_steps must be an integer in [1, {MAX_STEP_BUDGET:,}], got "
+                             f"{max_steps!r:.60}")
+    return int(max_steps)
+
+
+def check_time_limit(time_limit) -> float:
+    """A run's wall-clock budget in (0, :data:`MAX_TIME_LIMIT`] [s]; None for none (inf)."""
+    if time_limit is None:
+        return math.inf
+    return float_in_range("time_limit [s]", time_limit, 0.0, MAX_TIME_LIMIT, include_low=False,
+                          unit="s")
+
+
 def _expect(name: str, value, kind: type) -> None:
     if not isinstance(value, kind):
         raise ParameterError(f"{name} must be a {kind.__name__}, got {type(value).__name__} "
@@ -267,6 +315,7 @@ RUN_OPTIONS: dict[str, object] = {
     "torque_limits": None, "feedback_delay": 0.0, "rtol": 1e-8, "atol": 1e-10,
     "sample_rate": 1000.0, "max_switches": 10_000, "description": "", "tilt": None,
     "proprioceptive_weight": 1.0, "tilt_axis_depth": 0.0, "motor_noise": None,
+    "max_steps": None, "time_limit": None,
 }
 
 
@@ -364,6 +413,8 @@ def _prepare(body: Body, muscles: MuscleSet, disturbance: Disturbance | None = N
     if isinstance(max_switches, bool) or not isinstance(max_switches, int | np.integer) \
             or max_switches < 0:
         raise ParameterError(f"max_switches must be an integer >= 0, got {max_switches!r}")
+    max_steps = check_step_budget(o["max_steps"], duration)
+    time_limit = check_time_limit(o["time_limit"])
     n = body.n_links
     if knee.mode != "free" and n < 2:
         raise ParameterError("knee mode 'locked' or 'stop' needs a body with at least 2 links")
@@ -425,7 +476,8 @@ def _prepare(body: Body, muscles: MuscleSet, disturbance: Disturbance | None = N
         rates_from=rates_from, tilt=tilt, proprioceptive_weight=weight, tilt_gains=tilt_gains,
         tilt_axis_depth=depth, velocity_jump=tuple(
             float(a + b) for a, b in zip(disturbance.velocity_change, jump, strict=True)),
-        motor_noise=noise, motor_torque=motor_torque,
+        motor_noise=noise, motor_torque=motor_torque, max_steps=max_steps,
+        time_limit=time_limit,
     )
     object.__setattr__(setup, "fall_at_start", _fall_at_start(setup))
     return setup
@@ -644,7 +696,7 @@ def outcome_message(status: str, t: float, setup: RunSetup, *, fall_reason: str 
     Parameters
     ----------
     status : {"completed", "fell", "step-too-small", "non-finite", "chattering", "no-memory",
-              "failed"}
+              "step-budget", "time-budget", "failed"}
         What happened ("failed" takes its words from ``detail``).
     t : float
         When it happened (the fall, the failure). [s]
@@ -663,4 +715,11 @@ def outcome_message(status: str, t: float, setup: RunSetup, *, fall_reason: str 
         return f"more than {setup.max_switches} switches by t = {t:.6g} s (chattering)"
     if status == "no-memory":
         return f"ran out of memory at t = {t:.6g} s"
+    if status == "step-budget":
+        return (f"stopped at t = {t:.6g} s: the step budget of {setup.max_steps:,} integrator "
+                "steps ran out (raise max_steps, or use an implicit method such as Radau "
+                "for very stiff or viscous gains)")
+    if status == "time-budget":
+        return (f"stopped at t = {t:.6g} s: the time limit of {setup.time_limit:g} s "
+                "(wall clock) ran out (raise time_limit, or use the compiled engine)")
     return detail

@@ -110,11 +110,11 @@ PARAMETER_UNITS: dict[str, str] = {n: parameter_unit(n) for n in SWEEP_PARAMETER
 #: Largest number of runs one sweep may ask for (a bound on the work and memory). [-]
 MAX_RUNS = 10_000_000
 #: Outcome columns of a sweep table (after the varied parameters), for 3 links.
-OUTCOME_COLUMNS: tuple[str, ...] = ("outcome", "fell", "fall_time", "peak_theta1",
+OUTCOME_COLUMNS: tuple[str, ...] = ("outcome", "failure", "fell", "fall_time", "peak_theta1",
                                     "peak_theta2", "peak_theta3", "settling_time",
                                     "final_lean", "final_rate")
 #: Unit of each outcome column ('' for the flag).
-OUTCOME_UNITS: dict[str, str] = {"outcome": "", "fell": "", "fall_time": "s",
+OUTCOME_UNITS: dict[str, str] = {"outcome": "", "failure": "", "fell": "", "fall_time": "s",
                                  "peak_theta1": "rad", "peak_theta2": "rad",
                                  "peak_theta3": "rad", "settling_time": "s",
                                  "final_lean": "rad", "final_rate": "rad/s"}
@@ -396,6 +396,7 @@ class SweepResult:
         o = self.outcomes
         n = o.final_state.shape[1] // 2
         cols.append(("outcome", o.outcome))
+        cols.append(("failure", o.failure))
         cols.append(("fell", o.fell))
         cols.append(("fall_time", o.fall_time))
         for i in range(o.peak_theta.shape[1]):
@@ -528,6 +529,7 @@ class _Task:
             sample_rate=sc.sample_rate, settle_tolerance=SETTLE_TOLERANCE, parallel=parallel,
             disturbance_scale=_rows(grid.disturbance_scale, lo, hi),
             tilt=sc.tilt, tilt_axis_depth=sc.tilt_axis_depth, motor_noise=sc.motor_noise,
+            max_steps=sc.max_steps, time_limit=sc.time_limit,
             proprioceptive_weight=(sc.proprioceptive_weight if grid.proprioceptive_weight is None
                                    else grid.proprioceptive_weight[lo:hi]),
             active_stiffness=_rows(grid.active_stiffness, lo, hi),

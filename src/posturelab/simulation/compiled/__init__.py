@@ -76,6 +76,7 @@ from ._layout import (
     R_N_SWITCHES,
     R_STATUS,
     R_T_REACHED,
+    STATUS_FAILURES,
     STATUS_FELL,
     STATUS_NAMES,
     STATUS_OUTCOMES,
@@ -340,7 +341,8 @@ class BatchResult:
         ``[Θ, Θ̇]`` at the last sample. [rad], [rad/s]
     status_code : numpy.ndarray of int8, shape (M,)
         0 completed, 1 fell, 2 step size underflow, 3 non-finite state,
-        4 too many switches (2–4 are "failed"). [-]
+        4 too many switches, 5 out of memory, 6 step budget spent, 7 time limit
+        reached (2–7 are "failed"). [-]
     n_steps : numpy.ndarray of int64, shape (M,)
         Accepted integrator steps. [-]
     n_switches : numpy.ndarray of int64, shape (M,)
@@ -371,6 +373,12 @@ class BatchResult:
     def status(self) -> np.ndarray:
         """"completed", "fell" or "failed" per run (as ``SimulationResult.status``)."""
         return np.array(STATUS_NAMES)[self.status_code]
+
+    @property
+    def failure(self) -> np.ndarray:
+        """Why each failed run failed, in a few words ("step budget spent", "non-finite
+        state", …); "" for a run that completed or fell."""
+        return np.array(STATUS_FAILURES)[self.status_code]
 
     @property
     def outcome(self) -> np.ndarray:
@@ -435,6 +443,8 @@ def simulate_batch(
     chunk: int = 64,
     method: str | None = None,
     disturbance_scale: np.ndarray | None = None,
+    max_steps: int | None = None,
+    time_limit: float | None = None,
 ) -> BatchResult:
     """Simulate M parameter sets on one body and disturbance; keep only the outcomes.
 
@@ -502,6 +512,12 @@ def simulate_batch(
         (:meth:`posturelab.model.platform.Disturbance.scaled`: the step speed, pulse
         peak, ramp displacement, sine amplitudes or measured accelerations times
         the factor); by default every run has ``disturbance`` as it is. [-]
+    max_steps : int, optional
+        The step budget of each run (:func:`posturelab.simulate`); a run that spends it
+        is ``failed`` (status code 6). [-]
+    time_limit : float, optional
+        The wall-clock budget of each run (status code 7 when spent); none by
+        default. [s]
 
     Returns
     -------
@@ -558,7 +574,8 @@ def simulate_batch(
                            torque_limits=limits, feedback_delay=delay, rtol=rtol, atol=atol,
                            sample_rate=sample_rate, max_switches=max_switches, tilt=tilt,
                            proprioceptive_weight=weight, tilt_axis_depth=tilt_axis_depth,
-                           motor_noise=motor_noise)
+                           motor_noise=motor_noise, max_steps=max_steps,
+                           time_limit=time_limit)
 
     weight = float(weights[0]) if M else 1.0
     for w in np.unique(weights):  # each checked as a single run's would be

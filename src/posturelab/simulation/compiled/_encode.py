@@ -24,9 +24,11 @@ from ._layout import (
     F_RTOL,
     F_SETTLE_TOL,
     F_STOP_ANGLE,
+    F_TIME_LIMIT,
     F_TOE,
     I_KNEE_MODE,
     I_LOCKED0,
+    I_MAX_STEPS,
     I_MAX_SWITCHES,
     I_USE_BOS,
     I_USE_COP,
@@ -152,12 +154,14 @@ def options(setup: RunSetup, settle_tolerance: float = 0.01) -> tuple[np.ndarray
         setup.motor_noise.max_step if setup.motor_noise is not None else math.inf)
     fpar[F_DURATION] = setup.duration
     fpar[F_SETTLE_TOL] = settle_tolerance
+    fpar[F_TIME_LIMIT] = setup.time_limit
     ipar = np.zeros(N_IPAR, dtype=np.int64)
     ipar[I_USE_BOS] = 1 if bos is not None else 0
     ipar[I_USE_COP] = 1 if fall.centre_of_pressure else 0
     ipar[I_KNEE_MODE] = {"free": KNEE_FREE, "locked": KNEE_LOCKED, "stop": KNEE_STOP}[knee.mode]
     ipar[I_MAX_SWITCHES] = setup.max_switches
     ipar[I_LOCKED0] = 1 if setup.locked0 else 0
+    ipar[I_MAX_STEPS] = setup.max_steps
     return readonly(fpar), readonly(ipar)
 
 

@@ -10,11 +10,17 @@ STATUS_STEP_TOO_SMALL = 2
 STATUS_NONFINITE = 3
 STATUS_CHATTERING = 4
 STATUS_NO_MEMORY = 5
+STATUS_STEP_BUDGET = 6
+STATUS_TIME_BUDGET = 7
 #: SimulationResult.status of each code.
-STATUS_NAMES = ("completed", "fell", "failed", "failed", "failed", "failed")
+STATUS_NAMES = ("completed", "fell", "failed", "failed", "failed", "failed", "failed", "failed")
+#: A failed run's reason in a few words ("" for a run that completed or fell).
+STATUS_FAILURES = ("", "", "step size underflow", "non-finite state",
+                   "chattering (too many switches)", "out of memory", "step budget spent",
+                   "time limit reached")
 #: The outcome of each code in the words of posturelab.simulation.setup.outcome_message.
 STATUS_OUTCOMES = ("completed", "fell", "step-too-small", "non-finite", "chattering",
-                   "no-memory")
+                   "no-memory", "step-budget", "time-budget")
 
 METHOD_RADAU = 0
 METHOD_EXPLICIT = 1
@@ -54,7 +60,8 @@ F_ATOL = 5  # [rad, rad/s]
 F_MAX_STEP = 6  # largest step resolving the profile, and at most the duration [s]
 F_DURATION = 7  # [s]
 F_SETTLE_TOL = 8  # [rad]
-N_FPAR = 9
+F_TIME_LIMIT = 9  # wall-clock budget of the run, inf for none [s]
+N_FPAR = 10
 
 # Options, integers ``ipar``
 I_USE_BOS = 0
@@ -62,7 +69,8 @@ I_USE_COP = 1
 I_KNEE_MODE = 2
 I_MAX_SWITCHES = 3
 I_LOCKED0 = 4
-N_IPAR = 5
+I_MAX_STEPS = 5  # the step budget: accepted steps [-]
+N_IPAR = 6
 
 # Result vector of one run
 R_STATUS = 0

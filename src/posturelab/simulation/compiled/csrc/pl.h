@@ -15,7 +15,7 @@
 
 /* Outcome codes (R_STATUS of the result vector); _layout.py holds the same numbers. */
 enum { PL_COMPLETED = 0, PL_FELL = 1, PL_STEP_TOO_SMALL = 2, PL_NONFINITE = 3,
-       PL_CHATTERING = 4, PL_NO_MEMORY = 5 };
+       PL_CHATTERING = 4, PL_NO_MEMORY = 5, PL_STEP_BUDGET = 6, PL_TIME_BUDGET = 7 };
 
 /* Result vector indices */
 enum { R_STATUS = 0, R_N_SAMPLES, R_FALL_KIND, R_FALL_INDEX, R_FALL_TIME, R_N_SWITCHES,
@@ -24,8 +24,8 @@ enum { R_STATUS = 0, R_N_SAMPLES, R_FALL_KIND, R_FALL_INDEX, R_FALL_TIME, R_N_SW
 
 /* fpar / ipar indices */
 enum { F_MAX_ANGLE = 0, F_HEEL, F_TOE, F_STOP_ANGLE, F_RTOL, F_ATOL, F_MAX_STEP, F_DURATION,
-       F_SETTLE_TOL, N_FPAR };
-enum { I_USE_BOS = 0, I_USE_COP, I_KNEE_MODE, I_MAX_SWITCHES, I_LOCKED0, N_IPAR };
+       F_SETTLE_TOL, F_TIME_LIMIT, N_FPAR };
+enum { I_USE_BOS = 0, I_USE_COP, I_KNEE_MODE, I_MAX_SWITCHES, I_LOCKED0, I_MAX_STEPS, N_IPAR };
 enum { KNEE_FREE = 0, KNEE_LOCKED = 1, KNEE_STOP = 2 };
 
 /* Packed disturbance: dp[0] = number of terms, then rows of DIST_ROW numbers

@@ -10,11 +10,24 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include "pl.h"
 #include "pl_events.h"
 
 #define EPS 2.220446049250313e-16
 #define SAMPLE_BLOCK 64  /* samples evaluated together */
+#define CLOCK_EVERY 256  /* attempted steps between looks at the clock (a time limit) */
+
+/* Seconds on a clock that only moves forward (wall-clock seconds without one). [s] */
+static double wall_seconds(void)
+{
+#if defined(CLOCK_MONOTONIC)
+    struct timespec ts;
+    if (clock_gettime(CLOCK_MONOTONIC, &ts) == 0)
+        return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+#endif
+    return (double)time(NULL);
+}
 
 typedef struct {
     double *tm, *sat, *base, *work, *tau, *active, *x, *y, *Q, *inp, *g_old, *g_new, *sc_out,
@@ -109,6 +122,10 @@ int64_t pl_integrate(const pl_run *run, pl_out *out)
     if (delay > 0.0)
         max_step = fmin(max_step, delay);  /* the method of steps: the past is computed */
     const int64_t max_switches = run->ipar[I_MAX_SWITCHES];
+    const int64_t max_steps = run->ipar[I_MAX_STEPS];
+    const double time_limit = fpar[F_TIME_LIMIT];
+    const int timed = isfinite(time_limit);
+    const double started = timed ? wall_seconds() : 0.0;
     int locked = run->ipar[I_LOCKED0] != 0;
     const int has_inputs = run->dp[0] > 0.0 || delay > 0.0 || run->tp[0] > 0.0
                            || run->mp[0] > 0.0;
@@ -183,6 +200,15 @@ int64_t pl_integrate(const pl_run *run, pl_out *out)
         }
         if (!(h > 10.0 * EPS * fabs(t))) {
             status = PL_STEP_TOO_SMALL;
+            break;
+        }
+        if (n_steps >= max_steps) {  /* the budgets: a runaway integration ends as failed */
+            status = PL_STEP_BUDGET;
+            break;
+        }
+        if (timed && (n_steps + n_rejected) % CLOCK_EVERY == 0
+            && wall_seconds() - started > time_limit) {
+            status = PL_TIME_BUDGET;
             break;
         }
         const double t_new = landing ? t_stop : t + h;
