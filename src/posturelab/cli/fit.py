@@ -6,7 +6,14 @@ import argparse
 
 from ..model.muscles import PAPER_PAIR_NAMES
 from ..simulation.results import atomic_write_text
-from ..studies.identification import ENGINES, VISCOSITY_RATIO, fit_stiffness, read_trajectory_csv
+from ..studies.identification import (
+    ENGINES,
+    RESIDUAL_MODELS,
+    VISCOSITY_RATIO,
+    fit_stiffness,
+    read_trajectory_csv,
+)
+from ..studies.sweep import parameter_unit
 from ._common import check_writable, print_json
 from .simulate import add_experiment_arguments, scenario_from_args
 
@@ -17,7 +24,9 @@ fit. The experiment (body, disturbance, initial state) is described exactly as f
 'posturelab simulate' (--case/--stiffness give the starting guess and the fixed
 pairs; or --scenario / --builtin). --data is a CSV with columns t [s] and
 theta1..theta3 [rad] (what 'posturelab simulate --out' writes). Reports each
-estimate with its standard error and 95 % confidence interval.
+estimate with its standard error and 95 % confidence interval; by default these
+allow for residuals correlated from sample to sample (a first-order autoregression
+per link, estimated from the residuals), which measured sway always has.
 """
 
 
@@ -37,6 +46,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="engine inside the fit: compiled (default; the scenario's "
                    "tolerances) or reference (scipy, the scenario's solver); fast is a "
                    "former name of compiled.")
+    g.add_argument("--residual-model", choices=RESIDUAL_MODELS, default="ar1",
+                   help="residuals of the standard errors: ar1 (default: correlated from "
+                   "sample to sample, estimated per link) or independent (the textbook "
+                   "s²(JᵀJ)⁻¹, too narrow when the residuals are correlated).")
     g.add_argument("--report", metavar="FIT.json", help="also write the JSON summary to a file.")
     g.add_argument("--json", action="store_true", help="print one JSON object instead of text.")
 
@@ -52,7 +65,7 @@ def run(args: argparse.Namespace) -> int:
     free = [s.strip() for s in args.free.split(",") if s.strip()]
     ratio = 0.25 if args.viscosity_ratio is None else args.viscosity_ratio
     fit = fit_stiffness(sc, time, theta, free, viscosity_ratio=ratio,
-                        engine=args.engine)
+                        engine=args.engine, residual_model=args.residual_model)
     summary = fit.to_dict()
     if args.report:
         atomic_write_text(args.report, json.dumps(summary, indent=2) + "\n")
@@ -61,11 +74,13 @@ def run(args: argparse.Namespace) -> int:
         return 0
     print(f"fitted {len(free)} parameter(s) to {fit.n_samples} angle samples with "
           f"{fit.n_simulations} simulations; residual RMS {fit.residual_rms:.3g} rad")
+    if fit.residual_model == "ar1":
+        rho = ", ".join(f"{v:.2f}" for v in fit.residual_autocorrelation)
+        print(f"residuals: lag-1 correlation per link {rho} (allowed for in the intervals; "
+              f"{fit.degrees_of_freedom:.0f} effective degrees of freedom)")
     for name, e, se, (lo, hi) in zip(fit.parameter_names, fit.estimates, fit.standard_errors,
                                      fit.confidence_intervals, strict=True):
-        unit = ("s" if name in (VISCOSITY_RATIO, "feedback_delay") else "-"
-                if name == "proprioceptive_weight" else "N·m·s/rad"
-                if name.startswith("active_viscosity_") else "N·m/rad")
+        unit = parameter_unit(name)
         print(f"  {name:<16} {e:10.4g} ± {se:.3g} {unit}   (95 % CI {lo:.4g} … {hi:.4g})")
     if not fit.success:
         print(f"warning: the optimiser did not converge: {fit.message}")
