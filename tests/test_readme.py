@@ -68,6 +68,8 @@ def test_the_readme_has_its_commands():
 def test_every_readme_command_runs_as_written(command, folder):
     import shlex
 
+    if command.startswith("posturelab explore"):
+        return _serves_the_explorer(shlex.split(command), folder)
     p = subprocess.run([sys.executable, "-m", *shlex.split(command)], cwd=folder,
                        capture_output=True, text=True, timeout=600)
     assert p.returncode == 0, f"{command}\n{p.stderr[-2000:]}"
@@ -78,3 +80,25 @@ def test_the_readme_python_runs(folder):
     p = subprocess.run([sys.executable, "-c", readme_python()], cwd=folder,
                        capture_output=True, text=True, timeout=600)
     assert p.returncode == 0, p.stderr[-2000:]
+
+
+def _serves_the_explorer(argv: list[str], folder: Path) -> None:
+    """The explorer serves until stopped: start it (on a free port, without opening a
+    browser), load its page, then stop it as Ctrl-C would."""
+    import signal
+    import urllib.request
+
+    pytest.importorskip("flask")
+    p = subprocess.Popen([sys.executable, "-m", *argv, "--port", "0", "--no-browser"],
+                         cwd=folder, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        line = p.stdout.readline()
+        url = re.search(r"http://127\.0\.0\.1:\d+/", line)
+        assert url, line + p.stderr.read()
+        with urllib.request.urlopen(url.group(0), timeout=30) as page:
+            assert page.status == 200 and b"posturelab explore" in page.read()
+    finally:
+        p.send_signal(signal.SIGINT)
+        out, err = p.communicate(timeout=30)
+    assert p.returncode == 0, err
+    assert "Traceback" not in err and "stopped" in out

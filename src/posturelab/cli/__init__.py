@@ -28,6 +28,7 @@ SUBCOMMANDS: dict[str, str] = {
     "frf-model": "frf_model",
     "fit-frf": "fit_frf",
     "compare": "compare",
+    "explore": "explore",
 }
 
 

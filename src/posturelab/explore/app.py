@@ -1,0 +1,131 @@
+"""The explorer's web application (Flask) and its local server (Werkzeug).
+
+Why Flask: a WSGI micro-framework kept by the Pallets project since 2010, pure Python,
+with five small dependencies of its own (Werkzeug, Jinja2 — which posturelab already
+uses for its report —, MarkupSafe, itsdangerous, click, blinker), no build step and
+no JavaScript toolchain. The page draws its charts in the browser with Chart.js (MIT,
+kept since 2014, one file with no dependencies, shipped in ``static/`` with its
+licence), so a control change costs one JSON request: the server computes numbers
+with the public API and never renders an image.
+
+The server binds to 127.0.0.1 only: nothing outside this machine can reach it.
+"""
+
+from __future__ import annotations
+
+import sys
+import threading
+from typing import TextIO
+
+from ..errors import ParameterError, PostureLabError
+
+__all__ = ["create_app", "serve", "HOST"]
+
+#: The only address the explorer listens on (loopback).
+HOST = "127.0.0.1"
+#: Largest request body the API reads. [bytes]
+MAX_REQUEST_BYTES = 64 * 1024
+
+
+def create_app():
+    """The Flask application: the page at ``/``, the views at ``POST /api/views``.
+
+    ``POST /api/views`` takes a JSON object of control values
+    (:data:`posturelab.explore.views.CONTROLS`; missing ones take their defaults) and
+    answers 200 with :func:`posturelab.explore.views.compute_views`, or 422 with
+    ``{"error": one line, "field": the control}`` for a bad value; any other failure
+    is 500 with ``{"error": …}``, never an HTML error page.
+    """
+    from flask import Flask, jsonify, render_template, request
+
+    from .views import CONTROLS, compute_views, parse_parameters
+
+    app = Flask(__name__, static_folder="static", template_folder="templates")
+    app.config["MAX_CONTENT_LENGTH"] = MAX_REQUEST_BYTES
+    app.json.sort_keys = False
+
+    @app.get("/")
+    def page():
+        groups: dict[str, list] = {}
+        for c in CONTROLS:
+            groups.setdefault(c.group, []).append(c)
+        return render_template("explore.html", groups=groups, controls=CONTROLS)
+
+    @app.post("/api/views")
+    def views():
+        fields = request.get_json(silent=True)
+        if fields is None:
+            return jsonify(error="the request must be a JSON object of control values",
+                           field=None), 422
+        try:
+            return jsonify(compute_views(parse_parameters(fields)))
+        except PostureLabError as exc:
+            return jsonify(error=str(exc).splitlines()[0],
+                           field=getattr(exc, "field", None)), 422
+
+    @app.errorhandler(404)
+    @app.errorhandler(405)
+    @app.errorhandler(413)
+    def client_error(exc):
+        return jsonify(error=exc.description, field=None), exc.code
+
+    @app.errorhandler(Exception)
+    def server_error(exc):  # a bug: still an answer the page can show
+        from werkzeug.exceptions import HTTPException
+
+        if isinstance(exc, HTTPException):
+            return jsonify(error=exc.description, field=None), exc.code
+        return jsonify(error=f"posturelab could not compute this: {type(exc).__name__}: "
+                       f"{exc}", field=None), 500
+
+    return app
+
+
+def serve(port: int = 8050, *, open_browser: bool = True, stream: TextIO | None = None,
+          ready: threading.Event | None = None) -> None:
+    """Serve the explorer on http://127.0.0.1:PORT/ until interrupted.
+
+    Parameters
+    ----------
+    port : int
+        TCP port, 0 … 65535; 0 picks a free one. [-]
+    open_browser : bool
+        Open the page in the user's web browser once the server listens.
+    stream : text stream, optional
+        Where the address is printed (standard output by default).
+    ready : threading.Event, optional
+        Set once the server listens (for tests that run it in a thread).
+
+    Raises
+    ------
+    ParameterError
+        A port outside 0 … 65535, or one already in use.
+    """
+    from werkzeug.serving import WSGIRequestHandler, make_server
+
+    class QuietHandler(WSGIRequestHandler):
+        def log_request(self, code="-", size="-") -> None:  # no line per request
+            pass
+
+    if isinstance(port, bool) or not isinstance(port, int) or not 0 <= port <= 65535:
+        raise ParameterError(f"port must be an integer in [0, 65535], got {port!r}")
+    try:
+        server = make_server(HOST, port, create_app(), threaded=True,
+                             request_handler=QuietHandler)
+    except OSError as exc:
+        raise ParameterError(f"cannot listen on {HOST}:{port}: {exc.strerror or exc}") from None
+    url = f"http://{HOST}:{server.server_port}/"
+    print(f"posturelab explore: serving {url} (Ctrl-C to stop)", file=stream or sys.stdout,
+          flush=True)
+    if open_browser:
+        import webbrowser
+
+        threading.Thread(target=webbrowser.open, args=(url,), daemon=True).start()
+    if ready is not None:
+        ready.url = url
+        ready.server = server
+        ready.set()
+    try:
+        server.serve_forever()
+    finally:
+        server.server_close()

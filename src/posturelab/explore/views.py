@@ -1,0 +1,260 @@
+"""What the explorer shows, as pure functions of its parameters.
+
+:data:`CONTROLS` states every control once: its name, words, unit, default, the range
+the package accepts and the range of its slider. The page is built from it and
+:func:`parse_parameters` checks a request against it, so the page and the server
+cannot disagree. :func:`compute_views` turns checked parameters into the numbers and
+figures of the page with the public API only: :func:`posturelab.analyse`,
+:func:`posturelab.rightmost_roots`, :func:`posturelab.delay_margin`,
+:func:`posturelab.frequency.model.model_frf` and :func:`posturelab.simulate` on the
+compiled engine.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import ParameterError
+
+__all__ = ["Control", "CONTROLS", "PAIRS", "parse_parameters", "build_model", "compute_views"]
+
+#: The paper's five pairs, in the order of their stiffness arrays.
+PAIRS = ("ankle", "knee", "hip", "quadriceps", "gastrocnemius")
+#: Table I, case 1: the paper's stable reference gains. [N·m/rad]
+_CASE1 = (500.0, 300.0, 300.0, 300.0, 300.0)
+
+
+@dataclass(frozen=True)
+class Control:
+    """One control of the page.
+
+    Attributes
+    ----------
+    name : str
+        The request field.
+    label : str
+        Words on the page.
+    unit : str
+        Unit of the value ("" for none, or for a choice).
+    default : float or str
+        The starting value.
+    low, high : float
+        The values the package accepts, inclusive. [unit]
+    slider_low, slider_high, step : float
+        The slider's range and step (a typed value may go beyond the slider). [unit]
+    group : str
+        Where on the page it sits.
+    choices : tuple of str
+        For a choice, its options (then ``low`` … ``step`` are unused).
+    """
+
+    name: str
+    label: str
+    unit: str
+    default: float | str
+    low: float = 0.0
+    high: float = 0.0
+    slider_low: float = 0.0
+    slider_high: float = 0.0
+    step: float = 1.0
+    group: str = ""
+    choices: tuple[str, ...] = ()
+
+
+def _pair_controls() -> tuple[Control, ...]:
+    out = []
+    for name, k in zip(PAIRS, _CASE1, strict=True):
+        out.append(Control(f"stiffness_{name}", f"{name} stiffness", "N·m/rad", k, 0.0, 1e8,
+                           0.0, 3000.0, 10.0, "pairs"))
+    for name in PAIRS:
+        out.append(Control(f"active_{name}", f"{name} active stiffness", "N·m/rad", 0.0, 0.0,
+                           1e8, 0.0, 3000.0, 10.0, "active"))
+    for name in PAIRS:
+        out.append(Control(f"active_viscosity_{name}", f"{name} active viscosity", "N·m·s/rad",
+                           0.0, 0.0, 1e7, 0.0, 1000.0, 5.0, "active"))
+    return tuple(out)
+
+
+#: Every control of the explorer, in page order.
+CONTROLS: tuple[Control, ...] = (
+    Control("body", "body", "", "paper", group="body",
+            choices=("paper", "height and mass")),
+    Control("height", "height", "m", 1.75, 0.5, 2.5, 1.0, 2.2, 0.01, "body"),
+    Control("mass", "mass", "kg", 75.0, 10.0, 300.0, 30.0, 150.0, 0.5, "body"),
+    *_pair_controls(),
+    Control("viscosity_ratio", "viscosity ratio L/K", "s", 0.25, 0.0, 10.0, 0.0, 1.0, 0.01,
+            "pairs"),
+    Control("feedback_delay", "feedback delay τ", "s", 0.0, 0.0, 1.0, 0.0, 0.3, 0.005,
+            "neural"),
+    Control("proprioceptive_weight", "proprioceptive weight W", "-", 1.0, 0.0, 1.0, 0.0, 1.0,
+            0.05, "neural"),
+    Control("perturbation", "perturbation", "", "backward step", group="perturbation",
+            choices=("backward step", "forward step", "tilt")),
+    Control("step_speed", "step speed", "m/s", 0.3, 0.0, 20.0, 0.0, 2.0, 0.05, "perturbation"),
+    Control("tilt_amplitude", "tilt amplitude", "rad", 0.02, 0.0, 0.5, 0.0, 0.1, 0.002,
+            "perturbation"),
+    Control("tilt_frequency", "tilt frequency", "Hz", 0.2, 0.01, 10.0, 0.05, 2.0, 0.05,
+            "perturbation"),
+    Control("duration", "duration", "s", 5.0, 0.5, 30.0, 0.5, 20.0, 0.5, "perturbation"),
+)
+_BY_NAME = {c.name: c for c in CONTROLS}
+
+
+def _number(value: float) -> str:
+    return f"{value:g}"
+
+
+def parse_parameters(fields: dict) -> dict:
+    """Check a request's fields against :data:`CONTROLS`; missing ones take their default.
+
+    Returns
+    -------
+    dict
+        Control name -> float (or str for a choice).
+
+    Raises
+    ------
+    ParameterError
+        An unknown field, a value that is not a finite number, a number outside the
+        control's range or an unknown choice; the message names the control, the value
+        and the range, and ``error.field`` the control's name.
+    """
+    if not isinstance(fields, dict):
+        raise ParameterError("the request must be a JSON object of control values")
+    unknown = sorted(set(fields) - set(_BY_NAME))
+    if unknown:
+        raise _field_error(unknown[0], f"unknown control {unknown[0]!r:.60}")
+    out: dict = {}
+    for c in CONTROLS:
+        raw = fields.get(c.name, c.default)
+        if c.choices:
+            if raw not in c.choices:
+                raise _field_error(c.name, f"{c.label} must be one of "
+                                   f"{', '.join(c.choices)}; got {str(raw)!r:.60}")
+            out[c.name] = raw
+            continue
+        try:
+            if isinstance(raw, bool):
+                raise ValueError
+            value = float(raw.strip() if isinstance(raw, str) else raw)
+        except (TypeError, ValueError):
+            raise _field_error(c.name, f"{c.label} [{c.unit}] must be a number, got "
+                               f"{str(raw)!r:.60}") from None
+        if not math.isfinite(value) or not c.low <= value <= c.high:
+            raise _field_error(c.name, f"{c.label} [{c.unit}] must be in "
+                               f"[{_number(c.low)}, {_number(c.high)}], got {_number(value)}")
+        out[c.name] = value
+    return out
+
+
+def _field_error(field: str, message: str) -> ParameterError:
+    error = ParameterError(message)
+    error.field = field
+    return error
+
+
+def build_model(p: dict):
+    """The body, muscle set, disturbance and tilt the checked parameters ``p`` describe."""
+    import posturelab as pl
+
+    from ..model.tilt import SineTilt
+
+    if p["body"] == "paper":
+        body = pl.paper_body()
+    else:
+        body = pl.body_from_anthropometry(p["height"], p["mass"])
+    active_k = [p[f"active_{n}"] for n in PAIRS]
+    active_l = [p[f"active_viscosity_{n}"] for n in PAIRS]
+    active = any(v > 0 for v in active_k + active_l)
+    muscles = pl.paper_muscles(stiffness=[p[f"stiffness_{n}"] for n in PAIRS],
+                               viscosity_ratio=p["viscosity_ratio"],
+                               active_stiffness=active_k if active else None,
+                               active_viscosity=active_l if active else None)
+    disturbance, tilt = None, None
+    if p["perturbation"] == "backward step":
+        disturbance = pl.VelocityStep.backward(p["step_speed"])
+    elif p["perturbation"] == "forward step":
+        disturbance = pl.VelocityStep.forward(p["step_speed"])
+    else:
+        tilt = SineTilt(p["tilt_amplitude"], p["tilt_frequency"])
+    return body, muscles, disturbance, tilt
+
+
+def _complex_list(values) -> list[dict]:
+    return [{"re": float(z.real), "im": float(z.imag)} for z in values]
+
+
+def _rounded(values, digits: int = 6) -> list:
+    return np.round(np.asarray(values, dtype=float), digits).tolist()
+
+
+#: Frequencies of the FRF view. [Hz]
+FRF_FREQUENCIES = np.logspace(-2, math.log10(5.0), 120)
+#: Output samples per second of the simulated response. [Hz]
+SAMPLE_RATE = 100.0
+#: Stick-figure frames per second. [Hz]
+FRAME_RATE = 25.0
+#: The wall-clock budget of one simulated response. [s]
+TIME_LIMIT = 5.0
+
+
+def compute_views(p: dict) -> dict:
+    """Everything the page shows for the checked parameters ``p``
+    (:func:`parse_parameters`).
+
+    Returns
+    -------
+    dict (JSON-ready)
+        ``stable`` and ``verdict`` (words); ``poles`` at τ = 0 and ``roots`` (the six
+        rightmost characteristic roots at τ) as {"re", "im"} [1/s]; ``delay_margin``
+        [s] (None when unstable without delay, inf as None with ``no_margin``);
+        ``frf`` (frequencies [Hz], gain [-], phase [deg]); ``run`` (outcome words,
+        time [s], link angles [rad], CoG position [m] and velocity [m/s], joint positions
+        [m] of the stick figure at :data:`FRAME_RATE`).
+    """
+    import posturelab as pl
+
+    from ..frequency.model import model_frf
+    from ..viz.animation import joint_positions
+
+    body, muscles, disturbance, tilt = build_model(p)
+    delay, weight = p["feedback_delay"], p["proprioceptive_weight"]
+    lin = pl.analyse(body, muscles)
+    roots = (pl.rightmost_roots(body, muscles, delay, count=6) if delay > 0
+             else lin.poles[np.argsort(-lin.poles.real, kind="stable")][:6])
+    rightmost = complex(roots[0])
+    stable = rightmost.real < 0
+    margin = pl.delay_margin(body, muscles, max_delay=1.0)
+    frf = model_frf(body, muscles, FRF_FREQUENCIES, input="tilt", output="com_angle",
+                    feedback_delay=delay, proprioceptive_weight=weight)
+    run = pl.simulate(body, muscles, disturbance, p["duration"], engine="compiled",
+                      feedback_delay=delay, proprioceptive_weight=weight, tilt=tilt,
+                      sample_rate=SAMPLE_RATE, time_limit=TIME_LIMIT)
+    every = max(1, int(round(SAMPLE_RATE / FRAME_RATE)))
+    frames = joint_positions(body, run.theta[::every])
+
+    outcome = run.outcome
+    return {
+        "stable": bool(stable),
+        "verdict": (f"stable about upright (rightmost root {rightmost.real:.3g} 1/s)" if stable
+                    else f"unstable about upright (rightmost root {rightmost.real:+.3g} 1/s)"),
+        "poles": _complex_list(lin.poles),
+        "roots": _complex_list(roots),
+        "delay_margin": (None if margin.delay_margin is None
+                         or math.isinf(margin.delay_margin) else float(margin.delay_margin)),
+        "stable_without_delay": bool(margin.stable_without_delay),
+        "delayed_part": "active" if muscles.has_active_feedback else "all",
+        "frf": {"frequency": _rounded(FRF_FREQUENCIES, 9), "gain": _rounded(np.abs(frf), 9),
+                "phase": _rounded(np.degrees(np.unwrap(np.angle(frf))), 4)},
+        "run": {"outcome": outcome.kind, "message": outcome.message,
+                "time": _rounded(run.time, 6),
+                "theta": [_rounded(run.theta[:, i]) for i in range(body.n_links)],
+                "link_names": [seg.name for seg in body.segments],
+                "cog_x": _rounded(run.cog_position[:, 0]),
+                "cog_v": _rounded(run.cog_velocity[:, 0]),
+                "frame_rate": FRAME_RATE, "frames": _rounded(frames, 5),
+                "height": float(body.lengths.sum())},
+    }

@@ -1,0 +1,186 @@
+"""``posturelab explore``: the controls and views (against the API), the Flask application,
+the loopback server and the command line, and the page itself in a real headless Chromium
+(Playwright driving Debian's chromium): a stiffness slider moved, a bad value typed, a
+screenshot taken."""
+
+from __future__ import annotations
+
+import math
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import posturelab as pl
+from posturelab.errors import ParameterError
+from posturelab.explore import CONTROLS, compute_views, parse_parameters
+from posturelab.explore.browser import chromium_path
+
+flask = pytest.importorskip("flask")
+
+CASE1 = [500.0, 300.0, 300.0, 300.0, 300.0]
+
+
+def _api_poles(stiffness, ratio=0.25):
+    return pl.analyse(pl.paper_body(), pl.paper_muscles(stiffness=stiffness,
+                                                        viscosity_ratio=ratio))
+
+
+def test_defaults_and_bounds_come_from_one_table():
+    p = parse_parameters({})
+    assert p["stiffness_ankle"] == 500.0 and p["perturbation"] == "backward step"
+    assert {c.name for c in CONTROLS} == set(p)
+    for c in CONTROLS:  # every slider lies inside what the package accepts
+        if not c.choices:
+            assert c.low <= c.slider_low < c.slider_high <= c.high, c.name
+            assert c.low <= c.default <= c.high, c.name
+    for fields, words, field in (
+            ({"stiffness_ankle": "-5"},
+             "ankle stiffness [N·m/rad] must be in [0, 1e+08], got -5", "stiffness_ankle"),
+            ({"feedback_delay": "abc"}, "feedback delay τ [s] must be a number, got 'abc'",
+             "feedback_delay"),
+            ({"mass": True}, "mass [kg] must be a number", "mass"),
+            ({"duration": "inf"}, "duration [s] must be in [0.5, 30], got inf", "duration"),
+            ({"perturbation": "kick"}, "perturbation must be one of backward step",
+             "perturbation"),
+            ({"speed": 1}, "unknown control 'speed'", "speed")):
+        with pytest.raises(ParameterError) as info:
+            parse_parameters(fields)
+        assert words in str(info.value) and info.value.field == field
+
+
+def test_views_are_what_the_api_computes():
+    p = parse_parameters({"stiffness_ankle": 800, "feedback_delay": 0.1, "active_ankle": 400,
+                          "active_viscosity_ankle": 100, "perturbation": "tilt"})
+    v = compute_views(p)
+    body = pl.paper_body()
+    muscles = pl.paper_muscles(stiffness=[800, 300, 300, 300, 300],
+                               active_stiffness=[400, 0, 0, 0, 0],
+                               active_viscosity=[100, 0, 0, 0, 0])
+    lin = pl.analyse(body, muscles)
+    np.testing.assert_allclose([z["re"] + 1j * z["im"] for z in v["poles"]], lin.poles)
+    roots = pl.rightmost_roots(body, muscles, 0.1, count=6)
+    np.testing.assert_allclose([z["re"] + 1j * z["im"] for z in v["roots"]], roots)
+    assert v["stable"] == (roots[0].real < 0)
+    margin = pl.delay_margin(body, muscles, max_delay=1.0).delay_margin
+    assert (v["delay_margin"] is None if math.isinf(margin)
+            else v["delay_margin"] == pytest.approx(margin))
+    assert compute_views(parse_parameters({}))["delay_margin"] == pytest.approx(
+        pl.delay_margin(body, pl.paper_muscles(stiffness=CASE1), max_delay=1.0).delay_margin)
+    assert v["delayed_part"] == "active"
+    frf = pl.frequency.model.model_frf(body, muscles, v["frf"]["frequency"], input="tilt",
+                                       output="com_angle", feedback_delay=0.1)
+    np.testing.assert_allclose(v["frf"]["gain"], np.abs(frf), rtol=1e-8)
+    run = pl.simulate(body, muscles, None, 5.0, engine="compiled", feedback_delay=0.1,
+                      tilt=pl.model.tilt.SineTilt(0.02, 0.2), sample_rate=100.0)
+    np.testing.assert_allclose(v["run"]["theta"][0], run.theta[:, 0], atol=1e-6)
+    assert v["run"]["outcome"] == run.outcome.kind
+    assert len(v["run"]["frames"]) == math.ceil(run.time.size / 4)
+
+
+def test_the_application_answers_json_and_never_a_server_page():
+    client = __import__("posturelab.explore.app", fromlist=["x"]).create_app().test_client()
+    page = client.get("/")
+    assert page.status_code == 200 and b'id="stiffness_ankle"' in page.data
+    assert b"chart.umd.min.js" in page.data and client.get(
+        "/static/chart.umd.min.js").status_code == 200
+    ok = client.post("/api/views", json={"stiffness_hip": 350})
+    assert ok.status_code == 200 and ok.get_json()["stable"] in (True, False)
+    bad = client.post("/api/views", json={"stiffness_hip": -1})
+    assert bad.status_code == 422
+    assert bad.get_json() == {"error": "hip stiffness [N·m/rad] must be in [0, 1e+08], got -1",
+                              "field": "stiffness_hip"}
+    for response in (client.post("/api/views", data="not json"),
+                     client.post("/api/views", json=[1, 2])):
+        assert response.status_code == 422 and "JSON object" in response.get_json()["error"]
+    assert client.get("/nothing").status_code == 404
+    assert client.get("/nothing").is_json
+    huge = client.post("/api/views", data="x" * 100_000, content_type="application/json")
+    assert huge.status_code == 413 and huge.is_json
+
+
+def test_the_server_listens_on_loopback_only():
+    import urllib.request
+
+    from posturelab.explore.browser import running_server
+
+    with running_server() as url:
+        assert url.startswith("http://127.0.0.1:")
+        with urllib.request.urlopen(url, timeout=10) as response:
+            assert response.status == 200
+
+
+def test_cli_explore_bad_port_and_help():
+    p = subprocess.run([sys.executable, "-m", "posturelab", "explore", "--port", "70000",
+                        "--no-browser"], capture_output=True, text=True, timeout=60)
+    assert p.returncode == 2 and "Traceback" not in p.stderr
+    assert p.stderr.strip() == ("posturelab: error: port must be an integer in [0, 65535], "
+                                "got 70000")
+    p = subprocess.run([sys.executable, "-m", "posturelab", "explore", "--help"],
+                       capture_output=True, text=True, timeout=60)
+    assert p.returncode == 0 and "--no-browser" in p.stdout and "127.0.0.1" in p.stdout
+
+
+# -- in a real browser ----------------------------------------------------------------------
+
+needs_browser = pytest.mark.skipif(
+    (chromium_path() is None or __import__("importlib").util.find_spec("playwright") is None)
+    and not os.environ.get("CI"),
+    reason="needs Debian's chromium and Playwright (CI installs both)")
+
+
+def _table(page, cls):
+    cells = page.locator(f"#poles td.{cls}[data-re]")
+    return np.array([float(c.get_attribute("data-re")) + 1j * float(c.get_attribute("data-im"))
+                     for c in cells.all()])
+
+
+@needs_browser
+def test_the_page_in_chromium(tmp_path):
+    from playwright.sync_api import sync_playwright
+
+    from posturelab.explore.browser import launch_chromium, running_server
+
+    with running_server() as url, sync_playwright() as playwright:
+        browser = launch_chromium(playwright)
+        page = browser.new_page(viewport={"width": 1400, "height": 1000})
+        errors = []
+        page.on("pageerror", lambda exc: errors.append(str(exc)))
+        page.goto(url)
+        page.wait_for_function("Number(document.body.dataset.updates) >= 1", timeout=30_000)
+        np.testing.assert_allclose(_table(page, "pole"), _api_poles(CASE1).poles, rtol=1e-9)
+        assert page.locator("#verdict").get_attribute("class") == "stable"
+
+        # move the ankle stiffness slider: 100 N·m/rad is far below the load mgh
+        page.locator('input[type=range][data-for="stiffness_ankle"]').fill("100")
+        page.wait_for_function("Number(document.body.dataset.updates) >= 2", timeout=30_000)
+        want = _api_poles([100.0, 300.0, 300.0, 300.0, 300.0])
+        np.testing.assert_allclose(_table(page, "pole"), want.poles, rtol=1e-9)
+        assert page.input_value("#stiffness_ankle") == "100"
+        verdict = page.locator("#verdict")
+        assert verdict.get_attribute("class") == ("stable" if want.stable else "unstable")
+        assert ("unstable" in verdict.inner_text()) == (not want.stable)
+        assert float(page.evaluate("document.body.dataset.roundTrip")) > 0
+
+        # a bad value: the message names the field, value and range; the views stay
+        before = _table(page, "pole")
+        page.fill("#stiffness_ankle", "-5")
+        page.wait_for_selector("#message:not([hidden])", timeout=30_000)
+        assert page.inner_text("#message") == (
+            "ankle stiffness [N·m/rad] must be in [0, 1e+08], got -5")
+        assert "invalid" in page.get_attribute("#stiffness_ankle", "class")
+        np.testing.assert_array_equal(_table(page, "pole"), before)
+
+        # a good value again clears the message
+        page.fill("#stiffness_ankle", "700")
+        page.wait_for_selector("#message[hidden]", state="attached", timeout=30_000)
+        np.testing.assert_allclose(_table(page, "pole"),
+                                   _api_poles([700.0, 300.0, 300.0, 300.0, 300.0]).poles,
+                                   rtol=1e-9)
+        shot = tmp_path / "explore.png"
+        page.screenshot(path=str(shot), full_page=True)
+        browser.close()
+    assert shot.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and shot.stat().st_size > 50_000
+    assert errors == []
