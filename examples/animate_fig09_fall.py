@@ -1,4 +1,8 @@
-"""A stick-figure GIF of the paper's Fig. 9 run (forward platform motion, case 2: falls).
+"""A stick-figure animation of the paper's Fig. 9 fall
+=====================================================
+
+A GIF of the Fig. 9 run (forward platform motion, case 2: falls). Not run when the
+documentation is built.
 
 Usage: python examples/animate_fig09_fall.py [OUTPUT_DIR]   (default: current directory)
 """

@@ -1,4 +1,5 @@
-"""The D-subdivision figure: where a delayed PD controller keeps the inverted pendulum up.
+"""D-subdivision: where a delayed PD controller keeps the inverted pendulum up
+=============================================================================
 
 The paper's body as one link (``paper-1link``, mgh = 564 N·m/rad) with the small intrinsic
 ankle stiffness and viscosity of a typical identification (5 % and 2 % of mgh) and an active,
@@ -33,14 +34,20 @@ def compute(resolution: int = 200):
     return delay_stability_map(body, base, DELAY, (0.0, 3 * mgh), (0.0, 1.2 * mgh), resolution)
 
 
-def main(out_dir: Path) -> Path:
-    dmap = compute()
+def make_figure(resolution: int = 200):
+    """The figure (a pyplot-free matplotlib Figure), Peterka's controller marked."""
+    dmap = compute(resolution)
     preset = get_controller("peterka-2002")
     mgh = dmap.load_stiffness
-    fig = plot_delay_stability_map(dmap, mark=(preset.active_stiffness * mgh,
-                                               preset.active_viscosity * mgh, "Peterka 2002"))
-    return save_figure(fig, out_dir / "delay_stability_map.png")
+    return plot_delay_stability_map(dmap, mark=(preset.active_stiffness * mgh,
+                                                preset.active_viscosity * mgh, "Peterka 2002"))
+
+
+def main(out_dir: Path) -> Path:
+    return save_figure(make_figure(), out_dir / "delay_stability_map.png")
 
 
 if __name__ == "__main__":
-    print(f"wrote {main(Path(sys.argv[1]) if len(sys.argv) > 1 else Path('.'))}")
+    out_dir = Path(sys.argv[1]) if len(sys.argv) > 1 else Path(".")
+    fig = make_figure()
+    print(f"wrote {save_figure(fig, out_dir / 'delay_stability_map.png')}")

@@ -1,4 +1,5 @@
-"""How often the time-domain fit's 95 % intervals cover the truth.
+"""How often the time-domain fit's 95 % intervals cover the truth
+================================================================
 
 Synthetic experiments of known gains: the paper's case 1 after a 1 m/s backward step,
 2 s sampled at 50 Hz (the 'measurement'), plus seeded sensor noise of 2 mrad that is
@@ -10,7 +11,8 @@ true value, once with the default AR(1) residual model and once with the textboo
 independent one.
 
 Run:  python examples/fit_coverage.py [--trials 300]
-(about 0.06 s per fit: 300 trials take about two minutes).
+(about 0.06 s per fit: 300 trials take about two minutes; not run when the documentation
+is built).
 """
 
 from __future__ import annotations

@@ -1,4 +1,7 @@
-"""How large a backward platform step does each ankle stiffness absorb? (beyond the paper)
+"""How large a backward platform step does each ankle stiffness absorb?
+======================================================================
+
+Beyond the paper.
 
 Case 1 of Table I with the ankle stiffness varied from 300 to 2000 N·m/rad
 (viscosity 0.25 s × stiffness, as in the paper), standing upright at rest when
@@ -49,7 +52,8 @@ def largest_recovered(ankle: np.ndarray = ANKLE, speed: np.ndarray = SPEED,
     return recovered, first_fall
 
 
-def main(out_dir: Path) -> Path:
+def make_figure():
+    """The figure (a pyplot-free matplotlib Figure)."""
     recovered, first_fall = largest_recovered()
     fig, ax = new_figure(figsize=(7.0, 4.2))
     ax.fill_between(ANKLE, recovered, first_fall, step="mid", alpha=0.25,
@@ -59,8 +63,14 @@ def main(out_dir: Path) -> Path:
     ax.set_ylabel("backward platform step [m/s]")
     ax.set_title("Case 1, upright start, literature-sized foot: how large a step is absorbed")
     ax.legend(loc="lower right")
-    return save_figure(fig, out_dir / "largest_step_vs_ankle.png")
+    return fig
+
+
+def main(out_dir: Path) -> Path:
+    return save_figure(make_figure(), out_dir / "largest_step_vs_ankle.png")
 
 
 if __name__ == "__main__":
-    print(main(Path(sys.argv[1]) if len(sys.argv) > 1 else Path(".")))
+    out_dir = Path(sys.argv[1]) if len(sys.argv) > 1 else Path(".")
+    fig = make_figure()
+    print(save_figure(fig, out_dir / "largest_step_vs_ankle.png"))

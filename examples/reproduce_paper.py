@@ -1,4 +1,7 @@
-"""Regenerate the whole paper (Table II, J⁻¹H, Figs. 3–10, errata) as an HTML report.
+"""Regenerate the whole paper as an HTML report
+=============================================
+
+Table II, J⁻¹H, Figs. 3–10 and the errata. Not run when the documentation is built.
 
 The same as ``posturelab reproduce --out OUTPUT_DIR``.
 

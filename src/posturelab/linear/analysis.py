@@ -191,6 +191,17 @@ def analyse(body: Body, muscles: MuscleSet, one_sided: OneSided = "active") -> L
     Returns
     -------
     LinearAnalysis
+
+    Examples
+    --------
+    Table II, case 3 (erratum 1: the slowest pole is −0.092 1/s, not the printed −0.90):
+
+    >>> import posturelab as pl
+    >>> res = pl.analyse(pl.paper_body(), pl.paper_muscles("3"))
+    >>> res.stable
+    True
+    >>> [round(float(p), 3) for p in res.poles.real]  # [1/s]
+    [-575.405, -90.564, -3.641, -2.948, -2.948, -0.092]
     """
     A = state_matrix(body, muscles, one_sided)
     poles = sorted_poles(np.linalg.eigvals(A))
@@ -242,6 +253,17 @@ def disturbance_sensitivity(body: Body, posture: np.ndarray | None = None) -> np
     -------
     numpy.ndarray, shape (N,)
         J⁻¹H. [rad/m] (rate change [rad/s] per platform velocity change [m/s])
+
+    Examples
+    --------
+    The paper's body upright, and at its flexed initial posture (erratum 5):
+
+    >>> import posturelab as pl
+    >>> [round(float(v), 4) for v in pl.disturbance_sensitivity(pl.paper_body())]  # [rad/m]
+    [2.558, -0.0654, 0.0027]
+    >>> [round(float(v), 3) for v in pl.disturbance_sensitivity(pl.paper_body(),
+    ...                                                         [0.1, -0.1, 0.1])]
+    [2.268, 0.291, -0.071]
     """
     from .._validation import check_model
 

@@ -311,6 +311,19 @@ def delay_margin(body: Body, muscles: MuscleSet, *, max_delay: float = 2.0,
     Returns
     -------
     DelayMargin
+
+    Examples
+    --------
+    The paper's case 1 gains, all of their feedback delayed, lose stability at 2.81 ms, to a
+    mode at 88.6 Hz:
+
+    >>> import math
+    >>> import posturelab as pl
+    >>> dm = pl.delay_margin(pl.paper_body(), pl.paper_muscles("1"))
+    >>> round(dm.delay_margin * 1000, 2)  # [ms]
+    2.81
+    >>> round(dm.crossing_frequency / (2 * math.pi), 1)  # [Hz]
+    88.6
     """
     max_delay = float_in_range("max_delay [s]", max_delay, 0.0, 1e3, unit="s")
     system = delayed_system(body, muscles, one_sided)

@@ -9,6 +9,7 @@ Presets
 -------
 ``"paper"``
     Appendix A of the ankle-strategy paper: leg, thigh, torso (65.59 kg).
+
 Use :func:`get_body` or :data:`BODY_PRESETS`; an unknown name raises an
 error that lists the known ones.
 """
@@ -282,6 +283,15 @@ def paper_body(gravity: float = STANDARD_GRAVITY) -> Body:
     ----------
     gravity : float, optional
         Gravitational acceleration. [m/s²]
+
+    Examples
+    --------
+    >>> import posturelab as pl
+    >>> body = pl.paper_body()
+    >>> body.n_links, [s.name for s in body.segments]
+    (3, ['leg', 'thigh', 'torso'])
+    >>> round(body.total_mass, 2), round(body.load_stiffness, 1)  # [kg], mgh [N·m/rad]
+    (65.59, 564.0)
     """
     return Body.from_arrays(
         masses=[5.05, 18.67, 41.87],

@@ -560,6 +560,17 @@ def paper_muscles(
     Returns
     -------
     MuscleSet
+
+    Examples
+    --------
+    >>> import posturelab as pl
+    >>> muscles = pl.paper_muscles("1")  # Table I, case 1
+    >>> muscles.names
+    ['ankle', 'knee', 'hip', 'quadriceps', 'gastrocnemius']
+    >>> [float(k) for k in muscles.stiffnesses]  # [N·m/rad]
+    [500.0, 300.0, 300.0, 300.0, 300.0]
+    >>> [float(v) for v in muscles.viscosities]  # 0.25 s × stiffness [N·m·s/rad]
+    [125.0, 75.0, 75.0, 75.0, 75.0]
     """
     if (case is None) == (stiffness is None):
         raise ParameterError("give exactly one of case (Table I) or stiffness (5 values)")

@@ -3,7 +3,7 @@
 :func:`simulate` is the entry point (:mod:`.engines`). :mod:`.setup` validates a
 run and works out what both engines share; the reference engine
 (:mod:`.reference`, the numpy model integrated by scipy) and the compiled engine
-(:mod:`.compiled`, numba, imported on first use) integrate it with the events of
+(:mod:`.compiled`, C, built when posturelab is installed) integrate it with the events of
 :mod:`posturelab.model.events` and return a :class:`~.results.SimulationResult`,
 whose derived series come from :mod:`.derived`.
 """

@@ -146,6 +146,28 @@ def simulate(
         A fall is reported in ``fell``/``fall_time``/``status`` and the
         state at the fall is the last sample (off the regular grid); a failed
         integration in ``status == "failed"`` with a ``message``.
+
+    Examples
+    --------
+    The paper's Fig. 3 run: a 1 m/s backward platform step, case 1, from the flexed posture:
+
+    >>> import posturelab as pl
+    >>> run = pl.simulate(pl.paper_body(), pl.paper_muscles("1"), pl.VelocityStep.backward(1.0),
+    ...                   duration=5.0, initial_state=[0.1, -0.1, 0.1, 0, 0, 0])
+    >>> run.outcome.kind, run.fell
+    ('recovered', False)
+    >>> run.theta.shape  # samples at 1 kHz × link angles [rad]
+    (5001, 3)
+    >>> [round(float(a), 3) for a in run.max_abs_theta]  # [rad]
+    [0.217, 0.216, 0.288]
+
+    Fig. 9: forward, case 2 (no gastrocnemius) falls, here on the compiled engine:
+
+    >>> fall = pl.simulate(pl.paper_body(), pl.paper_muscles("2"), pl.VelocityStep.forward(1.0),
+    ...                    duration=5.0, initial_state=[0.1, -0.1, 0.1, 0, 0, 0],
+    ...                    engine="compiled")
+    >>> fall.outcome.kind, round(fall.fall_time, 2)  # [s]
+    ('fell', 1.19)
     """
     name = engine_name(engine)
     d_rtol, d_atol, d_method = ENGINE_DEFAULTS[name]

@@ -695,9 +695,10 @@ def outcome_message(status: str, t: float, setup: RunSetup, *, fall_reason: str 
 
     Parameters
     ----------
-    status : {"completed", "fell", "step-too-small", "non-finite", "chattering", "no-memory",
-              "step-budget", "time-budget", "failed"}
-        What happened ("failed" takes its words from ``detail``).
+    status : str
+        What happened: one of "completed", "fell", "step-too-small", "non-finite",
+        "chattering", "no-memory", "step-budget", "time-budget", "failed" ("failed" takes
+        its words from ``detail``).
     t : float
         When it happened (the fall, the failure). [s]
     """
