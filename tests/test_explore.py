@@ -179,8 +179,42 @@ def test_the_page_in_chromium(tmp_path):
         np.testing.assert_allclose(_table(page, "pole"),
                                    _api_poles([700.0, 300.0, 300.0, 300.0, 300.0]).poles,
                                    rtol=1e-9)
+        # a bad value in a box that then goes grey no longer blocks the page
+        page.select_option("#body", "height and mass")
+        page.wait_for_function("Number(document.body.dataset.updates) >= 4", timeout=30_000)
+        page.fill("#height", "5")
+        page.wait_for_selector("#message:not([hidden])", timeout=30_000)
+        assert page.inner_text("#message").startswith("height [m] must be in [0.5, 2.5]")
+        page.select_option("#body", "paper")
+        page.wait_for_selector("#message[hidden]", state="attached", timeout=30_000)
+        assert page.is_disabled("#height")
+        assert "invalid" not in (page.get_attribute("#height", "class") or "")
+        np.testing.assert_allclose(_table(page, "pole"),
+                                   _api_poles([700.0, 300.0, 300.0, 300.0, 300.0]).poles,
+                                   rtol=1e-9)
         shot = tmp_path / "explore.png"
         page.screenshot(path=str(shot), full_page=True)
         browser.close()
     assert shot.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and shot.stat().st_size > 50_000
     assert errors == []
+
+
+def test_values_the_page_could_send_that_the_package_refuses_are_named():
+    """Cross-field bounds land on a field; odd numbers get one line; no 500."""
+    for fields, words, field in (
+            ({"stiffness_ankle": 1e8}, "ankle viscosity = viscosity ratio × stiffness = "
+             "2.5e+07 N·m·s/rad must be at most 1e+07", "stiffness_ankle"),
+            ({"stiffness_ankle": 10**400}, "ankle stiffness [N·m/rad] must be a number, "
+             "got '1000", "stiffness_ankle"),
+            ({"mass": "1_000"}, "mass [kg] must be a number, got '1_000'", "mass"),
+            ({"height": ""}, "height [m] must be a number, got an empty box", "height"),
+            ({"step_speed": 0}, "step speed [m/s] must be in [0.01, 20], got 0", "step_speed")):
+        with pytest.raises(ParameterError) as info:
+            parse_parameters(fields)
+        assert str(info.value).startswith(words) and info.value.field == field
+    client = __import__("posturelab.explore.app", fromlist=["x"]).create_app().test_client()
+    huge = client.post("/api/views", data='{"stiffness_ankle": 1' + "0" * 400 + "}",
+                       content_type="application/json")
+    assert huge.status_code == 422 and huge.get_json()["field"] == "stiffness_ankle"
+    undamped = compute_views(parse_parameters({"viscosity_ratio": 0}))
+    assert undamped["verdict"].startswith("marginal") and not undamped["stable"]

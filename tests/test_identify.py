@@ -174,7 +174,8 @@ def test_ar1_covariance_equals_the_written_out_sandwich():
     np.testing.assert_allclose(cov, _naive_ar1_sandwich(jac, residuals, n_links, rho,
                                                         variance), rtol=1e-10)
     np.testing.assert_allclose(se, np.sqrt(np.diag(cov)))
-    assert dof == pytest.approx(np.sum(samples * (1 - rho) / (1 + rho)) - p)
+    assert dof == pytest.approx(
+        np.sum(np.minimum(samples, samples * (1 - rho) / (1 + rho))) - p)
     x = rng.normal(size=(samples, 4))
     lags = np.abs(np.subtract.outer(np.arange(samples), np.arange(samples)))
     np.testing.assert_allclose(ar1_filter_sum(x, 0.7), (0.7**lags) @ x, rtol=1e-12)
@@ -214,3 +215,27 @@ def test_fit_reports_its_residual_model(experiment):
     assert d["parameters"]["ankle"]["unit"] == "N·m/rad"
     with pytest.raises(pl.PostureLabError, match="residual_model 'white'; known: ar1"):
         fit_stiffness(start, truth.time, noisy, ["ankle"], residual_model="white")
+
+
+def test_a_fit_never_uses_a_run_that_stopped_short(experiment, tmp_path):
+    """A spent budget inside a fit stops the fit with the run's message (the CLI: one line,
+    exit 2), instead of fitting to a truncated run."""
+    import subprocess
+    import sys
+
+    from posturelab.identify import FitError
+
+    sc, truth = experiment
+    start = sc.replace(muscles=pl.paper_muscles(stiffness=[800, 300, 300, 300, 100]),
+                       max_steps=20)
+    with pytest.raises(FitError, match="a simulation inside the fit failed at ankle = 800: "
+                                       "stopped at t = .* the step budget of 20"):
+        fit_stiffness(start, truth.time, truth.theta, ["ankle"])
+    data = tmp_path / "m.csv"
+    truth.to_csv(data)
+    p = subprocess.run([sys.executable, "-m", "posturelab", "fit", "--data", str(data),
+                        "--stiffness", "800,300,300,300,100", "--disturbance", "backward",
+                        "--free", "ankle", "--max-steps", "20"],
+                       capture_output=True, text=True, timeout=120)
+    assert p.returncode == 2 and len(p.stderr.strip().splitlines()) == 1
+    assert "a simulation inside the fit failed" in p.stderr and "Traceback" not in p.stderr

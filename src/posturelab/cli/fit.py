@@ -41,7 +41,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="measured angles: columns t [s], theta1..theta3 [rad].")
     g.add_argument("--free", required=True, metavar="NAME[,NAME…]",
                    help="parameters to fit: pair names (" + ", ".join(PAPER_PAIR_NAMES)
-                   + f") and/or {VISCOSITY_RATIO}.")
+                   + f"), {VISCOSITY_RATIO}, feedback_delay, proprioceptive_weight, "
+                   "active_PAIR and active_viscosity_PAIR.")
     g.add_argument("--engine", choices=ENGINES, default="compiled",
                    help="engine inside the fit: compiled (default; the scenario's "
                    "tolerances) or reference (scipy, the scenario's solver); fast is a "

@@ -12,12 +12,14 @@ compiled engine.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..errors import ParameterError
+from ..model.muscles import MAX_PAIR_VISCOSITY
 
 __all__ = ["Control", "CONTROLS", "PAIRS", "parse_parameters", "build_model", "compute_views"]
 
@@ -93,7 +95,8 @@ CONTROLS: tuple[Control, ...] = (
             0.05, "neural"),
     Control("perturbation", "perturbation", "", "backward step", group="perturbation",
             choices=("backward step", "forward step", "tilt")),
-    Control("step_speed", "step speed", "m/s", 0.3, 0.0, 20.0, 0.0, 2.0, 0.05, "perturbation"),
+    Control("step_speed", "step speed", "m/s", 0.3, 0.01, 20.0, 0.01, 2.0, 0.01,
+            "perturbation"),
     Control("tilt_amplitude", "tilt amplitude", "rad", 0.02, 0.0, 0.5, 0.0, 0.1, 0.002,
             "perturbation"),
     Control("tilt_frequency", "tilt frequency", "Hz", 0.2, 0.01, 10.0, 0.05, 2.0, 0.05,
@@ -105,6 +108,12 @@ _BY_NAME = {c.name: c for c in CONTROLS}
 
 def _number(value: float) -> str:
     return f"{value:g}"
+
+
+def _shown(raw) -> str:
+    """A request value as a message quotes it: its repr, cut at 40 characters."""
+    text = repr(raw if isinstance(raw, str) else str(raw))
+    return text if len(text) <= 40 else text[:39] + "…"
 
 
 def parse_parameters(fields: dict) -> dict:
@@ -126,27 +135,36 @@ def parse_parameters(fields: dict) -> dict:
         raise ParameterError("the request must be a JSON object of control values")
     unknown = sorted(set(fields) - set(_BY_NAME))
     if unknown:
-        raise _field_error(unknown[0], f"unknown control {unknown[0]!r:.60}")
+        raise _field_error(unknown[0], f"unknown control {_shown(unknown[0])}")
     out: dict = {}
     for c in CONTROLS:
         raw = fields.get(c.name, c.default)
         if c.choices:
             if raw not in c.choices:
                 raise _field_error(c.name, f"{c.label} must be one of "
-                                   f"{', '.join(c.choices)}; got {str(raw)!r:.60}")
+                                   f"{', '.join(c.choices)}; got {_shown(raw)}")
             out[c.name] = raw
             continue
         try:
-            if isinstance(raw, bool):
+            if isinstance(raw, bool) or (isinstance(raw, str) and "_" in raw):
                 raise ValueError
             value = float(raw.strip() if isinstance(raw, str) else raw)
-        except (TypeError, ValueError):
+        except (TypeError, ValueError, OverflowError):
+            got = ("an empty box (or one the browser could not read as a number)"
+                   if isinstance(raw, str) and not raw.strip() else _shown(raw))
             raise _field_error(c.name, f"{c.label} [{c.unit}] must be a number, got "
-                               f"{str(raw)!r:.60}") from None
+                               f"{got}") from None
         if not math.isfinite(value) or not c.low <= value <= c.high:
             raise _field_error(c.name, f"{c.label} [{c.unit}] must be in "
                                f"[{_number(c.low)}, {_number(c.high)}], got {_number(value)}")
         out[c.name] = value
+    for name in PAIRS:  # a pair's viscosity is ratio × stiffness: its bound, on the stiffness
+        viscosity = out["viscosity_ratio"] * out[f"stiffness_{name}"]
+        if viscosity > MAX_PAIR_VISCOSITY:
+            raise _field_error(f"stiffness_{name}", (
+                f"{name} viscosity = viscosity ratio × stiffness = {_number(viscosity)} "
+                f"N·m·s/rad must be at most {_number(MAX_PAIR_VISCOSITY)} (lower the "
+                f"{name} stiffness or the viscosity ratio)"))
     return out
 
 
@@ -192,7 +210,18 @@ def _rounded(values, digits: int = 6) -> list:
 
 
 #: Frequencies of the FRF view. [Hz]
-FRF_FREQUENCIES = np.logspace(-2, math.log10(5.0), 120)
+FRF_FREQUENCIES = np.logspace(-2, 1, 140)
+#: |Re z| at most this times max(1, |z|) [1/s] counts as on the imaginary axis. [-]
+MARGINAL = 1e-9
+
+
+@functools.lru_cache(maxsize=64)
+def _linear(body, muscles):
+    """The poles and the delay margin, which depend on the body and gains only: kept for
+    the changes of delay, weight or perturbation that follow."""
+    import posturelab as pl
+
+    return pl.analyse(body, muscles), pl.delay_margin(body, muscles, max_delay=1.0)
 #: Output samples per second of the simulated response. [Hz]
 SAMPLE_RATE = 100.0
 #: Stick-figure frames per second. [Hz]
@@ -222,25 +251,30 @@ def compute_views(p: dict) -> dict:
 
     body, muscles, disturbance, tilt = build_model(p)
     delay, weight = p["feedback_delay"], p["proprioceptive_weight"]
-    lin = pl.analyse(body, muscles)
+    lin, margin = _linear(body, muscles)
     roots = (pl.rightmost_roots(body, muscles, delay, count=6) if delay > 0
              else lin.poles[np.argsort(-lin.poles.real, kind="stable")][:6])
     rightmost = complex(roots[0])
-    stable = rightmost.real < 0
-    margin = pl.delay_margin(body, muscles, max_delay=1.0)
+    # a root on the imaginary axis to rounding (no damping at all) is neither side
+    marginal = abs(rightmost.real) <= MARGINAL * max(1.0, abs(rightmost))
+    stable = rightmost.real < 0 and not marginal
     frf = model_frf(body, muscles, FRF_FREQUENCIES, input="tilt", output="com_angle",
                     feedback_delay=delay, proprioceptive_weight=weight)
+    rate = SAMPLE_RATE if tilt is None else max(SAMPLE_RATE, 40.0 * tilt.frequency)
     run = pl.simulate(body, muscles, disturbance, p["duration"], engine="compiled",
                       feedback_delay=delay, proprioceptive_weight=weight, tilt=tilt,
-                      sample_rate=SAMPLE_RATE, time_limit=TIME_LIMIT)
-    every = max(1, int(round(SAMPLE_RATE / FRAME_RATE)))
+                      sample_rate=rate, time_limit=TIME_LIMIT)
+    every = max(1, int(round(rate / FRAME_RATE)))
     frames = joint_positions(body, run.theta[::every])
 
     outcome = run.outcome
     return {
         "stable": bool(stable),
-        "verdict": (f"stable about upright (rightmost root {rightmost.real:.3g} 1/s)" if stable
-                    else f"unstable about upright (rightmost root {rightmost.real:+.3g} 1/s)"),
+        "verdict": (
+            "marginal: the rightmost root is on the imaginary axis (no damping), "
+            f"{rightmost.imag:+.3g}j rad/s" if marginal
+            else f"stable about upright (rightmost root {rightmost.real:.3g} 1/s)" if stable
+            else f"unstable about upright (rightmost root {rightmost.real:+.3g} 1/s)"),
         "poles": _complex_list(lin.poles),
         "roots": _complex_list(roots),
         "delay_margin": (None if margin.delay_margin is None

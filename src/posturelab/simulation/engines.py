@@ -138,7 +138,8 @@ def simulate(
         what a legitimate run needs. [-]
     time_limit : float, optional
         A wall-clock budget of the integration: past it the run stops as ``failed``
-        (the samples so far kept); none by default. [s]
+        (the samples so far kept); none by default. The compiled engine looks at the
+        clock every 256 attempted steps, so a run shorter than that always finishes. [s]
 
     Returns
     -------

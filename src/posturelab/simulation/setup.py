@@ -718,9 +718,9 @@ def outcome_message(status: str, t: float, setup: RunSetup, *, fall_reason: str 
         return f"ran out of memory at t = {t:.6g} s"
     if status == "step-budget":
         return (f"stopped at t = {t:.6g} s: the step budget of {setup.max_steps:,} integrator "
-                "steps ran out (raise max_steps, or use an implicit method such as Radau "
-                "for very stiff or viscous gains)")
+                "steps ran out (raise max_steps; for very stiff or viscous gains an implicit "
+                "method such as Radau needs far fewer steps)")
     if status == "time-budget":
         return (f"stopped at t = {t:.6g} s: the time limit of {setup.time_limit:g} s "
-                "(wall clock) ran out (raise time_limit, or use the compiled engine)")
+                "(wall clock) ran out (raise time_limit)")
     return detail

@@ -39,13 +39,18 @@ from pathlib import Path
 import numpy as np
 
 from .._validation import finite_array
-from ..errors import DataFileError, ParameterError, UnknownNameError
+from ..errors import DataFileError, ParameterError, PostureLabError, UnknownNameError
 from ..model.muscles import MuscleSet
 from ..scenarios import Scenario
 from ..simulation.results import SimulationResult
 from .sweep import parameter_unit
 
-__all__ = ["FitResult", "fit_stiffness", "read_trajectory_csv"]
+__all__ = ["FitResult", "FitError", "fit_stiffness", "read_trajectory_csv"]
+
+
+class FitError(PostureLabError):
+    """A fit that cannot go on: a simulation inside it failed (a spent step or time
+    budget, a non-finite state, …)."""
 
 VISCOSITY_RATIO = "viscosity_ratio"
 #: How the uncertainty treats the residuals (:func:`fit_stiffness`).
@@ -193,6 +198,12 @@ def fit_stiffness(
     Returns
     -------
     FitResult
+
+    Raises
+    ------
+    FitError
+        A simulation inside the fit failed (its message is given): the fit never uses a
+        run that stopped short.
     """
     from scipy import stats
     from scipy.optimize import least_squares
@@ -256,7 +267,11 @@ def fit_stiffness(
             muscles = muscles.with_active_feedback(ka, va)
         options = {k: value[k] for k in ("feedback_delay", "proprioceptive_weight")
                    if k in value}
-        return sc.run(engine=engine, muscles=muscles, **options)
+        result = sc.run(engine=engine, muscles=muscles, **options)
+        if result.status == "failed":  # never fit to a run that stopped short
+            shown = ", ".join(f"{nm} = {v:.6g}" for nm, v in value.items())
+            raise FitError(f"a simulation inside the fit failed at {shown}: {result.message}")
+        return result
 
     def residuals(params: np.ndarray) -> np.ndarray:
         r = run(params)
@@ -367,7 +382,8 @@ def _ar1_covariance(jac: np.ndarray, x: np.ndarray, residuals: np.ndarray, n_lin
             lag1 = float(ri[1:] @ ri[:-1] / ss)
             # Kendall's (1954) correction of the estimator's small-sample bias −(1 + 3ρ)/S
             rho[i] = float(np.clip(lag1 + (1 + 3 * lag1) / samples, -_MAX_RHO, _MAX_RHO))
-    effective = float(np.sum(samples * (1 - rho) / (1 + rho)))
+    # (negative correlation would count more samples than there are: capped at the count)
+    effective = float(np.sum(np.minimum(samples, samples * (1 - rho) / (1 + rho))))
     dof = max(effective - p, 1.0)
     cov = np.full((p, p), np.nan)
     good = _identifiable(jac, x)

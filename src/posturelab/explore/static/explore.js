@@ -14,7 +14,9 @@ let updates = 0;
 
 function values() {
   const out = {};
-  for (const el of form.querySelectorAll("input[name], select[name]")) out[el.name] = el.value;
+  for (const el of form.querySelectorAll("input[name], select[name]")) {
+    if (!el.disabled) out[el.name] = el.value;  // a greyed-out box is not used: not sent
+  }
   return out;
 }
 
@@ -40,6 +42,7 @@ function enableFields() {
     const box = document.getElementById(name);
     box.disabled = !on;
     form.querySelector(`input[data-for="${name}"]`).disabled = !on;
+    if (!on) { box.classList.remove("invalid"); box.removeAttribute("aria-invalid"); }
   }
 }
 
@@ -53,6 +56,7 @@ function schedule() {
 async function update() {
   const mine = ++requested;
   const started = performance.now();
+  document.getElementById("timing").textContent = "computing…";
   let response, data;
   try {
     response = await fetch("api/views", {
@@ -65,7 +69,11 @@ async function update() {
     return;
   }
   if (mine !== requested) return;  // a newer change is on its way: draw that one
-  if (!response.ok) { showError(data.error, data.field); return; }
+  if (!response.ok) {
+    showError(data.error, data.field);
+    document.getElementById("timing").textContent = "";
+    return;
+  }
   clearError();
   draw(data);
   const ms = performance.now() - started;
@@ -158,10 +166,11 @@ function complexText(z) {
 function draw(d) {
   const verdict = document.getElementById("verdict");
   verdict.textContent = d.verdict;
-  verdict.className = d.stable ? "stable" : "unstable";
+  verdict.className = d.stable ? "stable" : d.verdict.startsWith("marginal") ? "marginal"
+    : "unstable";
   document.getElementById("delay-margin").textContent =
     !d.stable_without_delay ? "none (unstable without delay)"
-      : d.delay_margin === null ? "∞ (no crossing)" : `${d.delay_margin.toFixed(3)} s`;
+      : d.delay_margin === null ? "∞ (no crossing)" : `${d.delay_margin.toPrecision(3)} s`;
   document.getElementById("delay-note").textContent =
     d.delayed_part === "active" ? "(of the active gains)" : "(of the whole pair feedback)";
   const outcome = document.getElementById("outcome");
