@@ -218,3 +218,14 @@ def test_values_the_page_could_send_that_the_package_refuses_are_named():
     assert huge.status_code == 422 and huge.get_json()["field"] == "stiffness_ankle"
     undamped = compute_views(parse_parameters({"viscosity_ratio": 0}))
     assert undamped["verdict"].startswith("marginal") and not undamped["stable"]
+
+
+def test_the_stick_figure_gets_the_surface_tilt():
+    v = compute_views(parse_parameters({"perturbation": "tilt", "tilt_amplitude": 0.05,
+                                        "tilt_frequency": 0.5}))
+    alpha = np.array(v["run"]["surface_tilt"])
+    t = np.arange(alpha.size) / v["run"]["frame_rate"]
+    np.testing.assert_allclose(alpha, 0.05 * np.sin(2 * np.pi * 0.5 * t), atol=1e-6)
+    assert len(v["run"]["frames"]) == alpha.size
+    still = compute_views(parse_parameters({}))["run"]["surface_tilt"]
+    assert set(still) == {0.0}

@@ -242,7 +242,7 @@ def compute_views(p: dict) -> dict:
         [s] (None when unstable without delay, inf as None with ``no_margin``);
         ``frf`` (frequencies [Hz], gain [-], phase [deg]); ``run`` (outcome words,
         time [s], link angles [rad], CoG position [m] and velocity [m/s], joint positions
-        [m] of the stick figure at :data:`FRAME_RATE`).
+        [m] of the stick figure and the surface tilt [rad] at :data:`FRAME_RATE`).
     """
     import posturelab as pl
 
@@ -266,6 +266,8 @@ def compute_views(p: dict) -> dict:
                       sample_rate=rate, time_limit=TIME_LIMIT)
     every = max(1, int(round(rate / FRAME_RATE)))
     frames = joint_positions(body, run.theta[::every])
+    surface = (np.zeros(len(frames)) if tilt is None
+               else np.asarray(tilt.angle_and_rate(run.time[::every])[0], dtype=float))
 
     outcome = run.outcome
     return {
@@ -290,5 +292,6 @@ def compute_views(p: dict) -> dict:
                 "cog_x": _rounded(run.cog_position[:, 0]),
                 "cog_v": _rounded(run.cog_velocity[:, 0]),
                 "frame_rate": FRAME_RATE, "frames": _rounded(frames, 5),
+                "surface_tilt": _rounded(surface, 6),
                 "height": float(body.lengths.sum())},
     }

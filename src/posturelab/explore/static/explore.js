@@ -236,6 +236,12 @@ function stickFrame(now) {
     const elapsed = Math.max(0, now - stick.started) / 1000;  // (a frame's time may be earlier)
     const k = Math.floor(elapsed * run.frame_rate) % (n + 10);
     const frame = run.frames[Math.min(k, n - 1)];  // hold the last frame a moment
+    const alpha = run.surface_tilt[Math.min(k, n - 1)];  // [rad], positive toes-up (+x up)
+    const platform = document.getElementById("platform");
+    platform.setAttribute("x1", (-1.1 * Math.cos(alpha)).toFixed(4));
+    platform.setAttribute("y1", (-1.1 * Math.sin(alpha)).toFixed(4));
+    platform.setAttribute("x2", (1.1 * Math.cos(alpha)).toFixed(4));
+    platform.setAttribute("y2", (1.1 * Math.sin(alpha)).toFixed(4));
     document.getElementById("chain").setAttribute(
       "points", frame.map(p => `${(p[0] * scale).toFixed(4)},${(p[1] * scale).toFixed(4)}`).join(" "));
     const circles = document.getElementById("joints").children;
