@@ -15,7 +15,7 @@ import pytest
 
 import posturelab as pl
 from posturelab.errors import ParameterError
-from posturelab.explore import CONTROLS, compute_views, parse_parameters
+from posturelab.explore import CONTROLS, compute_views, create_app, parse_parameters
 from posturelab.explore.browser import chromium_path
 
 flask = pytest.importorskip("flask")
@@ -81,7 +81,7 @@ def test_views_are_what_the_api_computes():
 
 
 def test_the_application_answers_json_and_never_a_server_page():
-    client = __import__("posturelab.explore.app", fromlist=["x"]).create_app().test_client()
+    client = create_app().test_client()
     page = client.get("/")
     assert page.status_code == 200 and b'id="stiffness_ankle"' in page.data
     assert b"chart.umd.min.js" in page.data and client.get(
@@ -212,7 +212,7 @@ def test_values_the_page_could_send_that_the_package_refuses_are_named():
         with pytest.raises(ParameterError) as info:
             parse_parameters(fields)
         assert str(info.value).startswith(words) and info.value.field == field
-    client = __import__("posturelab.explore.app", fromlist=["x"]).create_app().test_client()
+    client = create_app().test_client()
     huge = client.post("/api/views", data='{"stiffness_ankle": 1' + "0" * 400 + "}",
                        content_type="application/json")
     assert huge.status_code == 422 and huge.get_json()["field"] == "stiffness_ankle"

@@ -239,3 +239,31 @@ def test_a_fit_never_uses_a_run_that_stopped_short(experiment, tmp_path):
                        capture_output=True, text=True, timeout=120)
     assert p.returncode == 2 and len(p.stderr.strip().splitlines()) == 1
     assert "a simulation inside the fit failed" in p.stderr and "Traceback" not in p.stderr
+
+
+def test_cli_fit_prints_the_residual_correlation_it_used(tmp_path, capsys):
+    """The text's residual line carries the JSON's numbers."""
+    data = tmp_path / "meas.csv"
+    assert main(["simulate", "--case", "1", "--disturbance", "backward", "--duration", "1.5",
+                 "--sample-rate", "50", "--out", str(data)]) == 0
+    rng = np.random.default_rng(3)
+    lines = data.read_text().splitlines()
+    header = lines[0].split(",")
+    cols = [header.index(f"theta{i}") for i in (1, 2, 3)]
+    noisy = [lines[0]]
+    for line in lines[1:]:
+        cells = line.split(",")
+        for c in cols:
+            cells[c] = repr(float(cells[c]) + rng.normal(0.0, 0.002))
+        noisy.append(",".join(cells))
+    data.write_text("\n".join(noisy) + "\n")
+    capsys.readouterr()
+    args = ["fit", "--data", str(data), "--stiffness", "700,300,300,300,300", "--disturbance",
+            "backward", "--free", "ankle"]
+    assert main([*args, "--json"]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert main(args) == 0
+    text = capsys.readouterr().out
+    rho = ", ".join(f"{v:.2f}" for v in summary["residual_autocorrelation"])
+    assert (f"residuals: lag-1 correlation per link {rho} (allowed for in the intervals; "
+            f"{summary['degrees_of_freedom']:.0f} effective degrees of freedom)") in text

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import sys
 import threading
+from collections.abc import Callable
 from typing import TextIO
 
 from ..errors import ParameterError, PostureLabError
@@ -82,7 +83,7 @@ def create_app():
 
 
 def serve(port: int = 8050, *, open_browser: bool = True, stream: TextIO | None = None,
-          ready: threading.Event | None = None) -> None:
+          on_ready: Callable[[object], None] | None = None) -> None:
     """Serve the explorer on http://127.0.0.1:PORT/ until interrupted.
 
     Parameters
@@ -93,8 +94,9 @@ def serve(port: int = 8050, *, open_browser: bool = True, stream: TextIO | None 
         Open the page in the user's web browser once the server listens.
     stream : text stream, optional
         Where the address is printed (standard output by default).
-    ready : threading.Event, optional
-        Set once the server listens (for tests that run it in a thread).
+    on_ready : callable, optional
+        Called with the server once it listens (``server.server_port``, ``shutdown()``:
+        for tests that run it in a thread).
 
     Raises
     ------
@@ -121,10 +123,8 @@ def serve(port: int = 8050, *, open_browser: bool = True, stream: TextIO | None 
         import webbrowser
 
         threading.Thread(target=webbrowser.open, args=(url,), daemon=True).start()
-    if ready is not None:
-        ready.url = url
-        ready.server = server
-        ready.set()
+    if on_ready is not None:
+        on_ready(server)
     try:
         server.serve_forever()
     finally:

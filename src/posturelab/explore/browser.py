@@ -28,19 +28,25 @@ def running_server() -> Iterator[str]:
     the server on exit."""
     import io
 
-    from .app import serve
+    from .app import HOST, serve
 
     ready = threading.Event()
+    servers = []
+
+    def listening(server) -> None:
+        servers.append(server)
+        ready.set()
+
     thread = threading.Thread(target=serve, args=(0,), daemon=True,
                               kwargs={"open_browser": False, "stream": io.StringIO(),
-                                      "ready": ready})
+                                      "on_ready": listening})
     thread.start()
     if not ready.wait(30):
         raise RuntimeError("the explorer's server did not start within 30 s")
     try:
-        yield ready.url
+        yield f"http://{HOST}:{servers[0].server_port}/"
     finally:
-        ready.server.shutdown()
+        servers[0].shutdown()
         thread.join(10)
 
 

@@ -19,14 +19,21 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ParameterError
-from ..model.muscles import MAX_PAIR_VISCOSITY
+from ..model.anthropometry import HEIGHT_RANGE, MASS_RANGE
+from ..model.muscles import (
+    MAX_PAIR_STIFFNESS,
+    MAX_PAIR_VISCOSITY,
+    PAPER_PAIR_NAMES,
+    STIFFNESS_CASES,
+)
+from ..model.platform import MAX_PLATFORM_SPEED
+from ..model.tilt import MAX_TILT
+from ..simulation.setup import MAX_FEEDBACK_DELAY
 
 __all__ = ["Control", "CONTROLS", "PAIRS", "parse_parameters", "build_model", "compute_views"]
 
 #: The paper's five pairs, in the order of their stiffness arrays.
-PAIRS = ("ankle", "knee", "hip", "quadriceps", "gastrocnemius")
-#: Table I, case 1: the paper's stable reference gains. [N·m/rad]
-_CASE1 = (500.0, 300.0, 300.0, 300.0, 300.0)
+PAIRS = PAPER_PAIR_NAMES
 
 
 @dataclass(frozen=True)
@@ -68,15 +75,16 @@ class Control:
 
 def _pair_controls() -> tuple[Control, ...]:
     out = []
-    for name, k in zip(PAIRS, _CASE1, strict=True):
-        out.append(Control(f"stiffness_{name}", f"{name} stiffness", "N·m/rad", k, 0.0, 1e8,
-                           0.0, 3000.0, 10.0, "pairs"))
+    # the defaults: Table I, case 1, the paper's stable reference gains
+    for name, k in zip(PAIRS, STIFFNESS_CASES["1"], strict=True):
+        out.append(Control(f"stiffness_{name}", f"{name} stiffness", "N·m/rad", float(k), 0.0,
+                           MAX_PAIR_STIFFNESS, 0.0, 3000.0, 10.0, "pairs"))
     for name in PAIRS:
         out.append(Control(f"active_{name}", f"{name} active stiffness", "N·m/rad", 0.0, 0.0,
-                           1e8, 0.0, 3000.0, 10.0, "active"))
+                           MAX_PAIR_STIFFNESS, 0.0, 3000.0, 10.0, "active"))
     for name in PAIRS:
         out.append(Control(f"active_viscosity_{name}", f"{name} active viscosity", "N·m·s/rad",
-                           0.0, 0.0, 1e7, 0.0, 1000.0, 5.0, "active"))
+                           0.0, 0.0, MAX_PAIR_VISCOSITY, 0.0, 1000.0, 5.0, "active"))
     return tuple(out)
 
 
@@ -84,20 +92,21 @@ def _pair_controls() -> tuple[Control, ...]:
 CONTROLS: tuple[Control, ...] = (
     Control("body", "body", "", "paper", group="body",
             choices=("paper", "height and mass")),
-    Control("height", "height", "m", 1.75, 0.5, 2.5, 1.0, 2.2, 0.01, "body"),
-    Control("mass", "mass", "kg", 75.0, 10.0, 300.0, 30.0, 150.0, 0.5, "body"),
+    Control("height", "height", "m", 1.75, *HEIGHT_RANGE, 1.0, 2.2, 0.01, "body"),
+    Control("mass", "mass", "kg", 75.0, *MASS_RANGE, 30.0, 150.0, 0.5, "body"),
     *_pair_controls(),
     Control("viscosity_ratio", "viscosity ratio L/K", "s", 0.25, 0.0, 10.0, 0.0, 1.0, 0.01,
             "pairs"),
-    Control("feedback_delay", "feedback delay τ", "s", 0.0, 0.0, 1.0, 0.0, 0.3, 0.005,
+    Control("feedback_delay", "feedback delay τ", "s", 0.0, 0.0, MAX_FEEDBACK_DELAY, 0.0, 0.3,
+            0.005,
             "neural"),
     Control("proprioceptive_weight", "proprioceptive weight W", "-", 1.0, 0.0, 1.0, 0.0, 1.0,
             0.05, "neural"),
     Control("perturbation", "perturbation", "", "backward step", group="perturbation",
             choices=("backward step", "forward step", "tilt")),
-    Control("step_speed", "step speed", "m/s", 0.3, 0.01, 20.0, 0.01, 2.0, 0.01,
+    Control("step_speed", "step speed", "m/s", 0.3, 0.01, MAX_PLATFORM_SPEED, 0.01, 2.0, 0.01,
             "perturbation"),
-    Control("tilt_amplitude", "tilt amplitude", "rad", 0.02, 0.0, 0.5, 0.0, 0.1, 0.002,
+    Control("tilt_amplitude", "tilt amplitude", "rad", 0.02, 0.0, MAX_TILT, 0.0, 0.1, 0.002,
             "perturbation"),
     Control("tilt_frequency", "tilt frequency", "Hz", 0.2, 0.01, 10.0, 0.05, 2.0, 0.05,
             "perturbation"),

@@ -50,6 +50,12 @@ WINTER_TABLE: dict[str, tuple[float, float, float, float, int]] = {
 ANTHROPOMETRIC_TABLES = {"winter": (WINTER_TABLE, WINTER_CITATION)}
 
 
+#: Standing heights a body can be scaled to. [m]
+HEIGHT_RANGE = (0.5, 2.5)
+#: Body masses a body can be scaled to. [kg]
+MASS_RANGE = (10.0, 300.0)
+
+
 def body_from_anthropometry(height: float, mass: float, table: str = "winter",
                             gravity: float = 9.81) -> Body:
     """A leg / thigh / HAT body scaled to a subject.
@@ -71,8 +77,8 @@ def body_from_anthropometry(height: float, mass: float, table: str = "winter",
         Three links; the feet (about 2.9 % of M in Winter's table) are not
         part of the chain, so ``total_mass`` is about 0.971 M.
     """
-    h = float_in_range("height [m]", height, 0.5, 2.5, unit="m")
-    m = float_in_range("mass [kg]", mass, 10.0, 300.0, unit="kg")
+    h = float_in_range("height [m]", height, *HEIGHT_RANGE, unit="m")
+    m = float_in_range("mass [kg]", mass, *MASS_RANGE, unit="kg")
     try:
         rows, citation = ANTHROPOMETRIC_TABLES[table]
     except KeyError:

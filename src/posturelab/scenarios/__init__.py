@@ -116,6 +116,7 @@ from ..model.tilt import (
 )
 from ..simulation.engines import engine_name, simulate
 from ..simulation.results import SimulationResult
+from ..simulation.setup import check_step_budget, check_time_limit
 
 __all__ = [
     "Scenario",
@@ -381,22 +382,19 @@ def _parse(data: dict, base_dir: Path, origin: str) -> Scenario:
         sample_rate=finite_float("solver.sample_rate [Hz]", st.get("sample_rate", 1000.0)),
         method=method, case=case, torque_limits=torque_limits, feedback_delay=delay,
         tilt=tilt, proprioceptive_weight=weight, tilt_axis_depth=depth, motor_noise=noise,
-        max_steps=_budget(origin, "solver.max_steps", st.get("max_steps"), duration),
-        time_limit=_budget(origin, "solver.time_limit [s]", st.get("time_limit"), duration),
+        max_steps=_budget(origin, st.get("max_steps"),
+                          lambda v: check_step_budget(v, duration)),
+        time_limit=_budget(origin, st.get("time_limit"), check_time_limit),
     )
 
 
-def _budget(origin: str, name: str, value, duration: float):
-    """A scenario's step budget or time limit, checked as a run checks it (None: none
-    given)."""
+def _budget(origin: str, value, check):
+    """A scenario's step budget or time limit checked as a run checks it (``check``), the
+    message prefixed with the table; None when none is given."""
     if value is None:
         return None
-    from ..simulation.setup import check_step_budget, check_time_limit
-
     try:
-        if name.startswith("solver.max_steps"):
-            return check_step_budget(value, duration)
-        return check_time_limit(value)
+        return check(value)
     except ParameterError as exc:
         raise ScenarioError(f"{origin}: solver.{exc}") from None
 
