@@ -176,6 +176,8 @@ def test_a_published_controller_on_a_body_from_height_and_mass_on_every_command(
     obj = json.loads(p.stdout)
     assert obj["linear_stability"] == pl.upright_verdict(body, muscles, delay).to_dict()
     assert "one link" in obj["body"]
+    assert p.stderr == ("posturelab: note: --controller peterka-2002 is a one-link controller: "
+                        "the body is winter H=1.8 m M=82 kg, one link (knee and hip locked)\n")
     np.testing.assert_allclose([z["re"] + 1j * z["im"] for z in obj["poles"]],
                                pl.analyse(body, muscles).poles, rtol=1e-12)
 

@@ -130,23 +130,17 @@ def body_from_args(args: argparse.Namespace):
         mass = parse_float_list(args.mass, "--mass [kg]", 1)[0]
         body = body_from_anthropometry(height, mass)
         if getattr(args, "controller", None) is not None:
-            return one_link_body(body)
+            from ..model.anthropometry import one_link
+
+            body = one_link(body)
+            print(f"posturelab: note: --controller {args.controller} is a one-link controller: "
+                  f"the body is {body.name}", file=sys.stderr)
         return body
     if getattr(args, "body", None) is not None:
         return get_body(args.body)
     if getattr(args, "controller", None) is not None:
         return get_body("paper-1link")
     return paper_body()
-
-
-def one_link_body(body):
-    """``body`` with every joint locked: one rigid inverted pendulum about the ankle, the
-    body a one-link controller acts on (same mass [kg], centre of mass and inertia about
-    the ankle [kg·m²]; :func:`posturelab.lump`)."""
-    from ..model.anthropometry import lump
-
-    return lump(body, [list(range(1, body.n_links + 1))],
-                name=f"{body.name}, one link (knee and hip locked)")
 
 
 def _pairs(body) -> int:

@@ -212,10 +212,10 @@ def build_body(p: dict):
     else:
         body = pl.body_from_anthropometry(p["height"], p["mass"])
     if p["body"].endswith("one link") or p["controller"] != OWN_GAINS:
-        from ..cli._common import one_link_body
+        from ..model.anthropometry import one_link
 
         body = (pl.get_body("paper-1link") if p["body"].startswith("paper")
-                else one_link_body(body))
+                else one_link(body))
     return body
 
 
