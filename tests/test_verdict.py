@@ -102,6 +102,25 @@ def test_without_a_switch_one_linearisation_and_the_delay_s_roots():
     assert both.status == "depends on the side" and "τ = 0.002 s" in both.describe()
 
 
+def test_two_one_sided_pairs_give_four_sides():
+    """Each one-sided pair engaged or slack: four linearisations, each numpy's by hand."""
+    from dataclasses import replace
+
+    m = pl.paper_muscles("1")
+    muscles = pl.MuscleSet(tuple(replace(p, one_sided=p.name in ("quadriceps", "gastrocnemius"))
+                                 for p in m.pairs), 3)
+    v = pl.upright_verdict(pl.paper_body(), muscles)
+    assert v.switching_pairs == ("quadriceps", "gastrocnemius")
+    assert v.switching_conditions == ("θ3 − θ1 ≥ 0", "θ2 ≥ 0")
+    assert [s.engaged for s in v.sides] == [("quadriceps", "gastrocnemius"), ("quadriceps",),
+                                            ("gastrocnemius",), ()]
+    for side in v.sides:
+        by_hand = _poles_by_hand({n: k for n, k in CASE1.items() if n not in side.slack})
+        np.testing.assert_allclose(side.rightmost_root, _rightmost(by_hand), rtol=1e-9)
+    statuses = {s.status for s in v.sides}
+    assert v.status == (statuses.pop() if len(statuses) == 1 else "depends on the side")
+
+
 def test_an_undamped_pendulum_is_marginal():
     body = pl.get_body("paper-1link")
     muscles = pl.model.muscles.muscles_for(1, [3 * body.load_stiffness], [0.0])

@@ -35,6 +35,7 @@ from dataclasses import dataclass, replace
 from typing import Literal
 
 from .._validation import float_in_range
+from ..errors import ParameterError
 from ..model.body import Body
 from ..model.muscles import MusclePair, MuscleSet
 from .analysis import _check_match
@@ -236,8 +237,6 @@ def upright_verdict(body: Body, muscles: MuscleSet, feedback_delay: float = 0.0,
                            unit="s")
     one_sided = [p for p in muscles.pairs if p.one_sided]
     if len(one_sided) > MAX_SWITCHING_PAIRS:
-        from ..errors import ParameterError
-
         raise ParameterError(f"upright_verdict takes at most {MAX_SWITCHING_PAIRS} one-sided "
                              f"pairs (2**k linearisations), got {len(one_sided)}")
     names = [p.name for p in one_sided]
