@@ -104,7 +104,7 @@ def test_poles_case_3_json(capsys):
     assert code == 0 and err == ""
     obj = one_json_object(out)
     assert set(obj) == {"stiffness", "viscosity", "stiffness_fraction_of_mgh", "viscosity_ratio",
-                        "poles", "stable"}
+                        "poles", "stable", "linear_stability"}
     assert obj["stiffness"] == [1000.0, 300.0, 300.0, 300.0, 0.0]
     assert obj["viscosity"] == [250.0, 75.0, 75.0, 75.0, 0.0]
     from posturelab import paper_body

@@ -174,7 +174,10 @@ def test_bad_delayed_maps(capsys, tmp_path, argv, needle):
 def test_poles_with_a_delay_give_the_rightmost_roots(capsys):
     code, out, _ = run(capsys, "poles", "--case", "1", "--feedback-delay", "0.01", "--json")
     obj = json.loads(out)
-    assert code == 0 and obj["stable"] is True and obj["stable_with_delay"] is False
+    # one verdict, with the delay: unstable at 10 ms although stable without it
+    assert code == 0 and obj["stable"] is False and obj["stable_without_delay"] is True
+    assert obj["linear_stability"]["status"] == "unstable"
+    assert obj["linear_stability"]["feedback_delay"] == 0.01
     roots = [complex(r["re"], r["im"]) for r in obj["rightmost_roots"]]
     np.testing.assert_allclose(roots, pl.rightmost_roots(pl.paper_body(), pl.paper_muscles("1"),
                                                          0.01, 6), rtol=1e-12)

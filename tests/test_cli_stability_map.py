@@ -183,3 +183,73 @@ def test_known_figure_formats_are_matplotlib_formats():
     supported = set(Figure().canvas.get_supported_filetypes())
     assert cli_map.FIGURE_FORMATS <= supported
     assert {"png", "pdf", "svg"} <= cli_map.FIGURE_FORMATS and "csv" not in supported
+
+
+def _eig_max_real(body, n_links, stiffness, ratio):
+    """The largest real part of the poles, from numpy eigvals of the state matrix built here
+    from the body's mass matrix and gravity torques (independent of the batch kernels)."""
+    from posturelab.model.dynamics import mass_matrix
+
+    n = n_links
+    E = np.eye(n) - np.eye(n, k=-1)  # one pair per joint: stretch θ_j − θ_{j−1}
+    K = E.T @ np.diag(stiffness) @ E
+    J0 = mass_matrix(body, np.zeros(n))
+    A = np.zeros((2 * n, 2 * n))
+    A[:n, n:] = np.eye(n)
+    A[n:, :n] = np.linalg.solve(J0, body.gravity * np.diag(body.gravity_coefficients) - K)
+    A[n:, n:] = -np.linalg.solve(J0, ratio * K)
+    return float(np.linalg.eigvals(A).real.max())
+
+
+@pytest.mark.parametrize("argv,n_links,base,ratio", [
+    (["--body", "paper-1link", "--stiffness", "700", "--y", "viscosity_ratio:0.01:0.6"],
+     1, [700.0], None),
+    (["--body", "paper-2link", "--stiffness", "900,250", "--y", "hip:0:800"],
+     2, [900.0, 250.0], 0.25),
+    (["--height", "1.8", "--mass", "82", "--case", "1", "--y", "hip:0:800"],
+     3, [500.0, 300.0, 300.0], 0.25),
+])
+def test_pair_maps_for_any_body_are_numpy_s_eigenvalues(tmp_path, argv, n_links, base, ratio):
+    """`stability-map` over pair stiffness on a one-, two- and anthropometric three-link body
+    (a real subprocess): every CSV row equals numpy's eigenvalues of the state matrix."""
+    import subprocess
+    import sys
+
+    import posturelab as pl
+
+    out = tmp_path / "any.png"
+    proc = subprocess.run([sys.executable, "-m", "posturelab", "stability-map",
+                           "--x", "ankle:0:2500", *argv, "--resolution", "5", "--out",
+                           str(out)], capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 0, proc.stderr
+    assert "parameter sets of body" in proc.stdout
+    header, rows = read_csv(tmp_path / "any.csv")
+    assert header[0] == "ankle" and len(rows) == 25
+    body = (pl.body_from_anthropometry(1.8, 82.0) if "--height" in argv
+            else pl.get_body(argv[1]))
+    for row in rows:
+        x, y, max_real, stable = float(row[0]), float(row[1]), float(row[2]), row[3]
+        if n_links == 3:
+            # case 1 with the hip axis: the gastrocnemius and quadriceps at 300 (five pairs)
+            muscles = paper_muscles(stiffness=[x, 300, y, 300, 300])
+            want = analyse(body, muscles).max_real_part
+        else:
+            gains = [x] if n_links == 1 else [x, y]
+            want = _eig_max_real(body, n_links, gains, y if ratio is None else ratio)
+        assert max_real == pytest.approx(want, abs=1e-7 * max(1.0, abs(want)))
+        assert stable == ("1" if want < -1e-9 else "0")
+
+
+def test_pair_map_of_another_body_refuses_what_it_cannot_map(tmp_path, capsys):
+    for argv, words in (
+            (["--body", "paper-1link", "--x", "ankle:0:1", "--y", "viscosity_ratio:0:1"],
+             "give --stiffness (1 value: ankle)"),
+            (["--body", "paper-1link", "--stiffness", "600", "--x", "ankle:0:1", "--y",
+              "hip:0:1"], "unknown parameter 'hip'; known parameters: ankle, viscosity_ratio"),
+            (["--x", "ankle:0:1", "--y", "hip:0:1", "--gastrocnemius", "one-sided"],
+             "switching point"),
+            (["--x", "ankle:0:1", "--y", "hip:0:1", "--controller", "peterka-2002"],
+             "--controller is for the delayed map")):
+        code, _, err = run(capsys, "stability-map", *argv, "--out", str(tmp_path / "e.png"))
+        assert code == 2 and words in err and err.count("\n") == 1, err
+    assert list(tmp_path.iterdir()) == []

@@ -17,6 +17,7 @@ import posturelab as pl
 from posturelab.errors import ParameterError
 from posturelab.explore import CONTROLS, compute_views, create_app, parse_parameters
 from posturelab.explore.browser import chromium_path
+from posturelab.model.muscles import muscles_for
 
 flask = pytest.importorskip("flask")
 
@@ -229,3 +230,67 @@ def test_the_stick_figure_gets_the_surface_tilt():
     assert len(v["run"]["frames"]) == alpha.size
     still = compute_views(parse_parameters({}))["run"]["surface_tilt"]
     assert set(still) == {0.0}
+
+
+def test_the_one_link_body_and_the_controller_presets_are_the_api_s():
+    """A one-link body with own gains acts through the ankle pair only; a controller preset
+    gives its gains on the body lumped to one link (as `simulate --controller`); the
+    verdict is posturelab.upright_verdict's."""
+    from posturelab.model.controllers import get_controller
+
+    v = compute_views(parse_parameters({"body": "paper, one link", "stiffness_ankle": 900,
+                                        "stiffness_knee": 7}))
+    body = pl.get_body("paper-1link")
+    lin = pl.analyse(body, muscles_for(1, [900.0]))
+    np.testing.assert_allclose([z["re"] + 1j * z["im"] for z in v["poles"]], lin.poles)
+    assert v["n_links"] == 1 and len(v["run"]["theta"]) == 1 and v["body"] == "paper-1link"
+
+    p = parse_parameters({"body": "height and mass", "height": 1.8, "mass": 82,
+                          "controller": "peterka-2002", "feedback_delay": 0.15})
+    v = compute_views(p)
+    three = pl.body_from_anthropometry(1.8, 82.0)
+    one = pl.lump(three, [[1, 2, 3]])
+    assert v["n_links"] == 1 and "one link" in v["body"]
+    muscles = get_controller("peterka-2002").muscles(one)
+    verdict = pl.upright_verdict(one, muscles, 0.15)
+    assert v["linear_stability"] == verdict.to_dict() and v["verdict"] == verdict.describe()
+    np.testing.assert_allclose([z["re"] + 1j * z["im"] for z in v["roots"]],
+                               pl.rightmost_roots(one, muscles, 0.15, count=2), rtol=1e-10)
+
+
+@needs_browser
+def test_the_page_offers_the_one_link_body_and_the_controller_presets():
+    from playwright.sync_api import sync_playwright
+
+    from posturelab.explore.browser import launch_chromium, running_server
+    from posturelab.model.controllers import get_controller
+
+    with running_server() as url, sync_playwright() as playwright:
+        browser = launch_chromium(playwright)
+        page = browser.new_page(viewport={"width": 1400, "height": 1000})
+        errors = []
+        page.on("pageerror", lambda exc: errors.append(str(exc)))
+        page.goto(url)
+        page.wait_for_function("Number(document.body.dataset.updates) >= 1", timeout=30_000)
+
+        page.select_option("#body", "paper, one link")
+        page.wait_for_function("Number(document.body.dataset.updates) >= 2", timeout=30_000)
+        body = pl.get_body("paper-1link")
+        want = pl.analyse(body, muscles_for(1, [500.0]))
+        np.testing.assert_allclose(_table(page, "pole"), want.poles, rtol=1e-9)
+        assert not page.is_disabled("#stiffness_ankle") and page.is_disabled("#stiffness_hip")
+
+        page.select_option("#controller", "peterka-2002")
+        page.wait_for_function("Number(document.body.dataset.updates) >= 3", timeout=30_000)
+        preset = get_controller("peterka-2002")
+        assert float(page.input_value("#feedback_delay")) == preset.feedback_delay
+        assert page.is_disabled("#stiffness_ankle") and page.is_disabled("#viscosity_ratio")
+        muscles = preset.muscles(body)
+        verdict = pl.upright_verdict(body, muscles, preset.feedback_delay)
+        np.testing.assert_allclose(_table(page, "pole"), pl.analyse(body, muscles).poles,
+                                   rtol=1e-9)
+        assert page.inner_text("#verdict") == verdict.describe()
+        assert page.locator("#verdict").get_attribute("class") == (
+            "stable" if verdict.stable else "unstable")
+        browser.close()
+    assert errors == []

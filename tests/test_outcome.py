@@ -16,7 +16,7 @@ import sys
 import numpy as np
 
 import posturelab as pl
-from posturelab.linear.delay import upright_stability
+from posturelab.linear.verdict import upright_verdict
 from posturelab.simulation.outcome import REST_RATE, UPRIGHT_BAND, classify, classify_rows
 
 
@@ -64,7 +64,7 @@ def test_a_body_left_leaning_is_not_recovered_and_warned_of():
 def test_an_anthropometric_body_unstable_with_case_1_gains_is_not_called_recovered():
     body = pl.body_from_anthropometry(1.80, 82.0)
     muscles = pl.paper_muscles("1")
-    verdict = upright_stability(body, muscles)
+    verdict = upright_verdict(body, muscles)
     assert not verdict.stable
     r = pl.simulate(body, muscles, pl.VelocityStep.backward(1.0), 5.0, engine="compiled",
                     initial_state=np.array([0.1, -0.1, 0.1, 0, 0, 0]))

@@ -98,6 +98,9 @@ def test_figure_verdicts(built):
     assert v[9].verdict == "supported" and "falls at t = 1.1" in v[9].evidence
     assert v[10].verdict == "supported"
     assert "case 2 falls" in report.findings[0]  # one-sided gastrocnemius = case 2
+    # the report names the pair it used and gives the one verdict about upright
+    assert "--gastrocnemius one-sided" in report.findings[0]
+    assert "'depends on the side'" in report.findings[0]
     assert "51 of 54" in report.summary()
 
 

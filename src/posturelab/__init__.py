@@ -36,6 +36,7 @@ from .linear.analysis import (  # noqa: E402
     state_matrix,
 )
 from .linear.delay import DelayMargin, delay_margin, rightmost_roots  # noqa: E402
+from .linear.verdict import UprightVerdict, upright_verdict  # noqa: E402
 from .model.anthropometry import body_from_anthropometry, lump  # noqa: E402
 from .model.body import BODY_PRESETS, Body, Segment, get_body, paper_body  # noqa: E402
 from .model.dynamics import (  # noqa: E402
@@ -130,7 +131,7 @@ __all__ = [
     "ParameterError", "PostureLabError", "UnknownNameError",
     "LinearAnalysis", "analyse", "analyse_both_sides", "disturbance_sensitivity",
     "finite_difference_state_matrix", "state_matrix",
-    "DelayMargin", "delay_margin", "rightmost_roots",
+    "DelayMargin", "delay_margin", "rightmost_roots", "UprightVerdict", "upright_verdict",
     "STIFFNESS_CASES", "MusclePair", "MuscleSet", "get_stiffness_case", "joint_torques",
     "pair_torques", "paper_muscles",
     "centre_of_gravity", "centre_of_gravity_velocity", "physiological_state",

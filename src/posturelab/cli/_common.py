@@ -11,9 +11,15 @@ from ..errors import ParameterError
 from ..model.muscles import PAPER_PAIR_NAMES, STIFFNESS_CASES
 
 GASTROCNEMIUS_HELP = (
-    "two-sided (default) adds the paper's artificial antagonist so the gastrocnemius pair "
-    "acts for either sign of θ2; one-sided lets it act only while θ2 >= 0."
+    "two-sided (default): the paper's artificial antagonist added, the gastrocnemius pair "
+    "acts for either sign of θ2 (the paper's analysis, Figs. 3–8); one-sided: the paper's "
+    "real gastrocnemius, acting only while its stretch θ2 >= 0 and slack while θ2 < 0; "
+    "pull-only: one-sided and also slack while its torque k·θ2 + l·θ̇2 would push (a muscle "
+    "cannot push; beyond the paper)."
 )
+#: The --gastrocnemius choices (posturelab.model.muscles.GASTROCNEMIUS_FORMS, without
+#: importing it).
+GASTROCNEMIUS_CHOICES = ("two-sided", "one-sided", "pull-only")
 
 
 def parse_float_list(text: str, field: str, n: int | None = None) -> list[float]:
@@ -67,7 +73,8 @@ def add_muscle_arguments(p: argparse.ArgumentParser, *, require: bool = False,
                       help=f"body preset: {', '.join(BODY_PRESETS)} (default paper).")
     body.add_argument("--height", type=str, metavar="M",
                       help="subject height [m], with --mass: leg, thigh and HAT scaled by "
-                      "Winter's anthropometric table (three links).")
+                      "Winter's anthropometric table (three links; with --controller, a "
+                      "one-link controller, the same body as one rigid link).")
     body.add_argument("--mass", type=str, metavar="KG", help="subject mass [kg], with --height.")
     fb = p.add_argument_group("feedback (muscle pairs)")
     g = fb.add_mutually_exclusive_group(required=require)
@@ -80,14 +87,16 @@ def add_muscle_arguments(p: argparse.ArgumentParser, *, require: bool = False,
                    "one-link body). With active gains this is the intrinsic (undelayed) part.")
     g.add_argument("--controller", metavar="NAME",
                    help="a published one-link controller (intrinsic and active gains as "
-                   f"fractions of mgh, delay, weight): {', '.join(CONTROLLERS)}.")
+                   f"fractions of mgh, delay, weight): {', '.join(CONTROLLERS)}. Its body: "
+                   "the paper's as one link (paper-1link) by default, --height/--mass "
+                   "lumped to one link, or a one-link --body.")
     fb.add_argument("--viscosity", metavar="LIST",
                     help="pair viscosities [N·m·s/rad], one per pair (instead of a ratio).")
     if not own_case:
         fb.add_argument("--viscosity-ratio", type=float, default=None, metavar="R",
                         help="pair viscosity = R × pair stiffness [s] (default 0.25, the "
                         "paper's).")
-    fb.add_argument("--gastrocnemius", choices=["two-sided", "one-sided"], default="two-sided",
+    fb.add_argument("--gastrocnemius", choices=GASTROCNEMIUS_CHOICES, default="two-sided",
                     help=GASTROCNEMIUS_HELP)
     fb.add_argument("--active-stiffness", metavar="LIST",
                     help="active (neural) pair stiffnesses [N·m/rad], delayed by "
@@ -119,7 +128,14 @@ def body_from_args(args: argparse.Namespace):
             raise ParameterError("give --body or --height/--mass, not both")
         height = parse_float_list(args.height, "--height [m]", 1)[0]
         mass = parse_float_list(args.mass, "--mass [kg]", 1)[0]
-        return body_from_anthropometry(height, mass)
+        body = body_from_anthropometry(height, mass)
+        if getattr(args, "controller", None) is not None:
+            from ..model.anthropometry import one_link
+
+            body = one_link(body)
+            print(f"posturelab: note: --controller {args.controller} is a one-link controller: "
+                  f"the body is {body.name}", file=sys.stderr)
+        return body
     if getattr(args, "body", None) is not None:
         return get_body(args.body)
     if getattr(args, "controller", None) is not None:
@@ -146,7 +162,13 @@ def muscles_from_args(args: argparse.Namespace, body=None):
         if clash:
             raise ParameterError(f"--controller sets every gain; it cannot be combined with "
                                  f"--{clash[0].replace('_', '-')}")
-        return get_controller(args.controller).muscles(body)
+        controller = get_controller(args.controller)
+        if body.n_links != 1:
+            raise ParameterError(
+                f"--controller {controller.name} is a one-link controller (an inverted pendulum "
+                f"about the ankle); --body {args.body} has {body.n_links} links: give a one-link "
+                "--body (paper-1link), --height/--mass (lumped to one link), or no body")
+        return controller.muscles(body)
     if args.case is None and args.stiffness is None:
         raise ParameterError("give --case (Table I), --stiffness LIST or --controller NAME")
     if args.viscosity is not None and args.viscosity_ratio is not None:

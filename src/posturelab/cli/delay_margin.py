@@ -37,7 +37,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..linear.delay import delay_margin, rightmost_roots
+    from ..linear.delay import delay_margin
+    from ..linear.verdict import upright_verdict
     from ._common import feedback_options_from_args
 
     body = body_from_args(args)
@@ -58,9 +59,13 @@ def run(args: argparse.Namespace) -> int:
         w = result.crossing_frequency
         print(f"  τ = {result.delay_margin:.6g} s ({result.delay_margin * 1000:.4g} ms), a root "
               f"crosses at ω = {w:.6g} rad/s ({w / (2 * math.pi):.4g} Hz)")
-    if delay is not None:
-        roots = rightmost_roots(body, muscles, delay, 4)
-        verdict = "stable" if roots[0].real < 0 else "unstable"
-        print(f"at τ = {delay:g} s: {verdict}; rightmost roots [1/s]: "
+    if muscles.one_sided_mask.any():
+        print("  (of the side where the one-sided pairs are engaged; upright is their "
+              "switching point)")
+    if delay is not None or muscles.one_sided_mask.any():
+        # the one verdict about upright (posturelab poles and simulate give it too)
+        verdict = upright_verdict(body, muscles, delay or 0.0)
+        roots = verdict.side(engaged=True).roots[:4]
+        print(f"at τ = {delay or 0.0:g} s: {verdict.describe()}; rightmost roots [1/s]: "
               + ", ".join(f"{z.real:.4g}{z.imag:+.4g}j" for z in roots))
     return 0

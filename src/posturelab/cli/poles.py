@@ -15,19 +15,27 @@ from ._common import (
 )
 
 DESCRIPTION = """\
-Poles [1/s] of the paper's three-link biped (Appendix A) linearised about upright
-stance (Θ = 0, Θ̇ = 0), with the five muscle pairs acting as stiffness K [N·m/rad]
-and viscosity L = R·K [N·m·s/rad]. The system is stable when every pole has a
-negative real part.
+Poles [1/s] of the paper's three-link biped (Appendix A; or any --body, --height/--mass)
+linearised about upright stance (Θ = 0, Θ̇ = 0), with the muscle pairs acting as
+stiffness K [N·m/rad] and viscosity L = R·K [N·m·s/rad]. The system is stable when every
+pole has a negative real part. --controller NAME: a published one-link controller on the
+paper's body as one link, or on --height/--mass lumped to one link.
 
-With --feedback-delay the rightmost characteristic roots at that delay are printed too
-('rightmost_roots' and 'stable_with_delay' in JSON).
+With --feedback-delay (or a --controller's delay) the rightmost characteristic roots at
+that delay are printed too ('rightmost_roots' and 'stable_without_delay' in JSON).
 
-A one-sided gastrocnemius (--gastrocnemius one-sided) has no derivative at upright,
-where its stretch θ2 is exactly 0. It is linearised on both sides of its switch:
-the side θ2 >= 0 where it acts (the poles printed, identical to two-sided) and the
-side θ2 < 0 where it is slack (printed too; 'inactive_side_poles' in JSON). The
-system is reported stable only if both sides are.
+The verdict (the last lines; 'stable' and 'linear_stability' in JSON) is the one that
+posturelab simulate, sweep, the explorer and the report give (posturelab.upright_verdict):
+with a feedback delay (given, or a --controller's) it is that of the delay equation's
+roots.
+
+A one-sided gastrocnemius (--gastrocnemius one-sided or pull-only) has no derivative at
+upright: upright is exactly its switching point (stretch θ2 = 0). It is linearised on both
+sides of its switch: the side θ2 >= 0 where it acts (the poles printed first, identical to
+two-sided) and the side θ2 < 0 where it is slack (printed too; 'inactive_side_poles' in
+JSON). Both sides stable: stable; both unstable: unstable; otherwise the verdict is
+"depends on the side" (a switched system whose stability about upright the linear model
+cannot settle), and 'stable' is false.
 """
 
 
@@ -60,17 +68,14 @@ def run(args: argparse.Namespace) -> int:
 
             raise UsageError("poles: --all takes no --case or --stiffness")
         return _run_all(args)
+    from ..linear.verdict import upright_verdict
+
     body = body_from_args(args)
     muscles = muscles_from_args(args, body)
     active, inactive = analyse_both_sides(body, muscles)
-    one_sided = args.gastrocnemius == "one-sided"
-    stable = active.stable and inactive.stable
+    one_sided = muscles.one_sided_mask.any()
     delay = feedback_options_from_args(args).get("feedback_delay")
-    delayed = None
-    if delay is not None:
-        from ..linear.delay import rightmost_roots
-
-        delayed = rightmost_roots(body, muscles, delay, 2 * body.n_links)
+    verdict = upright_verdict(body, muscles, delay or 0.0)
     if args.json:
         out = {
             "stiffness": [float(x) for x in muscles.stiffnesses],
@@ -79,10 +84,11 @@ def run(args: argparse.Namespace) -> int:
                                           muscles.stiffnesses / body.load_stiffness],
             "viscosity_ratio": float(_ratio(args)),
             "poles": [{"re": float(z.real), "im": float(z.imag)} for z in active.poles],
-            "stable": bool(stable),
+            "stable": verdict.stable,
+            "linear_stability": verdict.to_dict(),
         }
         if one_sided:
-            out["gastrocnemius"] = "one-sided"
+            out["gastrocnemius"] = args.gastrocnemius
             out["inactive_side_poles"] = [
                 {"re": float(z.real), "im": float(z.imag)} for z in inactive.poles
             ]
@@ -91,32 +97,48 @@ def run(args: argparse.Namespace) -> int:
             out["active_viscosity"] = [float(x) for x in muscles.active_viscosities]
         if args.controller is not None:
             out["viscosity_ratio"] = None  # (the preset gives every gain)
-        if delayed is not None:
+            out["controller"] = args.controller
+            out["body"] = body.name
+        if delay is not None:
             out["feedback_delay"] = float(delay)
+            out["stable_without_delay"] = bool(active.stable and inactive.stable)
             out["rightmost_roots"] = [{"re": float(z.real), "im": float(z.imag)}
-                                      for z in delayed]
-            out["stable_with_delay"] = bool(delayed[0].real < 0)
+                                      for z in verdict.side(engaged=True).roots]
         print_json(out)
         return 0
-    label = f"case {args.case} (Table I)" if args.case else "custom stiffness"
     pairs = " ".join(f"{n}={k:g}" for n, k in zip(muscles.names, muscles.stiffnesses, strict=True))
-    print(f"{label}: stiffness [N·m/rad] {pairs}; viscosity = {_ratio(args):g} × stiffness")
-    head = "poles [1/s]" + (" (gastrocnemius acting, θ2 >= 0)" if one_sided else "")
+    if args.controller is not None:
+        active_pairs = " ".join(f"{n}={k:.4g}" for n, k in
+                                zip(muscles.names, muscles.active_stiffnesses, strict=True))
+        print(f"controller {args.controller} on body {body.name}: intrinsic stiffness "
+              f"[N·m/rad] {pairs}; active stiffness [N·m/rad] {active_pairs}")
+    else:
+        label = f"case {args.case} (Table I)" if args.case else "custom stiffness"
+        side = f"; {args.gastrocnemius} gastrocnemius" if body.n_links == 3 else ""
+        where = f" on body {body.name}" if body.name != "paper" else ""
+        print(f"{label}{where}: stiffness [N·m/rad] {pairs}; viscosity = {_ratio(args):g} × "
+              f"stiffness{side}")
+    head = "poles [1/s] at τ = 0" + (" (gastrocnemius engaged, θ2 >= 0)" if one_sided else "")
     print(head + ":")
     for z in active.poles:
         print(f"  {_fmt_pole(z)}")
     if one_sided:
-        print("poles [1/s] (gastrocnemius slack, θ2 < 0):")
+        print("poles [1/s] at τ = 0 (gastrocnemius slack, θ2 < 0):")
         for z in inactive.poles:
             print(f"  {_fmt_pole(z)}")
-    worst = max(active.max_real_part, inactive.max_real_part)
-    print(f"stable: {'yes' if stable else 'no'} (largest real part {worst:.3f} 1/s)")
-    if delayed is not None:
-        print(f"with the feedback delay τ = {delay:g} s, rightmost roots [1/s]:")
-        for z in delayed:
-            print(f"  {_fmt_pole(z)}")
-        print(f"stable with the delay: {'yes' if delayed[0].real < 0 else 'no'} "
-              "(posturelab delay-margin gives the delay at which it changes)")
+    if delay is not None:
+        for s in verdict.sides:
+            which = f" ({s.label()})" if s.label() else ""
+            print(f"rightmost roots [1/s] with the feedback delay τ = {delay:g} s{which}:")
+            for z in s.roots:
+                print(f"  {_fmt_pole(z)}")
+    worst = verdict.rightmost_root.real
+    words = {"stable": "yes", "unstable": "no", "marginal": "no (marginal)",
+             "depends on the side": "depends on the side"}[verdict.status]
+    print(f"stable: {words} (largest real part {worst:.3f} 1/s)")
+    print(f"verdict: {verdict.describe()}")
+    if delay is not None:
+        print("(posturelab delay-margin gives the delay at which stability changes)")
     return 0
 
 

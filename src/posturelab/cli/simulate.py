@@ -68,9 +68,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                      'failed), "settling_time", "fall_time", "fall_reason", "final_lean", '
                      '"final_rate", "outcome_message", "fell", "status", "message", '
                      '"max_abs_theta", "final_state", "hip_fraction", "linear_stability" '
-                     '({"stable", "rightmost_root", "feedback_delay"})}; hip_fraction [-] is '
-                     'the share of the anti-phase (hip) mode of leg and trunk, null for one '
-                     'link.')
+                     '(the verdict about upright, as posturelab poles: {"status": stable, '
+                     'unstable, marginal or "depends on the side" of a one-sided pair\'s '
+                     'switch, "stable", "rightmost_root" [1/s], "feedback_delay" [s], '
+                     '"sides", ...})}; hip_fraction [-] is the share of the anti-phase (hip) '
+                     'mode of leg and trunk, null for one link.')
     p.add_argument("--engine", choices=["reference", "compiled"], default="reference",
                    help="reference (default): the numpy model integrated by scipy at the "
                    "scenario's solver settings; compiled: the C engine (hundreds of times "
@@ -275,6 +277,10 @@ def _scenario_from_options(args: argparse.Namespace, command: str) -> Scenario:
              if args.initial_rates else [0.0] * n)
     label = (f"case {args.case}" if args.case else f"controller {args.controller}"
              if args.controller else "custom stiffness")
+    if args.gastrocnemius != "two-sided":
+        label += f", {args.gastrocnemius} gastrocnemius"
+    if args.body is not None or args.height is not None:
+        label += f", body {body.name}"
     what = disturbance.describe() + (f", {tilt.describe()}" if tilt is not None else "")
     return Scenario(
         name="cli", description=f"{label}, {what}", source="command line",
@@ -326,9 +332,9 @@ def run(args: argparse.Namespace) -> int:
         from ..viz.animation import animate
 
         animate(result, sc.body, args.animate)
-    from ..linear.delay import upright_stability
+    from ..linear.verdict import upright_verdict
 
-    verdict = upright_stability(sc.body, sc.muscles, sc.feedback_delay)
+    verdict = upright_verdict(sc.body, sc.muscles, sc.feedback_delay)
     outcome = result.outcome
     if args.json:
         print_json({**result.summary(), "linear_stability": verdict.to_dict()})
@@ -344,7 +350,11 @@ def run(args: argparse.Namespace) -> int:
         print("final state [rad, rad/s]: " + ", ".join(f"{x:.4g}" for x in result.final_state))
         for path in outputs:
             print(f"wrote {path}")
-    if not verdict.stable:
+    if verdict.status == "depends on the side":
+        print("posturelab: warning: upright's linear stability depends on the side of a "
+              f"one-sided pair's switch for these gains and this body ({verdict.describe()})",
+              file=sys.stderr)
+    elif not verdict.stable:
         print(f"posturelab: warning: these gains are {verdict.describe()} for this body",
               file=sys.stderr)
     if result.status == "failed":

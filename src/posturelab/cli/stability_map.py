@@ -22,12 +22,14 @@ from ._common import load_compiled
 PARAMETER_NAMES: tuple[str, ...] = (*PAPER_PAIR_NAMES, "viscosity_ratio")
 
 DESCRIPTION = """\
-Map the stability of the paper's three-link biped linearised about upright over two
-parameters. Each axis is NAME:LO:HI with NAME one of
+Map the stability of the paper's three-link biped (or any body: --body, --height/--mass)
+linearised about upright over two parameters. Each axis is NAME:LO:HI with NAME one of
   ankle, knee, hip, quadriceps, gastrocnemius   a muscle pair's stiffness [N·m/rad]
   viscosity_ratio                               pair viscosity / pair stiffness [s]
-Every other parameter is taken from a Table I case (--case, default 1), with
-viscosity = 0.25 × stiffness unless --viscosity-ratio is given.
+(for a body of other than three links, its pairs: ankle for one link, ankle and hip for
+two, ankle, knee, hip, joint4, ... beyond). Every other parameter is taken from a Table I
+case (--case, default 1; three links) or from --stiffness (one value per pair, any body),
+with viscosity = 0.25 × stiffness unless --viscosity-ratio is given.
 
 Writes the figure --out (colour = largest real part of the poles [1/s], stable region
 outlined, Table I cases that lie in the plane marked) and a CSV beside it with the same
@@ -89,18 +91,19 @@ def add_parser(sub, name: str) -> argparse.ArgumentParser:
 # ---- argument parsing -------------------------------------------------------
 
 
-def parse_axis(text: str, flag: str):
-    """Parse ``NAME:LO:HI`` into a :class:`posturelab.batch_linear.ParameterRange`."""
+def parse_axis(text: str, flag: str, names: tuple[str, ...] = PARAMETER_NAMES):
+    """Parse ``NAME:LO:HI`` into a :class:`posturelab.batch_linear.ParameterRange`; ``names``
+    are the parameters known (the body's pairs and viscosity_ratio)."""
     from ..linear.batch import ParameterRange
 
     parts = str(text).split(":")
     if len(parts) != 3:
         raise ParameterError(f"{flag} must be NAME:LO:HI (e.g. ankle:0:2000), got {text!r}")
     name = parts[0].strip().lower().replace("-", "_")
-    if name not in PARAMETER_NAMES:
+    if name not in names:
         raise UnknownNameError(
             f"{flag}: unknown parameter {parts[0].strip()!r}; known parameters: "
-            f"{', '.join(PARAMETER_NAMES)}"
+            f"{', '.join(names)}"
         )
     bounds = []
     for label, value in (("LO", parts[1]), ("HI", parts[2])):
@@ -265,11 +268,16 @@ def plot_stability_map(smap, figure_file, fmt: str) -> None:
     fixed = []
     if "viscosity_ratio" not in (grid.x.name, grid.y.name):
         fixed.append(f"viscosity ratio {grid.base_viscosity_ratio:g} s")
-    others = [f"{n} {v:g}" for n, v in zip(PAPER_PAIR_NAMES, grid.base_stiffness, strict=True)
+    others = [f"{n} {v:g}" for n, v in zip(grid.pair_names, grid.base_stiffness, strict=True)
               if n not in (grid.x.name, grid.y.name)]
+    if others:
+        fixed.insert(0, f"{', '.join(others)} N·m/rad")
+    source = (f"others from Table I case {grid.base_case}" if grid.base_case is not None
+              else "others fixed" if fixed else "")
     ax.set_title(
-        f"Linearised stability about upright; others from Table I case {grid.base_case}\n"
-        f"({', '.join(others)} N·m/rad{'; ' + fixed[0] if fixed else ''}); "
+        f"Linearised stability about upright of body {smap.body_name}"
+        f"{'; ' + source if source else ''}\n"
+        f"{'(' + '; '.join(fixed) + '); ' if fixed else ''}"
         f"{100 * smap.stable_fraction:.1f}% stable",
         fontsize=9,
     )
@@ -283,6 +291,26 @@ def plot_stability_map(smap, figure_file, fmt: str) -> None:
 
 
 # ---- run ------------------------------------------------------------------------
+
+
+def _base_muscles(args: argparse.Namespace, body):
+    """The base muscle set of the pair map: None for a Table I case (three links; --case),
+    else --stiffness on this body (one value per pair)."""
+    if args.stiffness is None:
+        if body.n_links != 3:
+            from ..model.muscles import joint_pair_names
+
+            names = joint_pair_names(body.n_links)
+            raise ParameterError(
+                f"--case is a Table I set for three links; this body has {body.n_links}: give "
+                f"--stiffness ({len(names)} value{'s' if len(names) > 1 else ''}: "
+                f"{', '.join(names)}), the pairs not on an axis keep theirs")
+        return None
+    from ..model.muscles import muscles_for
+    from ._common import _pairs, parse_float_list
+
+    stiffness = parse_float_list(args.stiffness, "--stiffness [N·m/rad]", _pairs(body))
+    return muscles_for(body.n_links, stiffness)
 
 
 def _temporary_beside(path: Path) -> Path:
@@ -328,17 +356,28 @@ def run(args: argparse.Namespace) -> int:
         from ._delay_map import run_delay_map
 
         return run_delay_map(args)
-    model = [f for f in ("body", "height", "mass", "stiffness", "controller", "viscosity",
-                         "active_stiffness", "active_viscosity", "active_viscosity_ratio",
-                         "feedback_delay", "proprioceptive_weight", "pair")
+    model = [f for f in ("controller", "viscosity", "active_stiffness", "active_viscosity",
+                         "active_viscosity_ratio", "feedback_delay", "proprioceptive_weight",
+                         "pair")
              if getattr(args, f, None) is not None]
     if model:
         raise ParameterError(
             f"--{model[0].replace('_', '-')} is for the delayed map (axes "
             "active_stiffness:LO:HI and active_viscosity:LO:HI with --feedback-delay); the map "
-            "over pair stiffnesses is of the paper's body with --case and --viscosity-ratio")
-    x = parse_axis(args.x, "--x")
-    y = parse_axis(args.y, "--y")
+            "over pair stiffnesses takes --body or --height/--mass, --case or --stiffness, and "
+            "--viscosity-ratio")
+    if args.gastrocnemius != "two-sided":
+        raise ParameterError(
+            f"--gastrocnemius {args.gastrocnemius}: the map is of the linearisation with every "
+            "pair acting; upright is a one-sided pair's switching point (posturelab poles "
+            "gives both of its sides)")
+    from ._common import body_from_args
+
+    body = body_from_args(args)
+    base = _base_muscles(args, body)
+    names = (PARAMETER_NAMES if base is None else (*base.names, "viscosity_ratio"))
+    x = parse_axis(args.x, "--x", names)
+    y = parse_axis(args.y, "--y", names)
     if x.name == y.name:
         raise ParameterError(f"--x and --y must be different parameters, both are {x.name!r}")
     resolution = parse_resolution(args.resolution)
@@ -351,9 +390,11 @@ def run(args: argparse.Namespace) -> int:
 
     from ..linear.batch import parameter_grid, stability_map
 
-    parameter_grid(x, y, resolution, case=args.case, viscosity_ratio=ratio)  # validates --case
-    load_compiled(lambda: stability_map(x, y, 2, case=args.case, viscosity_ratio=ratio)
-                  .write_csv(io.StringIO()), "the stability evaluator")
+    where = dict(case=args.case, viscosity_ratio=ratio, body=body, muscles=base)
+    parameter_grid(x, y, resolution, case=args.case, viscosity_ratio=ratio,
+                   muscles=base)  # validates --case
+    load_compiled(lambda: stability_map(x, y, 2, **where).write_csv(io.StringIO()),
+                  "the stability evaluator")
 
     temporaries: list[Path] = []
     try:
@@ -368,8 +409,8 @@ def run(args: argparse.Namespace) -> int:
         # The compiled map and CSV writer release the GIL: each runs on a worker thread
         # while this one imports matplotlib and then draws the figure.
         with ThreadPoolExecutor(max_workers=1) as worker:
-            computing = worker.submit(stability_map, x, y, resolution, case=args.case,
-                                      viscosity_ratio=ratio, progress=progress)
+            computing = worker.submit(stability_map, x, y, resolution, progress=progress,
+                                      **where)
             _import_plotting()
             smap = computing.result()
             writing = worker.submit(_write_csv, smap, tmp_csv, show)
@@ -389,7 +430,8 @@ def run(args: argparse.Namespace) -> int:
         for tmp in temporaries:
             tmp.unlink(missing_ok=True)
     ny, nx = smap.grid.shape
-    print(f"wrote {figure_path} and {csv_path}: {nx} × {ny} parameter sets, "
+    on = "" if body.name == "paper" else f" of body {body.name}"
+    print(f"wrote {figure_path} and {csv_path}: {nx} × {ny} parameter sets{on}, "
           f"{100 * smap.stable_fraction:.1f}% stable "
           f"(largest real part {smap.max_real_part.min():.3g} .. "
           f"{smap.max_real_part.max():.3g} 1/s)")

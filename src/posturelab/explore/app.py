@@ -39,7 +39,7 @@ def create_app():
     """
     from flask import Flask, jsonify, render_template, request
 
-    from .views import CONTROLS, compute_views, parse_parameters
+    from .views import CONTROLS, compute_views, controller_presets, parse_parameters
 
     app = Flask(__name__, static_folder="static", template_folder="templates")
     app.config["MAX_CONTENT_LENGTH"] = MAX_REQUEST_BYTES
@@ -50,7 +50,8 @@ def create_app():
         groups: dict[str, list] = {}
         for c in CONTROLS:
             groups.setdefault(c.group, []).append(c)
-        return render_template("explore.html", groups=groups, controls=CONTROLS)
+        return render_template("explore.html", groups=groups, controls=CONTROLS,
+                               presets=controller_presets())
 
     @app.post("/api/views")
     def views():

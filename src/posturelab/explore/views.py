@@ -20,6 +20,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..model.anthropometry import HEIGHT_RANGE, MASS_RANGE
+from ..model.controllers import CONTROLLERS
 from ..model.muscles import (
     MAX_PAIR_STIFFNESS,
     MAX_PAIR_VISCOSITY,
@@ -30,7 +31,8 @@ from ..model.platform import MAX_PLATFORM_SPEED
 from ..model.tilt import MAX_TILT
 from ..simulation.setup import MAX_FEEDBACK_DELAY
 
-__all__ = ["Control", "CONTROLS", "PAIRS", "parse_parameters", "build_model", "compute_views"]
+__all__ = ["Control", "CONTROLS", "PAIRS", "BODIES", "OWN_GAINS", "parse_parameters",
+           "build_body", "build_model", "compute_views", "controller_presets"]
 
 #: The paper's five pairs, in the order of their stiffness arrays.
 PAIRS = PAPER_PAIR_NAMES
@@ -88,10 +90,18 @@ def _pair_controls() -> tuple[Control, ...]:
     return tuple(out)
 
 
+#: The bodies of the page: the paper's (three links) or one from height and mass, each also
+#: as one rigid link (knee and hip locked: the inverted pendulum of a one-link controller).
+BODIES = ("paper", "height and mass", "paper, one link", "height and mass, one link")
+#: "own gains" (the pair controls) or a published one-link controller
+#: (:data:`posturelab.model.controllers.CONTROLLERS`), whose gains scale with the body's mgh.
+OWN_GAINS = "own gains"
+
 #: Every control of the explorer, in page order.
 CONTROLS: tuple[Control, ...] = (
-    Control("body", "body", "", "paper", group="body",
-            choices=("paper", "height and mass")),
+    Control("body", "body", "", "paper", group="body", choices=BODIES),
+    Control("controller", "controller", "", OWN_GAINS, group="body",
+            choices=(OWN_GAINS, *CONTROLLERS)),
     Control("height", "height", "m", 1.75, *HEIGHT_RANGE, 1.0, 2.2, 0.01, "body"),
     Control("mass", "mass", "kg", 75.0, *MASS_RANGE, 30.0, 150.0, 0.5, "body"),
     *_pair_controls(),
@@ -183,23 +193,56 @@ def _field_error(field: str, message: str) -> ParameterError:
     return error
 
 
-def build_model(p: dict):
-    """The body, muscle set, disturbance and tilt the checked parameters ``p`` describe."""
+def controller_presets() -> dict:
+    """What the page fills in when a controller is chosen: its feedback delay τ [s] and
+    proprioceptive weight W [-], by name, and its citation."""
+    return {name: {"feedback_delay": c.feedback_delay,
+                   "proprioceptive_weight": c.proprioceptive_weight,
+                   "citation": c.citation}
+            for name, c in CONTROLLERS.items()}
+
+
+def build_body(p: dict):
+    """The body of the checked parameters ``p``: a one-link body for a one-link choice or a
+    controller (the three-link body lumped, as ``posturelab simulate --controller`` does)."""
     import posturelab as pl
 
-    from ..model.tilt import SineTilt
-
-    if p["body"] == "paper":
+    if p["body"].startswith("paper"):
         body = pl.paper_body()
     else:
         body = pl.body_from_anthropometry(p["height"], p["mass"])
-    active_k = [p[f"active_{n}"] for n in PAIRS]
-    active_l = [p[f"active_viscosity_{n}"] for n in PAIRS]
-    active = any(v > 0 for v in active_k + active_l)
-    muscles = pl.paper_muscles(stiffness=[p[f"stiffness_{n}"] for n in PAIRS],
-                               viscosity_ratio=p["viscosity_ratio"],
-                               active_stiffness=active_k if active else None,
-                               active_viscosity=active_l if active else None)
+    if p["body"].endswith("one link") or p["controller"] != OWN_GAINS:
+        from ..model.anthropometry import one_link
+
+        body = (pl.get_body("paper-1link") if p["body"].startswith("paper")
+                else one_link(body))
+    return body
+
+
+def build_model(p: dict):
+    """The body, muscle set, disturbance and tilt the checked parameters ``p`` describe.
+
+    A controller gives every gain (scaled by the body's mgh); the feedback delay and the
+    proprioceptive weight are the page's (the page sets them to the controller's when it
+    is chosen). On a one-link body with own gains only the ankle pair acts.
+    """
+    import posturelab as pl
+
+    from ..model.muscles import muscles_for
+    from ..model.tilt import SineTilt
+
+    body = build_body(p)
+    if p["controller"] != OWN_GAINS:
+        muscles = CONTROLLERS[p["controller"]].muscles(body)
+    else:
+        names = PAIRS if body.n_links == 3 else ("ankle",)
+        active_k = [p[f"active_{n}"] for n in names]
+        active_l = [p[f"active_viscosity_{n}"] for n in names]
+        active = any(v > 0 for v in active_k + active_l)
+        muscles = muscles_for(body.n_links, [p[f"stiffness_{n}"] for n in names],
+                              viscosity_ratio=p["viscosity_ratio"],
+                              active_stiffness=active_k if active else None,
+                              active_viscosity=active_l if active else None)
     disturbance, tilt = None, None
     if p["perturbation"] == "backward step":
         disturbance = pl.VelocityStep.backward(p["step_speed"])
@@ -220,8 +263,6 @@ def _rounded(values, digits: int = 6) -> list:
 
 #: Frequencies of the FRF view. [Hz]
 FRF_FREQUENCIES = np.logspace(-2, 1, 140)
-#: |Re z| at most this times max(1, |z|) [1/s] counts as on the imaginary axis. [-]
-MARGINAL = 1e-9
 
 
 @functools.lru_cache(maxsize=64)
@@ -246,9 +287,11 @@ def compute_views(p: dict) -> dict:
     Returns
     -------
     dict (JSON-ready)
-        ``stable`` and ``verdict`` (words); ``poles`` at τ = 0 and ``roots`` (the six
-        rightmost characteristic roots at τ) as {"re", "im"} [1/s]; ``delay_margin``
-        [s] (None when unstable without delay, inf as None with ``no_margin``);
+        ``stable``, ``verdict`` (words) and ``linear_stability``
+        (:func:`posturelab.upright_verdict`); ``body`` (its name) and ``n_links``;
+        ``poles`` at τ = 0 and ``roots`` (the 2N rightmost characteristic roots at τ) as
+        {"re", "im"} [1/s]; ``delay_margin`` [s] (None when unstable without delay, inf
+        as None with ``no_margin``);
         ``frf`` (frequencies [Hz], gain [-], phase [deg]); ``run`` (outcome words,
         time [s], link angles [rad], CoG position [m] and velocity [m/s], joint positions
         [m] of the stick figure and the surface tilt [rad] at :data:`FRAME_RATE`).
@@ -261,12 +304,9 @@ def compute_views(p: dict) -> dict:
     body, muscles, disturbance, tilt = build_model(p)
     delay, weight = p["feedback_delay"], p["proprioceptive_weight"]
     lin, margin = _linear(body, muscles)
-    roots = (pl.rightmost_roots(body, muscles, delay, count=6) if delay > 0
-             else lin.poles[np.argsort(-lin.poles.real, kind="stable")][:6])
-    rightmost = complex(roots[0])
-    # a root on the imaginary axis to rounding (no damping at all) is neither side
-    marginal = abs(rightmost.real) <= MARGINAL * max(1.0, abs(rightmost))
-    stable = rightmost.real < 0 and not marginal
+    # the one verdict about upright (posturelab poles, simulate and the report give it too)
+    verdict = pl.upright_verdict(body, muscles, delay)
+    roots = verdict.side(engaged=True).roots
     frf = model_frf(body, muscles, FRF_FREQUENCIES, input="tilt", output="com_angle",
                     feedback_delay=delay, proprioceptive_weight=weight)
     rate = SAMPLE_RATE if tilt is None else max(SAMPLE_RATE, 40.0 * tilt.frequency)
@@ -280,12 +320,11 @@ def compute_views(p: dict) -> dict:
 
     outcome = run.outcome
     return {
-        "stable": bool(stable),
-        "verdict": (
-            "marginal: the rightmost root is on the imaginary axis (no damping), "
-            f"{rightmost.imag:+.3g}j rad/s" if marginal
-            else f"stable about upright (rightmost root {rightmost.real:.3g} 1/s)" if stable
-            else f"unstable about upright (rightmost root {rightmost.real:+.3g} 1/s)"),
+        "stable": verdict.stable,
+        "verdict": verdict.describe(),
+        "linear_stability": verdict.to_dict(),
+        "body": body.name,
+        "n_links": body.n_links,
         "poles": _complex_list(lin.poles),
         "roots": _complex_list(roots),
         "delay_margin": (None if margin.delay_margin is None

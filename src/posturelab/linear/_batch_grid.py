@@ -1,8 +1,9 @@
-"""Two-parameter grids of the paper model and the stability maps over them.
+"""Two-parameter grids of pair gains and the stability maps over them.
 
 :func:`parameter_grid` sweeps two named parameters (:data:`GRID_PARAMETERS`: the
-paper's five pair stiffnesses [N·m/rad] and the viscosity ratio [s]) over ranges,
-every other parameter taken from a Table I case; :func:`stability_map` evaluates
+paper's five pair stiffnesses [N·m/rad] and the viscosity ratio [s]; or, for any body,
+the pairs of a base muscle set) over ranges, every other parameter taken from a Table I
+case (or from the base muscle set); :func:`stability_map` evaluates
 the largest real part of the poles [1/s] and the stable flag at every point with
 :func:`posturelab.linear.batch.batch_analyse`, and :meth:`StabilityMap.write_csv`
 writes it as CSV. The public names are those of :mod:`posturelab.linear.batch`.
@@ -24,6 +25,7 @@ from ..model.muscles import (
     DEFAULT_VISCOSITY_RATIO,
     PAPER_PAIR_NAMES,
     STIFFNESS_CASES,
+    MuscleSet,
     get_stiffness_case,
 )
 
@@ -48,11 +50,21 @@ GRID_PARAMETER_UNITS: dict[str, str] = {
 }
 
 
-def _check_parameter_name(name: str) -> str:
-    if name not in GRID_PARAMETERS:
+def _check_parameter_name(name: str, known: tuple[str, ...] = GRID_PARAMETERS) -> str:
+    if name not in known:
         raise UnknownNameError(
-            f"unknown parameter {name!r}; known parameters: {', '.join(GRID_PARAMETERS)}"
+            f"unknown parameter {name!r}; known parameters: {', '.join(known)}"
         )
+    return name
+
+
+def _check_name_form(name) -> str:
+    """A pair name or "viscosity_ratio": a non-empty identifier (checked against the muscle
+    set by :func:`parameter_grid`)."""
+    if not isinstance(name, str) or not name.isidentifier():
+        raise UnknownNameError(
+            f"unknown parameter {name!r}; known parameters: {', '.join(GRID_PARAMETERS)} "
+            "(or the pairs of the muscle set)")
     return name
 
 
@@ -63,8 +75,8 @@ class ParameterRange:
     Parameters
     ----------
     name : str
-        One of :data:`GRID_PARAMETERS`: a pair name (stiffness [N·m/rad]) or
-        ``"viscosity_ratio"`` [s].
+        A pair name (stiffness [N·m/rad]: one of :data:`GRID_PARAMETERS`, or of the base
+        muscle set's pairs) or ``"viscosity_ratio"`` [s].
     low, high : float
         Range ends, 0 <= low < high. [N·m/rad] or [s]
     """
@@ -74,8 +86,8 @@ class ParameterRange:
     high: float
 
     def __post_init__(self) -> None:
-        _check_parameter_name(self.name)
-        unit = GRID_PARAMETER_UNITS[self.name]
+        _check_name_form(self.name)
+        unit = self.unit
         low = nonnegative_float(f"{self.name} low [{unit}]", self.low)
         high = nonnegative_float(f"{self.name} high [{unit}]", self.high)
         if not low < high:
@@ -88,7 +100,7 @@ class ParameterRange:
     @property
     def unit(self) -> str:
         """Unit of the parameter: "N·m/rad" or "s"."""
-        return GRID_PARAMETER_UNITS[self.name]
+        return "s" if self.name == "viscosity_ratio" else "N·m/rad"
 
     @property
     def label(self) -> str:
@@ -116,7 +128,7 @@ def _as_range(value: ParameterRange | tuple) -> ParameterRange:
 
 @dataclass(frozen=True)
 class ParameterGrid:
-    """A two-parameter grid of the paper model's gains around a Table I case.
+    """A two-parameter grid of pair gains around a Table I case or a base muscle set.
 
     Set index ``iy * nx + ix`` has ``x = x_values[ix]`` and ``y = y_values[iy]``
     (row-major, y along rows as an image).
@@ -129,21 +141,25 @@ class ParameterGrid:
         Values along x. [N·m/rad] or [s]
     y_values : numpy.ndarray, shape (ny,)
         Values along y. [N·m/rad] or [s]
-    base_case : str
-        Table I case giving every parameter not swept.
-    base_stiffness : numpy.ndarray, shape (5,)
-        That case's pair stiffness (ankle, knee, hip, quadriceps, gastrocnemius). [N·m/rad]
+    base_case : str or None
+        Table I case giving every parameter not swept; None for a base muscle set.
+    base_stiffness : numpy.ndarray, shape (P,)
+        The pair stiffness of the parameters not swept, in the order of ``pair_names``.
+        [N·m/rad]
     base_viscosity_ratio : float
         Viscosity ratio when not swept. [s]
+    pair_names : tuple of str
+        The pairs, in column order (the paper's five by default).
     """
 
     x: ParameterRange
     y: ParameterRange
     x_values: np.ndarray
     y_values: np.ndarray
-    base_case: str
+    base_case: str | None
     base_stiffness: np.ndarray
     base_viscosity_ratio: float
+    pair_names: tuple[str, ...] = PAPER_PAIR_NAMES
 
     @property
     def shape(self) -> tuple[int, int]:
@@ -160,7 +176,7 @@ class ParameterGrid:
 
         Returns
         -------
-        pair_stiffness : numpy.ndarray, shape (rows·nx, 5)
+        pair_stiffness : numpy.ndarray, shape (rows·nx, P)
             [N·m/rad]
         viscosity_ratio : numpy.ndarray, shape (rows·nx,)
             [s]
@@ -168,19 +184,19 @@ class ParameterGrid:
         ys = self.y_values[start:stop]
         xs = self.x_values
         count = ys.size * xs.size
-        stiffness = np.empty((count, len(PAPER_PAIR_NAMES)))
+        stiffness = np.empty((count, len(self.pair_names)))
         stiffness[:] = self.base_stiffness
         ratio = np.full(count, self.base_viscosity_ratio)
         for rng, vals in ((self.x, np.tile(xs, ys.size)), (self.y, np.repeat(ys, xs.size))):
             if rng.name == "viscosity_ratio":
                 ratio[:] = vals
             else:
-                stiffness[:, PAPER_PAIR_NAMES.index(rng.name)] = vals
+                stiffness[:, self.pair_names.index(rng.name)] = vals
         return stiffness, ratio
 
     @property
     def pair_stiffness(self) -> np.ndarray:
-        """All sets' pair stiffness, shape (nx·ny, 5). [N·m/rad]"""
+        """All sets' pair stiffness, shape (nx·ny, P). [N·m/rad]"""
         return self.rows()[0]
 
     @property
@@ -196,6 +212,8 @@ class ParameterGrid:
         and its two swept values fall within the ranges.
         """
         points = []
+        if self.base_case is None or tuple(self.pair_names) != PAPER_PAIR_NAMES:
+            return points  # Table I is of the paper's five pairs
         names = list(PAPER_PAIR_NAMES)
         for case, stiffness in STIFFNESS_CASES.items():
             params = dict(zip(names, stiffness, strict=True))
@@ -218,26 +236,46 @@ def parameter_grid(
     *,
     case: str = "1",
     viscosity_ratio: float | None = None,
+    muscles: MuscleSet | None = None,
 ) -> ParameterGrid:
-    """Grid over two named parameters, every other one from a Table I case.
+    """Grid over two named parameters, every other one from a Table I case (or from
+    ``muscles``).
 
     Parameters
     ----------
     x, y : ParameterRange or (name, low, high)
-        Parameters to sweep, names from :data:`GRID_PARAMETERS`; different names.
-        [N·m/rad] for a pair stiffness, [s] for ``"viscosity_ratio"``.
+        Parameters to sweep, names from :data:`GRID_PARAMETERS` (or ``muscles``' pairs
+        and ``"viscosity_ratio"``); different names. [N·m/rad] for a pair stiffness, [s]
+        for ``"viscosity_ratio"``.
     resolution : int or (nx, ny)
         Points per axis, each in [2, 5000]. [-]
     case : str, optional
         Table I case for the parameters not swept ("1" … "7", "6a", "6b").
     viscosity_ratio : float, optional
         Viscosity ratio when it is not swept; the paper's 0.25 by default. [s]
+    muscles : MuscleSet, optional
+        A base muscle set of any body instead of a Table I case: its pairs name the
+        parameters and its stiffness gives those not swept ([N·m/rad]; viscosity = ratio
+        × stiffness; active gains are not part of this map: see
+        :func:`posturelab.linear.delay_batch.delay_stability_map`).
 
     Returns
     -------
     ParameterGrid
     """
     x, y = _as_range(x), _as_range(y)
+    if muscles is not None:
+        if not isinstance(muscles, MuscleSet):
+            raise ParameterError(f"muscles must be a MuscleSet, got {type(muscles).__name__}")
+        if muscles.has_active_feedback:
+            raise ParameterError("a pair-stiffness map is of the pair gains only; this muscle "
+                                 "set has active (delayed) gains: map them with "
+                                 "delay_stability_map")
+        pair_names = tuple(muscles.names)
+    else:
+        pair_names = PAPER_PAIR_NAMES
+    for rng in (x, y):
+        _check_parameter_name(rng.name, (*pair_names, "viscosity_ratio"))
     if x.name == y.name:
         raise ParameterError(f"x and y must be different parameters, both are {x.name!r}")
     if isinstance(resolution, int | np.integer):
@@ -252,8 +290,12 @@ def parameter_grid(
     for label, count in (("nx", nx), ("ny", ny)):
         if not 2 <= count <= 5000:
             raise ParameterError(f"resolution {label} must be in [2, 5000], got {count}")
-    base = np.array(get_stiffness_case(case), dtype=float)
-    case_key = str(case).strip().lower().replace("case", "").replace(" ", "")
+    if muscles is not None:
+        base = np.array(muscles.stiffnesses, dtype=float)
+        case_key = None
+    else:
+        base = np.array(get_stiffness_case(case), dtype=float)
+        case_key = str(case).strip().lower().replace("case", "").replace(" ", "")
     if viscosity_ratio is None:
         ratio = DEFAULT_VISCOSITY_RATIO
     else:
@@ -266,7 +308,7 @@ def parameter_grid(
     xv, yv = x.values(nx), y.values(ny)
     xv.setflags(write=False)
     yv.setflags(write=False)
-    return ParameterGrid(x, y, xv, yv, case_key, base, ratio)
+    return ParameterGrid(x, y, xv, yv, case_key, base, ratio, pair_names)
 
 
 @dataclass(frozen=True)
@@ -282,11 +324,14 @@ class StabilityMap:
     stable : numpy.ndarray of bool, shape (ny, nx)
         True where every pole has real part < −δ (:mod:`posturelab.linear.batch`,
         *Stability margin*).
+    body_name : str
+        The name of the body the map is of.
     """
 
     grid: ParameterGrid
     max_real_part: np.ndarray
     stable: np.ndarray
+    body_name: str = "paper"
 
     @property
     def stable_fraction(self) -> float:
@@ -363,15 +408,17 @@ def stability_map(
     viscosity_ratio: float | None = None,
     body: Body | None = None,
     progress: Callable[[int, int], None] | None = None,
+    muscles: MuscleSet | None = None,
 ) -> StabilityMap:
-    """Largest real part and stability over a two-parameter grid of the paper model.
+    """Largest real part and stability over a two-parameter grid of pair gains.
 
     Parameters
     ----------
-    x, y, resolution, case, viscosity_ratio
-        As in :func:`parameter_grid`.
+    x, y, resolution, case, viscosity_ratio, muscles
+        As in :func:`parameter_grid`; ``muscles`` (its pairs, any number of links) is
+        needed for a body other than three links.
     body : Body, optional
-        Three-link body; the paper's by default.
+        The body; the paper's by default.
     progress : callable(done, total), optional
         Called after each block of sets with the number of sets done and the
         total. [-]
@@ -382,8 +429,22 @@ def stability_map(
     """
     from .batch import batch_analyse  # imports numba
 
-    grid = parameter_grid(x, y, resolution, case=case, viscosity_ratio=viscosity_ratio)
+    grid = parameter_grid(x, y, resolution, case=case, viscosity_ratio=viscosity_ratio,
+                          muscles=muscles)
     body = paper_body() if body is None else body
+    if not isinstance(body, Body):
+        raise ParameterError(f"body must be a Body, got {type(body).__name__}")
+    layout = muscles
+    if layout is None:
+        if body.n_links != 3:
+            raise ParameterError(f"a map over Table I's pairs is for three links; this body "
+                                 f"has {body.n_links}: give muscles (its pairs)")
+        from ..model.muscles import paper_muscles
+
+        layout = paper_muscles("1")
+    elif layout.n_links != body.n_links:
+        raise ParameterError(f"muscle set is for {layout.n_links} links but the body has "
+                             f"{body.n_links}")
     ny, nx = grid.shape
     max_real = np.empty((ny, nx))
     stable = np.empty((ny, nx), dtype=bool)
@@ -394,11 +455,11 @@ def stability_map(
     for start in range(0, ny, rows_per_block):
         stop = min(ny, start + rows_per_block)
         stiffness, ratio = grid.rows(start, stop)
-        res = batch_analyse(stiffness, ratio, body=body)
+        res = batch_analyse(stiffness, ratio, body=body, muscles=layout)
         max_real[start:stop] = res.max_real_part.reshape(stop - start, nx)
         stable[start:stop] = res.stable.reshape(stop - start, nx)
         done += (stop - start) * nx
         if progress is not None:
             progress(done, grid.size)
-    return StabilityMap(grid, max_real, stable)
+    return StabilityMap(grid, max_real, stable, body.name)
 

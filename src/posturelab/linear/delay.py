@@ -59,8 +59,6 @@ __all__ = [
     "delay_margin",
     "rightmost_roots",
     "MAX_DELAY_FOR_ROOTS",
-    "UprightStability",
-    "upright_stability",
 ]
 
 #: Largest delay :func:`rightmost_roots` accepts. [s]
@@ -438,44 +436,3 @@ def _newton_root(system: DelayedSystem, s: complex, delay: float) -> complex | N
         if abs(step) <= 1e-14 * max(1.0, abs(s)):
             return s
     return s if abs(step) <= 1e-9 * max(1.0, abs(s)) else None
-
-
-@dataclass(frozen=True)
-class UprightStability:
-    """Whether upright is stable for a body and gains, with the delay (the verdict a run
-    reports beside its outcome).
-
-    Attributes
-    ----------
-    stable : bool
-        Every characteristic root has a negative real part.
-    rightmost_root : complex
-        The root with the largest real part (its growth rate and frequency). [1/s]
-    feedback_delay : float
-        τ the roots are for. [s]
-    """
-
-    stable: bool
-    rightmost_root: complex
-    feedback_delay: float
-
-    def to_dict(self) -> dict:
-        """Plain-Python form: stable, the rightmost root {"re", "im"} [1/s], τ [s]."""
-        return {"stable": self.stable, "rightmost_root": {"re": self.rightmost_root.real,
-                                                          "im": self.rightmost_root.imag},
-                "feedback_delay": self.feedback_delay}
-
-    def describe(self) -> str:
-        z = self.rightmost_root
-        root = f"{z.real:.3g} ± {abs(z.imag):.3g}j" if abs(z.imag) > 0 else f"{z.real:.3g}"
-        delay = f" with τ = {self.feedback_delay:g} s" if self.feedback_delay > 0 else ""
-        return (f"{'stable' if self.stable else 'unstable'} about upright{delay} (rightmost "
-                f"root {root} 1/s)")
-
-
-def upright_stability(body: Body, muscles: MuscleSet, feedback_delay: float = 0.0
-                      ) -> UprightStability:
-    """The linear verdict about upright for this body, these gains and this delay
-    (:func:`rightmost_roots`; one-sided pairs linearised active). [s]"""
-    z = complex(rightmost_roots(body, muscles, feedback_delay, count=1)[0])
-    return UprightStability(bool(z.real < 0.0), z, float(feedback_delay))

@@ -28,7 +28,7 @@ from .._validation import float_in_range
 from ..errors import ParameterError, UnknownNameError
 from .body import Body, BodyPreset, paper_body, register_body_preset
 
-__all__ = ["WINTER_TABLE", "body_from_anthropometry", "lump", "ANTHROPOMETRIC_TABLES"]
+__all__ = ["WINTER_TABLE", "body_from_anthropometry", "lump", "one_link", "ANTHROPOMETRIC_TABLES"]
 
 WINTER_CITATION = (
     "Winter DA (2009) Biomechanics and Motor Control of Human Movement, 4th ed., Table 4.1 "
@@ -137,6 +137,24 @@ def lump(body: Body, groups: Sequence[Sequence[int]], name: str | None = None) -
     return Body.from_arrays(masses, lengths, coms, inertias, names=names,
                             name=name or f"{body.name} lumped {list(map(list, groups))}",
                             citation=body.citation, gravity=body.gravity)
+
+
+def one_link(body: Body) -> Body:
+    """``body`` with every joint locked: one rigid inverted pendulum about the ankle (the
+    body of a one-link controller), with the same mass [kg], centre of mass [m] and inertia
+    about the ankle [kg·m²] in the straight posture (:func:`lump`).
+
+    Examples
+    --------
+    >>> import posturelab as pl
+    >>> pl.model.anthropometry.one_link(pl.body_from_anthropometry(1.8, 82.0)).name
+    'winter H=1.8 m M=82 kg, one link (knee and hip locked)'
+    """
+    if body.n_links == 1:
+        return body
+    locked = "knee and hip" if body.n_links == 3 else "every joint above the ankle"
+    return lump(body, [list(range(1, body.n_links + 1))],
+                name=f"{body.name}, one link ({locked} locked)")
 
 
 register_body_preset(BodyPreset(

@@ -42,6 +42,7 @@ __all__ = [
     "MuscleSet",
     "PAPER_PAIRS",
     "PAPER_PAIR_NAMES",
+    "GASTROCNEMIUS_FORMS",
     "STIFFNESS_CASES",
     "TABLE_I_CITATION",
     "DEFAULT_VISCOSITY_RATIO",
@@ -61,7 +62,19 @@ __all__ = [
 #: Viscosity as a fraction of stiffness used throughout the paper (Appendix C). [s]
 DEFAULT_VISCOSITY_RATIO = 0.25
 
-Gastrocnemius = Literal["two-sided", "one-sided"]
+Gastrocnemius = Literal["two-sided", "one-sided", "pull-only"]
+
+#: The gastrocnemius pair's forms (:func:`paper_muscles`): name -> (one_sided, pull_only) and
+#: what it does.
+GASTROCNEMIUS_FORMS: dict[str, tuple[bool, bool, str]] = {
+    "two-sided": (False, False, "acts for either sign of θ2 (the paper's artificial "
+                  "antagonist added; the paper's analysis and Figs. 3–8)"),
+    "one-sided": (True, False, "acts only while its stretch θ2 ≥ 0, slack while θ2 < 0 (the "
+                  "paper's real gastrocnemius, section V.C)"),
+    "pull-only": (True, True, "acts only while θ2 ≥ 0 and its torque k θ2 + l θ̇2 pulls: it "
+                  "also goes slack while it would push (a muscle cannot push; beyond the "
+                  "paper)"),
+}
 
 
 #: Largest pair stiffness, intrinsic or active: 10⁵ times a standing adult's mgh. [N·m/rad]
@@ -94,9 +107,10 @@ class MusclePair:
         stiffness is given). [N·m·s/rad]
     pull_only : bool
         For a one-sided pair: it also goes slack while its torque k s + l ṡ would be
-        negative (a muscle pulls, it cannot push), not only while its stretch is. True by
-        default; False is the stretch-only switch of earlier versions. Ignored for a
-        two-sided pair.
+        negative (a muscle pulls, it cannot push), not only while its stretch is. False by
+        default: a one-sided pair switches on its stretch only, as the paper's real
+        gastrocnemius does (``gastrocnemius="one-sided"``; True is ``"pull-only"``).
+        Ignored for a two-sided pair.
     """
 
     name: str
@@ -107,7 +121,7 @@ class MusclePair:
     one_sided: bool = False
     active_stiffness: float | None = None
     active_viscosity: float | None = None
-    pull_only: bool = True
+    pull_only: bool = False
 
     def __post_init__(self) -> None:
         label = f"muscle pair {self.name!r}"
@@ -545,9 +559,11 @@ def paper_muscles(
         L_d = ratio · K_d when ``viscosity`` is not given; the paper uses 0.25. [s]
     viscosity : sequence of 5 floats, optional
         Per-pair viscosity, overriding ``viscosity_ratio``. [N·m·s/rad]
-    gastrocnemius : {"two-sided", "one-sided"}
+    gastrocnemius : {"two-sided", "one-sided", "pull-only"}
         ``"two-sided"`` adds the paper's artificial antagonist; ``"one-sided"``
-        lets the gastrocnemius act only while θ2 >= 0.
+        lets the gastrocnemius act only while θ2 >= 0 (the paper's real pair,
+        ``pull_only=False``); ``"pull-only"`` also lets it go slack while its torque
+        would push (``pull_only=True``). See :data:`GASTROCNEMIUS_FORMS`.
     active_stiffness : sequence of 5 floats, optional
         Active (neural, delayed) pair stiffness, same order; none by default (the
         paper's model, whose pair gains are then the whole feedback). [N·m/rad]
@@ -590,13 +606,16 @@ def paper_muscles(
         v = ratio * k
     else:
         v = _five("viscosity [N·m·s/rad]", viscosity)
-    if gastrocnemius not in ("two-sided", "one-sided"):
+    if gastrocnemius not in GASTROCNEMIUS_FORMS:
         raise ParameterError(
-            f"gastrocnemius must be 'two-sided' or 'one-sided', got {gastrocnemius!r}"
+            f"gastrocnemius must be one of {', '.join(map(repr, GASTROCNEMIUS_FORMS))}, got "
+            f"{gastrocnemius!r}"
         )
+    one_sided, pull_only, _ = GASTROCNEMIUS_FORMS[gastrocnemius]
     pairs = tuple(
         MusclePair(name, lo, hi, float(k[i]), float(v[i]),
-                   one_sided=(name == "gastrocnemius" and gastrocnemius == "one-sided"))
+                   one_sided=(name == "gastrocnemius" and one_sided),
+                   pull_only=(name == "gastrocnemius" and pull_only))
         for i, (name, (lo, hi, _)) in enumerate(PAPER_PAIRS.items())
     )
     return _with_active(MuscleSet(pairs, 3), active_stiffness, active_viscosity,
@@ -634,8 +653,8 @@ def muscles_for(n_links: int, stiffness: Sequence[float], viscosity: Sequence[fl
         [s]
     active_stiffness, active_viscosity, active_viscosity_ratio
         As for :func:`paper_muscles`. [N·m/rad], [N·m·s/rad], [s]
-    gastrocnemius : {"two-sided", "one-sided"}
-        N = 3 only.
+    gastrocnemius : {"two-sided", "one-sided", "pull-only"}
+        N = 3 only (:func:`paper_muscles`).
     """
     if n_links == 3:
         return paper_muscles(stiffness=stiffness, viscosity=viscosity,

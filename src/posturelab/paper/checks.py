@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 
-from ..linear.analysis import analyse, analyse_both_sides, disturbance_sensitivity
+from ..linear.analysis import analyse, disturbance_sensitivity
 from ..model.body import Body
 from ..model.muscles import MuscleSet, paper_muscles
 from ..model.options import BaseOfSupport, FallCriteria
@@ -204,12 +204,15 @@ class LinearFacts:
     one_sided_acting, one_sided_slack : float
         Largest real part of the case 1 poles with the one-sided gastrocnemius, on its
         acting side (θ2 ≥ 0) and on its slack side (θ2 < 0). [1/s]
+    one_sided_verdict : str
+        :func:`posturelab.upright_verdict`'s status for it ("depends on the side").
     """
 
     case2_pole: float
     case3_slow_pole: float
     one_sided_acting: float
     one_sided_slack: float
+    one_sided_verdict: str = ""
 
 
 @dataclass(frozen=True)
@@ -277,8 +280,13 @@ def linear_facts(body: Body) -> LinearFacts:
     case2_pole = float(analyse(body, paper_muscles("2")).max_real_part)
     case3 = analyse(body, paper_muscles("3"))
     slow3 = float(max(p.real for p in case3.poles if abs(p.imag) < 1e-9))
-    act, slack = analyse_both_sides(body, paper_muscles("1", gastrocnemius="one-sided"))
-    return LinearFacts(case2_pole, slow3, float(act.max_real_part), float(slack.max_real_part))
+    from ..linear.verdict import upright_verdict
+    from .runs import ONE_SIDED_FORM
+
+    verdict = upright_verdict(body, paper_muscles("1", gastrocnemius=ONE_SIDED_FORM))
+    return LinearFacts(case2_pole, slow3, float(verdict.side(engaged=True).rightmost_root.real),
+                       float(verdict.side(engaged=False).rightmost_root.real),
+                       verdict.status)
 
 
 # ---------------------------------------------------------------------------
@@ -496,7 +504,8 @@ def one_sided_finding(runs: PaperRuns, linear: LinearFacts) -> OneSidedFinding:
     """The forward case 1 run with the real, one-sided gastrocnemius against case 2."""
     return OneSidedFinding(float(runs.one_sided.theta[:, 1].max()), Outcome.of(runs.one_sided),
                            Outcome.of(runs.forward2), linear.one_sided_acting,
-                           linear.one_sided_slack, linear.case2_pole)
+                           linear.one_sided_slack, linear.case2_pole,
+                           linear.one_sided_verdict)
 
 
 def foot_finding(runs: PaperRuns) -> FootFinding:

@@ -154,7 +154,7 @@ def _beyond1(runs: PaperRuns, names: list[str]) -> Figure:
                    label="two-sided gastrocnemius (the paper's artificial antagonist)",
                    color="#1f77b4")
     plot_cog_phase(runs.one_sided, ax,
-                   label="one-sided gastrocnemius (acts only while θ2 ≥ 0 and pulling)",
+                   label="one-sided gastrocnemius (the paper's: acts only while θ2 ≥ 0)",
                    color="#d62728")
     fig.suptitle("Forward platform motion, case 1: artificial vs real gastrocnemius")
     return fig

@@ -131,6 +131,9 @@ class OneSidedFinding:
         acting side (θ2 ≥ 0) and on its slack side (θ2 < 0). [1/s]
     case2_pole : float
         Largest real part of the linearised case 2. [1/s]
+    verdict : str
+        :func:`posturelab.upright_verdict`'s status about upright ("depends on the side":
+        upright is the pair's switching point and its sides disagree).
     """
 
     theta2_max: float
@@ -139,13 +142,15 @@ class OneSidedFinding:
     acting: float
     slack: float
     case2_pole: float
+    verdict: str = ""
 
     @property
     def text(self) -> str:
         """The finding in words, with its numbers."""
         return (
-            "The real gastrocnemius pulls one way only (it acts while θ2 ≥ 0 and its torque "
-            "pulls). In the forward case 1 run with it, "
+            "The real gastrocnemius pulls one way only: the paper's one-sided pair "
+            "(--gastrocnemius one-sided) acts only while θ2 ≥ 0. In the forward case 1 run "
+            "with it, "
             + (f"θ2 reaches {self.theta2_max:+.3f} rad, so the pair acts at times, "
                if self.theta2_max >= 0.0 else
                f"θ2 stays negative (max θ2 = {self.theta2_max:+.3f} rad), so the pair never "
@@ -155,6 +160,9 @@ class OneSidedFinding:
             f"{self.slack:+.3f} 1/s against {self.case2_pole:+.3f} 1/s; on the acting "
             f"side {self.acting:+.3f} 1/s). On the slack side case 1 is case 2: the "
             "paper's Fig. 8 recovers only because of the artificial antagonist."
+            + (" Upright is the pair's switching point, so the linear verdict about it is "
+               f"'{self.verdict}' (stable while engaged, unstable while slack), not stable."
+               if self.verdict == "depends on the side" else "")
         )
 
 

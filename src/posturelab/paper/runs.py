@@ -27,6 +27,10 @@ PAPER_SCENARIOS: dict[str, tuple[str, str]] = {
     "forward2": ("paper-forward-case2", "Fig. 9"),
     "forward3": ("paper-forward-case3", "Fig. 10"),
 }
+#: The gastrocnemius of the finding beyond the paper: the paper's real one (section V.C),
+#: acting only while θ2 >= 0 (``--gastrocnemius one-sided``; GASTROCNEMIUS_FORMS).
+ONE_SIDED_FORM = "one-sided"
+
 #: Duration of the continued Fig. 10 run (case 3), to see whether it settles at all. [s]
 CASE3_LONG_DURATION = 60.0
 #: Sampling rate of the continued Fig. 10 run. [Hz]
@@ -106,8 +110,9 @@ def run_paper(tick: Callable[[str], None] | None = None,
     long3 = scen["forward3"].run(duration=CASE3_LONG_DURATION,
                                  sample_rate=CASE3_LONG_SAMPLE_RATE, engine="compiled")
     step("simulate forward case 1 with the real one-sided gastrocnemius (beyond the paper)")
-    # the runs beyond the paper on the compiled engine, at the scenarios' tolerances
-    one_sided = scen["forward1"].run(muscles=paper_muscles("1", gastrocnemius="one-sided"),
+    # the runs beyond the paper on the compiled engine, at the scenarios' tolerances; the
+    # gastrocnemius of the finding is the paper's real one (ONE_SIDED_FORM)
+    one_sided = scen["forward1"].run(muscles=paper_muscles("1", gastrocnemius=ONE_SIDED_FORM),
                                      engine="compiled")
     # the same runs with posturelab's own base-of-support fall check (an independent path to
     # the foot finding: events in the integrator instead of post-processing)

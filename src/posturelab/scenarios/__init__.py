@@ -21,7 +21,7 @@ Schema (every table optional except where noted; units in brackets)::
                                          # or pairs = [{name, lo, hi, stiffness,
                                          #              viscosity, one_sided}]
     viscosity_ratio = 0.25               # [s]
-    gastrocnemius = "two-sided"          # or "one-sided"
+    gastrocnemius = "two-sided"          # or "one-sided" (θ2 ≥ 0), "pull-only"
     feedback_delay = 0.0                 # neural delay of the muscle feedback [s]
     active_stiffness = [5 values]        # active (neural, delayed) gains [N·m/rad]; with
     active_viscosity = [5 values]        #   pairs = [...], per pair instead [N·m·s/rad]
@@ -497,7 +497,7 @@ def _parse_muscles(mt: dict, body: Body, origin: str) -> tuple[MuscleSet, str | 
             pairs.append(MusclePair(str(p.get("name", f"pair{i + 1}")), p["lo"], p["hi"],
                                     p["stiffness"], visc, bool(p.get("one_sided", False)),
                                     p.get("active_stiffness"), p.get("active_viscosity"),
-                                    bool(p.get("pull_only", True))))
+                                    bool(p.get("pull_only", False))))
         return MuscleSet(tuple(pairs), body.n_links), None
     if body.n_links != 3:
         raise ScenarioError(f"{origin}: muscles.case / muscles.stiffness are the paper's five "

@@ -67,7 +67,7 @@ class MusclesTable(_Table):
     stiffness: list[float] | None = None
     pairs: list[PairTable] | None = None
     viscosity_ratio: float | None = None
-    gastrocnemius: Literal["two-sided", "one-sided"] | None = None
+    gastrocnemius: Literal["two-sided", "one-sided", "pull-only"] | None = None
     feedback_delay: float | None = None
     active_stiffness: list[float] | None = None
     active_viscosity: list[float] | None = None

@@ -29,16 +29,42 @@ for (const slider of form.querySelectorAll("input[type=range]")) {
     schedule();
   });
 }
+// a controller's delay τ [s] and weight W [-] (posturelab.model.controllers), by name
+const PRESETS = JSON.parse(document.getElementById("controller-presets").textContent);
+
+function setBox(name, value) {
+  document.getElementById(name).value = String(value);
+  form.querySelector(`input[data-for="${name}"]`).value = String(value);
+}
+
 for (const select of form.querySelectorAll("select")) {
-  select.addEventListener("change", () => { enableFields(); schedule(); });
+  select.addEventListener("change", () => {
+    const preset = select.id === "controller" ? PRESETS[select.value] : undefined;
+    if (preset) {  // the controller's own delay and weight, still editable
+      setBox("feedback_delay", preset.feedback_delay);
+      setBox("proprioceptive_weight", preset.proprioceptive_weight);
+    }
+    enableFields();
+    schedule();
+  });
 }
 
 function enableFields() {
-  const v = values();
-  const bodyFree = v.body !== "paper";
-  const tilt = v.perturbation === "tilt";
-  for (const [name, on] of [["height", bodyFree], ["mass", bodyFree], ["step_speed", !tilt],
-                            ["tilt_amplitude", tilt], ["tilt_frequency", tilt]]) {
+  const body = document.getElementById("body").value;
+  const controller = document.getElementById("controller").value;
+  const ownGains = !(controller in PRESETS);
+  const oneLink = body.endsWith("one link") || !ownGains;
+  const bodyFree = body.startsWith("height");
+  const tilt = document.getElementById("perturbation").value === "tilt";
+  const fields = [["height", bodyFree], ["mass", bodyFree], ["step_speed", !tilt],
+                  ["tilt_amplitude", tilt], ["tilt_frequency", tilt],
+                  ["viscosity_ratio", ownGains]];
+  for (const box of form.querySelectorAll("#group-pairs input[name], #group-active input[name]")) {
+    if (box.name === "viscosity_ratio") continue;
+    // own gains only; on one link only the ankle pair's
+    fields.push([box.name, ownGains && (!oneLink || box.name.endsWith("_ankle"))]);
+  }
+  for (const [name, on] of fields) {
     const box = document.getElementById(name);
     box.disabled = !on;
     form.querySelector(`input[data-for="${name}"]`).disabled = !on;
