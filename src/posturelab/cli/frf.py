@@ -17,7 +17,7 @@ averaged over cycles at the stimulus's odd harmonics and then over frequency ban
 FRF is G_xy/G_xx, with the coherence and 95 % bounds on gain and phase.
 
 The file has a header row and a uniform time column [s] (the sample rate comes from it).
---bands peterka (default) averages Peterka's 11 bands (for a 20 s cycle 0.05 … 2.20 Hz; for
+--bands peterka (default) averages the 11 bands of an 80-state PRTS (20 s: 0.05 … 2.20 Hz; for
 another cycle length the same harmonic numbers); --bands harmonics gives every odd harmonic.
 
 Sign: a tilt FRF is reported so that a body that follows the surface has gain 1 and phase 0.

@@ -123,9 +123,11 @@ def add_experiment_arguments(p: argparse.ArgumentParser) -> None:
                      help="support-surface tilt α, positive toes-up, about the ankle: "
                      "sine:AMPLITUDE_RAD:FREQUENCY_HZ[:PHASE_RAD], "
                      "raised-cosine:AMPLITUDE_RAD:DURATION_S[:START_S] (a smooth ramp, then "
-                     "held), prts:AMPLITUDE_RAD[:STATE_DURATION_S] (peak to peak; Peterka's "
-                     "80-state, 20 s sequence). A tilt column [rad] in --platform-profile "
-                     "does the same from data.")
+                     "held), prts:AMPLITUDE_RAD[:STATE_DURATION_S][:SEQUENCE] (peak to peak; "
+                     "SEQUENCE posturelab-80 (default: posturelab's own 80-state, 20 s "
+                     "sequence), comtest-80 (the Eurobench COMTEST protocol's 80-state one) "
+                     "or peterka-2002-242 (Peterka 2002's 242-state, 60.5 s one)). A tilt "
+                     "column [rad] in --platform-profile does the same from data.")
     src.add_argument("--tilt-axis-depth", type=float, default=None, metavar="M",
                      help="the tilt axis this far below the ankle [m], in [0, 1] (default 0: "
                      "about the ankle; then the ankle moves with the surface). Needs a tilt "

@@ -66,7 +66,7 @@ knee model.
 experiment instead of one simulation: the base experiment's --tilt prts:… for
 --discard-cycles + --cycles cycles, recorded at --record-rate with --sensor-noise [rad] of
 white measurement noise (seeded per run from --seed), --motor-noise in the loop (seeded per
-run), the FRF of --output at Peterka's bands, and with --fit NAMES the FRF fit of those
+run), the FRF of --output at the sequence's bands, and with --fit NAMES the FRF fit of those
 parameters (posturelab fit-frf's names) started from the base experiment's values. Its
 columns: the varied parameters, fell, gain_B, phase_deg_B [deg], coherence_B per band, then
 fit_NAME and se_NAME per fitted parameter and fit_error.

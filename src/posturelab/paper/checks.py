@@ -708,7 +708,7 @@ def frf_experiment(seed: int = 20261201) -> FRFExperiment:
     preset = get_controller("peterka-2002")
     muscles = preset.muscles(body)
     cycles, noise, fs = 5, 0.001, 100.0
-    tilt = PRTSTilt.peterka_2002(0.035)
+    tilt = PRTSTilt.named("posturelab-80", 0.035)
     r = simulate(body, muscles, None, 20.0 * (cycles + 1), tilt=tilt, sample_rate=fs,
                  engine="compiled", **preset.run_options())
     rng = np.random.default_rng(seed)

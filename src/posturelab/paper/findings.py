@@ -461,7 +461,7 @@ class FRFFinding:
             "delayed controller's phase keeps falling past −180° with frequency, the shape "
             "people's FRFs have; the paper's instantaneous impedance stays near −90°. A "
             "simulated PRTS "
-            f"experiment with it ({self.cycles} cycles of Peterka's 80-state sequence, "
+            f"experiment with it ({self.cycles} cycles of posturelab's 80-state sequence, "
             f"{self.noise * 1000:.1f} mrad of white sensor noise on the sway, seeded) gives, "
             f"fitted to its 11-band FRF: {fit}; fit error {self.fit_error:.2g} (the weighted "
             "RMS residual). Each estimate is within 0.5 % of the truth; the few-SE offsets of "

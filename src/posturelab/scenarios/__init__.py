@@ -33,7 +33,7 @@ Schema (every table optional except where noted; units in brackets)::
     # sine: amplitude [rad], frequency [Hz], phase [rad]
     # raised-cosine: amplitude [rad], duration [s], start [s]
     # prts: amplitude [rad] peak to peak; state_duration [s], registers, taps, seed
-    #       (default: Peterka 2002's 80-state, 20 s sequence)
+    #       (default: posturelab's own 80-state, 20 s sequence, "posturelab-80")
     # profile: file = "tilt.csv" with columns time [s] and tilt [rad]
     axis_depth = 0.0                     # the tilt axis this far below the ankle [m]
 
@@ -423,7 +423,7 @@ def _parse_tilt(tt: dict, base_dir: Path, origin: str) -> Tilt | None:
             return RaisedCosineTilt(tt.get("amplitude"), tt.get("duration"), tt.get("start", 0.0))
         if kind == "prts":
             if set(tt) <= {"type", "amplitude"}:
-                return PRTSTilt.peterka_2002(tt.get("amplitude"))
+                return PRTSTilt.named("posturelab-80", tt.get("amplitude"))
             return PRTSTilt(tt.get("amplitude"), tt.get("state_duration", 0.25),
                             tt.get("registers", 4), tuple(tt.get("taps", PETERKA_TAPS)),
                             tuple(tt.get("seed", PETERKA_SEED)))
