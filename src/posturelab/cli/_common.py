@@ -80,7 +80,9 @@ def add_muscle_arguments(p: argparse.ArgumentParser, *, require: bool = False,
                    "one-link body). With active gains this is the intrinsic (undelayed) part.")
     g.add_argument("--controller", metavar="NAME",
                    help="a published one-link controller (intrinsic and active gains as "
-                   f"fractions of mgh, delay, weight): {', '.join(CONTROLLERS)}.")
+                   f"fractions of mgh, delay, weight): {', '.join(CONTROLLERS)}. Which of "
+                   "its numbers come from the source: "
+                   + " ".join(f"{c.name}: {c.provenance_text()}" for c in CONTROLLERS.values()))
     fb.add_argument("--viscosity", metavar="LIST",
                     help="pair viscosities [N·m·s/rad], one per pair (instead of a ratio).")
     if not own_case:
