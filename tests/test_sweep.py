@@ -304,7 +304,7 @@ def test_a_one_link_sweep_over_delay_active_gain_and_weight_equals_single_runs(t
             assert sway.start == 2.0  # after one 2 s period
             assert float(row["steady_rms_theta1"]) == sway.rms_theta[0]
             assert float(row["steady_peak_theta1"]) == sway.peak_theta[0]
-            np.testing.assert_equal(float(row["steady_rms_cop"] or "nan"), sway.rms_cop)
+    assert "steady_rms_cop" not in rows[0]  # the centre of pressure's: single runs only
     assert {r["fell"] for r in rows} == {"true", "false"}  # τ = 0.3 s is past the margin
 
 

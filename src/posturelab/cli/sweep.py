@@ -52,9 +52,10 @@ end of the platform motion or tilt (0 for a velocity step) to the last sample ti
 some |θ_i| exceeded 0.01 rad (0 if none did; empty if the run fell, had not settled by
 the end, or the stimulus is sustained); final_lean [rad] and final_rate [rad/s] are the
 largest |θ_i| and |θ̇_i| at the last sample. Under a sustained stimulus the columns
-steady_rms_thetaI, steady_peak_thetaI [rad], steady_rms_cop, steady_peak_cop [m] follow:
-RMS about upright and peak |·| after the first stimulus cycle (or over the second half of a
-run shorter than two cycles); each run is then run again alone for its trajectory.
+steady_rms_thetaI, steady_peak_thetaI [rad] follow: RMS about upright and peak |·| after the
+first stimulus cycle (or over the second half of a run shorter than two cycles); each run
+that completed is then run again alone for its trajectory (the centre of pressure's steady
+sway, ten times as costly, is left to posturelab simulate).
 The file type follows the suffix of --out: .csv or .parquet (pyarrow); it is
 written to a temporary file and renamed, so no half-written file is left behind.
 

@@ -241,19 +241,23 @@ class SimulationResult:
             return 0.0
         return float(self.time[np.nonzero(after)[0][-1]]) - timing.end
 
-    def steady_sway(self):
+    def steady_sway(self, centre_of_pressure: bool = True):
         """RMS and peak of each θ_i [rad] and of the centre of pressure [m] over the steady
         part of a run under a sustained stimulus
-        (:class:`posturelab.simulation.outcome.SteadySway`); None for a transient one."""
+        (:class:`posturelab.simulation.outcome.SteadySway`); None for a transient one.
+        ``centre_of_pressure=False`` leaves the centre of pressure out (it needs the derived
+        series, which cost about ten times the compiled run itself)."""
         from .outcome import steady_sway
 
         timing = self.stimulus
         if timing is None or not timing.sustained:
             return None
-        try:
-            cop = self.centre_of_pressure
-        except PostureLabError:  # built without its derived series
-            cop = None
+        cop = None
+        if centre_of_pressure:
+            try:
+                cop = self.centre_of_pressure
+            except PostureLabError:  # built without its derived series
+                cop = None
         return steady_sway(self.time, self.theta, cop,
                            timing.steady_start(float(self.time[-1])))
 

@@ -120,8 +120,9 @@ OUTCOME_UNITS: dict[str, str] = {"outcome": "", "failure": "", "fell": "", "fall
                                  "final_lean": "rad", "final_rate": "rad/s"}
 #: Columns added after :data:`OUTCOME_COLUMNS` under a sustained stimulus (periodic or PRTS
 #: tilt, sum of sines, motor noise), per link i: ``steady_rms_theta{i}``,
-#: ``steady_peak_theta{i}`` [rad], then ``steady_rms_cop``, ``steady_peak_cop`` [m] (RMS
-#: about upright and peak |·| over the steady part: :mod:`posturelab.simulation.outcome`).
+#: ``steady_peak_theta{i}`` [rad] (RMS about upright and peak |·| over the steady part:
+#: :mod:`posturelab.simulation.outcome`); ``steady_rms_cop``, ``steady_peak_cop`` [m] follow
+#: only when the batch carries them (a sweep does not: single runs report them).
 STEADY_COLUMN_PREFIXES = ("steady_rms_theta", "steady_peak_theta", "steady_rms_cop",
                           "steady_peak_cop")
 
@@ -422,8 +423,9 @@ class SweepResult:
             for i in range(n):
                 cols.append((f"steady_rms_theta{i + 1}", o.steady_rms_theta[:, i]))
                 cols.append((f"steady_peak_theta{i + 1}", o.steady_peak_theta[:, i]))
-            cols.append(("steady_rms_cop", o.steady_rms_cop))
-            cols.append(("steady_peak_cop", o.steady_peak_cop))
+            if o.steady_rms_cop is not None:
+                cols.append(("steady_rms_cop", o.steady_rms_cop))
+                cols.append(("steady_peak_cop", o.steady_peak_cop))
         return cols
 
     def units(self) -> dict[str, str]:
@@ -542,54 +544,67 @@ class _Task:
     def run(self, grid: SweepGrid, lo: int, hi: int, parallel: bool) -> BatchResult:
         result = self._batch(grid, lo, hi, parallel)
         if result.stimulus is not None and result.stimulus.sustained:
-            result = self._with_steady_sway(result, grid, lo, hi)
+            result = self._with_steady_sway(result, grid, lo, hi, parallel)
         return result
 
-    def _with_steady_sway(self, result: BatchResult, grid: SweepGrid, lo: int,
-                          hi: int) -> BatchResult:
-        """The batch's rows with their steady sway: under a sustained stimulus each row that
-        completed is run again, alone on the compiled engine, for its trajectory (the batch
-        keeps none), and its RMS and peak over the steady part are computed as for one run
-        (:meth:`SimulationResult.steady_sway`)."""
+    def _steady_row(self, grid: SweepGrid, r: int):
+        """Row ``r`` run alone on the compiled engine: its steady sway (or None)."""
         from dataclasses import replace
 
         from ..simulation.engines import simulate
 
         sc = self.scenario
-        m, n = hi - lo, sc.body.n_links
+        pairs = []
+        for j, pair in enumerate(sc.muscles.pairs):
+            extra = {} if grid.active_stiffness is None else {
+                "active_stiffness": float(grid.active_stiffness[r, j]),
+                "active_viscosity": float(grid.active_viscosity[r, j])}
+            pairs.append(replace(pair, stiffness=float(grid.stiffness[r, j]),
+                                 viscosity=float(grid.viscosity[r, j]), **extra))
+        muscles = type(sc.muscles)(tuple(pairs), sc.muscles.n_links)
+        disturbance = sc.disturbance
+        if grid.disturbance_scale is not None:
+            disturbance = disturbance.scaled(float(grid.disturbance_scale[r]))
+        limits = None if grid.torque_limits is None else grid.torque_limits[r]
+        weight = (sc.proprioceptive_weight if grid.proprioceptive_weight is None
+                  else float(grid.proprioceptive_weight[r]))
+        run = simulate(
+            sc.body, muscles, disturbance, sc.duration, initial_state=sc.initial_state,
+            rates_from=sc.rates_from, knee=sc.knee, fall=sc.fall, torque_limits=limits,
+            feedback_delay=float(grid.feedback_delay[r]), rtol=self.rtol, atol=self.atol,
+            sample_rate=sc.sample_rate, engine="compiled", tilt=sc.tilt,
+            proprioceptive_weight=weight, tilt_axis_depth=sc.tilt_axis_depth,
+            motor_noise=sc.motor_noise, max_steps=sc.max_steps, time_limit=sc.time_limit)
+        return run.steady_sway(centre_of_pressure=False)
+
+    def _with_steady_sway(self, result: BatchResult, grid: SweepGrid, lo: int, hi: int,
+                          parallel: bool) -> BatchResult:
+        """The batch's rows with their steady sway: under a sustained stimulus each row that
+        completed is run again, alone on the compiled engine, for its trajectory (the batch
+        keeps none), and the RMS and peak of its angles over the steady part are computed as
+        for one run (:meth:`SimulationResult.steady_sway`; the centre of pressure's would
+        cost ten times the run, so a sweep leaves it to single runs); over threads when
+        ``parallel``."""
+        from concurrent.futures import ThreadPoolExecutor
+        from dataclasses import replace
+
+        from ..simulation.compiled import batch_threads
+
+        n = self.scenario.body.n_links
+        m = hi - lo
         rms, peak = np.full((m, n), np.nan), np.full((m, n), np.nan)
-        rms_cop, peak_cop = np.full(m, np.nan), np.full(m, np.nan)
-        for k in np.nonzero(result.status == "completed")[0]:
-            r = lo + int(k)
-            pairs = []
-            for j, pair in enumerate(sc.muscles.pairs):
-                extra = {} if grid.active_stiffness is None else {
-                    "active_stiffness": float(grid.active_stiffness[r, j]),
-                    "active_viscosity": float(grid.active_viscosity[r, j])}
-                pairs.append(replace(pair, stiffness=float(grid.stiffness[r, j]),
-                                     viscosity=float(grid.viscosity[r, j]), **extra))
-            muscles = type(sc.muscles)(tuple(pairs), sc.muscles.n_links)
-            disturbance = sc.disturbance
-            if grid.disturbance_scale is not None:
-                disturbance = disturbance.scaled(float(grid.disturbance_scale[r]))
-            limits = None if grid.torque_limits is None else grid.torque_limits[r]
-            weight = (sc.proprioceptive_weight if grid.proprioceptive_weight is None
-                      else float(grid.proprioceptive_weight[r]))
-            run = simulate(
-                sc.body, muscles, disturbance, sc.duration, initial_state=sc.initial_state,
-                rates_from=sc.rates_from, knee=sc.knee, fall=sc.fall, torque_limits=limits,
-                feedback_delay=float(grid.feedback_delay[r]), rtol=self.rtol, atol=self.atol,
-                sample_rate=sc.sample_rate, engine="compiled", tilt=sc.tilt,
-                proprioceptive_weight=weight, tilt_axis_depth=sc.tilt_axis_depth,
-                motor_noise=sc.motor_noise, max_steps=sc.max_steps, time_limit=sc.time_limit)
-            sway = run.steady_sway()
+        rows = [int(k) for k in np.nonzero(result.status == "completed")[0]]
+        threads = batch_threads() if parallel else 1
+        if threads > 1 and len(rows) > 1:
+            with ThreadPoolExecutor(max_workers=threads) as pool:
+                sways = list(pool.map(lambda k: self._steady_row(grid, lo + k), rows))
+        else:
+            sways = [self._steady_row(grid, lo + k) for k in rows]
+        for k, sway in zip(rows, sways, strict=True):
             if sway is None:
                 continue
             rms[k], peak[k] = sway.rms_theta, sway.peak_theta
-            if sway.rms_cop is not None:
-                rms_cop[k], peak_cop[k] = sway.rms_cop, sway.peak_cop
-        return replace(result, steady_rms_theta=rms, steady_peak_theta=peak,
-                       steady_rms_cop=rms_cop, steady_peak_cop=peak_cop)
+        return replace(result, steady_rms_theta=rms, steady_peak_theta=peak)
 
     def _batch(self, grid: SweepGrid, lo: int, hi: int, parallel: bool) -> BatchResult:
         sc = self.scenario
