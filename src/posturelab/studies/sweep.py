@@ -544,7 +544,7 @@ class _Task:
     def run(self, grid: SweepGrid, lo: int, hi: int, parallel: bool) -> BatchResult:
         result = self._batch(grid, lo, hi, parallel)
         if result.stimulus is not None and result.stimulus.sustained:
-            result = self._with_steady_sway(result, grid, lo, hi, parallel)
+            result = self._with_steady_sway(result, grid, lo, hi)
         return result
 
     def _steady_row(self, grid: SweepGrid, r: int):
@@ -577,29 +577,21 @@ class _Task:
             motor_noise=sc.motor_noise, max_steps=sc.max_steps, time_limit=sc.time_limit)
         return run.steady_sway(centre_of_pressure=False)
 
-    def _with_steady_sway(self, result: BatchResult, grid: SweepGrid, lo: int, hi: int,
-                          parallel: bool) -> BatchResult:
+    def _with_steady_sway(self, result: BatchResult, grid: SweepGrid, lo: int,
+                          hi: int) -> BatchResult:
         """The batch's rows with their steady sway: under a sustained stimulus each row that
         completed is run again, alone on the compiled engine, for its trajectory (the batch
         keeps none), and the RMS and peak of its angles over the steady part are computed as
         for one run (:meth:`SimulationResult.steady_sway`; the centre of pressure's would
-        cost ten times the run, so a sweep leaves it to single runs); over threads when
-        ``parallel``."""
-        from concurrent.futures import ThreadPoolExecutor
+        cost ten times the run, so a sweep leaves it to single runs)."""
         from dataclasses import replace
-
-        from ..simulation.compiled import batch_threads
 
         n = self.scenario.body.n_links
         m = hi - lo
         rms, peak = np.full((m, n), np.nan), np.full((m, n), np.nan)
         rows = [int(k) for k in np.nonzero(result.status == "completed")[0]]
-        threads = batch_threads() if parallel else 1
-        if threads > 1 and len(rows) > 1:
-            with ThreadPoolExecutor(max_workers=threads) as pool:
-                sways = list(pool.map(lambda k: self._steady_row(grid, lo + k), rows))
-        else:
-            sways = [self._steady_row(grid, lo + k) for k in rows]
+        # (one at a time: the rerun is mostly Python, which threads would not speed up)
+        sways = [self._steady_row(grid, lo + k) for k in rows]
         for k, sway in zip(rows, sways, strict=True):
             if sway is None:
                 continue
