@@ -21,8 +21,9 @@ For Peterka 2002's 242-state, 60.5 s sequence (:data:`PETERKA_242_BAND_HARMONICS
 averaging - 1,1,2,2,3,4,4,4,5,5,6,8,9,10,11,13,15 partial overlapping pts", kept in the same
 COMTEST files); their *placement* was not found, and is posturelab's rule: the first 11 as
 above, then each band starting at the last harmonic of the one before (as bands 9–11 do).
-Its band frequencies run from 0.0165 Hz to 2.56 Hz, above the 2.23 Hz reported as the top
-of Peterka 2002's frequency range, so the paper's own bands 12–17 lie lower than these.
+Its band frequencies run from 0.0165 Hz to 2.56 Hz; the range quoted for Peterka 2002's
+stimulus is 0.017–2.23 Hz (not checked against the paper here), so the paper's own bands
+12–17 probably overlap more and lie lower than these.
 
 :data:`SEQUENCE_BANDS` gives each named sequence's layout
 (:data:`posturelab.model.tilt.PRTS_SEQUENCES`); :func:`harmonic_bands` gives one band per odd

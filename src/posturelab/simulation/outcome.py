@@ -7,9 +7,10 @@ run). :func:`stimulus_timing` says which.
 
 * ``recovered``: a transient run completed, and at its last sample every |θ_i| is within
   :data:`UPRIGHT_BAND` of upright and every |θ̇_i| within :data:`REST_RATE`; the settling
-  time is counted from the end of the perturbation (the end of the platform motion or of
-  the tilt; 0 for a velocity step at t = 0) to the last sample after it at which some |θ_i|
-  was outside the band (0 if none was).
+  time is counted from the end of the perturbation (the end of the platform's acceleration:
+  a ramp-and-hold's stop, a pulse's end, a measured profile's last sample; the end of a
+  tilt's ramp; 0 for a velocity step at t = 0) to the last sample after it at which some
+  |θ_i| was outside the band (0 if none was).
 * ``not recovered``: a transient run completed but ended outside that band of upright, or
   still moving; the final lean max |θ_i| [rad] and rate max |θ̇_i| [rad/s] say how far.
 * ``steady sway``: a sustained run completed. It has no settling time; its sway is the RMS
