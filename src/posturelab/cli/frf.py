@@ -46,8 +46,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="stimulus cycle [s] (20 for Peterka's PRTS).")
     p.add_argument("--discard-cycles", type=int, default=0, metavar="N",
                    help="leading cycles to drop (the transient; default 0).")
-    p.add_argument("--bands", choices=["peterka", "harmonics"], default="peterka",
-                   help="frequency bands (default peterka).")
+    p.add_argument("--bands", choices=["peterka", "harmonics", "peterka-2002-242"],
+                   default="peterka",
+                   help="frequency bands (default peterka: the 11 of an 80-state PRTS; "
+                   "peterka-2002-242: 17 bands for Peterka 2002's 242-state sequence, "
+                   "posturelab's placement).")
     p.add_argument("--response-sign", choices=["auto", "1", "-1"], default="auto",
                    help="multiply the response (default auto: see above).")
     p.add_argument("--ci", choices=["periodic", "otnes-enochson"], default="periodic",
