@@ -196,3 +196,17 @@ def test_simulate_prts_on_the_command_line_reports_a_steady_sway():
                           "--duration", "30", "--engine", "compiled")
     assert "outcome: steady sway under a sustained stimulus (PRTS tilt" in text.stdout
     assert "not recovered" not in text.stdout
+
+
+def test_a_steady_sway_without_a_defined_centre_of_pressure_still_writes_json():
+    from posturelab.simulation.outcome import steady_sway
+
+    t = np.linspace(0.0, 4.0, 401)
+    sway = steady_sway(t, np.sin(t)[:, None], np.where(t > 3.0, np.nan, 0.01), start=2.0)
+    assert np.isnan(sway.rms_cop)
+    d = sway.to_dict()
+    assert d["steady_rms_cop"] is None and d["steady_peak_cop"] is None
+    json.dumps(d, allow_nan=False)  # no NaN reaches the JSON
+    keep = t >= 2.0
+    np.testing.assert_allclose(d["steady_rms_theta"][0], np.sqrt(np.mean(np.sin(t[keep]) ** 2)),
+                               rtol=1e-13)

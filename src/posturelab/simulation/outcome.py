@@ -146,10 +146,15 @@ class SteadySway:
     peak_cop: float | None = None
 
     def to_dict(self) -> dict:
-        """Plain-Python form (times [s], angles [rad], centre of pressure [m])."""
-        return {"steady_from": self.start, "steady_rms_theta": list(self.rms_theta),
-                "steady_peak_theta": list(self.peak_theta), "steady_rms_cop": self.rms_cop,
-                "steady_peak_cop": self.peak_cop}
+        """Plain-Python form (times [s], angles [rad], centre of pressure [m]); a value that
+        is not finite (a centre of pressure undefined where the foot is unloaded) is None."""
+        def finite(v):
+            return v if v is not None and math.isfinite(v) else None
+
+        return {"steady_from": self.start,
+                "steady_rms_theta": [finite(v) for v in self.rms_theta],
+                "steady_peak_theta": [finite(v) for v in self.peak_theta],
+                "steady_rms_cop": finite(self.rms_cop), "steady_peak_cop": finite(self.peak_cop)}
 
     @property
     def text(self) -> str:
