@@ -269,11 +269,11 @@ def classify(status: str, settling_time: float | None, final_state, *, fall_time
     kind = str(classify_rows(np.array([status]), np.array(
         [np.nan if settling_time is None else settling_time]), final_state[None],
         timing.sustained)[0])
-    after = (f" after the perturbation ended at {timing.end:.3g} s" if timing.end > 0
-             else "")
-    if kind == "recovered":
-        words = (f"recovered: within ±{UPRIGHT_BAND:g} rad of upright {settling_time:.3f} s"
-                 f"{after or ' from the start'}")
+    if kind == "recovered" and timing.end > 0:
+        words = (f"recovered: within ±{UPRIGHT_BAND:g} rad of upright {settling_time:.3f} s "
+                 f"after the perturbation ended at {timing.end:.4g} s")
+    elif kind == "recovered":
+        words = f"recovered: within ±{UPRIGHT_BAND:g} rad of upright from {settling_time:.3f} s"
     elif kind == "not recovered":
         words = (f"not recovered: ended {lean:.4g} rad from upright, moving at up to "
                  f"{rate:.4g} rad/s (recovered means within ±{UPRIGHT_BAND:g} rad and "
