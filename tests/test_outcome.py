@@ -1,4 +1,4 @@
-"""Every run says what happened: recovered, not recovered, fell or failed
+"""Every run says what happened: recovered, not recovered, steady sway, fell or failed
 (posturelab.simulation.outcome), with the linear verdict about upright beside it.
 
 Checked against: the rule at its thresholds on hand-made states; the two misleading runs
