@@ -2,13 +2,14 @@
 ===================================================================
 
 The independent-channel model of the identification literature on one link: the paper's
-body as an inverted pendulum (``paper-1link``) with Peterka's controller (the
-``peterka-2002`` preset: active stiffness 1.35 mgh, active viscosity 0.47 mgh·s, feedback
-delay 0.15 s, proprioceptive weight 1). The support surface turns by Peterka's 80-state
-pseudorandom ternary sequence (0.035 rad peak to peak, 20 s cycle) for five cycles, the
-first discarded, on the compiled engine; the recorded centre-of-mass angle gets 1 mrad of
-seeded white sensor noise (:func:`posturelab.frequency.experiment.prts_experiment`). The
-FRF is estimated over Peterka's 11 frequency bands with its coherence and 95 % bounds
+body as an inverted pendulum (``paper-1link``) with the ``peterka-2002`` preset (active
+stiffness 1.35 mgh, active viscosity 0.47 mgh·s, feedback delay 0.15 s: round values after
+Peterka 2002; proprioceptive weight 1: posturelab's choice). The support surface turns by
+posturelab's own 80-state pseudorandom ternary sequence (``posturelab-80``: 0.035 rad peak to
+peak, 20 s cycle; Peterka 2002 used 242-state ones) for five cycles, the first discarded, on
+the compiled engine; the recorded centre-of-mass angle gets 1 mrad of seeded white sensor
+noise (:func:`posturelab.frequency.experiment.prts_experiment`). The FRF is estimated over
+the 11 frequency bands of an 80-state sequence with its coherence and 95 % bounds
 (:func:`posturelab.frequency.estimate_frf`) and drawn against the linearised model's FRF,
 exact in the delay (:func:`posturelab.frequency.model_frf`), with
 :func:`posturelab.viz.plots.plot_bode`. The literature's sign: a body that follows the

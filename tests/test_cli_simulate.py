@@ -27,7 +27,9 @@ def test_simulate_csv_and_json(tmp_path, capsys):
     assert set(summary) == {"outcome", "settling_time", "fall_time", "fall_reason",
                             "final_lean", "final_rate", "outcome_message", "fell", "status",
                             "message", "max_abs_theta", "final_state", "hip_fraction",
-                            "linear_stability"}
+                            "linear_stability", "perturbation_end", "steady_from",
+                            "steady_rms_theta", "steady_peak_theta", "steady_rms_cop",
+                            "steady_peak_cop"}
     assert summary["outcome"] == "recovered" and 0 < summary["settling_time"] < 5
     assert summary["linear_stability"]["stable"] is True
     assert 0.0 <= summary["hip_fraction"] <= 1.0

@@ -186,3 +186,20 @@ def test_bad_weight_in_a_scenario(tmp_path):
     text = MINIMAL.replace('case = "1"', 'case = "1"\nproprioceptive_weight = 1.5')
     with pytest.raises(ScenarioError, match=r"proprioceptive_weight \[-\] must be in \[0, 1\]"):
         load_scenario(write(tmp_path, text))
+
+
+def test_a_scenario_names_its_prts_sequence(tmp_path):
+    from posturelab.model.tilt import PRTSTilt
+
+    named = load_scenario(write(tmp_path, MINIMAL + '[tilt]\ntype = "prts"\namplitude = 0.02\n'
+                                'sequence = "peterka-2002-242"\n', "n.toml"))
+    assert named.tilt == PRTSTilt.named("peterka-2002-242", 0.02)
+    assert named.tilt.cycle == 60.5
+    with pytest.raises(ScenarioError, match=r"n2.toml: tilt.sequence: unknown PRTS sequence "
+                       r"'peterka'; known sequences: posturelab-80, comtest-80, "
+                       r"peterka-2002-242"):
+        load_scenario(write(tmp_path, MINIMAL + '[tilt]\ntype = "prts"\namplitude = 0.02\n'
+                            'sequence = "peterka"\n', "n2.toml"))
+    with pytest.raises(ScenarioError, match="takes sequence or a register"):
+        load_scenario(write(tmp_path, MINIMAL + '[tilt]\ntype = "prts"\namplitude = 0.02\n'
+                            'sequence = "comtest-80"\nregisters = 4\n', "n3.toml"))

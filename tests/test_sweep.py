@@ -296,6 +296,15 @@ def test_a_one_link_sweep_over_delay_active_gain_and_weight_equals_single_runs(t
                           engine="compiled")
         assert (row["fell"] == "true") == one.fell
         assert float(row["peak_theta1"]) == one.max_abs_theta[0]
+        # a sine tilt is sustained: a steady sway, never "recovered" (the sine crossing zero)
+        assert row["outcome"] == ("fell" if one.fell else "steady sway")
+        assert row["settling_time"] == "" and row["outcome"] == one.outcome.kind
+        if not one.fell:
+            sway = one.steady_sway()
+            assert sway.start == 2.0  # after one 2 s period
+            assert float(row["steady_rms_theta1"]) == sway.rms_theta[0]
+            assert float(row["steady_peak_theta1"]) == sway.peak_theta[0]
+    assert "steady_rms_cop" not in rows[0]  # the centre of pressure's: single runs only
     assert {r["fell"] for r in rows} == {"true", "false"}  # τ = 0.3 s is past the margin
 
 

@@ -212,3 +212,115 @@ def test_an_axis_depth_needs_a_smooth_tilt():
         pl.simulate(body, muscles, None, 1.0, tilt_axis_depth=0.05)
     with pytest.raises(ParameterError, match=r"tilt_axis_depth \[m\] must be"):
         pl.simulate(body, muscles, None, 1.0, tilt=SineTilt(0.01, 1.0), tilt_axis_depth=-1)
+
+
+# --- named PRTS sequences, with their sources (posturelab.model.tilt.PRTS_SEQUENCES) ---
+
+
+def _pseudogen3(feedback, seed, states):
+    """The register as the Matlab script that follows Peterka 2002 writes it out (its lines:
+    ``Output(i) = mod(Reg(3)-Reg(4)-Reg(5), 3); Reg(2:5) = Reg(1:4); Reg(1) = Output(i)``,
+    here for any feedback), digits 0, 1, 2 to velocities 0, +1, −1."""
+    reg, out = list(seed), []
+    for _ in range(states):
+        new = sum(f * r for f, r in zip(feedback, reg, strict=True)) % 3
+        reg[1:] = reg[:-1]
+        reg[0] = new
+        out.append(new)
+    return np.array([0.0, 1.0, -1.0])[np.array(out)]
+
+
+@pytest.mark.parametrize(("name", "feedback", "seed", "registers"), [
+    # Peterka 2002: pseudogen3(5, [0 0 1 −1 −1], [2 0 2 0 2]), "242 state sequence"
+    ("peterka-2002-242", (0, 0, 1, -1, -1), (2, 0, 2, 0, 2), 5),
+    # COMTEST PRTS2012.m / PRTS2020.m: pseudogen3(4, [0 0 −1 1], [0 0 0 1], 25)
+    ("comtest-80", (0, 0, -1, 1), (0, 0, 0, 1), 4),
+])
+def test_a_named_sequence_is_its_sources_shift_register(name, feedback, seed, registers):
+    from posturelab.model.tilt import PRTSTilt, get_prts_sequence
+
+    states = 3 ** registers - 1
+    tilt = PRTSTilt.named(name, 0.035)
+    v = tilt.velocity_sequence
+    expected = _pseudogen3(feedback, seed, 2 * states)
+    np.testing.assert_array_equal(v, expected[:states])
+    np.testing.assert_array_equal(expected[states:], expected[:states])  # period 3ⁿ − 1
+    assert v.size == states and set(np.unique(v)) == {-1.0, 0.0, 1.0} and v.sum() == 0
+    assert np.count_nonzero(v) == 2 * 3 ** (registers - 1)
+    np.testing.assert_array_equal(v[states // 2:], -v[:states // 2])  # odd harmonics only
+    spectrum = np.abs(np.fft.fft(v))
+    assert spectrum[0::2].max() < 1e-9
+    # a maximum-length ternary sequence: the same power 4·3ⁿ⁻¹ at every odd harmonic
+    np.testing.assert_allclose(spectrum[1::2] ** 2, 4 * 3 ** (registers - 1), rtol=1e-12)
+    seq = get_prts_sequence(name)
+    assert tilt.cycle == seq.cycle == states * 0.25 and tilt.sequence_name == name
+
+
+def test_peterka_2002s_sequence_has_242_states_and_a_60_5_s_cycle():
+    from posturelab.frequency.bands import (
+        PETERKA_242_BAND_HARMONICS,
+        PETERKA_242_BAND_SIZES,
+        band_frequencies,
+    )
+    from posturelab.model.tilt import PETERKA_2002_CITATION, PRTSTilt
+
+    tilt = PRTSTilt.named("peterka-2002-242", 0.035)
+    assert tilt.cycle == 60.5 and tilt.velocity_sequence.size == 242
+    assert "242-state PRTS, 0.25 s per state, 60.5 s cycle" in PETERKA_2002_CITATION
+    # the band sizes of Peterka's analysis code: "1,1,2,2,3,4,4,4,5,5,6,8,9,10,11,13,15"
+    assert tuple(len(b) for b in PETERKA_242_BAND_HARMONICS) == PETERKA_242_BAND_SIZES == (
+        1, 1, 2, 2, 3, 4, 4, 4, 5, 5, 6, 8, 9, 10, 11, 13, 15)
+    f = band_frequencies(PETERKA_242_BAND_HARMONICS, tilt.cycle)
+    assert f[0] == pytest.approx(1 / 60.5) and round(f[0], 3) == 0.017  # the lowest, 0.017 Hz
+    assert np.all(np.diff(f) > 0)
+
+
+def test_the_80_state_default_is_posturelabs_own_and_says_so():
+    from posturelab.model.tilt import DEFAULT_PRTS, PRTS_SEQUENCES, PRTSTilt
+
+    assert DEFAULT_PRTS == "posturelab-80"
+    assert PRTSTilt.peterka_2002(0.035) == PRTSTilt.named("posturelab-80", 0.035)
+    assert "posturelab's own" in PRTS_SEQUENCES["posturelab-80"].citation
+    assert "not Peterka 2002's" in PRTS_SEQUENCES["posturelab-80"].citation
+    a, b = (PRTSTilt.named(n).velocity_sequence for n in ("posturelab-80", "comtest-80"))
+    assert not any(np.array_equal(np.roll(a, k), s * b) for k in range(80) for s in (1, -1))
+
+
+def test_an_unknown_sequence_lists_the_known_ones():
+    import subprocess
+    import sys
+
+    from posturelab.errors import UnknownNameError
+    from posturelab.model.tilt import PRTSTilt
+
+    with pytest.raises(UnknownNameError, match="known sequences: posturelab-80, comtest-80, "
+                       "peterka-2002-242"):
+        PRTSTilt.named("peterka-2002")
+    bad = subprocess.run([sys.executable, "-m", "posturelab", "simulate", "--controller",
+                          "peterka-2002", "--tilt", "prts:0.035:peterka", "--duration", "1"],
+                         capture_output=True, text=True, timeout=120)
+    assert bad.returncode == 2 and bad.stdout == ""
+    assert bad.stderr.strip().splitlines() == [
+        "posturelab: error: unknown PRTS sequence 'peterka'; known sequences: posturelab-80, "
+        "comtest-80, peterka-2002-242"]
+    ok = subprocess.run([sys.executable, "-m", "posturelab", "simulate", "--controller",
+                         "peterka-2002", "--tilt", "prts:0.035:peterka-2002-242", "--duration",
+                         "2", "--engine", "compiled"], capture_output=True, text=True,
+                        timeout=120)
+    assert ok.returncode == 0, ok.stderr
+    assert "(peterka-2002-242), 242 states of 0.25 s (60.5 s cycle)" in ok.stdout
+
+
+def test_a_242_state_experiment_is_analysed_at_its_own_bands():
+    from posturelab.frequency.bands import PETERKA_242_BAND_HARMONICS, band_frequencies
+    from posturelab.frequency.experiment import prts_experiment
+    from posturelab.model.controllers import get_controller
+    from posturelab.model.tilt import PRTSTilt
+
+    body = pl.get_body("paper-1link")
+    preset = get_controller("peterka-2002")
+    tilt = PRTSTilt.named("peterka-2002-242", 0.035)
+    exp = prts_experiment(body, preset.muscles(body), tilt=tilt, cycles=2, discard=1,
+                          **preset.run_options())
+    np.testing.assert_allclose(exp.estimate.frequency,
+                               band_frequencies(PETERKA_242_BAND_HARMONICS, 60.5), rtol=1e-12)

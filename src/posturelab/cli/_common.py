@@ -89,7 +89,9 @@ def add_muscle_arguments(p: argparse.ArgumentParser, *, require: bool = False,
                    help="a published one-link controller (intrinsic and active gains as "
                    f"fractions of mgh, delay, weight): {', '.join(CONTROLLERS)}. Its body: "
                    "the paper's as one link (paper-1link) by default, --height/--mass "
-                   "lumped to one link, or a one-link --body.")
+                   "lumped to one link, or a one-link --body. Which of its numbers come from "
+                   "the source: "
+                   + " ".join(f"{c.name}: {c.provenance_text()}" for c in CONTROLLERS.values()))
     fb.add_argument("--viscosity", metavar="LIST",
                     help="pair viscosities [N·m·s/rad], one per pair (instead of a ratio).")
     if not own_case:
@@ -229,17 +231,25 @@ def feedback_options_from_args(args: argparse.Namespace) -> dict:
 def parse_tilt(text: str):
     """``--tilt``: ``sine:AMPLITUDE_RAD:FREQUENCY_HZ[:PHASE_RAD]``,
     ``raised-cosine:AMPLITUDE_RAD:DURATION_S[:START_S]`` or
-    ``prts:AMPLITUDE_RAD[:STATE_DURATION_S]`` (peak to peak; Peterka's 80-state sequence)."""
-    from ..model.tilt import PRTSTilt, RaisedCosineTilt, SineTilt
+    ``prts:AMPLITUDE_RAD[:STATE_DURATION_S][:SEQUENCE]`` (peak to peak; SEQUENCE one of
+    :data:`posturelab.model.tilt.PRTS_SEQUENCES`, posturelab-80 by default)."""
+    from ..model.tilt import DEFAULT_PRTS, PRTSTilt, RaisedCosineTilt, SineTilt, get_prts_sequence
 
     forms = ("sine:AMPLITUDE_RAD:FREQUENCY_HZ[:PHASE_RAD], "
              "raised-cosine:AMPLITUDE_RAD:DURATION_S[:START_S] or "
-             "prts:AMPLITUDE_RAD[:STATE_DURATION_S]")
+             "prts:AMPLITUDE_RAD[:STATE_DURATION_S][:SEQUENCE]")
     kind, _, rest = str(text).partition(":")
     kind = kind.strip().lower()
     counts = {"sine": (2, 3), "raised-cosine": (2, 3), "prts": (1, 2)}
     if kind not in counts or not rest:
         raise ParameterError(f"--tilt must be {forms}, got {text!r}")
+    sequence = None
+    if kind == "prts":
+        head, _, last = rest.rpartition(":")
+        if head and last.strip() and not last.strip()[0].isdigit() \
+                and last.strip()[0] not in "+-.":
+            sequence = get_prts_sequence(last)  # an unknown name lists the known ones
+            rest = head
     values = parse_float_list(rest.replace(":", ","), f"--tilt {kind}", None)
     lo, hi = counts[kind]
     if not lo <= len(values) <= hi:
@@ -248,7 +258,9 @@ def parse_tilt(text: str):
         return SineTilt(*values)
     if kind == "raised-cosine":
         return RaisedCosineTilt(*values)
-    return PRTSTilt(values[0], values[1]) if len(values) == 2 else PRTSTilt.peterka_2002(values[0])
+    sequence = sequence or get_prts_sequence(DEFAULT_PRTS)
+    state = values[1] if len(values) == 2 else sequence.state_duration
+    return PRTSTilt(values[0], state, sequence.registers, sequence.taps, sequence.seed)
 
 
 def print_json(obj) -> None:

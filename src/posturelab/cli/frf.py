@@ -17,7 +17,7 @@ averaged over cycles at the stimulus's odd harmonics and then over frequency ban
 FRF is G_xy/G_xx, with the coherence and 95 % bounds on gain and phase.
 
 The file has a header row and a uniform time column [s] (the sample rate comes from it).
---bands peterka (default) averages Peterka's 11 bands (for a 20 s cycle 0.05 … 2.20 Hz; for
+--bands peterka (default) averages the 11 bands of an 80-state PRTS (20 s: 0.05 … 2.20 Hz; for
 another cycle length the same harmonic numbers); --bands harmonics gives every odd harmonic.
 
 Sign: a tilt FRF is reported so that a body that follows the surface has gain 1 and phase 0.
@@ -46,8 +46,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="stimulus cycle [s] (20 for Peterka's PRTS).")
     p.add_argument("--discard-cycles", type=int, default=0, metavar="N",
                    help="leading cycles to drop (the transient; default 0).")
-    p.add_argument("--bands", choices=["peterka", "harmonics"], default="peterka",
-                   help="frequency bands (default peterka).")
+    p.add_argument("--bands", choices=["peterka", "harmonics", "peterka-2002-242"],
+                   default="peterka",
+                   help="frequency bands (default peterka: the 11 of an 80-state PRTS; "
+                   "peterka-2002-242: 17 bands for Peterka 2002's 242-state sequence, "
+                   "posturelab's placement).")
     p.add_argument("--response-sign", choices=["auto", "1", "-1"], default="auto",
                    help="multiply the response (default auto: see above).")
     p.add_argument("--ci", choices=["periodic", "otnes-enochson"], default="periodic",

@@ -23,7 +23,9 @@ posturelab simulate). --input tilt (the surface angle, rad) or translation (the 
 displacement, m); --output com_angle (Σ a_i θ_i / Σ a_i), theta1 … or a joint angle
 (ankle_angle, knee_angle, hip_angle). Tilt FRFs use the literature's sign: a body that
 follows the surface has gain 1 and phase 0. At --frequencies LIST [Hz] or at the band
-frequencies of Peterka's 11 bands (--bands peterka, for --cycle-length s, default 20).
+frequencies of the 11 bands of an 80-state PRTS (--bands peterka, for --cycle-length s,
+default 20) or of a named sequence's bands (--bands peterka-2002-242: 17 bands of the 242-state
+sequence, cycle 60.5 s by default; posturelab.frequency.bands.SEQUENCE_BANDS).
 
 --json prints one object: {"frequency": [Hz], "frf": [{"re", "im"}], "gain", "phase_deg"}.
 
@@ -40,16 +42,21 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="com_angle (default), thetaN or a joint angle (ankle_angle, …).")
     g = p.add_mutually_exclusive_group()
     g.add_argument("--frequencies", metavar="LIST", help="frequencies [Hz], > 0.")
-    g.add_argument("--bands", choices=["peterka"], help="Peterka's 11 band frequencies.")
-    p.add_argument("--cycle-length", type=float, default=20.0, metavar="SECONDS",
-                   help="stimulus cycle for --bands [s] (default 20).")
+    g.add_argument("--bands", choices=["peterka", "posturelab-80", "comtest-80",
+                                       "peterka-2002-242"],
+                   help="the band frequencies of an 80-state sequence (peterka, "
+                   "posturelab-80, comtest-80: the same 11 bands) or of Peterka 2002's "
+                   "242-state sequence (17 bands).")
+    p.add_argument("--cycle-length", type=float, default=None, metavar="SECONDS",
+                   help="stimulus cycle for --bands [s] (default 20; 60.5 for "
+                   "peterka-2002-242).")
     p.add_argument("--json", action="store_true", help="print one JSON object.")
 
 
 def run(args: argparse.Namespace) -> int:
     import numpy as np
 
-    from ..frequency.bands import PETERKA_BAND_HARMONICS, band_frequencies
+    from ..frequency.bands import PETERKA_BAND_HARMONICS, SEQUENCE_BANDS, band_frequencies
     from ..frequency.model import model_frf
 
     body = body_from_args(args)
@@ -60,9 +67,13 @@ def run(args: argparse.Namespace) -> int:
         if np.any(f <= 0) or f.size > 100_000:
             raise ParameterError("--frequencies [Hz] must be 1 … 100,000 values > 0")
     else:
-        if not (np.isfinite(args.cycle_length) and args.cycle_length > 0):
-            raise ParameterError(f"--cycle-length [s] must be > 0, got {args.cycle_length:g}")
-        f = band_frequencies(PETERKA_BAND_HARMONICS, args.cycle_length)
+        bands = SEQUENCE_BANDS.get(args.bands, PETERKA_BAND_HARMONICS)
+        cycle = args.cycle_length
+        if cycle is None:
+            cycle = 60.5 if args.bands == "peterka-2002-242" else 20.0
+        if not (np.isfinite(cycle) and cycle > 0):
+            raise ParameterError(f"--cycle-length [s] must be > 0, got {cycle:g}")
+        f = band_frequencies(bands, cycle)
     H = model_frf(body, muscles, f, input=args.input, output=args.output.strip().lower(),
                   feedback_delay=options.get("feedback_delay", 0.0),
                   proprioceptive_weight=options.get("proprioceptive_weight", 1.0))

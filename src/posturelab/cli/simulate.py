@@ -46,7 +46,12 @@ U1..3 [N·m], joint_moment1..3 [N·m], cog_x, cog_y [m], cog_vx, cog_vy [m/s],
 platform_ax, platform_ay [m/s²], platform_vx, platform_vy [m/s], platform_x,
 platform_y [m], cop_x [m] (centre of pressure from the ankle), ground_fx, ground_fy [N]
 (force of the platform on the foot), and with a tilt, tilt and com_angle [rad]. The first
-line printed (outcome in --json) is recovered, not recovered, fell or failed.
+line printed (outcome in --json) is recovered, not recovered, steady sway, fell or failed.
+Settling is counted from the end of the platform motion or tilt (0 for a velocity step). A
+sustained stimulus (a sine or PRTS tilt, a sum of sines, motor noise) has no settling time:
+its outcome is a steady sway, the RMS (about upright) and peak |·| of each θ_i [rad] and of
+the centre of pressure [m] after the first stimulus cycle (or over the second half of a
+run shorter than two cycles).
 """
 
 
@@ -64,9 +69,12 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     out.add_argument("--plot", metavar="RUN.png", help="write a 2×2 summary figure (PNG/SVG/PDF).")
     out.add_argument("--animate", metavar="RUN.gif", help="write a stick-figure animation (GIF).")
     out.add_argument("--json", action="store_true",
-                     help='print one JSON summary: {"outcome" (recovered, not recovered, fell, '
-                     'failed), "settling_time", "fall_time", "fall_reason", "final_lean", '
-                     '"final_rate", "outcome_message", "fell", "status", "message", '
+                     help='print one JSON summary: {"outcome" (recovered, not recovered, '
+                     'steady sway, fell, failed), "settling_time", "fall_time", "fall_reason", '
+                     '"final_lean", "final_rate", "outcome_message", "perturbation_end", '
+                     '"steady_from", "steady_rms_theta", "steady_peak_theta" [rad], '
+                     '"steady_rms_cop", "steady_peak_cop" [m] (null unless a steady sway), '
+                     '"fell", "status", "message", '
                      '"max_abs_theta", "final_state", "hip_fraction", "linear_stability" '
                      '(the verdict about upright, as posturelab poles: {"status": stable, '
                      'unstable, marginal or "depends on the side" of a one-sided pair\'s '
@@ -117,9 +125,11 @@ def add_experiment_arguments(p: argparse.ArgumentParser) -> None:
                      help="support-surface tilt α, positive toes-up, about the ankle: "
                      "sine:AMPLITUDE_RAD:FREQUENCY_HZ[:PHASE_RAD], "
                      "raised-cosine:AMPLITUDE_RAD:DURATION_S[:START_S] (a smooth ramp, then "
-                     "held), prts:AMPLITUDE_RAD[:STATE_DURATION_S] (peak to peak; Peterka's "
-                     "80-state, 20 s sequence). A tilt column [rad] in --platform-profile "
-                     "does the same from data.")
+                     "held), prts:AMPLITUDE_RAD[:STATE_DURATION_S][:SEQUENCE] (peak to peak; "
+                     "SEQUENCE posturelab-80 (default: posturelab's own 80-state, 20 s "
+                     "sequence), comtest-80 (the Eurobench COMTEST protocol's 80-state one) "
+                     "or peterka-2002-242 (Peterka 2002's 242-state, 60.5 s one)). A tilt "
+                     "column [rad] in --platform-profile does the same from data.")
     src.add_argument("--tilt-axis-depth", type=float, default=None, metavar="M",
                      help="the tilt axis this far below the ankle [m], in [0, 1] (default 0: "
                      "about the ankle; then the ankle moves with the surface). Needs a tilt "

@@ -44,12 +44,19 @@ base experiment's (0.25, the paper's, for --case).
 
 Columns: the varied parameters, then {", ".join(OUTCOME_COLUMNS)} (one peak_theta
 per link). outcome is recovered (completed, ending within ±0.01 rad of upright and below
-0.05 rad/s), not recovered (completed but ending farther or still moving), fell or failed;
-fell is true/false; fall_time [s] is empty if the run did not fall; peak_thetaI [rad]
-are the largest |θ_i| over the samples; settling_time [s] is the last sample time at which
-some |θ_i| exceeded 0.01 rad (0 if none did; empty if the run fell or had not settled by
-the end); final_lean [rad] and final_rate [rad/s] are the largest |θ_i| and |θ̇_i| at the
-last sample. The file type follows the suffix of --out: .csv or .parquet (pyarrow); it is
+0.05 rad/s), not recovered (completed but ending farther or still moving), steady sway
+(completed under a sustained stimulus: a sine or PRTS tilt, a sum of sines, motor noise),
+fell or failed; fell is true/false; fall_time [s] is empty if the run did not fall;
+peak_thetaI [rad] are the largest |θ_i| over the samples; settling_time [s] runs from the
+end of the platform motion or tilt (0 for a velocity step) to the last sample time at which
+some |θ_i| exceeded 0.01 rad (0 if none did; empty if the run fell, had not settled by
+the end, or the stimulus is sustained); final_lean [rad] and final_rate [rad/s] are the
+largest |θ_i| and |θ̇_i| at the last sample. Under a sustained stimulus the columns
+steady_rms_thetaI, steady_peak_thetaI [rad] follow: RMS about upright and peak |·| after the
+first stimulus cycle (or over the second half of a run shorter than two cycles); each run
+that completed is then run again alone for its trajectory (the centre of pressure's steady
+sway, ten times as costly, is left to posturelab simulate).
+The file type follows the suffix of --out: .csv or .parquet (pyarrow); it is
 written to a temporary file and renamed, so no half-written file is left behind.
 
 Everything of the base experiment carries into every run: --torque-limits, --feedback-delay,
@@ -60,7 +67,7 @@ knee model.
 experiment instead of one simulation: the base experiment's --tilt prts:… for
 --discard-cycles + --cycles cycles, recorded at --record-rate with --sensor-noise [rad] of
 white measurement noise (seeded per run from --seed), --motor-noise in the loop (seeded per
-run), the FRF of --output at Peterka's bands, and with --fit NAMES the FRF fit of those
+run), the FRF of --output at the sequence's bands, and with --fit NAMES the FRF fit of those
 parameters (posturelab fit-frf's names) started from the base experiment's values. Its
 columns: the varied parameters, fell, gain_B, phase_deg_B [deg], coherence_B per band, then
 fit_NAME and se_NAME per fitted parameter and fit_error.
@@ -158,7 +165,8 @@ def run(args: argparse.Namespace) -> int:
     failed = int((o.status_code >= 2).sum())
     kinds = o.outcome
     counts = ", ".join(f"{int((kinds == k).sum())} {k}" for k in
-                       ("recovered", "not recovered", "fell", "failed") if (kinds == k).any())
+                       ("recovered", "not recovered", "steady sway", "fell", "failed")
+                       if (kinds == k).any())
     print(f"wrote {args.out}: {o.n_runs} runs ({shape}: {', '.join(result.grid.names)}): "
           f"{counts}, in {elapsed:.2f} s")
     if args.workers is not None and total < SMALL_FOR_DASK:

@@ -1,6 +1,6 @@
 """A PRTS identification experiment in silico: simulate, add seeded sensor noise, estimate.
 
-:func:`prts_experiment` applies a periodic tilt (by default Peterka's 80-state PRTS) to the
+:func:`prts_experiment` applies a periodic tilt (by default posturelab's 80-state PRTS) to the
 nonlinear model on the compiled engine for ``discard + cycles`` cycles, adds white sensor
 noise of a given standard deviation [rad] to the measured angle (seeded), and estimates the
 FRF of that angle to the tilt in the literature's sign (:func:`posturelab.frequency.
@@ -47,7 +47,7 @@ class PRTSExperiment:
 
 def prts_experiment(body, muscles, *, tilt=None, cycles: int = 5, discard: int = 1,
                     sensor_noise: float = 0.0, seed: int = 0, sample_rate: float = 100.0,
-                    output: str = "com_angle", bands="peterka", **run_options
+                    output: str = "com_angle", bands=None, **run_options
                     ) -> PRTSExperiment:
     """Run one seeded PRTS experiment (module notes).
 
@@ -56,7 +56,8 @@ def prts_experiment(body, muscles, *, tilt=None, cycles: int = 5, discard: int =
     body, muscles
         The model.
     tilt : PRTSTilt, optional
-        Default: Peterka's 80-state sequence, 0.035 rad peak to peak.
+        Default: posturelab's 80-state sequence (``PRTSTilt.named("posturelab-80")``),
+        0.035 rad peak to peak.
     cycles, discard : int
         Cycles analysed, and cycles run before them (dropped). [-]
     sensor_noise : float
@@ -68,7 +69,8 @@ def prts_experiment(body, muscles, *, tilt=None, cycles: int = 5, discard: int =
     output : {"com_angle", "thetaN"}
         The angle measured.
     bands
-        As for :func:`posturelab.frequency.estimate_frf`.
+        As for :func:`posturelab.frequency.estimate_frf`; default: the tilt's sequence's
+        (:func:`posturelab.frequency.bands.sequence_bands`).
     **run_options
         For :func:`posturelab.simulate` (``feedback_delay``, ``proprioceptive_weight``,
         ``motor_noise``, …).
@@ -76,7 +78,7 @@ def prts_experiment(body, muscles, *, tilt=None, cycles: int = 5, discard: int =
     from ..model.tilt import PRTSTilt
     from ..simulation.engines import simulate
 
-    tilt = PRTSTilt.peterka_2002(0.035) if tilt is None else tilt
+    tilt = PRTSTilt.named("posturelab-80", 0.035) if tilt is None else tilt
     if not isinstance(tilt, PRTSTilt):
         raise ParameterError("tilt must be a PRTSTilt (a periodic stimulus)")
     for name, value, least in (("cycles", cycles, 2), ("discard", discard, 0)):
@@ -101,6 +103,10 @@ def prts_experiment(body, muscles, *, tilt=None, cycles: int = 5, discard: int =
     stimulus = tilt.angle(t)
     if r.fell:
         return PRTSExperiment(None, t, stimulus, measured, True)
+    if bands is None:
+        from .bands import sequence_bands
+
+        bands = sequence_bands(tilt)
     est = estimate_frf(stimulus, measured, sample_rate, tilt.cycle, discard_cycles=discard,
                        bands=bands, response_sign=-1)
     return PRTSExperiment(est, t, stimulus, measured, False)

@@ -57,7 +57,9 @@ class PRTSProtocol:
     output : str
         The angle recorded: ``com_angle`` or ``thetaI``.
     bands : "peterka", "harmonics" or a list of lists of odd-harmonic numbers
-        As for :func:`posturelab.frequency.estimate_frf`.
+        As for :func:`posturelab.frequency.estimate_frf`; "peterka" (the 11 bands of an
+        80-state sequence) becomes the sequence's own for another length
+        (:func:`posturelab.frequency.bands.sequence_bands`).
     fit : tuple of str
         Parameters for :func:`posturelab.frequency.fit_frf` to estimate per run (its names:
         ``stiffness``, ``active_stiffness:PAIR``, ``feedback_delay``, …); none: no fit.
@@ -261,7 +263,12 @@ def prts_sweep(scenario: Scenario, varies: Sequence, protocol: PRTSProtocol | No
                              f"at most {MAX_EXPERIMENTS:,}")
     cycle = scenario.tilt.cycle
     samples = int(round(protocol.sample_rate * cycle))
-    bands = resolve_bands(protocol.bands, samples // 4)
+    bands = protocol.bands
+    if isinstance(bands, str) and bands == "peterka" and scenario.tilt.registers != 4:
+        from .bands import sequence_bands  # the 11 bands are an 80-state sequence's
+
+        bands = sequence_bands(scenario.tilt)
+    bands = resolve_bands(bands, samples // 4)
     protocol = replace(protocol, bands=bands)
     task = _ExperimentTask(scenario, protocol)
     parts = run_chunks(task, grid, workers=workers, scheduler=scheduler, client=client,

@@ -10,6 +10,11 @@ intrinsic-only Table I (:func:`posturelab.paper_muscles`).
 
 Parts of a published model that posturelab does not model (activation dynamics, slow
 torque feedback) are left out and named in the preset's ``omitted``.
+
+Every number of a preset carries its provenance (:class:`Provenance`, in ``provenance``):
+the value as the source prints it, with its unit and where (table or figure), or that it is
+posturelab's own assumption. :meth:`ControllerPreset.provenance_text` says it in words;
+``--controller``'s help and the reproduction report print it.
 """
 
 from __future__ import annotations
@@ -20,7 +25,51 @@ from ..errors import ParameterError, UnknownNameError
 from .body import Body
 from .muscles import MusclePair, MuscleSet
 
-__all__ = ["ControllerPreset", "CONTROLLERS", "get_controller"]
+__all__ = ["ControllerPreset", "Provenance", "CONTROLLERS", "get_controller"]
+
+
+#: The preset fields that carry a number, in print order, with the symbol used in words.
+PRESET_NUMBERS = (("intrinsic_stiffness", "K/mgh"), ("intrinsic_viscosity", "B/mgh"),
+                  ("active_stiffness", "K_P/mgh"), ("active_viscosity", "K_D/mgh"),
+                  ("feedback_delay", "τ"), ("proprioceptive_weight", "W"))
+
+
+@dataclass(frozen=True)
+class Provenance:
+    """Where one number of a controller preset comes from.
+
+    Attributes
+    ----------
+    where : str or None
+        The place in the source (e.g. "PMC5664365 Table 1, K_P"); None when the number is
+        posturelab's assumption.
+    source_value : float or None
+        The number as the source prints it (in ``source_unit``); None for an assumption.
+    source_unit : str
+        Its unit as printed.
+    note : str
+        How the preset's number follows from it, or why posturelab assumed it.
+    """
+
+    where: str | None
+    source_value: float | None = None
+    source_unit: str = ""
+    note: str = ""
+
+    @property
+    def from_source(self) -> bool:
+        """True when the number is the source's (converted), False for an assumption."""
+        return self.where is not None
+
+    def text(self, symbol: str, value: float) -> str:
+        """One phrase: the symbol, the preset's value and where it comes from."""
+        if not self.from_source:
+            return f"{symbol} = {value:.4g}: posturelab's assumption ({self.note})"
+        given = ("" if self.source_value is None else
+                 f" = {self.source_value:g}{' ' + self.source_unit if self.source_unit else ''}")
+        note = f"; {self.note}" if self.note else ""
+        return f"{symbol} = {value:.4g}: {self.where}{given}{note}"
+
 
 
 @dataclass(frozen=True)
@@ -45,6 +94,8 @@ class ControllerPreset:
         W. [-]
     omitted : str
         What of the published model is not modelled here.
+    provenance : tuple of (str, Provenance)
+        For each numeric field (:data:`PRESET_NUMBERS`), where it comes from.
     """
 
     name: str
@@ -56,6 +107,22 @@ class ControllerPreset:
     feedback_delay: float
     proprioceptive_weight: float
     omitted: str = ""
+    provenance: tuple[tuple[str, Provenance], ...] = ()
+
+    def provenance_of(self, field_name: str) -> Provenance:
+        """The :class:`Provenance` of one numeric field."""
+        return dict(self.provenance)[field_name]
+
+    def provenance_text(self) -> str:
+        """Which numbers come from the source (and where) and which are posturelab's, in
+        words (one sentence per number)."""
+        return "; ".join(self.provenance_of(name).text(symbol, getattr(self, name))
+                         for name, symbol in PRESET_NUMBERS) + "."
+
+    def assumed(self) -> tuple[str, ...]:
+        """The symbols of the numbers that are posturelab's assumptions."""
+        return tuple(symbol for name, symbol in PRESET_NUMBERS
+                     if not self.provenance_of(name).from_source)
 
     def muscles(self, body: Body) -> MuscleSet:
         """The ankle pair for ``body`` (one link), gains scaled by its mgh [N·m/rad]."""
@@ -77,6 +144,21 @@ class ControllerPreset:
                 "proprioceptive_weight": self.proprioceptive_weight}
 
 
+#: The body of PMC5664365 Table 1 (after Fonteyn et al. 2010): m [kg], h [m], g [m/s²].
+PMC5664365_BODY = (75.0, 0.83, 9.81)
+_MGH = PMC5664365_BODY[0] * PMC5664365_BODY[2] * PMC5664365_BODY[1]  # [N·m/rad]
+
+
+def _table1(symbol: str, value: float, unit: str, per_mgh: bool = True) -> Provenance:
+    note = (f"divided by the table's m g h = 75 × 9.81 × 0.83 = {_MGH:.2f} N·m/rad"
+            if per_mgh else "")
+    return Provenance(f"PMC5664365 Table 1, {symbol}", value, unit, note)
+
+
+#: A round value summarised for the Peterka 2002 / 2018 models that posturelab has not found
+#: in a table of Peterka 2002 (J Neurophysiol 88:1097–1118): posturelab's reading.
+_PETERKA_ROUND = "a round value after Peterka 2002, not found in its tables"
+
 #: The presets by name.
 CONTROLLERS: dict[str, ControllerPreset] = {
     "peterka-2002": ControllerPreset(
@@ -84,11 +166,23 @@ CONTROLLERS: dict[str, ControllerPreset] = {
         citation=("Peterka RJ (2002) Sensorimotor integration in human postural control. "
                   "J Neurophysiol 88:1097–1118; independent-channel model, round values "
                   "K_P ≈ 1.35 mgh, K_D ≈ 0.47 mgh·s, τ ≈ 0.15 s as summarised for the "
-                  "Peterka 2002 / 2018 models"),
+                  "Peterka 2002 / 2018 models (not checked against the paper's tables); "
+                  "W = 1 and no intrinsic impedance are posturelab's choices"),
         intrinsic_stiffness=0.0, intrinsic_viscosity=0.0,
         active_stiffness=1.35, active_viscosity=0.47, feedback_delay=0.15,
         proprioceptive_weight=1.0,
         omitted="the slow torque feedback; the passive stiffness (small) is taken as 0",
+        provenance=(
+            ("intrinsic_stiffness", Provenance(None, note="the passive stiffness, small in "
+                                               "the model, taken as 0")),
+            ("intrinsic_viscosity", Provenance(None, note="the passive damping taken as 0")),
+            ("active_stiffness", Provenance(None, note=_PETERKA_ROUND)),
+            ("active_viscosity", Provenance(None, note=_PETERKA_ROUND)),
+            ("feedback_delay", Provenance(None, note=_PETERKA_ROUND)),
+            ("proprioceptive_weight", Provenance(
+                None, note="proprioception only (eyes closed on a level surface); the "
+                "source's weights depend on the stimulus amplitude and condition")),
+        ),
     ),
     "icm-pmc5664365": ControllerPreset(
         name="icm-pmc5664365",
@@ -96,12 +190,20 @@ CONTROLLERS: dict[str, ControllerPreset] = {
                   "Table 1 (body J = 66 kg·m², m = 75 kg, h = 0.83 m after Fonteyn et al. "
                   "2010; K = 40.5 N·m/rad, B = 68.8 N·m·s/rad, K_P = 943.9 N·m/rad, "
                   "K_D = 313.5 N·m·s/rad, τ_D = 0.097 s, W_P = 0.8), gains / mgh"),
-        intrinsic_stiffness=40.5 / (75 * 9.81 * 0.83),
-        intrinsic_viscosity=68.8 / (75 * 9.81 * 0.83),
-        active_stiffness=943.9 / (75 * 9.81 * 0.83),
-        active_viscosity=313.5 / (75 * 9.81 * 0.83),
+        intrinsic_stiffness=40.5 / _MGH,
+        intrinsic_viscosity=68.8 / _MGH,
+        active_stiffness=943.9 / _MGH,
+        active_viscosity=313.5 / _MGH,
         feedback_delay=0.097, proprioceptive_weight=0.8,
         omitted="activation dynamics (16.8 rad/s, damping 0.99) and force feedback",
+        provenance=(
+            ("intrinsic_stiffness", _table1("K", 40.5, "N·m/rad")),
+            ("intrinsic_viscosity", _table1("B", 68.8, "N·m·s/rad")),
+            ("active_stiffness", _table1("K_P", 943.9, "N·m/rad")),
+            ("active_viscosity", _table1("K_D", 313.5, "N·m·s/rad")),
+            ("feedback_delay", _table1("τ_D", 0.097, "s", per_mgh=False)),
+            ("proprioceptive_weight", _table1("W_P", 0.8, "", per_mgh=False)),
+        ),
     ),
 }
 

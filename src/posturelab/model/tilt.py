@@ -15,8 +15,10 @@ Profiles (each gives α(t) and α̇(t) for any t; before t = 0 the surface is he
 - :class:`SineTilt`: α = A sin(2π f t + φ);
 - :class:`RaisedCosineTilt`: a smooth ramp to A over a duration, then held;
 - :class:`PRTSTilt`: a pseudorandom ternary sequence (PRTS) of surface velocities from a
-  shift register, integrated, repeated cycle after cycle (Peterka 2002's 80-state, 20 s
-  sequence is :meth:`PRTSTilt.peterka_2002`);
+  shift register, integrated, repeated cycle after cycle; the named sequences
+  (:data:`PRTS_SEQUENCES`, :meth:`PRTSTilt.named`) are posturelab's own 80-state one (the
+  default), the Eurobench COMTEST protocol's 80-state one and Peterka 2002's 242-state one,
+  each with its source;
 - :class:`MeasuredTilt`: sampled α, interpolated by a cubic spline whose derivative gives a
   smooth rate for the viscous terms.
 
@@ -49,6 +51,10 @@ __all__ = [
     "MAX_AXIS_DEPTH",
     "MAX_TILT",
     "PETERKA_2002_CITATION",
+    "PRTSSequence",
+    "PRTS_SEQUENCES",
+    "DEFAULT_PRTS",
+    "get_prts_sequence",
 ]
 
 #: Largest |α| a profile may reach. [rad]
@@ -58,7 +64,7 @@ MAX_AXIS_DEPTH = 1.0
 
 PETERKA_2002_CITATION = (
     "Peterka RJ (2002) Sensorimotor integration in human postural control. "
-    "J Neurophysiol 88:1097–1118 (80-state PRTS, 0.25 s per state, 20 s cycle)"
+    "J Neurophysiol 88:1097–1118 (242-state PRTS, 0.25 s per state, 60.5 s cycle)"
 )
 
 
@@ -312,10 +318,117 @@ def prts_sequence(registers: int, taps: tuple[int, ...], seed: tuple[int, ...]) 
     return values
 
 
-#: The 4-register feedback of the 80-state sequence: new = x_{k−4} + x_{k−3} (mod 3), from
-#: the primitive polynomial x⁴ + 2x + 2 over GF(3) (a test checks that its period is 80).
-PETERKA_TAPS = (1, 1, 0, 0)
-PETERKA_SEED = (1, 0, 0, 0)
+#: posturelab's own 80-state register: new = x_{k−4} + x_{k−3} (mod 3), from the primitive
+#: polynomial x⁴ + 2x + 2 over GF(3) (a test checks that its period is 80), started at
+#: (1, 0, 0, 0). Not a published sequence (see :data:`PRTS_SEQUENCES`).
+POSTURELAB_80_TAPS = (1, 1, 0, 0)
+POSTURELAB_80_SEED = (1, 0, 0, 0)
+#: Former names of the two above (they are posturelab's, not Peterka's). [-]
+PETERKA_TAPS, PETERKA_SEED = POSTURELAB_80_TAPS, POSTURELAB_80_SEED
+
+
+def peterka_register(feedback: tuple[int, ...], seed: tuple[int, ...]) -> tuple[tuple, tuple]:
+    """The ``taps`` and ``seed`` of :func:`prts_sequence` for a register written as in
+    Peterka's Matlab generator ``pseudogen3(n, feedback, seed, …)``: the register newest
+    digit first, each step's new digit Σ feedback_i · register_i (mod 3) shifted in at the
+    front and output (as a Matlab script that follows Peterka 2002 writes it out:
+    ``Output = mod(Reg(3)−Reg(4)−Reg(5), 3); Reg(2:5) = Reg(1:4); Reg(1) = Output``).
+    The output starts with the first new digit. [-]"""
+    taps = tuple(int(f) % 3 for f in reversed(feedback))
+    reg, first = list(seed), []
+    for _ in range(len(seed)):  # the first n new digits are the register that outputs them
+        new = sum(f * r for f, r in zip(feedback, reg, strict=True)) % 3
+        reg = [new] + reg[:-1]
+        first.append(new)
+    return taps, tuple(first)
+
+
+@dataclass(frozen=True)
+class PRTSSequence:
+    """A named PRTS: its shift register, its state duration and where it comes from.
+
+    Attributes
+    ----------
+    name : str
+    registers : int
+        Register length n; the sequence has 3ⁿ − 1 states. [-]
+    taps, seed : tuple of int
+        As for :func:`prts_sequence`. [-]
+    state_duration : float
+        Time per state. [s]
+    citation : str
+        The source, and what of it is posturelab's own.
+    """
+
+    name: str
+    registers: int
+    taps: tuple[int, ...]
+    seed: tuple[int, ...]
+    state_duration: float
+    citation: str
+
+    @property
+    def states(self) -> int:
+        """3ⁿ − 1. [-]"""
+        return 3 ** self.registers - 1
+
+    @property
+    def cycle(self) -> float:
+        """states × state_duration. [s]"""
+        return self.states * self.state_duration
+
+
+_COMTEST_TAPS, _COMTEST_SEED = peterka_register((0, 0, -1, 1), (0, 0, 0, 1))
+_PETERKA_242_TAPS, _PETERKA_242_SEED = peterka_register((0, 0, 1, -1, -1), (2, 0, 2, 0, 2))
+
+#: The named sequences. Sources (found with posturelab's search tool; see each citation):
+#: the COMTEST analysis code github.com/VittorioFreiburg/COMTEST, ANALYSIS/MATLAB/PRTS2012.m
+#: and PRTS2020.m ("Calc of the theoretical stimulus": pseudogen3(4, [0 0 −1 1], [0 0 0 1],
+#: 25) at 100 samples/s, 80 × 25 samples per cycle); for the 242-state register, Matlab
+#: code of Peterka's group and of others that follow Peterka 2002 (pseudogen3(5,
+#: [0 0 1 −1 −1], [2 0 2 0 2], …) "% 242 state sequence"; a script that cites the paper
+#: gives [2 0 2 0 2] as "the given initial sequence from the paper").
+PRTS_SEQUENCES: dict[str, PRTSSequence] = {
+    "posturelab-80": PRTSSequence(
+        "posturelab-80", 4, POSTURELAB_80_TAPS, POSTURELAB_80_SEED, 0.25,
+        "posturelab's own 80-state sequence (register x⁴ + 2x + 2 over GF(3), seed 1000), "
+        "0.25 s per state, 20 s cycle: the length, state time and 11-band analysis of the "
+        "80-state PRTS of the Eurobench COMTEST protocol (Lippi, Mergner et al.; "
+        "github.com/VittorioFreiburg/COMTEST, ANALYSIS/MATLAB/PRTS2020.m), not its register "
+        "(that is 'comtest-80'); not Peterka 2002's (that is 'peterka-2002-242')"),
+    "comtest-80": PRTSSequence(
+        "comtest-80", 4, _COMTEST_TAPS, _COMTEST_SEED, 0.25,
+        "The 80-state PRTS of the Eurobench COMTEST protocol's analysis code (Lippi, Mergner "
+        "et al.; github.com/VittorioFreiburg/COMTEST, ANALYSIS/MATLAB/PRTS2012.m, "
+        "PRTS2020.m: pseudogen3(4, [0 0 −1 1], [0 0 0 1], 25) at 100 samples/s, i.e. 0.25 s "
+        "per state, 20 s cycle); the register as posturelab reads pseudogen3's arguments "
+        "(peterka_register), and the cycle's start where the register's does (COMTEST "
+        "shifts its copy by 912 samples)"),
+    "peterka-2002-242": PRTSSequence(
+        "peterka-2002-242", 5, _PETERKA_242_TAPS, _PETERKA_242_SEED, 0.25,
+        PETERKA_2002_CITATION + "; the register pseudogen3(5, [0 0 1 −1 −1], [2 0 2 0 2]) "
+        "as Matlab code of Peterka's group and of others following the paper writes it "
+        "(peterka_register), not checked here against the paper's own appendix"),
+}
+#: The sequence of ``--tilt prts:A`` and of :meth:`PRTSTilt.named` without a name.
+DEFAULT_PRTS = "posturelab-80"
+
+
+def get_prts_sequence(name: str) -> PRTSSequence:
+    """The named sequence :data:`PRTS_SEQUENCES` [name].
+
+    Raises
+    ------
+    UnknownNameError
+        Naming the known sequences.
+    """
+    from ..errors import UnknownNameError
+
+    key = str(name).strip().lower()
+    if key not in PRTS_SEQUENCES:
+        raise UnknownNameError(f"unknown PRTS sequence {name!r}; known sequences: "
+                               f"{', '.join(PRTS_SEQUENCES)}")
+    return PRTS_SEQUENCES[key]
 
 
 @dataclass(frozen=True)
@@ -337,8 +450,8 @@ class PRTSTilt(Tilt):
     amplitude: float
     state_duration: float = 0.25
     registers: int = 4
-    taps: tuple[int, ...] = PETERKA_TAPS
-    seed: tuple[int, ...] = PETERKA_SEED
+    taps: tuple[int, ...] = POSTURELAB_80_TAPS
+    seed: tuple[int, ...] = POSTURELAB_80_SEED
     _term: TiltTerm = field(init=False, repr=False, compare=False, default=None)
 
     def __post_init__(self) -> None:
@@ -367,10 +480,27 @@ class PRTSTilt(Tilt):
         return False
 
     @classmethod
+    def named(cls, name: str = DEFAULT_PRTS, amplitude: float = 0.035) -> PRTSTilt:
+        """The named sequence ``name`` (:data:`PRTS_SEQUENCES`, each with its source) at its
+        own state duration, peak-to-peak ``amplitude`` [rad]."""
+        seq = get_prts_sequence(name)
+        return cls(amplitude, seq.state_duration, seq.registers, seq.taps, seq.seed)
+
+    @classmethod
     def peterka_2002(cls, amplitude: float) -> PRTSTilt:
-        """Peterka's 80-state PRTS with 0.25 s per state (a 20 s cycle), peak-to-peak
-        ``amplitude`` [rad] (:data:`PETERKA_2002_CITATION`)."""
-        return cls(amplitude, 0.25, 4, PETERKA_TAPS, PETERKA_SEED)
+        """Former name of ``PRTSTilt.named("posturelab-80", amplitude)``, kept so that
+        existing code runs: posturelab's own 80-state, 20 s sequence, which is NOT Peterka
+        2002's (that is ``named("peterka-2002-242")``, 242 states, 60.5 s)."""
+        return cls.named("posturelab-80", amplitude)
+
+    @property
+    def sequence_name(self) -> str | None:
+        """The name of this register in :data:`PRTS_SEQUENCES` (whatever the state duration),
+        None for another register."""
+        for seq in PRTS_SEQUENCES.values():
+            if (seq.registers, seq.taps, seq.seed) == (self.registers, self.taps, self.seed):
+                return seq.name
+        return None
 
     @cached_property
     def velocity_sequence(self) -> np.ndarray:
@@ -395,7 +525,9 @@ class PRTSTilt(Tilt):
         return self.state_duration
 
     def describe(self) -> str:
-        return (f"PRTS tilt {self.amplitude:g} rad peak to peak, {self.velocity_sequence.size} "
+        name = self.sequence_name
+        return (f"PRTS tilt {self.amplitude:g} rad peak to peak"
+                + (f" ({name})" if name else "") + f", {self.velocity_sequence.size} "
                 f"states of {self.state_duration:g} s ({self.cycle:g} s cycle)")
 
 

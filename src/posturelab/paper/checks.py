@@ -649,7 +649,7 @@ def literature_controller_finding(foot: BaseOfSupport, name: str = "peterka-2002
     return LiteratureControllerFinding(
         preset.name, preset.citation, preset.feedback_delay,
         float(delay_margin(body, muscles).delay_margin), RECOVERY_RAMP_DURATION,
-        search(True), search(False))
+        search(True), search(False), preset.provenance_text())
 
 
 def strategy_finding(body: Body, foot: BaseOfSupport, ankle_torque_limit: float = 60.0
@@ -701,13 +701,15 @@ class FRFExperiment:
     noise: float
 
 
-@functools.lru_cache(maxsize=2)
-def frf_experiment(seed: int = 20261201) -> FRFExperiment:
-    """The ``peterka-2002`` preset on ``paper-1link`` under Peterka's PRTS (0.035 rad peak to
-    peak; compiled engine, 6 cycles at 100 Hz, the first discarded, seeded sensor noise of
-    1 mrad), estimated at the 11 bands and fitted for K_P, K_D and τ from 20 % off."""
-    from ..frequency import estimate_frf
-    from ..frequency.fit import fit_frf
+#: Seeds of the fit-back spread (:func:`fit_back_errors`): the report's own and 19 more. [-]
+FIT_BACK_SEEDS: tuple[int, ...] = (20261201, *range(1, 20))
+
+
+@functools.lru_cache(maxsize=1)
+def _frf_run():
+    """The ``peterka-2002`` preset on ``paper-1link`` under posturelab's 80-state PRTS
+    (0.035 rad peak to peak; compiled engine, 6 cycles at 100 Hz): body, preset, muscles,
+    tilt, run (noise-free; the sensor noise is added after, outside the loop)."""
     from ..model.body import get_body
     from ..model.controllers import get_controller
     from ..model.tilt import PRTSTilt
@@ -716,27 +718,63 @@ def frf_experiment(seed: int = 20261201) -> FRFExperiment:
     body = get_body("paper-1link")
     preset = get_controller("peterka-2002")
     muscles = preset.muscles(body)
-    cycles, noise, fs = 5, 0.001, 100.0
-    tilt = PRTSTilt.peterka_2002(0.035)
-    r = simulate(body, muscles, None, 20.0 * (cycles + 1), tilt=tilt, sample_rate=fs,
+    tilt = PRTSTilt.named("posturelab-80", 0.035)
+    r = simulate(body, muscles, None, 20.0 * (FRF_CYCLES + 1), tilt=tilt, sample_rate=100.0,
                  engine="compiled", **preset.run_options())
+    return body, preset, muscles, tilt, r
+
+
+#: Cycles analysed in the report's PRTS experiment (one more runs first, dropped). [-]
+FRF_CYCLES = 5
+#: Standard deviation of its white sensor noise. [rad]
+FRF_NOISE = 0.001
+
+
+def _fit_back(seed: int):
+    """Estimate and fit of the report's PRTS experiment with the sensor noise of ``seed``:
+    (estimate, true (K_P, K_D, τ), fit)."""
+    from ..frequency import estimate_frf
+    from ..frequency.fit import fit_frf
+
+    body, preset, muscles, tilt, r = _frf_run()
     rng = np.random.default_rng(seed)
-    sway = r.theta[:-1, 0] + rng.normal(0.0, noise, r.time.size - 1)
-    est = estimate_frf(tilt.angle(r.time[:-1]), sway, fs, 20.0, discard_cycles=1,
+    sway = r.theta[:-1, 0] + rng.normal(0.0, FRF_NOISE, r.time.size - 1)
+    est = estimate_frf(tilt.angle(r.time[:-1]), sway, 100.0, 20.0, discard_cycles=1,
                        response_sign=-1)
     true = (muscles.active_stiffnesses[0], muscles.active_viscosities[0], preset.feedback_delay)
     start = muscles.with_active_feedback([0.8 * true[0]], [1.2 * true[1]])
     fit = fit_frf(body, start, est, ["active_stiffness", "active_viscosity", "feedback_delay"],
                   feedback_delay=0.8 * true[2])
-    return FRFExperiment(est, tuple(float(v) for v in true),
-                         tuple(float(v) for v in fit.estimates),
+    return est, tuple(float(v) for v in true), fit
+
+
+def fit_back_errors(seeds=FIT_BACK_SEEDS) -> np.ndarray:
+    """Relative error fitted/true − 1 of K_P, K_D and τ of the report's PRTS experiment for
+    each seed of the sensor noise (the same noise-free run), shape (S, 3). [-]"""
+    rows = []
+    for seed in seeds:
+        _, true, fit = _fit_back(int(seed))
+        rows.append(np.asarray(fit.estimates, dtype=float) / np.asarray(true) - 1.0)
+    return np.array(rows)
+
+
+@functools.lru_cache(maxsize=2)
+def frf_experiment(seed: int = 20261201) -> FRFExperiment:
+    """The ``peterka-2002`` preset on ``paper-1link`` under posturelab's 80-state PRTS
+    (0.035 rad peak to peak; compiled engine, 6 cycles at 100 Hz, the first discarded,
+    seeded sensor noise of 1 mrad), estimated at the 11 bands and fitted for K_P, K_D and τ
+    from 20 % off."""
+    est, true, fit = _fit_back(seed)
+    return FRFExperiment(est, true, tuple(float(v) for v in fit.estimates),
                          tuple(float(v) for v in fit.standard_errors), float(fit.fit_error),
-                         cycles, noise)
+                         FRF_CYCLES, FRF_NOISE)
 
 
 def frf_finding(seed: int = 20261201) -> FRFFinding:
     """The tilt FRFs of case 1 and of ``peterka-2002`` on ``paper-1link`` at 0.05, 0.55 and
-    2.2 Hz, and the simulated PRTS experiment of :func:`frf_experiment` fitted."""
+    2.2 Hz, the simulated PRTS experiment of :func:`frf_experiment` fitted, and the fit-back
+    errors over the :data:`FIT_BACK_SEEDS` noise realisations (:func:`fit_back_errors`:
+    median and largest |error| per parameter)."""
     from ..frequency import model_frf
     from ..model.body import get_body, paper_body
     from ..model.controllers import get_controller
@@ -751,7 +789,10 @@ def frf_finding(seed: int = 20261201) -> FRFFinding:
     def phase(h):
         return tuple(float(p) for p in np.degrees(np.unwrap(np.angle(h))))
 
+    errors = np.abs(fit_back_errors()) * 100.0
     return FRFFinding(tuple(float(v) for v in f), tuple(float(v) for v in np.abs(paper)),
                       phase(paper), tuple(float(v) for v in np.abs(delayed)), phase(delayed),
                       exp.true, exp.fitted, exp.standard_error, exp.cycles, exp.noise,
-                      exp.fit_error)
+                      exp.fit_error, len(FIT_BACK_SEEDS),
+                      tuple(float(v) for v in np.median(errors, axis=0)),
+                      tuple(float(v) for v in errors.max(axis=0)))

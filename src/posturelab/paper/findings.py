@@ -17,6 +17,7 @@ from ..simulation.results import SimulationResult
 __all__ = ["Outcome", "FootExcursion", "OneSidedFinding", "FOOT_RUN_LABELS", "FootFinding",
            "RecoveryFinding", "DelayFinding", "LiteratureControllerFinding", "StrategyFinding",
            "HUMAN_RECOVERY_CITATION", "HUMAN_RECOVERY_YOUNG", "HUMAN_RECOVERY_OLDER",
+           "HUMAN_RECOVERY_PROTOCOL",
            "FRFFinding"]
 
 #: Largest backward platform displacement recovered without stepping (PMC6338353): young
@@ -28,6 +29,11 @@ HUMAN_RECOVERY_CITATION = (
     "Maximal backward support-surface displacement recovered without stepping: 16.2 ± 2.6 cm "
     "(young, 20–30 years) and 11.8 ± 2.1 cm (older, 70–80 years); PMC6338353"
 )
+#: What posturelab knows of that study's platform motion: its displacement, velocity and
+#: acceleration profile were not found (posturelab's search tool reached neither the paper's
+#: text nor a summary of its protocol), so no model run can use the same profile, and the
+#: comparison below is stated as not like for like.
+HUMAN_RECOVERY_PROTOCOL: str | None = None
 
 
 @dataclass(frozen=True)
@@ -335,9 +341,11 @@ class LiteratureControllerFinding:
     ramp_duration : float
         The backward ramp-and-hold's duration. [s]
     by_cop : float
-        Largest recoverable displacement before the foot tips. [m]
+        Largest recoverable displacement before the foot tips (the centre of pressure leaves
+        the foot): the bound compared with people. [m]
     by_cog : float
-        Largest before the centre of gravity leaves the foot. [m]
+        Largest before the centre of gravity leaves the foot, the centre of pressure allowed
+        past the toe (a foot that cannot tip); not compared with people. [m]
     """
 
     controller: str
@@ -347,11 +355,25 @@ class LiteratureControllerFinding:
     ramp_duration: float
     by_cop: float
     by_cog: float
+    provenance: str = ""
 
     @property
     def text(self) -> str:
         """The finding in words, with its numbers."""
         young, older = HUMAN_RECOVERY_YOUNG, HUMAN_RECOVERY_OLDER
+        if HUMAN_RECOVERY_PROTOCOL is None:
+            protocol = (
+                "That study's platform protocol (its displacement, velocity and acceleration "
+                "profile) is not known to posturelab, so the model's profile above is "
+                "posturelab's choice and the two are not comparable like for like: a "
+                "different speed or acceleration moves the model's bound. The model's "
+                f"{self.by_cop * 100:.1f} cm against people's "
+                f"{young[0] * 100:.1f} cm says only that this linear ankle controller, "
+                "with its foot flat until it tips, recovers "
+                + ("less" if self.by_cop < young[0] else "as much or more")
+                + " under this profile.")
+        else:  # pragma: no cover - filled in when the protocol is known
+            protocol = f"The model ran that study's profile: {HUMAN_RECOVERY_PROTOCOL}."
         return (
             f"A delayed controller from the literature ({self.controller}: {self.citation}) on "
             "the paper's body lumped into one link (paper-1link): intrinsic ankle impedance "
@@ -360,13 +382,14 @@ class LiteratureControllerFinding:
             f"{(self.delay_margin - self.feedback_delay) * 1000:.0f} ms to spare. On a "
             f"backward ramp-and-hold of the platform over {self.ramp_duration:g} s (one sine "
             "cycle of acceleration, peak speed twice the mean) with the typical foot, it "
-            f"recovers up to {self.by_cop * 100:.1f} cm before the centre of pressure passes "
-            f"the toe, and up to {self.by_cog * 100:.1f} cm before the centre of gravity "
-            f"leaves the foot. People recover {young[0] * 100:.1f} ± {young[1] * 100:.1f} cm "
+            f"recovers up to {self.by_cop * 100:.1f} cm before the centre of pressure leaves "
+            "the foot (the foot tips): the bound consistent with a foot that can tip, and the "
+            "one to set beside people's. (A centre-of-gravity criterion alone, which lets the "
+            f"centre of pressure pass the toe, would allow {self.by_cog * 100:.1f} cm; no "
+            f"foot allows that.) People recover {young[0] * 100:.1f} ± {young[1] * 100:.1f} cm "
             f"(young) and {older[0] * 100:.1f} ± {older[1] * 100:.1f} cm (older) without "
-            "stepping (PMC6338353): the centre-of-gravity bound lies in the young range, the "
-            "centre-of-pressure bound far below both, so people recover by more than a linear "
-            "ankle controller whose foot stays flat can."
+            f"stepping (PMC6338353). {protocol}"
+            + (f" The preset's numbers: {self.provenance}" if self.provenance else "")
         )
 
 
@@ -432,6 +455,12 @@ class FRFFinding:
         PRTS cycles used (20 s each, one more discarded). [-]
     noise : float
         Standard deviation of the white sensor noise added to the sway. [rad]
+    fit_error : float
+        Weighted RMS residual of the shown fit. [-]
+    seeds : int
+        Noise realisations of the fit-back spread. [-]
+    median_error, max_error : tuple of float
+        Median and largest |fitted/true − 1| over them, K_P, K_D, τ. [%]
     """
 
     frequency: tuple
@@ -445,6 +474,9 @@ class FRFFinding:
     cycles: int
     noise: float
     fit_error: float = float("nan")
+    seeds: int = 0
+    median_error: tuple = ()
+    max_error: tuple = ()
 
     @property
     def text(self) -> str:
@@ -458,6 +490,11 @@ class FRFFinding:
         fit = "; ".join(f"{n} {f:.4g} ± {s:.2g} {u} (true {t:.4g})" for n, f, s, u, t in zip(
             names, self.fitted, self.standard_error, units, self.true, strict=True))
         paper = row(self.paper_gain, self.paper_phase)
+        spread = ("" if not self.seeds else
+                  f"over {self.seeds} seeds of the sensor noise (the same run) the median "
+                  "(largest) error is " + ", ".join(
+                      f"{n} {m:.2f} % ({x:.2f} %)" for n, m, x in zip(
+                          names, self.median_error, self.max_error, strict=True)) + ".")
         delayed = row(self.delayed_gain, self.delayed_phase)
         return (
             "Frequency response to surface tilt (posturelab.frequency; a body that follows the "
@@ -469,11 +506,11 @@ class FRFFinding:
             "delayed controller's phase keeps falling past −180° with frequency, the shape "
             "people's FRFs have; the paper's instantaneous impedance stays near −90°. A "
             "simulated PRTS "
-            f"experiment with it ({self.cycles} cycles of Peterka's 80-state sequence, "
+            f"experiment with it ({self.cycles} cycles of posturelab's 80-state sequence, "
             f"{self.noise * 1000:.1f} mrad of white sensor noise on the sway, seeded) gives, "
             f"fitted to its 11-band FRF: {fit}; fit error {self.fit_error:.2g} (the weighted "
-            "RMS residual). Each estimate is within 0.5 % of the truth; the few-SE offsets of "
-            "K_P are the sway's small nonlinearity at this amplitude, which the linear FRF "
-            "leaves out (noise-free, it is 0.04 % at 0.035 rad and vanishes at 0.0035 rad), a "
-            "bias that noise-based intervals do not include."
+            f"RMS residual). That is one seed; {spread} The few-SE offsets of K_P are the "
+            "sway's small nonlinearity at this amplitude, which the linear FRF leaves out "
+            "(noise-free, it is 0.04 % at 0.035 rad and vanishes at 0.0035 rad), a bias that "
+            "noise-based intervals do not include."
         )

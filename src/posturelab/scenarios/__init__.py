@@ -32,8 +32,9 @@ Schema (every table optional except where noted; units in brackets)::
     type = "sine"                        # sine | raised-cosine | prts | profile
     # sine: amplitude [rad], frequency [Hz], phase [rad]
     # raised-cosine: amplitude [rad], duration [s], start [s]
-    # prts: amplitude [rad] peak to peak; state_duration [s], registers, taps, seed
-    #       (default: Peterka 2002's 80-state, 20 s sequence)
+    # prts: amplitude [rad] peak to peak; sequence = "posturelab-80" (default: posturelab's
+    #       own 80-state, 20 s one), "comtest-80" or "peterka-2002-242"; or a register:
+    #       registers, taps, seed; state_duration [s]
     # profile: file = "tilt.csv" with columns time [s] and tilt [rad]
     axis_depth = 0.0                     # the tilt axis this far below the ankle [m]
 
@@ -90,7 +91,7 @@ from typing import Any
 import numpy as np
 
 from .._validation import finite_array, finite_float, reject_unknown_keys
-from ..errors import ParameterError, PostureLabError, ScenarioError
+from ..errors import ParameterError, PostureLabError, ScenarioError, UnknownNameError
 from ..model.body import Body, Segment, get_body
 from ..model.muscles import MusclePair, MuscleSet, paper_muscles
 from ..model.noise import MotorNoise
@@ -112,6 +113,7 @@ from ..model.tilt import (
     RaisedCosineTilt,
     SineTilt,
     Tilt,
+    get_prts_sequence,
     read_tilt_csv,
 )
 from ..simulation.engines import engine_name, simulate
@@ -400,7 +402,7 @@ def _budget(origin: str, value, check):
 
 
 TILT_KEYS = ("type", "amplitude", "frequency", "phase", "duration", "start", "state_duration",
-             "registers", "taps", "seed", "file", "axis_depth")
+             "registers", "taps", "seed", "sequence", "file", "axis_depth")
 
 
 def _parse_tilt(tt: dict, base_dir: Path, origin: str) -> Tilt | None:
@@ -410,7 +412,8 @@ def _parse_tilt(tt: dict, base_dir: Path, origin: str) -> Tilt | None:
     kind = tt.get("type")
     allowed = {"sine": ("amplitude", "frequency", "phase"),
                "raised-cosine": ("amplitude", "duration", "start"),
-               "prts": ("amplitude", "state_duration", "registers", "taps", "seed"),
+               "prts": ("amplitude", "state_duration", "registers", "taps", "seed",
+                        "sequence"),
                "profile": ("file",)}
     if kind not in allowed:
         raise ScenarioError(f"{origin}: tilt.type must be one of {', '.join(allowed)}; "
@@ -422,8 +425,19 @@ def _parse_tilt(tt: dict, base_dir: Path, origin: str) -> Tilt | None:
         if kind == "raised-cosine":
             return RaisedCosineTilt(tt.get("amplitude"), tt.get("duration"), tt.get("start", 0.0))
         if kind == "prts":
+            if "sequence" in tt:  # a named one: its register and state duration
+                if set(tt) & {"registers", "taps", "seed"}:
+                    raise ScenarioError(f"{origin}: tilt (type prts) takes sequence or a "
+                                        "register (registers, taps, seed), not both")
+                try:
+                    seq = get_prts_sequence(str(tt["sequence"]))
+                except UnknownNameError as exc:
+                    raise ScenarioError(f"{origin}: tilt.sequence: {exc}") from None
+                return PRTSTilt(tt.get("amplitude"),
+                                tt.get("state_duration", seq.state_duration), seq.registers,
+                                seq.taps, seq.seed)
             if set(tt) <= {"type", "amplitude"}:
-                return PRTSTilt.peterka_2002(tt.get("amplitude"))
+                return PRTSTilt.named("posturelab-80", tt.get("amplitude"))
             return PRTSTilt(tt.get("amplitude"), tt.get("state_duration", 0.25),
                             tt.get("registers", 4), tuple(tt.get("taps", PETERKA_TAPS)),
                             tuple(tt.get("seed", PETERKA_SEED)))

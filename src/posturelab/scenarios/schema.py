@@ -89,6 +89,7 @@ class TiltTable(_Table):
     registers: int | None = None
     taps: list[int] | None = None
     seed: int | None = None
+    sequence: str | None = None
     file: str | None = None
     axis_depth: float | None = None
 

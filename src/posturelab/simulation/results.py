@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import PostureLabError
+from .outcome import StimulusTiming
 
 __all__ = ["SimulationResult", "DerivedSeries", "atomic_write_text", "atomic_write_bytes",
            "new_file_mode", "read_run_csv"]
@@ -139,6 +140,10 @@ class SimulationResult:
         relative to the ankle. [m]
     derived : DerivedSeries or callable returning one
         Where the derived series come from (see above).
+    stimulus : StimulusTiming or None
+        When the perturbation acts (:mod:`posturelab.simulation.outcome`): a transient one
+        ends (settling is counted from then), a sustained one lasts the run (its outcome is
+        a steady sway). None: a transient one that ends at t = 0.
     """
 
     time: np.ndarray
@@ -154,6 +159,7 @@ class SimulationResult:
     description: str = ""
     derived: DerivedSeries | Callable[[], DerivedSeries] | None = field(
         default=None, repr=False)
+    stimulus: StimulusTiming | None = None
 
     @functools.cached_property
     def _series(self) -> DerivedSeries:
@@ -221,30 +227,60 @@ class SimulationResult:
         return hip_fraction(self.theta)
 
     def settling_time(self, tolerance: float = 0.01) -> float | None:
-        """Last time any |θ_i| exceeded ``tolerance`` [rad]; None if it never settled. [s]"""
+        """Time from the end of the perturbation (``stimulus.end``; 0 for a velocity step)
+        to the last sample after it at which some |θ_i| exceeded ``tolerance`` [rad] (0 if
+        none did); None if the run fell, ended outside, or the stimulus is sustained. [s]"""
+        timing = self.stimulus or StimulusTiming()
+        if timing.sustained:
+            return None
         outside = np.any(np.abs(self.theta) > tolerance, axis=1)
         if self.fell or outside[-1]:
             return None
-        if not outside.any():
+        after = outside & (self.time >= timing.end)
+        if not after.any():
             return 0.0
-        return float(self.time[np.nonzero(outside)[0][-1]])
+        return float(self.time[np.nonzero(after)[0][-1]]) - timing.end
+
+    def steady_sway(self, centre_of_pressure: bool = True):
+        """RMS and peak of each θ_i [rad] and of the centre of pressure [m] over the steady
+        part of a run under a sustained stimulus
+        (:class:`posturelab.simulation.outcome.SteadySway`); None for a transient one.
+        ``centre_of_pressure=False`` leaves the centre of pressure out (it needs the derived
+        series, which cost about ten times the compiled run itself)."""
+        from .outcome import steady_sway
+
+        timing = self.stimulus
+        if timing is None or not timing.sustained:
+            return None
+        cop = None
+        if centre_of_pressure:
+            try:
+                cop = self.centre_of_pressure
+            except PostureLabError:  # built without its derived series
+                cop = None
+        return steady_sway(self.time, self.theta, cop,
+                           timing.steady_start(float(self.time[-1])))
 
     @property
     def outcome(self):
-        """What happened: recovered, not recovered, fell or failed, with the settling time,
-        the fall's reason and time, the final lean and rate
-        (:class:`posturelab.simulation.outcome.Outcome`; the bands there)."""
+        """What happened: recovered, not recovered, steady sway, fell or failed, with the
+        settling time, the steady sway, the fall's reason and time, the final lean and rate
+        (:class:`posturelab.simulation.outcome.Outcome`; the rules there)."""
         from .outcome import UPRIGHT_BAND, classify
 
+        timing = self.stimulus or StimulusTiming()
+        steady = self.steady_sway() if self.status == "completed" else None
         return classify(self.status, self.settling_time(UPRIGHT_BAND), self.final_state,
                         fall_time=self.fall_time, fall_reason=self.fall_reason,
-                        message=self.message)
+                        message=self.message, timing=timing, steady=steady)
 
     def summary(self) -> dict:
         """Plain-Python summary (the CLI's ``--json``): the outcome (``outcome``,
         ``settling_time``, ``fall_time``, ``fall_reason``, ``final_lean``, ``final_rate``,
-        ``outcome_message``), angles [rad], rates [rad/s], times [s], the hip fraction [-]
-        (None for one link)."""
+        ``outcome_message``, ``perturbation_end``, and for a steady sway ``steady_from``,
+        ``steady_rms_theta``, ``steady_peak_theta`` [rad], ``steady_rms_cop``,
+        ``steady_peak_cop`` [m]), angles [rad], rates [rad/s], times [s], the hip fraction
+        [-] (None for one link)."""
         return {
             **self.outcome.to_dict(),
             "fell": bool(self.fell),

@@ -118,6 +118,21 @@ OUTCOME_UNITS: dict[str, str] = {"outcome": "", "failure": "", "fell": "", "fall
                                  "peak_theta1": "rad", "peak_theta2": "rad",
                                  "peak_theta3": "rad", "settling_time": "s",
                                  "final_lean": "rad", "final_rate": "rad/s"}
+#: Columns added after :data:`OUTCOME_COLUMNS` under a sustained stimulus (periodic or PRTS
+#: tilt, sum of sines, motor noise), per link i: ``steady_rms_theta{i}``,
+#: ``steady_peak_theta{i}`` [rad] (RMS about upright and peak |·| over the steady part:
+#: :mod:`posturelab.simulation.outcome`); ``steady_rms_cop``, ``steady_peak_cop`` [m] follow
+#: only when the batch carries them (a sweep does not: single runs report them).
+STEADY_COLUMN_PREFIXES = ("steady_rms_theta", "steady_peak_theta", "steady_rms_cop",
+                          "steady_peak_cop")
+
+
+def _steady_unit(name: str) -> str:
+    if name.startswith(("steady_rms_theta", "steady_peak_theta")):
+        return "rad"
+    return "m" if name in ("steady_rms_cop", "steady_peak_cop") else ""
+
+
 #: Angle threshold of the settling time. [rad]
 SETTLE_TOLERANCE = UPRIGHT_BAND
 
@@ -404,11 +419,18 @@ class SweepResult:
         cols.append(("settling_time", o.settling_time))
         cols.append(("final_lean", np.abs(o.final_state[:, :n]).max(axis=1)))
         cols.append(("final_rate", np.abs(o.final_state[:, n:]).max(axis=1)))
+        if o.steady_rms_theta is not None:  # a sustained stimulus: the steady sway
+            for i in range(n):
+                cols.append((f"steady_rms_theta{i + 1}", o.steady_rms_theta[:, i]))
+                cols.append((f"steady_peak_theta{i + 1}", o.steady_peak_theta[:, i]))
+            if o.steady_rms_cop is not None:
+                cols.append(("steady_rms_cop", o.steady_rms_cop))
+                cols.append(("steady_peak_cop", o.steady_peak_cop))
         return cols
 
     def units(self) -> dict[str, str]:
         """The unit of each column that has one."""
-        return {name: PARAMETER_UNITS.get(name, OUTCOME_UNITS.get(name, ""))
+        return {name: PARAMETER_UNITS.get(name, OUTCOME_UNITS.get(name, _steady_unit(name)))
                 for name, _ in self.columns()}
 
     def to_csv_text(self) -> str:
@@ -520,6 +542,63 @@ class _Task:
     atol: float
 
     def run(self, grid: SweepGrid, lo: int, hi: int, parallel: bool) -> BatchResult:
+        result = self._batch(grid, lo, hi, parallel)
+        if result.stimulus is not None and result.stimulus.sustained:
+            result = self._with_steady_sway(result, grid, lo, hi)
+        return result
+
+    def _steady_row(self, grid: SweepGrid, r: int):
+        """Row ``r`` run alone on the compiled engine: its steady sway (or None)."""
+        from dataclasses import replace
+
+        from ..simulation.engines import simulate
+
+        sc = self.scenario
+        pairs = []
+        for j, pair in enumerate(sc.muscles.pairs):
+            extra = {} if grid.active_stiffness is None else {
+                "active_stiffness": float(grid.active_stiffness[r, j]),
+                "active_viscosity": float(grid.active_viscosity[r, j])}
+            pairs.append(replace(pair, stiffness=float(grid.stiffness[r, j]),
+                                 viscosity=float(grid.viscosity[r, j]), **extra))
+        muscles = type(sc.muscles)(tuple(pairs), sc.muscles.n_links)
+        disturbance = sc.disturbance
+        if grid.disturbance_scale is not None:
+            disturbance = disturbance.scaled(float(grid.disturbance_scale[r]))
+        limits = None if grid.torque_limits is None else grid.torque_limits[r]
+        weight = (sc.proprioceptive_weight if grid.proprioceptive_weight is None
+                  else float(grid.proprioceptive_weight[r]))
+        run = simulate(
+            sc.body, muscles, disturbance, sc.duration, initial_state=sc.initial_state,
+            rates_from=sc.rates_from, knee=sc.knee, fall=sc.fall, torque_limits=limits,
+            feedback_delay=float(grid.feedback_delay[r]), rtol=self.rtol, atol=self.atol,
+            sample_rate=sc.sample_rate, engine="compiled", tilt=sc.tilt,
+            proprioceptive_weight=weight, tilt_axis_depth=sc.tilt_axis_depth,
+            motor_noise=sc.motor_noise, max_steps=sc.max_steps, time_limit=sc.time_limit)
+        return run.steady_sway(centre_of_pressure=False)
+
+    def _with_steady_sway(self, result: BatchResult, grid: SweepGrid, lo: int,
+                          hi: int) -> BatchResult:
+        """The batch's rows with their steady sway: under a sustained stimulus each row that
+        completed is run again, alone on the compiled engine, for its trajectory (the batch
+        keeps none), and the RMS and peak of its angles over the steady part are computed as
+        for one run (:meth:`SimulationResult.steady_sway`; the centre of pressure's would
+        cost ten times the run, so a sweep leaves it to single runs)."""
+        from dataclasses import replace
+
+        n = self.scenario.body.n_links
+        m = hi - lo
+        rms, peak = np.full((m, n), np.nan), np.full((m, n), np.nan)
+        rows = [int(k) for k in np.nonzero(result.status == "completed")[0]]
+        # (one at a time: the rerun is mostly Python, which threads would not speed up)
+        sways = [self._steady_row(grid, lo + k) for k in rows]
+        for k, sway in zip(rows, sways, strict=True):
+            if sway is None:
+                continue
+            rms[k], peak[k] = sway.rms_theta, sway.peak_theta
+        return replace(result, steady_rms_theta=rms, steady_peak_theta=peak)
+
+    def _batch(self, grid: SweepGrid, lo: int, hi: int, parallel: bool) -> BatchResult:
         sc = self.scenario
         return simulate_batch(
             sc.body, grid.stiffness[lo:hi], grid.viscosity[lo:hi], sc.disturbance,
@@ -550,8 +629,12 @@ def _concatenate(parts: list[BatchResult]) -> BatchResult:
         return parts[0]
     fields = ("fell", "fall_time", "peak_theta", "settling_time", "final_state", "status_code",
               "n_steps", "n_switches")
+    steady = ("steady_rms_theta", "steady_peak_theta", "steady_rms_cop", "steady_peak_cop")
     return BatchResult(**{f: np.concatenate([getattr(p, f) for p in parts]) for f in fields},
-                       settle_tolerance=parts[0].settle_tolerance)
+                       settle_tolerance=parts[0].settle_tolerance,
+                       stimulus=parts[0].stimulus,
+                       **{f: (None if getattr(parts[0], f) is None else
+                              np.concatenate([getattr(p, f) for p in parts])) for f in steady})
 
 
 class ProgressBar:

@@ -46,6 +46,7 @@ from ...model.platform import Disturbance
 from ...model.tilt import Tilt, check_proprioceptive_weight, tilt_pair_gains
 from ..derived import derived_series
 from ..engines import simulate
+from ..outcome import StimulusTiming, stimulus_timing
 from ..results import SimulationResult
 from ..setup import (
     RunSetup,
@@ -286,6 +287,7 @@ def integrate_compiled(setup: RunSetup, method: str | None = None) -> Simulation
         fall_time=fall_time, fall_reason=fall_reason,
         switch_times=tuple(float(v) for v in switches), description=setup.description,
         derived=derive,
+        stimulus=stimulus_timing(setup.disturbance, setup.tilt, setup.motor_noise),
     )
 
 
@@ -334,8 +336,9 @@ class BatchResult:
     peak_theta : numpy.ndarray, shape (M, N)
         Peak |θ_i| over the samples (``SimulationResult.max_abs_theta``). [rad]
     settling_time : numpy.ndarray, shape (M,)
-        Last sample time at which some |θ_i| exceeded ``settle_tolerance``; 0 if
-        none did; NaN if the run fell or had not settled by its last sample
+        From the end of the perturbation (``stimulus.end``) to the last sample time at
+        which some |θ_i| exceeded ``settle_tolerance``; 0 if none did after it; NaN if the
+        run fell, had not settled by its last sample, or the stimulus is sustained
         (``SimulationResult.settling_time``). [s]
     final_state : numpy.ndarray, shape (M, 2N)
         ``[Θ, Θ̇]`` at the last sample. [rad], [rad/s]
@@ -351,6 +354,15 @@ class BatchResult:
         Angle threshold of the settling time. [rad]
     fall_kind : numpy.ndarray of int64, shape (M,), optional
         Event code of the fall (:mod:`posturelab.model.events`), −1 if none. [-]
+    stimulus : StimulusTiming, optional
+        When the perturbation acts (:mod:`posturelab.simulation.outcome`); None: a
+        transient one that ends at t = 0.
+    steady_rms_theta, steady_peak_theta : numpy.ndarray, shape (M, N), optional
+        Under a sustained stimulus, the RMS and peak |θ_i| over each run's steady part
+        (``SimulationResult.steady_sway``), NaN for a run that did not complete; None when
+        not computed (the batch keeps no trajectories: a sweep computes them). [rad]
+    steady_rms_cop, steady_peak_cop : numpy.ndarray, shape (M,), optional
+        The same of the centre of pressure. [m]
     """
 
     fell: np.ndarray
@@ -363,6 +375,11 @@ class BatchResult:
     n_switches: np.ndarray
     settle_tolerance: float = 0.01
     fall_kind: np.ndarray | None = None
+    stimulus: StimulusTiming | None = None
+    steady_rms_theta: np.ndarray | None = None
+    steady_peak_theta: np.ndarray | None = None
+    steady_rms_cop: np.ndarray | None = None
+    steady_peak_cop: np.ndarray | None = None
 
     @property
     def n_runs(self) -> int:
@@ -382,11 +399,12 @@ class BatchResult:
 
     @property
     def outcome(self) -> np.ndarray:
-        """"recovered", "not recovered", "fell" or "failed" per run
+        """"recovered", "not recovered", "steady sway", "fell" or "failed" per run
         (:mod:`posturelab.simulation.outcome`, as ``SimulationResult.outcome``)."""
         from ..outcome import classify_rows
 
-        return classify_rows(self.status, self.settling_time, self.final_state)
+        sustained = self.stimulus is not None and self.stimulus.sustained
+        return classify_rows(self.status, self.settling_time, self.final_state, sustained)
 
 
 def _per_run(name: str, value, m: int, width: int | None) -> np.ndarray:
@@ -682,15 +700,17 @@ def simulate_batch(
     fall_time = np.where(fell, results[:, R_FALL_TIME], np.nan)
     final_outside = results[:, R_FINAL_OUTSIDE] > 0
     any_outside = results[:, R_ANY_OUTSIDE] > 0
-    settling = np.where(fell | final_outside, np.nan,
-                        np.where(any_outside, results[:, R_LAST_OUTSIDE], 0.0))
+    timing = stimulus_timing(base.disturbance, base.tilt, base.motor_noise)
+    # counted from the end of the perturbation (the C engine gives the last time outside)
+    settling = np.where(fell | final_outside | timing.sustained, np.nan, np.where(
+        any_outside, np.maximum(results[:, R_LAST_OUTSIDE] - timing.end, 0.0), 0.0))
     return BatchResult(
         fell=fell, fall_time=fall_time, peak_theta=peaks, settling_time=settling,
         final_state=finals, status_code=status,
         n_steps=results[:, R_N_STEPS].astype(np.int64),
         n_switches=results[:, R_N_SWITCHES].astype(np.int64),
         settle_tolerance=settle_tolerance,
-        fall_kind=results[:, R_FALL_KIND].astype(np.int64),
+        fall_kind=results[:, R_FALL_KIND].astype(np.int64), stimulus=timing,
     )
 
 
