@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import math
 import sys
@@ -227,6 +228,43 @@ def parse_tilt(text: str):
     if kind == "raised-cosine":
         return RaisedCosineTilt(*values)
     return PRTSTilt(values[0], values[1]) if len(values) == 2 else PRTSTilt.peterka_2002(values[0])
+
+
+@contextlib.contextmanager
+def naming_option(option: str):
+    """Put the command-line ``option`` (as the user typed it) before the message of a
+    ParameterError raised inside, so that a check deep in the model names what was given:
+    ``--duration: duration [s] must be in (0, 86400] s, got 1e+09``."""
+    try:
+        yield
+    except ParameterError as exc:
+        text = str(exc)
+        if text.startswith(option):
+            raise
+        raise ParameterError(f"{option}: {text}") from None
+
+
+#: The message prefix of a run setting's check (simulation/setup.py) -> the option that sets
+#: it on the command line.
+RUN_SETTING_OPTIONS = {"duration [s]": "--duration", "rtol": "--rtol", "atol": "--atol",
+                       "sample_rate [Hz]": "--sample-rate", "max_steps": "--max-steps",
+                       "time_limit [s]": "--time-limit"}
+
+
+@contextlib.contextmanager
+def naming_given_options(args: argparse.Namespace):
+    """Like :func:`naming_option` for the run settings checked when a run is set up: a
+    ParameterError about a setting the user gave (--duration, --rtol, ...) names that
+    option."""
+    try:
+        yield
+    except ParameterError as exc:
+        text = str(exc)
+        for field, option in RUN_SETTING_OPTIONS.items():
+            given = getattr(args, option[2:].replace("-", "_"), None) is not None
+            if given and (text.startswith(field + " ") or text.startswith(field + " ×")):
+                raise ParameterError(f"{option}: {text}") from None
+        raise
 
 
 def print_json(obj) -> None:

@@ -62,6 +62,17 @@ def _axis(axis: str) -> int:
 
 #: Largest platform velocity step: ten times the fastest perturbation of the field. [m/s]
 MAX_PLATFORM_SPEED = 20.0
+#: Largest platform acceleration of a profile, pulse, ramp or sum of sines: posturelab's bound
+#: (not a source's), the largest velocity step (:data:`MAX_PLATFORM_SPEED`) reached in 20 ms,
+#: about 100 g. [m/s²]
+MAX_PLATFORM_ACCELERATION = 1000.0
+
+
+def _check_acceleration(name: str, peak: float) -> None:
+    """ParameterError unless |``peak``| <= :data:`MAX_PLATFORM_ACCELERATION` [m/s²]."""
+    if not abs(peak) <= MAX_PLATFORM_ACCELERATION:
+        raise ParameterError(f"{name} must be within ±{MAX_PLATFORM_ACCELERATION:g} m/s², got "
+                             f"{peak:g}")
 
 
 @dataclass(frozen=True)
@@ -268,6 +279,7 @@ class HalfSinePulse(_SinePulse):
     def __post_init__(self) -> None:
         object.__setattr__(self, "peak_acceleration",
                            finite_float("peak_acceleration [m/s²]", self.peak_acceleration))
+        _check_acceleration("peak_acceleration [m/s²]", self.peak_acceleration)
         self._validate_window()
 
     @property
@@ -317,6 +329,7 @@ class RampAndHold(_SinePulse):
         object.__setattr__(self, "displacement",
                            finite_float("displacement [m]", self.displacement))
         self._validate_window()
+        _check_acceleration("peak acceleration 2πD/T² [m/s²]", self.peak_acceleration)
 
     def scaled(self, factor: float) -> RampAndHold:
         return replace(self, displacement=self.displacement * finite_float("factor [-]", factor))
@@ -367,6 +380,7 @@ class SumOfSines(Disturbance):
             raise ParameterError(f"frequencies [Hz] must be > 0, got {freq[freq <= 0][0]:g}")
         ph = (np.zeros_like(amp) if self.phases is None
               else finite_array("phases [rad]", self.phases, (amp.size,)))
+        _check_acceleration("sum of |amplitudes| [m/s²]", float(np.abs(amp).sum()))
         object.__setattr__(self, "amplitudes", tuple(amp.tolist()))
         object.__setattr__(self, "frequencies", tuple(freq.tolist()))
         object.__setattr__(self, "phases", tuple(ph.tolist()))
@@ -403,7 +417,9 @@ class SumOfSines(Disturbance):
 class MeasuredProfile(Disturbance):
     """A measured platform acceleration, linearly interpolated between samples.
 
-    Zero before the first and after the last sample.
+    Zero before the first and after the last sample: the platform keeps the velocity it has
+    at the last sample (and stays where it is only if that velocity is zero). Every sample
+    within ±:data:`MAX_PLATFORM_ACCELERATION` [m/s²].
 
     Parameters
     ----------
@@ -437,6 +453,9 @@ class MeasuredProfile(Disturbance):
         ax = finite_array("acceleration_x [m/s²]", self.acceleration_x, (t.size,))
         ay = (np.zeros_like(t) if self.acceleration_y is None
               else finite_array("acceleration_y [m/s²]", self.acceleration_y, (t.size,)))
+        for name, arr in (("acceleration_x", ax), ("acceleration_y", ay)):
+            i = int(np.argmax(np.abs(arr)))
+            _check_acceleration(f"{name} [m/s²] (sample {i + 1})", float(arr[i]))
         for name, arr in (("time", t), ("acceleration_x", ax), ("acceleration_y", ay)):
             arr.setflags(write=False)
             object.__setattr__(self, name, arr)
@@ -524,7 +543,9 @@ def read_profile_csv(path: str | Path) -> MeasuredProfile:
     ``x_acceleration`` [m/s²] and optionally ``y_acceleration`` [m/s²]
     (the aliases ``t``, ``ax``/``xdd`` and ``ay``/``ydd`` are accepted; a
     ``[unit]`` suffix such as ``time [s]`` is ignored). Time must be strictly
-    increasing and no value may be NaN or missing.
+    increasing, no value may be NaN or missing, and every acceleration lies within
+    ±:data:`MAX_PLATFORM_ACCELERATION` (1000 m/s²). The acceleration is zero after the last
+    sample (and before the first): the platform goes on at the velocity it has reached.
 
     Raises
     ------
@@ -571,6 +592,11 @@ def read_profile_csv(path: str | Path) -> MeasuredProfile:
                 raise DataFileError(
                     f"platform profile {str(path)!r} line {lineno}: column {name!r} is {v}; "
                     "NaN and inf are not allowed"
+                )
+            if name != "time" and not abs(v) <= MAX_PLATFORM_ACCELERATION:
+                raise DataFileError(
+                    f"platform profile {str(path)!r} line {lineno}: column {name!r} is {v:g} "
+                    f"m/s²; it must be within ±{MAX_PLATFORM_ACCELERATION:g} m/s²"
                 )
             data[name].append(v)
     t = np.array(data["time"])
