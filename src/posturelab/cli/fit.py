@@ -15,7 +15,7 @@ from ..studies.identification import (
 )
 from ..studies.sweep import parameter_unit
 from ._common import check_writable, print_json
-from .simulate import add_experiment_arguments, scenario_from_args
+from .simulate import add_experiment_arguments, experiment_inputs, scenario_from_args
 
 DESCRIPTION = """\
 Fit muscle-pair stiffness [N·m/rad] (and optionally the viscosity ratio [s]) to
@@ -58,8 +58,12 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     import json
 
+    from .._files import refuse_input_as_output
+
     if args.report:
         check_writable([args.report], {args.report: (".json",)})
+    refuse_input_as_output({"--data": args.data, **experiment_inputs(args)},
+                           {"--report": args.report})
     sc = scenario_from_args(args, "fit")
     time, theta = read_trajectory_csv(args.data, sc.body.n_links)
     sc = sc.replace(duration=max(float(time[-1]), 1e-3))

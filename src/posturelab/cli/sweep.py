@@ -20,7 +20,7 @@ from ..studies.sweep import (
 )
 from . import UsageError
 from ._common import check_writable
-from .simulate import add_experiment_arguments, scenario_from_args
+from .simulate import add_experiment_arguments, experiment_inputs, scenario_from_args
 
 DESCRIPTION = f"""\
 Simulate the nonlinear model for every combination of the --vary values (the full grid,
@@ -122,12 +122,15 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from .._files import refuse_input_as_output
+
     if not args.vary:
         raise UsageError("sweep: give at least one --vary NAME=LO:HI:N (see "
                          "'posturelab sweep --help')")
     varies = [parse_vary(v) for v in args.vary]
     table_format(args.out)
     check_writable([args.out])
+    refuse_input_as_output(experiment_inputs(args), {"--out": args.out})
     if not (args.scenario or args.builtin or args.case is not None
             or args.stiffness is not None or args.controller is not None):
         raise UsageError("sweep: give the base experiment: --case, --stiffness or --controller "

@@ -1,0 +1,128 @@
+"""Hostile input, as real subprocesses: absurd platform accelerations, an output naming an
+input, messages that name the option and the value as given."""
+
+from __future__ import annotations
+
+import shutil
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from posturelab.errors import ParameterError
+from posturelab.model.platform import (
+    MAX_PLATFORM_ACCELERATION,
+    HalfSinePulse,
+    MeasuredProfile,
+    SumOfSines,
+)
+
+
+def cli(*args, cwd=None):
+    return subprocess.run([sys.executable, "-m", "posturelab", *args], capture_output=True,
+                          text=True, timeout=120, cwd=cwd)
+
+
+def one_line_exit_2(p, *words: str) -> None:
+    err = p.stderr.strip()
+    assert p.returncode == 2, p.stderr
+    assert len(err.splitlines()) == 1 and "Traceback" not in err, err
+    for w in words:
+        assert w in err, err
+
+
+PROFILE = "time,x_acceleration\n0,0\n0.1,1\n0.2,0\n"
+
+
+@pytest.mark.parametrize("value", ["1e300", "-1e300", "1000.5"])
+def test_an_absurd_profile_acceleration_is_one_line_with_its_line(tmp_path, value):
+    path = tmp_path / "p.csv"
+    path.write_text(f"time,x_acceleration\n0,0\n0.1,{value}\n0.2,0\n")
+    for engine in ("reference", "compiled"):
+        one_line_exit_2(cli("simulate", "--case", "1", "--platform-profile", str(path),
+                            "--duration", "0.5", "--engine", engine),
+                        "line 3", "x_acceleration", "1000 m/s²")
+
+
+def test_platform_accelerations_are_bounded_in_the_api():
+    assert MAX_PLATFORM_ACCELERATION == 1000.0
+    t = np.array([0.0, 0.1, 0.2])
+    MeasuredProfile(t, np.array([0.0, 1000.0, 0.0]))  # the bound itself is allowed
+    with pytest.raises(ParameterError, match=r"acceleration_y \[m/s²\] \(sample 2\)"):
+        MeasuredProfile(t, np.zeros(3), np.array([0.0, -1e300, 0.0]))
+    with pytest.raises(ParameterError, match="peak_acceleration"):
+        HalfSinePulse(2000.0, 0.1)
+    with pytest.raises(ParameterError, match="sum of"):
+        SumOfSines((600.0, 600.0), (1.0, 2.0))
+
+
+def test_a_profile_is_zero_after_its_last_sample():
+    profile = MeasuredProfile(np.array([0.0, 1.0]), np.array([2.0, 2.0]))
+    assert profile.acceleration(np.array([0.5, 1.0, 1.0 + 1e-9, 5.0]))[:, 0].tolist() == \
+        [2.0, 2.0, 0.0, 0.0]
+
+
+@pytest.mark.parametrize("speed", ["25", "-3", "0"])
+def test_speed_is_named_with_the_value_as_given(speed):
+    p = cli("simulate", "--case", "1", "--disturbance", "backward", f"--speed={speed}",
+            "--duration", "0.1")
+    one_line_exit_2(p, "--speed [m/s] must be in (0, 20]", f"got {speed}")
+
+
+def test_speed_without_a_step_is_refused():
+    one_line_exit_2(cli("simulate", "--case", "1", "--speed", "3", "--duration", "0.1"),
+                    "--speed", "--disturbance backward or forward")
+
+
+@pytest.mark.parametrize("option,value", [("--duration", "1e9"), ("--rtol", "5"),
+                                          ("--sample-rate", "0"), ("--max-steps", "0"),
+                                          ("--time-limit", "-3"), ("--max-link-angle", "9"),
+                                          ("--tilt", "sine:9:1")])
+def test_run_settings_name_their_option(option, value):
+    p = cli("simulate", "--case", "1", "--disturbance", "backward", "--duration", "0.1",
+            f"{option}={value}")
+    one_line_exit_2(p, f"{option}: ")
+
+
+def _run_csv(tmp_path, name):
+    path = tmp_path / name
+    p = cli("simulate", "--case", "1", "--disturbance", "backward", "--duration", "0.2",
+            "--engine", "compiled", "--out", str(tmp_path / "run.csv"))
+    assert p.returncode == 0, p.stderr
+    shutil.copy(tmp_path / "run.csv", path)
+    return path
+
+
+def _commands(tmp_path):
+    """(command line, input) pairs whose output names the input by another spelling."""
+    profile = tmp_path / "p.csv"
+    profile.write_text(PROFILE)
+    run_png = _run_csv(tmp_path, "a.png")
+    run_json = _run_csv(tmp_path, "d.json")
+    frf_png = tmp_path / "f.png"
+    frf_png.write_text("t,tilt,com_angle\n0,0,0\n")
+    (tmp_path / "link.csv").symlink_to(profile)
+    return [
+        (["simulate", "--case", "1", "--platform-profile", "p.csv", "--out", "./p.csv"],
+         profile),
+        (["simulate", "--case", "1", "--platform-profile", "link.csv", "--out", "p.csv"],
+         profile),
+        (["sweep", "--case", "1", "--platform-profile", "p.csv", "--vary",
+          "ankle=100:200:2", "--out", "p.csv"], profile),
+        (["compare", "a.png", "--plot", "a.png"], run_png),
+        (["fit", "--data", "d.json", "--case", "1", "--disturbance", "backward", "--free",
+          "ankle", "--report", "d.json"], run_json),
+        (["frf", "--data", "f.png", "--stimulus", "tilt", "--response", "com_angle",
+          "--cycle-length", "20", "--plot", "f.png"], frf_png),
+        (["fit-frf", "--data", "f.png", "--case", "1", "--free", "active_stiffness",
+          "--plot", "f.png"], frf_png),
+    ]
+
+
+def test_an_output_never_overwrites_an_input(tmp_path):
+    for argv, source in _commands(tmp_path):
+        before = source.read_bytes()
+        p = cli(*argv, cwd=tmp_path)
+        one_line_exit_2(p, "is the input", "an output never overwrites an input")
+        assert source.read_bytes() == before, argv
