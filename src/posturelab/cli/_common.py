@@ -309,6 +309,35 @@ def check_writable(paths: list[str], suffixes: dict[str, tuple[str, ...]] | None
         seen[key] = p
 
 
+class ExpectedTime:
+    """A ``progress(done, total)`` callback for long computations that draw no bar: once
+    the first block is done, if the whole would take more than ``notice_after`` seconds,
+    one line on ``stream`` (standard error) says how many ``unit`` and about how long
+    (never for fewer than ``min_total``, which a slow start should not make noisy)."""
+
+    def __init__(self, what: str, unit: str, stream=None, notice_after: float = 10.0,
+                 min_total: int = 0) -> None:
+        import time
+
+        self.what, self.unit, self.notice_after = what, unit, notice_after
+        self.min_total = min_total
+        self.stream = sys.stderr if stream is None else stream
+        self.start = time.perf_counter()
+        self.said = False
+
+    def __call__(self, done: int, total: int) -> None:
+        import time
+
+        if self.said or done <= 0 or done >= total or total < self.min_total:
+            return
+        self.said = True
+        expected = (time.perf_counter() - self.start) * total / done
+        if expected > self.notice_after:
+            about = f"{expected / 60:.0f} min" if expected >= 120 else f"{expected:.0f} s"
+            print(f"posturelab: {self.what}: {total:,} {self.unit}, about {about} in all "
+                  "(--progress draws a bar)", file=self.stream, flush=True)
+
+
 def load_compiled(load, what: str, stream=None, notice_after: float = 2.0) -> float:
     """Run ``load()`` (which compiles or loads numba kernels) and say so if numba compiles.
 

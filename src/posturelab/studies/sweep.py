@@ -565,12 +565,16 @@ class ProgressBar:
         Where to draw; ``sys.stderr`` by default.
     width : int
         Characters of the bar itself. [-]
+    unit : str
+        What is counted ("runs", "sets", ...).
     """
 
-    def __init__(self, total: int, stream: IO[str] | None = None, width: int = 30):
+    def __init__(self, total: int, stream: IO[str] | None = None, width: int = 30,
+                 unit: str = "runs"):
         self.total = max(int(total), 1)
         self.stream = sys.stderr if stream is None else stream
         self.width = width
+        self.unit = unit
         self.start = time.perf_counter()
         self.done = 0
         self._draw()
@@ -593,7 +597,7 @@ class ProgressBar:
         eta = elapsed * (1 - frac) / frac if frac > 0 else math.nan
         eta_text = f", {eta:.1f} s left" if frac < 1 and math.isfinite(eta) else ""
         self.stream.write(f"\r[{'#' * filled}{'.' * (self.width - filled)}] {frac:4.0%} "
-                          f"{self.done}/{self.total} runs, {elapsed:.1f} s{eta_text} ")
+                          f"{self.done}/{self.total} {self.unit}, {elapsed:.1f} s{eta_text} ")
         self.stream.flush()
 
 
