@@ -126,3 +126,20 @@ def test_an_output_never_overwrites_an_input(tmp_path):
         p = cli(*argv, cwd=tmp_path)
         one_line_exit_2(p, "is the input", "an output never overwrites an input")
         assert source.read_bytes() == before, argv
+
+
+def test_the_scenario_schema_takes_the_prts_register_seed(tmp_path):
+    from posturelab.model.tilt import PETERKA_SEED, PETERKA_TAPS
+    from posturelab.scenarios import load_scenario
+
+    path = tmp_path / "prts.toml"
+    path.write_text("duration = 1.0\n[muscles]\ncase = '1'\n[tilt]\ntype = 'prts'\n"
+                    "amplitude = 0.02\nstate_duration = 0.25\nregisters = 4\n"
+                    f"taps = {list(PETERKA_TAPS)}\nseed = [2, 0, 0, 1]\n")
+    tilt = load_scenario(path).tilt
+    assert tilt.seed == (2, 0, 0, 1) and tilt.taps == PETERKA_TAPS
+    assert tilt.seed != PETERKA_SEED
+    p = cli("simulate", "--scenario", str(path), "--engine", "compiled", "--duration", "0.5")
+    assert p.returncode == 0, p.stderr
+    path.write_text(path.read_text().replace("seed = [2, 0, 0, 1]", "seed = 1000"))
+    one_line_exit_2(cli("simulate", "--scenario", str(path)), "tilt.seed must be an array")
