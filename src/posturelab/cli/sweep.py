@@ -14,6 +14,7 @@ from ..studies.sweep import (
     SWEEP_PARAMETERS,
     TORQUE_LIMIT_PARAMETERS,
     ProgressBar,
+    SweepInterrupted,
     parse_vary,
     run_sweep,
     table_format,
@@ -143,8 +144,29 @@ def run(args: argparse.Namespace) -> int:
     if ratio is None and not (args.scenario or args.builtin or args.controller):
         args.viscosity_ratio = DEFAULT_VISCOSITY_RATIO  # what --case / --stiffness build with
     scenario = scenario_from_args(args, "sweep")
-    if args.experiment == "prts":
-        return _run_experiments(args, scenario, varies, ratio)
+    try:
+        if args.experiment == "prts":
+            return _run_experiments(args, scenario, varies, ratio)
+        return _run_simulations(args, scenario, varies, ratio)
+    except SweepInterrupted as exc:
+        return _keep_finished(args, exc)
+
+
+def _keep_finished(args: argparse.Namespace, exc: SweepInterrupted) -> int:
+    """Ctrl-C or SIGTERM: write the rows that finished, say how many; 130 or 143."""
+    word = "terminated" if exc.terminated else "interrupted"
+    if exc.result is None:
+        print(f"posturelab: {word} before any run finished; nothing written",
+              file=sys.stderr)
+    else:
+        exc.result.write(args.out)
+        print(f"posturelab: {word}: wrote the {exc.rows:,} of {exc.total:,} runs that "
+              f"finished to {args.out}", file=sys.stderr)
+    return 143 if exc.terminated else 130
+
+
+def _run_simulations(args: argparse.Namespace, scenario, varies, ratio) -> int:
+    """The ordinary sweep: one simulation per parameter set."""
     tolerances = {}
     if args.rtol is not None:
         tolerances["rtol"] = scenario.rtol
