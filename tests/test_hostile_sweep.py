@@ -76,3 +76,28 @@ def test_an_ordinary_sweep_stops_at_once_and_keeps_what_finished(tmp_path):
     assert 0 < kept < 160_000 and len(rows) == 1 + kept and kept % 64 == 0
     assert rows[0][:3] == ["ankle", "hip", "outcome"]
     assert float(rows[1][0]) == 100.0 and float(rows[1][1]) == 100.0  # the grid's first rows
+
+
+def _one_line(p, *words):
+    err = p.stderr.strip()
+    assert p.returncode == 2 and len(err.splitlines()) == 1 and "Traceback" not in err, err
+    for w in words:
+        assert w in err, err
+
+
+def test_options_a_sweep_does_not_use_are_named_and_refused(tmp_path, prts_names):
+    out = tmp_path / "s.csv"
+
+    def sweep(*argv):
+        return subprocess.run([sys.executable, "-m", "posturelab", *argv, "--out", str(out)],
+                              capture_output=True, text=True, timeout=120)
+
+    _one_line(sweep("sweep", "--case", "1", "--disturbance", "backward", "--vary",
+                    "ankle=100:200:2", "--cycles", "3", "--sensor-noise", "0.001"),
+              "--cycles, --sensor-noise are not used by a simulation sweep")
+    _one_line(sweep(*prts_names[:7], "--vary", "feedback_delay=0.12:0.18:2", "--duration",
+                    "9", "--disturbance", "backward"),
+              "--disturbance, --duration are not used by --experiment prts")
+    _one_line(sweep(*prts_names[:7], "--vary", "feedback_delay=0.12:0.18:2", "--rates-from",
+                    "posture"), "--rates-from is not used by --experiment prts")
+    assert not out.exists()

@@ -103,16 +103,16 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     e.add_argument("--experiment", choices=["simulation", "prts"], default="simulation",
                    help="what each run is: one simulation (default) or a PRTS "
                    "identification experiment.")
-    e.add_argument("--cycles", type=int, default=5, metavar="N",
+    e.add_argument("--cycles", type=int, default=None, metavar="N",
                    help="cycles analysed per experiment (default 5).")
-    e.add_argument("--discard-cycles", type=int, default=1, metavar="N",
+    e.add_argument("--discard-cycles", type=int, default=None, metavar="N",
                    help="cycles run first and dropped (default 1).")
-    e.add_argument("--sensor-noise", type=float, default=0.0, metavar="RAD",
+    e.add_argument("--sensor-noise", type=float, default=None, metavar="RAD",
                    help="standard deviation of the measurement noise on the recorded angle "
                    "[rad] (default 0).")
-    e.add_argument("--record-rate", type=float, default=100.0, metavar="HZ",
+    e.add_argument("--record-rate", type=float, default=None, metavar="HZ",
                    help="samples per second of the recording [Hz] (default 100).")
-    e.add_argument("--output", default="com_angle", metavar="ANGLE",
+    e.add_argument("--output", default=None, metavar="ANGLE",
                    help="the angle recorded: com_angle (default) or thetaI.")
     e.add_argument("--fit", metavar="NAMES",
                    help="fit these parameters to each experiment's FRF (comma-separated, "
@@ -143,6 +143,7 @@ def run(args: argparse.Namespace) -> int:
     ratio = args.viscosity_ratio
     if ratio is None and not (args.scenario or args.builtin or args.controller):
         args.viscosity_ratio = DEFAULT_VISCOSITY_RATIO  # what --case / --stiffness build with
+    _refuse_unused(args)
     scenario = scenario_from_args(args, "sweep")
     try:
         if args.experiment == "prts":
@@ -150,6 +151,30 @@ def run(args: argparse.Namespace) -> int:
         return _run_simulations(args, scenario, varies, ratio)
     except SweepInterrupted as exc:
         return _keep_finished(args, exc)
+
+
+#: Options of one kind of sweep that the other does not use (attribute names).
+PRTS_ONLY = ("cycles", "discard_cycles", "sensor_noise", "record_rate", "output", "fit")
+#: The base experiment's options a PRTS experiment has no use for: its stimulus is the tilt,
+#: its length the cycles, its recording --record-rate, its integrator its own.
+SIMULATION_ONLY = ("disturbance", "speed", "platform_profile", "duration", "sample_rate",
+                   "initial_posture", "initial_rates", "rtol", "atol", "max_steps",
+                   "time_limit", "tilt_axis_depth")
+
+
+def _refuse_unused(args: argparse.Namespace) -> None:
+    """One line naming the options given that this kind of sweep does not use."""
+    prts = args.experiment == "prts"
+    unused = [f for f in (SIMULATION_ONLY if prts else PRTS_ONLY)
+              if getattr(args, f, None) is not None]
+    if prts and args.rates_from != "upright":
+        unused.append("rates_from")
+    if unused:
+        names = ", ".join(f"--{f.replace('_', '-')}" for f in unused)
+        raise UsageError(f"sweep: {names} {'is' if len(unused) == 1 else 'are'} not used by "
+                         + ("--experiment prts (the stimulus is the PRTS tilt, the length "
+                            "--discard-cycles + --cycles, the recording --record-rate)" if prts
+                            else "a simulation sweep (they are for --experiment prts)"))
 
 
 def _keep_finished(args: argparse.Namespace, exc: SweepInterrupted) -> int:
@@ -222,9 +247,10 @@ def _run_experiments(args: argparse.Namespace, scenario, varies, ratio) -> int:
     from ..frequency.population import PRTSProtocol, prts_sweep
 
     fit = tuple(s.strip() for s in (args.fit or "").split(",") if s.strip())
-    protocol = PRTSProtocol(cycles=args.cycles, discard=args.discard_cycles,
-                            sensor_noise=args.sensor_noise, seed=args.seed or 0,
-                            sample_rate=args.record_rate, output=args.output, fit=fit)
+    given = {key: getattr(args, flag) for key, flag in (
+        ("cycles", "cycles"), ("discard", "discard_cycles"), ("sensor_noise", "sensor_noise"),
+        ("sample_rate", "record_rate"), ("output", "output")) if getattr(args, flag) is not None}
+    protocol = PRTSProtocol(seed=args.seed or 0, fit=fit, **given)
     result, elapsed = _with_progress(args, _runs(varies), lambda progress: prts_sweep(
         scenario, varies, protocol, viscosity_ratio=ratio, workers=args.workers,
         scheduler=args.scheduler, chunk_size=args.chunk_size, progress=progress))
