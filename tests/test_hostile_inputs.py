@@ -143,3 +143,34 @@ def test_the_scenario_schema_takes_the_prts_register_seed(tmp_path):
     assert p.returncode == 0, p.stderr
     path.write_text(path.read_text().replace("seed = [2, 0, 0, 1]", "seed = 1000"))
     one_line_exit_2(cli("simulate", "--scenario", str(path)), "tilt.seed must be an array")
+
+
+def test_table_ii_caption_counts_its_rows():
+    from posturelab.paper.printed import TABLE_II_PRINTED, TABLE_II_SOURCE
+
+    assert len(TABLE_II_PRINTED) == 9 and "nine rows" in TABLE_II_SOURCE
+    assert "6a" in TABLE_II_PRINTED and "6b" in TABLE_II_PRINTED
+    assert "the seven cases of Table I" in TABLE_II_SOURCE
+
+
+def test_delay_margin_json_carries_its_units():
+    import json
+
+    p = cli("delay-margin", "--case", "1", "--json")
+    assert p.returncode == 0, p.stderr
+    obj = json.loads(p.stdout)
+    assert obj["units"] == {"delay_margin": "s", "crossing_frequency": "rad/s"}
+    assert obj["delay_margin"] > 0 and obj["crossing_frequency"] > 0
+
+
+def test_the_readme_commands_write_distinct_files():
+    import collections
+    import re
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).parent))
+    from test_readme import readme_commands
+
+    written = collections.Counter(m.group(1) for command in readme_commands()
+                                  for m in re.finditer(r"--out[= ](\S+)", command))
+    assert written and [name for name, n in written.items() if n > 1] == []
