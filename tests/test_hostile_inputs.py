@@ -174,3 +174,35 @@ def test_the_readme_commands_write_distinct_files():
     written = collections.Counter(m.group(1) for command in readme_commands()
                                   for m in re.finditer(r"--out[= ](\S+)", command))
     assert written and [name for name, n in written.items() if n > 1] == []
+
+
+def _write_run(path, t, theta):
+    lines = ["t,theta1,theta2,omega1,omega2"]
+    lines += [f"{float(a)!r},{float(b)!r},{float(c)!r},0,0"
+              for a, (b, c) in zip(t, theta, strict=True)]
+    path.write_text("\n".join(lines) + "\n")
+
+
+def test_compare_gives_the_differences_against_the_first_run(tmp_path):
+    import json
+
+    t = np.linspace(0.0, 2.0, 201)
+    first = np.column_stack([np.sin(t), 0.5 * np.cos(t)])
+    # the second: shorter, on another grid, link 1 off by 0.1·t, link 2 by a constant 0.02
+    t2 = np.linspace(0.0, 1.5, 76)
+    second = np.column_stack([np.sin(t2) + 0.1 * t2, 0.5 * np.cos(t2) - 0.02])
+    _write_run(tmp_path / "a.csv", t, first)
+    _write_run(tmp_path / "b.csv", t2, second)
+    p = cli("compare", "a.csv", "b.csv", "--json", cwd=tmp_path)
+    assert p.returncode == 0, p.stderr
+    (d,) = json.loads(p.stdout)["differences"]
+    assert d["label"] == "b.csv" and d["against"] == "a.csv"
+    assert d["common_time"] == [0.0, 1.5]
+    # largest at t = 1.5 s for link 1; linear interpolation of sin over 0.02 s steps
+    assert d["max_abs_theta_difference"] == pytest.approx([0.15, 0.02], abs=5e-5)
+    assert d["peak_difference"] == pytest.approx(  # the sampled peaks: sin(1.57) for link 1
+        [np.sin(1.5) + 0.15 - np.sin(1.57), 0.5 - 0.02 - 0.5], abs=1e-12)
+    assert d["end_time_difference"] == pytest.approx(-0.5)
+    assert d["units"]["max_abs_theta_difference"] == "rad"
+    text = cli("compare", "a.csv", "b.csv", cwd=tmp_path).stdout
+    assert "b.csv − a.csv: max |Δθ| [rad] 0.1500, 0.0200 over t = 0–1.5 s" in text
