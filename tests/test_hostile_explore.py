@@ -92,3 +92,45 @@ def test_a_busy_port_is_one_line_and_exit_2():
         f"posturelab: error: cannot listen on 127.0.0.1:{taken}: Address already in use "
         "(give another --port, or 0 for a free one)"]
     assert p.stdout == ""
+
+
+def test_an_unstable_loop_gets_a_notice_instead_of_an_frf():
+    from posturelab.explore import compute_views, parse_parameters
+
+    stable = compute_views(parse_parameters({}))
+    assert stable["stable"] and stable["frf"]["note"] is None
+    assert len(stable["frf"]["gain"]) == len(stable["frf"]["frequency"]) > 100
+    unstable = compute_views(parse_parameters({"stiffness_ankle": 100}))
+    assert not unstable["stable"]
+    assert unstable["frf"]["gain"] == unstable["frf"]["frequency"] == []
+    assert unstable["frf"]["note"].startswith(
+        "the loop is unstable at this delay: an FRF cannot be measured")
+    delayed = compute_views(parse_parameters({"feedback_delay": 0.2}))  # past the margin
+    assert not delayed["stable"] and "unstable at this delay" in delayed["frf"]["note"]
+
+
+def test_the_page_shows_the_notice_and_gives_the_frf_room(tmp_path):
+    import os
+
+    from posturelab.explore.browser import chromium_path
+
+    if chromium_path() is None and not os.environ.get("CI"):
+        pytest.skip("needs Debian's chromium")
+    playwright = pytest.importorskip("playwright.sync_api")
+    from posturelab.explore.browser import launch_chromium
+
+    with running_server() as url, playwright.sync_playwright() as pw:
+        browser = launch_chromium(pw)
+        page = browser.new_page(viewport={"width": 1400, "height": 1000})
+        page.goto(url)
+        page.wait_for_function("Number(document.body.dataset.updates) >= 1", timeout=60_000)
+        assert page.is_hidden("#frf-note")
+        gain = page.locator("#frf-gain").bounding_box()
+        poles = page.locator("#poles-chart").bounding_box()
+        assert gain["width"] >= poles["width"] and gain["height"] >= 200
+        page.fill("#stiffness_ankle", "100")
+        page.wait_for_function("Number(document.body.dataset.updates) >= 2", timeout=60_000)
+        assert page.is_visible("#frf-note")
+        assert "an FRF cannot be measured" in page.inner_text("#frf-note")
+        page.screenshot(path=str(tmp_path / "unstable.png"), full_page=True)
+        browser.close()
