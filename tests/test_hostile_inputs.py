@@ -206,3 +206,28 @@ def test_compare_gives_the_differences_against_the_first_run(tmp_path):
     assert d["units"]["max_abs_theta_difference"] == "rad"
     text = cli("compare", "a.csv", "b.csv", cwd=tmp_path).stdout
     assert "b.csv − a.csv: max |Δθ| [rad] 0.1500, 0.0200 over t = 0–1.5 s" in text
+
+
+@pytest.mark.parametrize("argv, words", [
+    (["simulate", "--case", "1", "--active-stiffness", "1e12,0,0,0,0"],
+     "--active-stiffness: muscle pair 'ankle' active stiffness must be in [0, 1e+08]"),
+    (["simulate", "--stiffness", "1e12,0,0,0,0"],
+     "--stiffness: muscle pair 'ankle' stiffness must be in [0, 1e+08]"),
+    (["simulate", "--case", "1", "--viscosity", "-1,0,0,0,0"], "--viscosity: "),
+    (["simulate", "--height", "9", "--mass", "80", "--stiffness", "100,100,100,100,100"],
+     "--height: height [m] must be in [0.5, 2.5]"),
+    (["poles", "--stiffness", "-5,1,1,1,1"], "--stiffness: "),
+    (["sweep", "--case", "1", "--disturbance", "backward", "--vary", "ankle=100:200:2",
+      "--out", "never.csv", "--duration", "1e9"], "--duration: duration [s]"),
+    (["sweep", "--experiment", "prts", "--controller", "peterka-2002", "--tilt", "prts:0.035",
+      "--vary", "feedback_delay=0.1:0.2:2", "--out", "never.csv", "--cycles", "0"],
+     "--cycles: cycles must be an integer >= 2, got 0"),
+    (["sweep", "--experiment", "prts", "--controller", "peterka-2002", "--tilt", "prts:0.035",
+      "--vary", "feedback_delay=0.1:0.2:2", "--out", "never.csv", "--sensor-noise", "-1"],
+     "--sensor-noise: "),
+    (["fit", "--data", "never.csv", "--case", "1", "--free", "ankle", "--duration", "3"],
+     "fit: --duration is set by --data"),
+])
+def test_deeper_checks_name_the_option_as_typed(tmp_path, argv, words):
+    one_line_exit_2(cli(*argv, cwd=tmp_path), words)
+    assert list(tmp_path.iterdir()) == []

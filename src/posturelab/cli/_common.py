@@ -107,6 +107,20 @@ def add_muscle_arguments(p: argparse.ArgumentParser, *, require: bool = False,
                     "vertical).")
 
 
+def _naming_model_options(function):
+    """Decorate ``function(args, ...)`` so that a bad body or gain it builds is named by the
+    option the user typed (:data:`MODEL_FIELD_OPTIONS`)."""
+    import functools
+
+    @functools.wraps(function)
+    def wrapper(args, *rest, **options):
+        with naming_given_options(args, MODEL_FIELD_OPTIONS):
+            return function(args, *rest, **options)
+
+    return wrapper
+
+
+@_naming_model_options
 def body_from_args(args: argparse.Namespace):
     """The body of --body / --height --mass (the paper's by default)."""
     from ..model.anthropometry import body_from_anthropometry
@@ -134,6 +148,7 @@ def _pairs(body) -> int:
     return 5 if body.n_links == 3 else len(joint_pair_names(body.n_links))
 
 
+@_naming_model_options
 def muscles_from_args(args: argparse.Namespace, body=None):
     """The MuscleSet of --case / --stiffness / --controller and the gain options."""
     from ..model.controllers import get_controller
@@ -249,21 +264,43 @@ def naming_option(option: str):
 RUN_SETTING_OPTIONS = {"duration [s]": "--duration", "rtol": "--rtol", "atol": "--atol",
                        "sample_rate [Hz]": "--sample-rate", "max_steps": "--max-steps",
                        "time_limit [s]": "--time-limit"}
+#: The message prefix of a check of the body or the gains (model/) -> the option.
+MODEL_FIELD_OPTIONS = {"height [m]": "--height", "mass [kg]": "--mass",
+                       "muscle pair '*' active stiffness": "--active-stiffness",
+                       "muscle pair '*' active viscosity": "--active-viscosity",
+                       "muscle pair '*' stiffness": "--stiffness",
+                       "muscle pair '*' viscosity": "--viscosity",
+                       "stiffness [N·m/rad]": "--stiffness",
+                       "viscosity [N·m·s/rad]": "--viscosity"}
+
+
+def _given_option(args: argparse.Namespace, text: str, table: dict[str, str]) -> str | None:
+    """The option of ``table`` whose message prefix starts ``text`` (``*`` matching a pair
+    name) if the user gave that option, else None."""
+    import re
+
+    for field, option in table.items():
+        given = getattr(args, option[2:].replace("-", "_"), None) is not None
+        pattern = "[^']*".join(re.escape(part) for part in field.split("*")) + " "
+        if given and re.match(pattern, text):
+            return option
+    return None
 
 
 @contextlib.contextmanager
-def naming_given_options(args: argparse.Namespace):
-    """Like :func:`naming_option` for the run settings checked when a run is set up: a
-    ParameterError about a setting the user gave (--duration, --rtol, ...) names that
+def naming_given_options(args: argparse.Namespace,
+                         table: dict[str, str] | None = None):
+    """Like :func:`naming_option` for values checked deeper in (the run settings when a
+    run is set up, by default; ``table`` for others such as :data:`MODEL_FIELD_OPTIONS`):
+    a ParameterError about a value the user gave (--duration, --rtol, ...) names that
     option."""
     try:
         yield
     except ParameterError as exc:
         text = str(exc)
-        for field, option in RUN_SETTING_OPTIONS.items():
-            given = getattr(args, option[2:].replace("-", "_"), None) is not None
-            if given and (text.startswith(field + " ") or text.startswith(field + " ×")):
-                raise ParameterError(f"{option}: {text}") from None
+        option = _given_option(args, text, RUN_SETTING_OPTIONS if table is None else table)
+        if option is not None and not text.startswith(option):
+            raise ParameterError(f"{option}: {text}") from None
         raise
 
 

@@ -14,6 +14,7 @@ from ..studies.identification import (
     read_trajectory_csv,
 )
 from ..studies.sweep import parameter_unit
+from . import UsageError
 from ._common import check_writable, print_json
 from .simulate import add_experiment_arguments, experiment_inputs, scenario_from_args
 
@@ -64,6 +65,8 @@ def run(args: argparse.Namespace) -> int:
         check_writable([args.report], {args.report: (".json",)})
     refuse_input_as_output({"--data": args.data, **experiment_inputs(args)},
                            {"--report": args.report})
+    if args.duration is not None:
+        raise UsageError("fit: --duration is set by --data (its last time); leave it out")
     sc = scenario_from_args(args, "fit")
     time, theta = read_trajectory_csv(args.data, sc.body.n_links)
     sc = sc.replace(duration=max(float(time[-1]), 1e-3))

@@ -20,7 +20,7 @@ from ..studies.sweep import (
     table_format,
 )
 from . import UsageError
-from ._common import check_writable
+from ._common import check_writable, naming_given_options
 from .simulate import add_experiment_arguments, experiment_inputs, scenario_from_args
 
 DESCRIPTION = f"""\
@@ -153,6 +153,11 @@ def run(args: argparse.Namespace) -> int:
         return _keep_finished(args, exc)
 
 
+#: The message prefix of a PRTS protocol's check -> the option that sets it.
+PROTOCOL_FIELD_OPTIONS = {"cycles": "--cycles", "discard": "--discard-cycles",
+                          "sensor_noise [rad]": "--sensor-noise",
+                          "sample_rate [Hz]": "--record-rate",
+                          "output": "--output"}
 #: Options of one kind of sweep that the other does not use (attribute names).
 PRTS_ONLY = ("cycles", "discard_cycles", "sensor_noise", "record_rate", "output", "fit")
 #: The base experiment's options a PRTS experiment has no use for: its stimulus is the tilt,
@@ -198,10 +203,11 @@ def _run_simulations(args: argparse.Namespace, scenario, varies, ratio) -> int:
     if args.atol is not None:
         tolerances["atol"] = scenario.atol
     total = _runs(varies)
-    result, elapsed = _with_progress(args, total, lambda progress: run_sweep(
-        scenario, varies, viscosity_ratio=ratio, workers=args.workers,
-        scheduler=args.scheduler, chunk_size=args.chunk_size, progress=progress,
-        **tolerances))
+    with naming_given_options(args):
+        result, elapsed = _with_progress(args, total, lambda progress: run_sweep(
+            scenario, varies, viscosity_ratio=ratio, workers=args.workers,
+            scheduler=args.scheduler, chunk_size=args.chunk_size, progress=progress,
+            **tolerances))
     result.write(args.out)
     o = result.outcomes
     shape = " × ".join(str(v.count) for v in varies)
@@ -250,10 +256,12 @@ def _run_experiments(args: argparse.Namespace, scenario, varies, ratio) -> int:
     given = {key: getattr(args, flag) for key, flag in (
         ("cycles", "cycles"), ("discard", "discard_cycles"), ("sensor_noise", "sensor_noise"),
         ("sample_rate", "record_rate"), ("output", "output")) if getattr(args, flag) is not None}
-    protocol = PRTSProtocol(seed=args.seed or 0, fit=fit, **given)
-    result, elapsed = _with_progress(args, _runs(varies), lambda progress: prts_sweep(
-        scenario, varies, protocol, viscosity_ratio=ratio, workers=args.workers,
-        scheduler=args.scheduler, chunk_size=args.chunk_size, progress=progress))
+    with naming_given_options(args, PROTOCOL_FIELD_OPTIONS):
+        protocol = PRTSProtocol(seed=args.seed or 0, fit=fit, **given)
+    with naming_given_options(args, PROTOCOL_FIELD_OPTIONS):
+        result, elapsed = _with_progress(args, _runs(varies), lambda progress: prts_sweep(
+            scenario, varies, protocol, viscosity_ratio=ratio, workers=args.workers,
+            scheduler=args.scheduler, chunk_size=args.chunk_size, progress=progress))
     result.write(args.out)
     fitted = f", fitted {', '.join(fit)}" if fit else ""
     print(f"wrote {args.out}: {result.fell.size} PRTS experiments ({', '.join(result.grid.names)}"
