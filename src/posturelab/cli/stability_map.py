@@ -323,7 +323,8 @@ def _write_csv(smap, path: Path, show: bool) -> None:
     """Write ``smap``'s CSV to ``path`` (a progress bar on standard error if ``show``)."""
     with open(path, "w", encoding="utf-8", newline="") as stream:
         smap.write_csv(stream, progress=ProgressBar(sys.stderr, "writing CSV  ", "rows")
-                       if show else None)
+                       if show else ExpectedTime("stability-map: writing the CSV", "rows",
+                                                 min_total=250_000))
 
 
 def run(args: argparse.Namespace) -> int:
