@@ -53,6 +53,11 @@ the end); final_lean [rad] and final_rate [rad/s] are the largest |θ_i| and |θ
 last sample. The file type follows the suffix of --out: .csv or .parquet (pyarrow); it is
 written to a temporary file and renamed, so no half-written file is left behind.
 
+Ctrl-C (or SIGTERM) stops a sweep at once: the runs not started are dropped, the rows that
+finished are written and counted (exit 130, 143). Options this kind of sweep does not use
+(the PRTS options on a simulation sweep; the step, profile, duration, sampling, initial
+state and integrator options on --experiment prts) are refused.
+
 Everything of the base experiment carries into every run: --torque-limits, --feedback-delay,
 active gains, --tilt and --proprioceptive-weight, --foot with --centre-of-pressure, the
 knee model.
