@@ -231,3 +231,20 @@ def test_compare_gives_the_differences_against_the_first_run(tmp_path):
 def test_deeper_checks_name_the_option_as_typed(tmp_path, argv, words):
     one_line_exit_2(cli(*argv, cwd=tmp_path), words)
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.filterwarnings("ignore::RuntimeWarning")
+@pytest.mark.parametrize("engine", ["reference", "compiled"])
+def test_a_run_that_fails_before_its_first_sample_keeps_its_initial_state(engine):
+    """The cause of the old traceback ("need at least one array to concatenate", an
+    IndexError in the compiled engine): a run that ends before its first sample. The bound
+    keeps such accelerations out; past it (here forced into the frozen profile), the run
+    is failed with its initial state as its one sample."""
+    import posturelab as pl
+
+    profile = MeasuredProfile(np.array([0.0, 0.1, 0.2]), np.array([0.0, 1.0, 0.0]))
+    object.__setattr__(profile, "acceleration_x", np.array([1e300, 1e300, 0.0]))
+    run = pl.simulate(pl.paper_body(), pl.paper_muscles("1"), profile, 1.0, engine=engine)
+    assert run.status == "failed" and run.outcome.kind == "failed"
+    assert run.time.tolist() == [0.0]
+    assert run.final_state.tolist() == [0.0] * 6
