@@ -45,6 +45,16 @@ def test_an_absurd_profile_acceleration_is_one_line_with_its_line(tmp_path, valu
                         "line 3", "x_acceleration", "1000 m/s²")
 
 
+def test_profile_samples_closer_than_a_microsecond_are_refused(tmp_path):
+    path = tmp_path / "p.csv"
+    path.write_text("time,x_acceleration\n0,0\n1e-300,1\n0.1,0\n")
+    p = cli("simulate", "--case", "1", "--platform-profile", str(path), "--duration", "0.5")
+    one_line_exit_2(p, "line 3", "at least 1e-06 s")
+    assert "tilt" not in p.stderr
+    with pytest.raises(ParameterError, match="samples 1 and 2 are 1e-07 s apart"):
+        MeasuredProfile(np.array([0.0, 1e-7]), np.zeros(2))
+
+
 def test_platform_accelerations_are_bounded_in_the_api():
     assert MAX_PLATFORM_ACCELERATION == 1000.0
     t = np.array([0.0, 0.1, 0.2])

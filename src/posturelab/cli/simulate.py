@@ -320,6 +320,8 @@ def _read_platform_file(path: str):
     try:
         return read_profile_csv(path), None
     except DataFileError as exc:
+        if "lacks column" not in str(exc):  # (a bad value: the column is there)
+            raise
         raise DataFileError(f"{exc} (or a tilt [rad] column)") from None
 
 

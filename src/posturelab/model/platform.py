@@ -66,6 +66,9 @@ MAX_PLATFORM_SPEED = 20.0
 #: (not a source's), the largest velocity step (:data:`MAX_PLATFORM_SPEED`) reached in 20 ms,
 #: about 100 g. [m/s²]
 MAX_PLATFORM_ACCELERATION = 1000.0
+#: Closest two samples of a measured profile may be: a 1 MHz recording (posturelab's bound;
+#: closer samples stall the integrator at its smallest step). [s]
+MIN_PROFILE_SPACING = 1e-6
 
 
 def _check_acceleration(name: str, peak: float) -> None:
@@ -450,6 +453,11 @@ class MeasuredProfile(Disturbance):
                 f"time [s] must be strictly increasing; sample {i + 2} ({t[i + 1]:g}) "
                 f"follows {t[i]:g}"
             )
+        if np.any(dt < MIN_PROFILE_SPACING):
+            i = int(np.argmax(dt < MIN_PROFILE_SPACING))
+            raise ParameterError(
+                f"time [s]: samples {i + 1} and {i + 2} are {dt[i]:g} s apart; at least "
+                f"{MIN_PROFILE_SPACING:g} s")
         ax = finite_array("acceleration_x [m/s²]", self.acceleration_x, (t.size,))
         ay = (np.zeros_like(t) if self.acceleration_y is None
               else finite_array("acceleration_y [m/s²]", self.acceleration_y, (t.size,)))
@@ -606,6 +614,14 @@ def read_profile_csv(path: str | Path) -> MeasuredProfile:
         raise DataFileError(
             f"platform profile {str(path)!r} line {lines[i + 2]}: time {t[i + 1]:g} s does not "
             f"increase (previous {t[i]:g} s); time must be strictly increasing"
+        )
+    close = np.nonzero(np.diff(t) < MIN_PROFILE_SPACING)[0]
+    if close.size:
+        i = int(close[0])
+        raise DataFileError(
+            f"platform profile {str(path)!r} line {lines[i + 2]}: time {t[i + 1]:g} s is "
+            f"{t[i + 1] - t[i]:g} s after the previous sample; at least "
+            f"{MIN_PROFILE_SPACING:g} s (a 1 MHz recording)"
         )
     return MeasuredProfile(
         t, np.array(data["x_acceleration"]),
