@@ -81,3 +81,24 @@ def test_expected_time_is_said_once_up_front_for_long_work():
     small = io.StringIO()
     ExpectedTime("x", "sets", stream=small, notice_after=0.0, min_total=2000)(10, 1000)
     assert small.getvalue() == ""
+
+
+def test_ctrl_c_stops_the_delayed_map_and_leaves_nothing(tmp_path):
+    import re
+    import signal
+
+    proc = subprocess.Popen([sys.executable, "-m", "posturelab", "stability-map", "--x",
+                             "active_stiffness:0:1700", "--y", "active_viscosity:0:680",
+                             "--feedback-delay", "0.15", "--case", "1", "--resolution", "120",
+                             "--progress", "--out", str(tmp_path / "m.png")],
+                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    seen = ""
+    while not re.search(r"\] +\d+% [1-9][\d,]*/", seen):
+        char = proc.stderr.read(1)
+        assert char, f"the map ended before any progress: {seen}"
+        seen += char
+    proc.send_signal(signal.SIGINT)
+    _, rest = proc.communicate(timeout=120)
+    assert proc.returncode == 130, seen + rest
+    assert rest.strip().splitlines()[-1] == "posturelab: interrupted"
+    assert list(tmp_path.iterdir()) == []
