@@ -113,7 +113,16 @@ def _commands(tmp_path):
     frf_png = tmp_path / "f.png"
     frf_png.write_text("t,tilt,com_angle\n0,0,0\n")
     (tmp_path / "link.csv").symlink_to(profile)
+    scenario = tmp_path / "s.toml"
+    scenario.write_text('duration = 1.0\n[muscles]\ncase = "1"\n')
+    run_csv = _run_csv(tmp_path, "x.csv")
     return [
+        (["simulate", "--scenario", "s.toml", "--out", "s.toml"], scenario),
+        (["sweep", "--scenario", "s.toml", "--vary", "ankle=1:2:2", "--out", "s.toml"],
+         scenario),
+        (["compare", "x.csv", "--plot", "x.csv"], run_csv),
+        (["fit", "--data", "x.csv", "--case", "1", "--disturbance", "backward", "--free",
+          "ankle", "--report", "x.csv"], run_csv),
         (["simulate", "--case", "1", "--platform-profile", "p.csv", "--out", "./p.csv"],
          profile),
         (["simulate", "--case", "1", "--platform-profile", "link.csv", "--out", "p.csv"],

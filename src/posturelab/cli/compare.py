@@ -72,9 +72,9 @@ def run(args: argparse.Namespace) -> int:
     from ..errors import ParameterError
     from ..simulation.results import read_run_csv
 
+    refuse_input_as_output({"RUN.csv": args.runs}, {"--plot": args.plot})
     if args.plot:
         check_writable([args.plot], {args.plot: FIGURE_SUFFIXES})
-    refuse_input_as_output({"RUN.csv": args.runs}, {"--plot": args.plot})
     labels = ([s.strip() for s in args.labels.split(",")] if args.labels
               else [Path(p).name for p in args.runs])
     if len(labels) != len(args.runs):

@@ -61,10 +61,10 @@ def run(args: argparse.Namespace) -> int:
 
     from .._files import refuse_input_as_output
 
-    if args.report:
-        check_writable([args.report], {args.report: (".json",)})
     refuse_input_as_output({"--data": args.data, **experiment_inputs(args)},
                            {"--report": args.report})
+    if args.report:
+        check_writable([args.report], {args.report: (".json",)})
     if args.duration is not None:
         raise UsageError("fit: --duration is set by --data (its last time); leave it out")
     sc = scenario_from_args(args, "fit")

@@ -120,8 +120,8 @@ def run(args: argparse.Namespace) -> int:
     from ..frequency.fit import fit_frf
     from .frf import check_plot_path
 
-    check_plot_path(args.plot)
     refuse_input_as_output({"--data": args.data}, {"--plot": args.plot})
+    check_plot_path(args.plot)
     body = body_from_args(args)
     muscles = muscles_from_args(args, body)
     options = feedback_options_from_args(args)

@@ -88,9 +88,9 @@ def run(args: argparse.Namespace) -> int:
     from ..frequency.data import read_series_csv
     from ..frequency.estimate import estimate_frf
 
-    check_plot_path(args.plot, args.plot_cycles)
     refuse_input_as_output({"--data": args.data},
                            {"--plot": args.plot, "--plot-cycles": args.plot_cycles})
+    check_plot_path(args.plot, args.plot_cycles)
     stim, resp = args.stimulus.strip().lower(), args.response.strip().lower()
     fs, cols = read_series_csv(args.data, [stim, resp])
     sign = response_sign(stim, resp, args.response_sign)

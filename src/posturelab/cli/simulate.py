@@ -334,12 +334,12 @@ def experiment_inputs(args: argparse.Namespace) -> dict[str, str | None]:
 def run(args: argparse.Namespace) -> int:
     from .._files import refuse_input_as_output
 
+    refuse_input_as_output(experiment_inputs(args),
+                           {"--out": args.out, "--plot": args.plot, "--animate": args.animate})
     sc = scenario_from_args(args)
     outputs = [p for p in (args.out, args.plot, args.animate) if p]
     check_writable(outputs, {args.out: (".csv",), args.plot: FIGURE_SUFFIXES,
                              args.animate: (".gif",)})
-    refuse_input_as_output(experiment_inputs(args),
-                           {"--out": args.out, "--plot": args.plot, "--animate": args.animate})
     if sc.time_limit is None:
         sc = sc.replace(time_limit=DEFAULT_TIME_LIMIT)
     with naming_given_options(args):

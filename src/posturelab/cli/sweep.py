@@ -134,9 +134,9 @@ def run(args: argparse.Namespace) -> int:
         raise UsageError("sweep: give at least one --vary NAME=LO:HI:N (see "
                          "'posturelab sweep --help')")
     varies = [parse_vary(v) for v in args.vary]
+    refuse_input_as_output(experiment_inputs(args), {"--out": args.out})
     table_format(args.out)
     check_writable([args.out])
-    refuse_input_as_output(experiment_inputs(args), {"--out": args.out})
     if not (args.scenario or args.builtin or args.case is not None
             or args.stiffness is not None or args.controller is not None):
         raise UsageError("sweep: give the base experiment: --case, --stiffness or --controller "
