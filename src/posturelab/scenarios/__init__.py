@@ -32,7 +32,8 @@ Schema (every table optional except where noted; units in brackets)::
     type = "sine"                        # sine | raised-cosine | prts | profile
     # sine: amplitude [rad], frequency [Hz], phase [rad]
     # raised-cosine: amplitude [rad], duration [s], start [s]
-    # prts: amplitude [rad] peak to peak; state_duration [s], registers, taps, seed
+    # prts: amplitude [rad] peak to peak; state_duration [s], registers, taps, seed (taps
+    #       and seed one digit 0-2 per register: taps = [1, 1, 0, 0], seed = [1, 0, 0, 0])
     #       (default: Peterka 2002's 80-state, 20 s sequence)
     # profile: file = "tilt.csv" with columns time [s] and tilt [rad]
     axis_depth = 0.0                     # the tilt axis this far below the ankle [m]
