@@ -134,3 +134,10 @@ def test_the_page_shows_the_notice_and_gives_the_frf_room(tmp_path):
         assert "an FRF cannot be measured" in page.inner_text("#frf-note")
         page.screenshot(path=str(tmp_path / "unstable.png"), full_page=True)
         browser.close()
+
+
+def test_a_body_not_declared_json_is_refused(port):
+    request = (b"POST /api/views HTTP/1.1\r\nHost: x\r\nContent-Type: text/plain\r\n"
+               b"Content-Length: 2\r\nConnection: close\r\n\r\n{}")
+    status, headers, body = _exchange(port, request)
+    assert status == 422 and "JSON object" in json.loads(body)["error"]

@@ -56,7 +56,7 @@ def create_app():
 
     @app.post("/api/views")
     def views():
-        fields = _json_object(request.get_data(cache=False))
+        fields = _json_object(request.get_data(cache=False)) if request.is_json else None
         if fields is None:
             return jsonify(error="the request must be a JSON object of control values",
                            field=None), 422
