@@ -267,3 +267,13 @@ def test_a_run_that_fails_before_its_first_sample_keeps_its_initial_state(engine
     assert run.status == "failed" and run.outcome.kind == "failed"
     assert run.time.tolist() == [0.0]
     assert run.final_state.tolist() == [0.0] * 6
+
+
+def test_json_with_a_nan_prints_nothing_and_one_line(capsys):
+    from posturelab.cli._common import print_json
+
+    with pytest.raises(ParameterError, match="cannot be printed as JSON"):
+        print_json({"first": [1.0, 2.0] * 1000, "later": float("nan")})
+    assert capsys.readouterr().out == ""
+    print_json({"fine": 1.0})
+    assert capsys.readouterr().out == '{"fine": 1.0}\n'

@@ -305,9 +305,14 @@ def naming_given_options(args: argparse.Namespace,
 
 
 def print_json(obj) -> None:
-    """Print exactly one JSON object on standard output."""
-    json.dump(obj, sys.stdout, allow_nan=False)
-    sys.stdout.write("\n")
+    """Print exactly one JSON object on standard output: all of it or, when a number in it
+    is NaN or infinite (which JSON cannot hold), nothing and one line (ParameterError)."""
+    try:
+        text = json.dumps(obj, allow_nan=False)
+    except ValueError as exc:
+        raise ParameterError(f"the result cannot be printed as JSON: {exc} (a NaN or "
+                             "infinite number; the text output shows it)") from None
+    sys.stdout.write(text + "\n")
 
 
 #: The file types each kind of output may have (suffixes, lower case).
