@@ -23,7 +23,8 @@ def cli(*args):
     (["--duration", "1e308"], "duration [s] must be in (0, 86400] s, got 1e+308"),
     (["--duration", "1e6"], "duration [s] must be in (0, 86400] s"),
     (["--duration", "50000"], "gives 50,000,001 output samples; at most 20,000,000"),
-    (["--speed", "1e300"], "velocity [m/s] must be in [-20, 20] m/s, got -1e+300"),
+    (["--speed", "1e300"], "--speed [m/s] must be in (0, 20] (the step's size; "
+     "--disturbance gives its direction), got 1e+300"),
 ])
 def test_unbounded_runs_are_refused_at_once(args, words):
     p = cli("simulate", "--case", "1", "--disturbance", "backward", *args)

@@ -31,7 +31,7 @@ def test_delay_margin_json_is_the_api_s_for_a_one_link_body(capsys):
                          "--viscosity", "100", "--json")
     assert code == 0 and err == ""
     obj = json.loads(out)
-    assert set(obj) == {"delay_margin", "crossing_frequency", "stable_without_delay"}
+    assert set(obj) == {"delay_margin", "crossing_frequency", "stable_without_delay", "units"}
     muscles = MuscleSet((MusclePair("ankle", 0, 1, 1000.0, 100.0),), 1)
     api = pl.delay_margin(pl.get_body("paper-1link"), muscles)
     assert obj["delay_margin"] == api.delay_margin
@@ -47,7 +47,8 @@ def test_delay_margin_json_is_the_api_s_for_a_one_link_body(capsys):
 ])
 def test_delay_margin_verdicts(capsys, argv, expected):
     code, out, _ = run(capsys, "delay-margin", *argv, "--json")
-    assert code == 0 and json.loads(out) == expected
+    units = {"units": {"delay_margin": "s", "crossing_frequency": "rad/s"}}
+    assert code == 0 and json.loads(out) == expected | units
 
 
 def test_delay_margin_text_names_the_margin_and_the_frequency(capsys):

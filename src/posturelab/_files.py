@@ -22,10 +22,10 @@ import stat
 from collections.abc import Iterator
 from pathlib import Path
 
-from .errors import DataFileError, PostureLabError
+from .errors import DataFileError, ParameterError, PostureLabError
 
 __all__ = ["MAX_INPUT_BYTES", "MAX_SCENARIO_BYTES", "MAX_DATA_ROWS", "MAX_FIELD_CHARS",
-           "read_text", "csv_rows", "refuse_non_regular"]
+           "read_text", "csv_rows", "refuse_non_regular", "refuse_input_as_output"]
 
 #: Largest data file read. [bytes]
 MAX_INPUT_BYTES = 512 * 2**20
@@ -114,3 +114,35 @@ def refuse_non_regular(path: str | Path, error: type[PostureLabError]) -> None:
     if not stat.S_ISREG(mode):
         raise error(f"cannot write {str(path)!r}: it exists and is not a regular file (a "
                     "device, FIFO or socket is never replaced)")
+
+
+def _named_paths(options: dict[str, str | Path | list | tuple | None]
+                 ) -> list[tuple[str, str]]:
+    """(option, path) of every path given, lists flattened, None left out."""
+    out = []
+    for option, value in options.items():
+        values = value if isinstance(value, list | tuple) else [value]
+        out.extend((option, str(v)) for v in values if v)
+    return out
+
+
+def refuse_input_as_output(inputs: dict[str, str | Path | list | tuple | None],
+                           outputs: dict[str, str | Path | list | tuple | None]) -> None:
+    """Raise ParameterError in one line, before any work, when an output would overwrite an
+    input: the same file by any path (a symbolic or hard link, ``./x`` for ``x``).
+
+    ``inputs`` and ``outputs`` map each option as the user typed it (``"--data"``,
+    ``"RUN.csv"`` for a positional argument) to its path, a list of paths or None (not
+    given). Every command that reads a file and writes one calls this once."""
+    given = _named_paths(inputs)
+    for out_option, out_path in _named_paths(outputs):
+        if not os.path.exists(out_path):
+            continue  # a file not there yet is no input
+        for in_option, in_path in given:
+            try:
+                same = os.path.samefile(out_path, in_path)
+            except OSError:
+                same = False
+            if same:
+                raise ParameterError(f"{out_option} {out_path!r} is the input {in_option} "
+                                     f"{in_path!r}; an output never overwrites an input")

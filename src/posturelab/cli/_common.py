@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import math
 import sys
@@ -117,6 +118,20 @@ def add_muscle_arguments(p: argparse.ArgumentParser, *, require: bool = False,
                     "vertical).")
 
 
+def _naming_model_options(function):
+    """Decorate ``function(args, ...)`` so that a bad body or gain it builds is named by the
+    option the user typed (:data:`MODEL_FIELD_OPTIONS`)."""
+    import functools
+
+    @functools.wraps(function)
+    def wrapper(args, *rest, **options):
+        with naming_given_options(args, MODEL_FIELD_OPTIONS):
+            return function(args, *rest, **options)
+
+    return wrapper
+
+
+@_naming_model_options
 def body_from_args(args: argparse.Namespace):
     """The body of --body / --height --mass (the paper's by default)."""
     from ..model.anthropometry import body_from_anthropometry
@@ -151,6 +166,7 @@ def _pairs(body) -> int:
     return 5 if body.n_links == 3 else len(joint_pair_names(body.n_links))
 
 
+@_naming_model_options
 def muscles_from_args(args: argparse.Namespace, body=None):
     """The MuscleSet of --case / --stiffness / --controller and the gain options."""
     from ..model.controllers import get_controller
@@ -263,10 +279,74 @@ def parse_tilt(text: str):
     return PRTSTilt(values[0], state, sequence.registers, sequence.taps, sequence.seed)
 
 
+@contextlib.contextmanager
+def naming_option(option: str):
+    """Put the command-line ``option`` (as the user typed it) before the message of a
+    ParameterError raised inside, so that a check deep in the model names what was given:
+    ``--duration: duration [s] must be in (0, 86400] s, got 1e+09``."""
+    try:
+        yield
+    except ParameterError as exc:
+        text = str(exc)
+        if text.startswith(option):
+            raise
+        raise ParameterError(f"{option}: {text}") from None
+
+
+#: The message prefix of a run setting's check (simulation/setup.py) -> the option that sets
+#: it on the command line.
+RUN_SETTING_OPTIONS = {"duration [s]": "--duration", "rtol": "--rtol", "atol": "--atol",
+                       "sample_rate [Hz]": "--sample-rate", "max_steps": "--max-steps",
+                       "time_limit [s]": "--time-limit"}
+#: The message prefix of a check of the body or the gains (model/) -> the option.
+MODEL_FIELD_OPTIONS = {"height [m]": "--height", "mass [kg]": "--mass",
+                       "muscle pair '*' active stiffness": "--active-stiffness",
+                       "muscle pair '*' active viscosity": "--active-viscosity",
+                       "muscle pair '*' stiffness": "--stiffness",
+                       "muscle pair '*' viscosity": "--viscosity",
+                       "stiffness [N·m/rad]": "--stiffness",
+                       "viscosity [N·m·s/rad]": "--viscosity"}
+
+
+def _given_option(args: argparse.Namespace, text: str, table: dict[str, str]) -> str | None:
+    """The option of ``table`` whose message prefix starts ``text`` (``*`` matching a pair
+    name) if the user gave that option, else None."""
+    import re
+
+    for field, option in table.items():
+        given = getattr(args, option[2:].replace("-", "_"), None) is not None
+        pattern = "[^']*".join(re.escape(part) for part in field.split("*")) + " "
+        if given and re.match(pattern, text):
+            return option
+    return None
+
+
+@contextlib.contextmanager
+def naming_given_options(args: argparse.Namespace,
+                         table: dict[str, str] | None = None):
+    """Like :func:`naming_option` for values checked deeper in (the run settings when a
+    run is set up, by default; ``table`` for others such as :data:`MODEL_FIELD_OPTIONS`):
+    a ParameterError about a value the user gave (--duration, --rtol, ...) names that
+    option."""
+    try:
+        yield
+    except ParameterError as exc:
+        text = str(exc)
+        option = _given_option(args, text, RUN_SETTING_OPTIONS if table is None else table)
+        if option is not None and not text.startswith(option):
+            raise ParameterError(f"{option}: {text}") from None
+        raise
+
+
 def print_json(obj) -> None:
-    """Print exactly one JSON object on standard output."""
-    json.dump(obj, sys.stdout, allow_nan=False)
-    sys.stdout.write("\n")
+    """Print exactly one JSON object on standard output: all of it or, when a number in it
+    is NaN or infinite (which JSON cannot hold), nothing and one line (ParameterError)."""
+    try:
+        text = json.dumps(obj, allow_nan=False)
+    except ValueError as exc:
+        raise ParameterError(f"the result cannot be printed as JSON: {exc} (a NaN or "
+                             "infinite number; the text output shows it)") from None
+    sys.stdout.write(text + "\n")
 
 
 #: The file types each kind of output may have (suffixes, lower case).
@@ -303,6 +383,35 @@ def check_writable(paths: list[str], suffixes: dict[str, tuple[str, ...]] | None
         if key in seen:
             raise ParameterError(f"{seen[key]!r} and {p!r} are the same file")
         seen[key] = p
+
+
+class ExpectedTime:
+    """A ``progress(done, total)`` callback for long computations that draw no bar: once
+    the first block is done, if the whole would take more than ``notice_after`` seconds,
+    one line on ``stream`` (standard error) says how many ``unit`` and about how long
+    (never for fewer than ``min_total``, which a slow start should not make noisy)."""
+
+    def __init__(self, what: str, unit: str, stream=None, notice_after: float = 10.0,
+                 min_total: int = 0) -> None:
+        import time
+
+        self.what, self.unit, self.notice_after = what, unit, notice_after
+        self.min_total = min_total
+        self.stream = sys.stderr if stream is None else stream
+        self.start = time.perf_counter()
+        self.said = False
+
+    def __call__(self, done: int, total: int) -> None:
+        import time
+
+        if self.said or done <= 0 or done >= total or total < self.min_total:
+            return
+        self.said = True
+        expected = (time.perf_counter() - self.start) * total / done
+        if expected > self.notice_after:
+            about = f"{expected / 60:.0f} min" if expected >= 120 else f"{expected:.0f} s"
+            print(f"posturelab: {self.what}: {total:,} {self.unit}, about {about} in all "
+                  "(--progress draws a bar)", file=self.stream, flush=True)
 
 
 def load_compiled(load, what: str, stream=None, notice_after: float = 2.0) -> float:

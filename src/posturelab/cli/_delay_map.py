@@ -29,22 +29,27 @@ def _axis(text: str, flag: str) -> tuple[str, float, float]:
 
 def run_delay_map(args: argparse.Namespace) -> int:
     """The delayed map: arguments of ``posturelab stability-map``."""
+    import sys
+
     import numpy as np
 
-    from ..linear.delay_batch import delay_stability_map
-    from ..simulation.results import atomic_write_text
-    from ..viz.plots import plot_delay_stability_map, save_figure
+    from ..linear.delay_batch import MAX_DELAY_MAP_RESOLUTION, delay_stability_map
+    from ..simulation.results import atomic_write_files
+    from ..studies.sweep import ProgressBar
+    from ..viz.plots import plot_delay_stability_map
+    from ._common import ExpectedTime
     from .stability_map import output_paths, parse_resolution, parse_viscosity_ratio
 
     axes = {name: (low, high) for name, low, high in
             (_axis(a, f) for a, f in ((args.x, "--x"), (args.y, "--y")))}
     if len(axes) != 2:
         raise ParameterError("--x and --y must be active_stiffness and active_viscosity")
-    resolution = parse_resolution(args.resolution)
+    resolution = parse_resolution(args.resolution, MAX_DELAY_MAP_RESOLUTION,
+                                  "with a feedback delay")
     delay = feedback_options_from_args(args).get("feedback_delay")
     if delay is None:
         raise ParameterError("a map over active gains needs --feedback-delay S [s]")
-    figure_path, csv_path, _ = output_paths(args.out)
+    figure_path, csv_path, fmt = output_paths(args.out)
     body = body_from_args(args)
     if args.stiffness is None and args.controller is None:
         if body.n_links != 3:
@@ -54,8 +59,20 @@ def run_delay_map(args: argparse.Namespace) -> int:
         args.case = None  # (--case has a default: the paper's Table I case 1)
     args.viscosity_ratio = parse_viscosity_ratio(args.viscosity_ratio)
     muscles = muscles_from_args(args, body)
-    dmap = delay_stability_map(body, muscles, delay, axes["active_stiffness"],
-                               axes["active_viscosity"], resolution, pair=args.pair)
+    if args.progress or sys.stderr.isatty():
+        bar = ProgressBar(resolution**2, unit="sets")
+
+        def progress(done: int, total: int) -> None:
+            bar.update(done)
+    else:
+        bar, progress = None, ExpectedTime("stability-map", "sets", min_total=2500)
+    try:
+        dmap = delay_stability_map(body, muscles, delay, axes["active_stiffness"],
+                                   axes["active_viscosity"], resolution, pair=args.pair,
+                                   progress=progress)
+    finally:
+        if bar is not None:
+            bar.close()
     x_first = str(args.x).split(":")[0].strip().lower() == "active_stiffness"
     fig = plot_delay_stability_map(dmap)
     kx, vy = np.meshgrid(dmap.active_stiffness, dmap.active_viscosity)
@@ -64,8 +81,9 @@ def run_delay_map(args: argparse.Namespace) -> int:
     buf = io.StringIO()
     np.savetxt(buf, table, delimiter=",", fmt=["%.17g", "%.17g", "%.17g", "%d"],
                header="active_stiffness,active_viscosity,max_real_part,stable", comments="")
-    save_figure(fig, figure_path)
-    atomic_write_text(csv_path, buf.getvalue())
+    image = io.BytesIO()
+    fig.savefig(image, format=fmt, dpi=110)
+    atomic_write_files({csv_path: buf.getvalue().encode("utf-8"), figure_path: image.getvalue()})
     print(f"wrote {figure_path} and {csv_path}: {resolution} × {resolution} sets of the "
           f"{dmap.pair} pair's active gains at τ = {delay:g} s, "
           f"{100 * float(np.mean(dmap.stable)):.1f}% stable"

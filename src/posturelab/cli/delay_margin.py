@@ -23,11 +23,16 @@ crossing polished by Newton's method), not by a frequency grid.
 Prints the margin in s and ms and the crossing frequency; with --feedback-delay also the
 rightmost roots at that delay. --json prints one object:
   {"delay_margin": seconds, or null if unstable without delay, or "infinite" if no crossing,
-   "crossing_frequency": rad/s or null, "stable_without_delay": true/false}
+   "crossing_frequency": rad/s or null, "stable_without_delay": true/false,
+   "units": {"delay_margin": "s", "crossing_frequency": "rad/s"}}
 
 Example: posturelab delay-margin --case 1
          posturelab delay-margin --controller peterka-2002 --json
 """
+
+
+#: The unit of each number of the JSON object. [-]
+JSON_UNITS = {"delay_margin": "s", "crossing_frequency": "rad/s"}
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -46,7 +51,7 @@ def run(args: argparse.Namespace) -> int:
     delay = feedback_options_from_args(args).get("feedback_delay")
     result = delay_margin(body, muscles)
     if args.json:
-        print_json(result.to_dict())
+        print_json({**result.to_dict(), "units": JSON_UNITS})
         return 0
     kind = ("intrinsic gains at once, active gains delayed" if muscles.has_active_feedback
             else "every pair's whole feedback delayed")

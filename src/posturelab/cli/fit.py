@@ -14,8 +14,9 @@ from ..studies.identification import (
     read_trajectory_csv,
 )
 from ..studies.sweep import parameter_unit
+from . import UsageError
 from ._common import check_writable, print_json
-from .simulate import add_experiment_arguments, scenario_from_args
+from .simulate import add_experiment_arguments, experiment_inputs, scenario_from_args
 
 DESCRIPTION = """\
 Fit muscle-pair stiffness [N·m/rad] (and optionally the viscosity ratio [s]) to
@@ -58,8 +59,14 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     import json
 
+    from .._files import refuse_input_as_output
+
+    refuse_input_as_output({"--data": args.data, **experiment_inputs(args)},
+                           {"--report": args.report})
     if args.report:
         check_writable([args.report], {args.report: (".json",)})
+    if args.duration is not None:
+        raise UsageError("fit: --duration is set by --data (its last time); leave it out")
     sc = scenario_from_args(args, "fit")
     time, theta = read_trajectory_csv(args.data, sc.body.n_links)
     sc = sc.replace(duration=max(float(time[-1]), 1e-3))

@@ -116,9 +116,11 @@ def _bounds(text: str) -> dict:
 
 
 def run(args: argparse.Namespace) -> int:
+    from .._files import refuse_input_as_output
     from ..frequency.fit import fit_frf
     from .frf import check_plot_path
 
+    refuse_input_as_output({"--data": args.data}, {"--plot": args.plot})
     check_plot_path(args.plot)
     body = body_from_args(args)
     muscles = muscles_from_args(args, body)

@@ -87,9 +87,12 @@ def whole_cycles(x, y, sample_rate: float, cycle_length: float):
 
 
 def run(args: argparse.Namespace) -> int:
+    from .._files import refuse_input_as_output
     from ..frequency.data import read_series_csv
     from ..frequency.estimate import estimate_frf
 
+    refuse_input_as_output({"--data": args.data},
+                           {"--plot": args.plot, "--plot-cycles": args.plot_cycles})
     check_plot_path(args.plot, args.plot_cycles)
     stim, resp = args.stimulus.strip().lower(), args.response.strip().lower()
     fs, cols = read_series_csv(args.data, [stim, resp])

@@ -10,7 +10,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..model.options import FOOT_FROM_LITERATURE, BaseOfSupport, FallCriteria, KneeModel
-from ..model.platform import NoDisturbance, VelocityStep, read_profile_csv
+from ..model.platform import MAX_PLATFORM_SPEED, NoDisturbance, VelocityStep, read_profile_csv
 from ..paper.printed import BACKWARD_INITIAL_STATE
 from ..scenarios import Scenario, builtin_scenario, builtin_scenario_names, load_scenario
 from . import UsageError
@@ -21,6 +21,8 @@ from ._common import (
     check_writable,
     feedback_options_from_args,
     muscles_from_args,
+    naming_given_options,
+    naming_option,
     parse_float_list,
     parse_limit_list,
     parse_tilt,
@@ -37,7 +39,7 @@ platform velocity change of --speed m/s (default 1); the link rates jump by
 value). These start from the paper's slightly flexed posture [0.1, −0.1, 0.1] rad
 unless --initial-posture is given. --platform-profile FILE.csv reads a measured
 acceleration (columns time [s], x_acceleration [m/s²], optional y_acceleration
-[m/s²]) and starts upright at rest unless told otherwise.
+[m/s²]; 0 after the last sample) and starts upright at rest unless told otherwise.
 
 A fall is any |θ_i| beyond --max-link-angle (default 1.047 rad = 60°) or, with
 --foot, the centre of gravity leaving the base of support; the run stops there.
@@ -99,11 +101,13 @@ def add_experiment_arguments(p: argparse.ArgumentParser) -> None:
     src.add_argument("--disturbance", choices=["backward", "forward", "none"],
                      help="platform velocity step of --speed m/s at t = 0 (backward: the "
                      "platform moves back, the body sways forward).")
-    src.add_argument("--speed", type=float, default=1.0,
+    src.add_argument("--speed", type=float, default=None,
                      help="size of the velocity step [m/s] (default 1).")
     src.add_argument("--platform-profile", metavar="FILE.csv",
                      help="measured platform acceleration (time [s], x_acceleration [m/s²], "
-                     "optional y_acceleration [m/s²]).")
+                     "optional y_acceleration [m/s²]; each within ±1000 m/s²), linearly "
+                     "interpolated and 0 after the last sample (the platform goes on at the "
+                     "velocity it has reached).")
     src.add_argument("--initial-posture", metavar="T1,T2,T3",
                      help="initial link angles [rad] (forward positive).")
     src.add_argument("--initial-rates", metavar="W1,W2,W3",
@@ -166,9 +170,9 @@ def add_experiment_arguments(p: argparse.ArgumentParser) -> None:
                      "(default: 600 for simulate, none for sweep).")
 
 
-MODEL_OPTIONS = ("case", "stiffness", "disturbance", "platform_profile", "initial_posture",
-                 "initial_rates", "controller", "body", "height", "mass", "viscosity",
-                 "active_stiffness", "active_viscosity", "active_viscosity_ratio")
+MODEL_OPTIONS = ("case", "stiffness", "disturbance", "speed", "platform_profile",
+                 "initial_posture", "initial_rates", "controller", "body", "height", "mass",
+                 "viscosity", "active_stiffness", "active_viscosity", "active_viscosity_ratio")
 
 
 def scenario_from_args(args: argparse.Namespace, command: str = "simulate") -> Scenario:
@@ -194,10 +198,13 @@ def scenario_from_args(args: argparse.Namespace, command: str = "simulate") -> S
     if overrides:
         sc = sc.replace(**overrides)
     if args.max_link_angle is not None or args.foot != "none" or args.centre_of_pressure:
-        sc = sc.replace(fall=FallCriteria(
-            args.max_link_angle if args.max_link_angle is not None else sc.fall.max_link_angle,
-            _foot(args.foot) if args.foot != "none" else sc.fall.base_of_support,
-            args.centre_of_pressure or sc.fall.centre_of_pressure))
+        with naming_option("--max-link-angle" if args.max_link_angle is not None
+                           else "--foot"):
+            sc = sc.replace(fall=FallCriteria(
+                args.max_link_angle if args.max_link_angle is not None
+                else sc.fall.max_link_angle,
+                _foot(args.foot) if args.foot != "none" else sc.fall.base_of_support,
+                args.centre_of_pressure or sc.fall.centre_of_pressure))
     feedback = feedback_options_from_args(args)
     if feedback:
         sc = sc.replace(**feedback)
@@ -205,7 +212,8 @@ def scenario_from_args(args: argparse.Namespace, command: str = "simulate") -> S
         if sc.tilt is not None:
             raise UsageError(f"{command}: the experiment already has a tilt; give --tilt or "
                              "a tilt column, not both")
-        tilt = parse_tilt(args.tilt)
+        with naming_option("--tilt"):
+            tilt = parse_tilt(args.tilt)
         sc = sc.replace(tilt=tilt, description=f"{sc.description}, {tilt.describe()}")
     if args.tilt_axis_depth is not None:
         depth = args.tilt_axis_depth
@@ -215,7 +223,8 @@ def scenario_from_args(args: argparse.Namespace, command: str = "simulate") -> S
     if args.torque_limits:
         sc = sc.replace(torque_limits=tuple(
             parse_limit_list(args.torque_limits, "--torque-limits [N·m]", sc.body.n_links)))
-    noise = motor_noise_from_args(args, sc.body.n_links)
+    with naming_option("--motor-noise"):
+        noise = motor_noise_from_args(args, sc.body.n_links)
     if noise is not None:
         if sc.motor_noise is not None:
             raise UsageError(f"{command}: the experiment already has motor noise; give "
@@ -276,11 +285,19 @@ def _scenario_from_options(args: argparse.Namespace, command: str) -> Scenario:
         default_posture = [0.0] * n
     elif args.disturbance in ("backward", "forward"):
         step = VelocityStep.backward if args.disturbance == "backward" else VelocityStep.forward
-        disturbance = step(args.speed)
+        speed = 1.0 if args.speed is None else args.speed
+        if not (math.isfinite(speed) and 0 < speed <= MAX_PLATFORM_SPEED):
+            raise ParameterError(f"--speed [m/s] must be in (0, {MAX_PLATFORM_SPEED:g}] (the "
+                                 f"step's size; --disturbance gives its direction), got "
+                                 f"{speed:g}")
+        disturbance = step(speed)
         default_posture = list(BACKWARD_INITIAL_STATE[:n]) if n == 3 else [0.0] * n
     else:
         disturbance = NoDisturbance()
         default_posture = [0.0] * n
+    if args.speed is not None and not isinstance(disturbance, VelocityStep):
+        raise UsageError(f"{command}: --speed is the size of a velocity step; it needs "
+                         "--disturbance backward or forward")
     posture = (parse_float_list(args.initial_posture, "--initial-posture [rad]", n)
                if args.initial_posture else default_posture)
     rates = (parse_float_list(args.initial_rates, "--initial-rates [rad/s]", n)
@@ -319,17 +336,30 @@ def _read_platform_file(path: str):
     try:
         return read_profile_csv(path), None
     except DataFileError as exc:
+        if "lacks column" not in str(exc):  # (a bad value: the column is there)
+            raise
         raise DataFileError(f"{exc} (or a tilt [rad] column)") from None
 
 
+def experiment_inputs(args: argparse.Namespace) -> dict[str, str | None]:
+    """The files an experiment's options read, by option (for
+    :func:`posturelab._files.refuse_input_as_output`)."""
+    return {"--scenario": args.scenario, "--platform-profile": args.platform_profile}
+
+
 def run(args: argparse.Namespace) -> int:
+    from .._files import refuse_input_as_output
+
+    refuse_input_as_output(experiment_inputs(args),
+                           {"--out": args.out, "--plot": args.plot, "--animate": args.animate})
     sc = scenario_from_args(args)
     outputs = [p for p in (args.out, args.plot, args.animate) if p]
     check_writable(outputs, {args.out: (".csv",), args.plot: FIGURE_SUFFIXES,
                              args.animate: (".gif",)})
     if sc.time_limit is None:
         sc = sc.replace(time_limit=DEFAULT_TIME_LIMIT)
-    result = sc.run(engine=args.engine)
+    with naming_given_options(args):
+        result = sc.run(engine=args.engine)
     if args.out:
         result.to_csv(args.out)
     if args.plot:

@@ -15,7 +15,7 @@ from typing import IO
 from ..errors import ParameterError, UnknownNameError
 from ..model.muscles import PAPER_PAIR_NAMES
 from . import CONVENTIONS_EPILOG
-from ._common import load_compiled
+from ._common import ExpectedTime, load_compiled
 
 #: Axis names: the paper's five pairs (stiffness [N·m/rad]) and the viscosity ratio [s]
 #: (the same as posturelab.batch_linear.GRID_PARAMETERS, which imports numba).
@@ -125,16 +125,17 @@ def parse_axis(text: str, flag: str, names: tuple[str, ...] = PARAMETER_NAMES):
     return ParameterRange(name, low, high)
 
 
-def parse_resolution(text: str) -> int:
-    """``--resolution``: an integer in [2, MAX_RESOLUTION]."""
+def parse_resolution(text: str, maximum: int = MAX_RESOLUTION, which: str = "") -> int:
+    """``--resolution``: an integer in [2, ``maximum``] (``which`` map, for the message)."""
+    where = f" {which}" if which else ""
     try:
         value = int(str(text).strip())
     except ValueError:
         raise ParameterError(
-            f"--resolution must be an integer in [2, {MAX_RESOLUTION}], got {text!r}"
+            f"--resolution must be an integer in [2, {maximum}]{where}, got {text!r}"
         ) from None
-    if not 2 <= value <= MAX_RESOLUTION:
-        raise ParameterError(f"--resolution must be in [2, {MAX_RESOLUTION}], got {value}")
+    if not 2 <= value <= maximum:
+        raise ParameterError(f"--resolution must be in [2, {maximum}]{where}, got {text}")
     return value
 
 
@@ -175,6 +176,9 @@ def output_paths(out: str) -> tuple[Path, Path, str]:
         raise ParameterError(f"--out directory {str(directory)!r} does not exist")
     if figure.is_dir():
         raise ParameterError(f"--out {out!r} is a directory")
+    from ._common import check_writable
+
+    check_writable([str(figure), str(figure.with_suffix(".csv"))])  # both, before any work
     return figure, figure.with_suffix(".csv"), fmt
 
 
@@ -347,7 +351,8 @@ def _write_csv(smap, path: Path, show: bool) -> None:
     """Write ``smap``'s CSV to ``path`` (a progress bar on standard error if ``show``)."""
     with open(path, "w", encoding="utf-8", newline="") as stream:
         smap.write_csv(stream, progress=ProgressBar(sys.stderr, "writing CSV  ", "rows")
-                       if show else None)
+                       if show else ExpectedTime("stability-map: writing the CSV", "rows",
+                                                 min_total=250_000))
 
 
 def run(args: argparse.Namespace) -> int:
@@ -405,7 +410,8 @@ def run(args: argparse.Namespace) -> int:
         temporaries.append(tmp_csv)
 
         show = args.progress or sys.stderr.isatty()
-        progress = ProgressBar(sys.stderr, "stability-map") if show else None
+        progress = ProgressBar(sys.stderr, "stability-map") if show else \
+            ExpectedTime("stability-map", "parameter sets", min_total=250_000)
         # The compiled map and CSV writer release the GIL: each runs on a worker thread
         # while this one imports matplotlib and then draws the figure.
         with ThreadPoolExecutor(max_workers=1) as worker:

@@ -14,13 +14,14 @@ from ..studies.sweep import (
     SWEEP_PARAMETERS,
     TORQUE_LIMIT_PARAMETERS,
     ProgressBar,
+    SweepInterrupted,
     parse_vary,
     run_sweep,
     table_format,
 )
 from . import UsageError
-from ._common import check_writable
-from .simulate import add_experiment_arguments, scenario_from_args
+from ._common import check_writable, naming_given_options
+from .simulate import add_experiment_arguments, experiment_inputs, scenario_from_args
 
 DESCRIPTION = f"""\
 Simulate the nonlinear model for every combination of the --vary values (the full grid,
@@ -58,6 +59,11 @@ that completed is then run again alone for its trajectory (the centre of pressur
 sway, ten times as costly, is left to posturelab simulate).
 The file type follows the suffix of --out: .csv or .parquet (pyarrow); it is
 written to a temporary file and renamed, so no half-written file is left behind.
+
+Ctrl-C (or SIGTERM) stops a sweep at once: the runs not started are dropped, the rows that
+finished are written and counted (exit 130, 143). Options this kind of sweep does not use
+(the PRTS options on a simulation sweep; the step, profile, duration, sampling, initial
+state and integrator options on --experiment prts) are refused.
 
 Everything of the base experiment carries into every run: --torque-limits, --feedback-delay,
 active gains, --tilt and --proprioceptive-weight, --foot with --centre-of-pressure, the
@@ -109,16 +115,16 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     e.add_argument("--experiment", choices=["simulation", "prts"], default="simulation",
                    help="what each run is: one simulation (default) or a PRTS "
                    "identification experiment.")
-    e.add_argument("--cycles", type=int, default=5, metavar="N",
+    e.add_argument("--cycles", type=int, default=None, metavar="N",
                    help="cycles analysed per experiment (default 5).")
-    e.add_argument("--discard-cycles", type=int, default=1, metavar="N",
+    e.add_argument("--discard-cycles", type=int, default=None, metavar="N",
                    help="cycles run first and dropped (default 1).")
-    e.add_argument("--sensor-noise", type=float, default=0.0, metavar="RAD",
+    e.add_argument("--sensor-noise", type=float, default=None, metavar="RAD",
                    help="standard deviation of the measurement noise on the recorded angle "
                    "[rad] (default 0).")
-    e.add_argument("--record-rate", type=float, default=100.0, metavar="HZ",
+    e.add_argument("--record-rate", type=float, default=None, metavar="HZ",
                    help="samples per second of the recording [Hz] (default 100).")
-    e.add_argument("--output", default="com_angle", metavar="ANGLE",
+    e.add_argument("--output", default=None, metavar="ANGLE",
                    help="the angle recorded: com_angle (default) or thetaI.")
     e.add_argument("--fit", metavar="NAMES",
                    help="fit these parameters to each experiment's FRF (comma-separated, "
@@ -129,10 +135,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from .._files import refuse_input_as_output
+
     if not args.vary:
         raise UsageError("sweep: give at least one --vary NAME=LO:HI:N (see "
                          "'posturelab sweep --help')")
     varies = [parse_vary(v) for v in args.vary]
+    refuse_input_as_output(experiment_inputs(args), {"--out": args.out})
     table_format(args.out)
     check_writable([args.out])
     if not (args.scenario or args.builtin or args.case is not None
@@ -146,19 +155,71 @@ def run(args: argparse.Namespace) -> int:
     ratio = args.viscosity_ratio
     if ratio is None and not (args.scenario or args.builtin or args.controller):
         args.viscosity_ratio = DEFAULT_VISCOSITY_RATIO  # what --case / --stiffness build with
+    _refuse_unused(args)
     scenario = scenario_from_args(args, "sweep")
-    if args.experiment == "prts":
-        return _run_experiments(args, scenario, varies, ratio)
+    try:
+        if args.experiment == "prts":
+            return _run_experiments(args, scenario, varies, ratio)
+        return _run_simulations(args, scenario, varies, ratio)
+    except SweepInterrupted as exc:
+        return _keep_finished(args, exc)
+
+
+#: The message prefix of a PRTS protocol's check -> the option that sets it.
+PROTOCOL_FIELD_OPTIONS = {"cycles": "--cycles", "discard": "--discard-cycles",
+                          "sensor_noise [rad]": "--sensor-noise",
+                          "sample_rate [Hz]": "--record-rate",
+                          "output": "--output"}
+#: Options of one kind of sweep that the other does not use (attribute names).
+PRTS_ONLY = ("cycles", "discard_cycles", "sensor_noise", "record_rate", "output", "fit")
+#: The base experiment's options a PRTS experiment has no use for: its stimulus is the tilt,
+#: its length the cycles, its recording --record-rate, its integrator its own.
+SIMULATION_ONLY = ("disturbance", "speed", "platform_profile", "duration", "sample_rate",
+                   "initial_posture", "initial_rates", "rtol", "atol", "max_steps",
+                   "time_limit", "tilt_axis_depth")
+
+
+def _refuse_unused(args: argparse.Namespace) -> None:
+    """One line naming the options given that this kind of sweep does not use."""
+    prts = args.experiment == "prts"
+    unused = [f for f in (SIMULATION_ONLY if prts else PRTS_ONLY)
+              if getattr(args, f, None) is not None]
+    if prts and args.rates_from != "upright":
+        unused.append("rates_from")
+    if unused:
+        names = ", ".join(f"--{f.replace('_', '-')}" for f in unused)
+        raise UsageError(f"sweep: {names} {'is' if len(unused) == 1 else 'are'} not used by "
+                         + ("--experiment prts (the stimulus is the PRTS tilt, the length "
+                            "--discard-cycles + --cycles, the recording --record-rate)" if prts
+                            else "a simulation sweep (they are for --experiment prts)"))
+
+
+def _keep_finished(args: argparse.Namespace, exc: SweepInterrupted) -> int:
+    """Ctrl-C or SIGTERM: write the rows that finished, say how many; 130 or 143."""
+    word = "terminated" if exc.terminated else "interrupted"
+    if exc.result is None:
+        print(f"posturelab: {word} before any run finished; nothing written",
+              file=sys.stderr)
+    else:
+        exc.result.write(args.out)
+        print(f"posturelab: {word}: wrote the {exc.rows:,} of {exc.total:,} runs that "
+              f"finished to {args.out}", file=sys.stderr)
+    return 143 if exc.terminated else 130
+
+
+def _run_simulations(args: argparse.Namespace, scenario, varies, ratio) -> int:
+    """The ordinary sweep: one simulation per parameter set."""
     tolerances = {}
     if args.rtol is not None:
         tolerances["rtol"] = scenario.rtol
     if args.atol is not None:
         tolerances["atol"] = scenario.atol
     total = _runs(varies)
-    result, elapsed = _with_progress(args, total, lambda progress: run_sweep(
-        scenario, varies, viscosity_ratio=ratio, workers=args.workers,
-        scheduler=args.scheduler, chunk_size=args.chunk_size, progress=progress,
-        **tolerances))
+    with naming_given_options(args):
+        result, elapsed = _with_progress(args, total, lambda progress: run_sweep(
+            scenario, varies, viscosity_ratio=ratio, workers=args.workers,
+            scheduler=args.scheduler, chunk_size=args.chunk_size, progress=progress,
+            **tolerances))
     result.write(args.out)
     o = result.outcomes
     shape = " × ".join(str(v.count) for v in varies)
@@ -205,12 +266,15 @@ def _run_experiments(args: argparse.Namespace, scenario, varies, ratio) -> int:
     from ..frequency.population import PRTSProtocol, prts_sweep
 
     fit = tuple(s.strip() for s in (args.fit or "").split(",") if s.strip())
-    protocol = PRTSProtocol(cycles=args.cycles, discard=args.discard_cycles,
-                            sensor_noise=args.sensor_noise, seed=args.seed or 0,
-                            sample_rate=args.record_rate, output=args.output, fit=fit)
-    result, elapsed = _with_progress(args, _runs(varies), lambda progress: prts_sweep(
-        scenario, varies, protocol, viscosity_ratio=ratio, workers=args.workers,
-        scheduler=args.scheduler, chunk_size=args.chunk_size, progress=progress))
+    given = {key: getattr(args, flag) for key, flag in (
+        ("cycles", "cycles"), ("discard", "discard_cycles"), ("sensor_noise", "sensor_noise"),
+        ("sample_rate", "record_rate"), ("output", "output")) if getattr(args, flag) is not None}
+    with naming_given_options(args, PROTOCOL_FIELD_OPTIONS):
+        protocol = PRTSProtocol(seed=args.seed or 0, fit=fit, **given)
+    with naming_given_options(args, PROTOCOL_FIELD_OPTIONS):
+        result, elapsed = _with_progress(args, _runs(varies), lambda progress: prts_sweep(
+            scenario, varies, protocol, viscosity_ratio=ratio, workers=args.workers,
+            scheduler=args.scheduler, chunk_size=args.chunk_size, progress=progress))
     result.write(args.out)
     fitted = f", fitted {', '.join(fit)}" if fit else ""
     print(f"wrote {args.out}: {result.fell.size} PRTS experiments ({', '.join(result.grid.names)}"

@@ -292,7 +292,8 @@ def compute_views(p: dict) -> dict:
         ``poles`` at τ = 0 and ``roots`` (the 2N rightmost characteristic roots at τ) as
         {"re", "im"} [1/s]; ``delay_margin`` [s] (None when unstable without delay, inf
         as None with ``no_margin``);
-        ``frf`` (frequencies [Hz], gain [-], phase [deg]); ``run`` (outcome words,
+        ``frf`` (frequencies [Hz], gain [-], phase [deg]; empty with a ``note`` saying why
+        when the loop is not stable at τ, else ``note`` None); ``run`` (outcome words,
         time [s], link angles [rad], CoG position [m] and velocity [m/s], joint positions
         [m] of the stick figure and the surface tilt [rad] at :data:`FRAME_RATE`).
     """
@@ -306,9 +307,18 @@ def compute_views(p: dict) -> dict:
     lin, margin = _linear(body, muscles)
     # the one verdict about upright (posturelab poles, simulate and the report give it too)
     verdict = pl.upright_verdict(body, muscles, delay)
-    roots = verdict.side(engaged=True).roots
-    frf = model_frf(body, muscles, FRF_FREQUENCIES, input="tilt", output="com_angle",
-                    feedback_delay=delay, proprioceptive_weight=weight)
+    engaged = verdict.side(engaged=True)  # the side the model FRF linearises
+    roots = engaged.roots
+    if engaged.status == "stable":
+        frf = model_frf(body, muscles, FRF_FREQUENCIES, input="tilt", output="com_angle",
+                        feedback_delay=delay, proprioceptive_weight=weight)
+        frf_view = {"frequency": _rounded(FRF_FREQUENCIES, 9), "gain": _rounded(np.abs(frf), 9),
+                    "phase": _rounded(np.degrees(np.unwrap(np.angle(frf))), 4), "note": None}
+    else:  # no steady response to measure: say so rather than draw a formula's curve
+        word = "marginal (undamped)" if engaged.status == "marginal" else "unstable"
+        frf_view = {"frequency": [], "gain": [], "phase": [],
+                    "note": f"the loop is {word} at this delay: an FRF cannot be measured "
+                    "(the sway grows or never settles), so none is drawn"}
     rate = SAMPLE_RATE if tilt is None else max(SAMPLE_RATE, 40.0 * tilt.frequency)
     run = pl.simulate(body, muscles, disturbance, p["duration"], engine="compiled",
                       feedback_delay=delay, proprioceptive_weight=weight, tilt=tilt,
@@ -331,8 +341,7 @@ def compute_views(p: dict) -> dict:
                          or math.isinf(margin.delay_margin) else float(margin.delay_margin)),
         "stable_without_delay": bool(margin.stable_without_delay),
         "delayed_part": "active" if muscles.has_active_feedback else "all",
-        "frf": {"frequency": _rounded(FRF_FREQUENCIES, 9), "gain": _rounded(np.abs(frf), 9),
-                "phase": _rounded(np.degrees(np.unwrap(np.angle(frf))), 4)},
+        "frf": frf_view,
         "run": {"outcome": outcome.kind, "message": outcome.message,
                 "time": _rounded(run.time, 6),
                 "theta": [_rounded(run.theta[:, i]) for i in range(body.n_links)],

@@ -244,7 +244,7 @@ def prts_sweep(scenario: Scenario, varies: Sequence, protocol: PRTSProtocol | No
     import os
 
     from ..model.tilt import PRTSTilt
-    from ..studies.sweep import run_chunks, sweep_grid
+    from ..studies.sweep import SweepInterrupted, run_chunks, sweep_grid
     from .bands import band_frequencies, resolve_bands
     from .fit import _parse
 
@@ -271,11 +271,22 @@ def prts_sweep(scenario: Scenario, varies: Sequence, protocol: PRTSProtocol | No
     bands = resolve_bands(bands, samples // 4)
     protocol = replace(protocol, bands=bands)
     task = _ExperimentTask(scenario, protocol)
-    parts = run_chunks(task, grid, workers=workers, scheduler=scheduler, client=client,
-                       chunk_size=chunk_size, progress=progress, largest_chunk=8,
-                       threads=max(1, min(os.cpu_count() or 1, 8)))
-    rows = [row for part in parts for row in part]
     freq = band_frequencies(bands, cycle)
+    try:
+        parts = run_chunks(task, grid, workers=workers, scheduler=scheduler, client=client,
+                           chunk_size=chunk_size, progress=progress, largest_chunk=8,
+                           threads=max(1, min(os.cpu_count() or 1, 8)))
+    except SweepInterrupted as exc:  # Ctrl-C: the table of the experiments that finished
+        if exc.parts:
+            exc.result = _sweep_result(grid.head(exc.rows), protocol, freq, exc.parts)
+        raise
+    return _sweep_result(grid, protocol, freq, parts)
+
+
+def _sweep_result(grid, protocol: PRTSProtocol, freq: np.ndarray, parts: list
+                  ) -> PRTSSweepResult:
+    """The table of ``grid``'s experiments from the chunks' rows (fell, estimate, fit)."""
+    rows = [row for part in parts for row in part]
     M, B, K = len(rows), freq.size, len(protocol.fit)
     frf = np.full((M, B), np.nan + 1j * np.nan)
     coherence = np.full((M, B), np.nan)

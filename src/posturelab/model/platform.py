@@ -62,6 +62,20 @@ def _axis(axis: str) -> int:
 
 #: Largest platform velocity step: ten times the fastest perturbation of the field. [m/s]
 MAX_PLATFORM_SPEED = 20.0
+#: Largest platform acceleration of a profile, pulse, ramp or sum of sines: posturelab's bound
+#: (not a source's), the largest velocity step (:data:`MAX_PLATFORM_SPEED`) reached in 20 ms,
+#: about 100 g. [m/s²]
+MAX_PLATFORM_ACCELERATION = 1000.0
+#: Closest two samples of a measured profile may be: a 1 MHz recording (posturelab's bound;
+#: closer samples stall the integrator at its smallest step). [s]
+MIN_PROFILE_SPACING = 1e-6
+
+
+def _check_acceleration(name: str, peak: float) -> None:
+    """ParameterError unless |``peak``| <= :data:`MAX_PLATFORM_ACCELERATION` [m/s²]."""
+    if not abs(peak) <= MAX_PLATFORM_ACCELERATION:
+        raise ParameterError(f"{name} must be within ±{MAX_PLATFORM_ACCELERATION:g} m/s², got "
+                             f"{peak:g}")
 
 
 @dataclass(frozen=True)
@@ -268,6 +282,7 @@ class HalfSinePulse(_SinePulse):
     def __post_init__(self) -> None:
         object.__setattr__(self, "peak_acceleration",
                            finite_float("peak_acceleration [m/s²]", self.peak_acceleration))
+        _check_acceleration("peak_acceleration [m/s²]", self.peak_acceleration)
         self._validate_window()
 
     @property
@@ -317,6 +332,7 @@ class RampAndHold(_SinePulse):
         object.__setattr__(self, "displacement",
                            finite_float("displacement [m]", self.displacement))
         self._validate_window()
+        _check_acceleration("peak acceleration 2πD/T² [m/s²]", self.peak_acceleration)
 
     def scaled(self, factor: float) -> RampAndHold:
         return replace(self, displacement=self.displacement * finite_float("factor [-]", factor))
@@ -367,6 +383,7 @@ class SumOfSines(Disturbance):
             raise ParameterError(f"frequencies [Hz] must be > 0, got {freq[freq <= 0][0]:g}")
         ph = (np.zeros_like(amp) if self.phases is None
               else finite_array("phases [rad]", self.phases, (amp.size,)))
+        _check_acceleration("sum of |amplitudes| [m/s²]", float(np.abs(amp).sum()))
         object.__setattr__(self, "amplitudes", tuple(amp.tolist()))
         object.__setattr__(self, "frequencies", tuple(freq.tolist()))
         object.__setattr__(self, "phases", tuple(ph.tolist()))
@@ -403,7 +420,9 @@ class SumOfSines(Disturbance):
 class MeasuredProfile(Disturbance):
     """A measured platform acceleration, linearly interpolated between samples.
 
-    Zero before the first and after the last sample.
+    Zero before the first and after the last sample: the platform keeps the velocity it has
+    at the last sample (and stays where it is only if that velocity is zero). Every sample
+    within ±:data:`MAX_PLATFORM_ACCELERATION` [m/s²].
 
     Parameters
     ----------
@@ -434,9 +453,17 @@ class MeasuredProfile(Disturbance):
                 f"time [s] must be strictly increasing; sample {i + 2} ({t[i + 1]:g}) "
                 f"follows {t[i]:g}"
             )
+        if np.any(dt < MIN_PROFILE_SPACING):
+            i = int(np.argmax(dt < MIN_PROFILE_SPACING))
+            raise ParameterError(
+                f"time [s]: samples {i + 1} and {i + 2} are {dt[i]:g} s apart; at least "
+                f"{MIN_PROFILE_SPACING:g} s")
         ax = finite_array("acceleration_x [m/s²]", self.acceleration_x, (t.size,))
         ay = (np.zeros_like(t) if self.acceleration_y is None
               else finite_array("acceleration_y [m/s²]", self.acceleration_y, (t.size,)))
+        for name, arr in (("acceleration_x", ax), ("acceleration_y", ay)):
+            i = int(np.argmax(np.abs(arr)))
+            _check_acceleration(f"{name} [m/s²] (sample {i + 1})", float(arr[i]))
         for name, arr in (("time", t), ("acceleration_x", ax), ("acceleration_y", ay)):
             arr.setflags(write=False)
             object.__setattr__(self, name, arr)
@@ -524,7 +551,9 @@ def read_profile_csv(path: str | Path) -> MeasuredProfile:
     ``x_acceleration`` [m/s²] and optionally ``y_acceleration`` [m/s²]
     (the aliases ``t``, ``ax``/``xdd`` and ``ay``/``ydd`` are accepted; a
     ``[unit]`` suffix such as ``time [s]`` is ignored). Time must be strictly
-    increasing and no value may be NaN or missing.
+    increasing, no value may be NaN or missing, and every acceleration lies within
+    ±:data:`MAX_PLATFORM_ACCELERATION` (1000 m/s²). The acceleration is zero after the last
+    sample (and before the first): the platform goes on at the velocity it has reached.
 
     Raises
     ------
@@ -572,6 +601,11 @@ def read_profile_csv(path: str | Path) -> MeasuredProfile:
                     f"platform profile {str(path)!r} line {lineno}: column {name!r} is {v}; "
                     "NaN and inf are not allowed"
                 )
+            if name != "time" and not abs(v) <= MAX_PLATFORM_ACCELERATION:
+                raise DataFileError(
+                    f"platform profile {str(path)!r} line {lineno}: column {name!r} is {v:g} "
+                    f"m/s²; it must be within ±{MAX_PLATFORM_ACCELERATION:g} m/s²"
+                )
             data[name].append(v)
     t = np.array(data["time"])
     bad = np.nonzero(np.diff(t) <= 0)[0]
@@ -580,6 +614,14 @@ def read_profile_csv(path: str | Path) -> MeasuredProfile:
         raise DataFileError(
             f"platform profile {str(path)!r} line {lines[i + 2]}: time {t[i + 1]:g} s does not "
             f"increase (previous {t[i]:g} s); time must be strictly increasing"
+        )
+    close = np.nonzero(np.diff(t) < MIN_PROFILE_SPACING)[0]
+    if close.size:
+        i = int(close[0])
+        raise DataFileError(
+            f"platform profile {str(path)!r} line {lines[i + 2]}: time {t[i + 1]:g} s is "
+            f"{t[i + 1] - t[i]:g} s after the previous sample; at least "
+            f"{MIN_PROFILE_SPACING:g} s (a 1 MHz recording)"
         )
     return MeasuredProfile(
         t, np.array(data["x_acceleration"]),

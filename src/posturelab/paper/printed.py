@@ -25,7 +25,8 @@ __all__ = [
     "match_printed_poles",
 ]
 
-TABLE_II_SOURCE = "Table II, poles of the linearized system for the seven cases"
+TABLE_II_SOURCE = ("Table II, poles of the linearized system: the seven cases of Table I and "
+                   "the variants 6a and 6b of case 6 (nine rows)")
 
 #: Table II as printed: one string per pole, in the paper's column order.
 #: Kept as text so the number of printed digits sets each test tolerance.

@@ -34,7 +34,8 @@ Schema (every table optional except where noted; units in brackets)::
     # raised-cosine: amplitude [rad], duration [s], start [s]
     # prts: amplitude [rad] peak to peak; sequence = "posturelab-80" (default: posturelab's
     #       own 80-state, 20 s one), "comtest-80" or "peterka-2002-242"; or a register:
-    #       registers, taps, seed; state_duration [s]
+    #       registers, taps, seed (taps and seed one digit 0-2 per register: taps =
+    #       [1, 1, 0, 0], seed = [1, 0, 0, 0]); state_duration [s]
     # profile: file = "tilt.csv" with columns time [s] and tilt [rad]
     axis_depth = 0.0                     # the tilt axis this far below the ankle [m]
 

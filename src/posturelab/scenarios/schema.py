@@ -88,7 +88,7 @@ class TiltTable(_Table):
     state_duration: float | None = None
     registers: int | None = None
     taps: list[int] | None = None
-    seed: int | None = None
+    seed: list[int] | None = None
     sequence: str | None = None
     file: str | None = None
     axis_depth: float | None = None

@@ -308,6 +308,10 @@ def integrate_reference(setup: RunSetup, method: str = "DOP853") -> SimulationRe
             saturation = saturation.copy()
             saturation[j] = sd if kind == ev.SATURATES else 0.0
 
+    if not times:  # the run ended before its first sample: the series is its initial state
+        times.append(np.array([0.0]))
+        states.append(setup.x0[None, :].copy())
+        locked_flags.append(np.array([setup.locked0]))
     time = np.concatenate(times)
     state = np.concatenate(states, axis=0)
     feedback_states = None

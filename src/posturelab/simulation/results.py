@@ -17,7 +17,7 @@ from ..errors import PostureLabError
 from .outcome import StimulusTiming
 
 __all__ = ["SimulationResult", "DerivedSeries", "atomic_write_text", "atomic_write_bytes",
-           "new_file_mode", "read_run_csv"]
+           "atomic_write_files", "new_file_mode", "read_run_csv"]
 
 
 @dataclass(frozen=True)
@@ -418,6 +418,44 @@ def _atomic_write(path: str | Path, data: bytes) -> None:
         except OSError:
             pass
         raise PostureLabError(f"cannot write {str(path)!r}: {exc.strerror}") from None
+
+
+def atomic_write_files(contents: dict[str | Path, bytes]) -> None:
+    """Write several files so that a failure leaves none of them written: each goes to a
+    temporary file beside it, and only when all are written are they renamed in turn."""
+    from .._files import refuse_non_regular
+
+    temporaries: list[tuple[str, Path]] = []
+    try:
+        for path, data in contents.items():
+            path = Path(path)
+            refuse_non_regular(path, PostureLabError)
+            directory = path.parent if str(path.parent) else Path(".")
+            try:
+                fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp",
+                                           dir=directory)
+            except OSError as exc:
+                raise PostureLabError(f"cannot write {str(path)!r}: {exc.strerror}") from None
+            temporaries.append((tmp, path))
+            try:
+                with os.fdopen(fd, "wb") as fh:
+                    fh.write(data)
+                os.chmod(tmp, new_file_mode())
+            except OSError as exc:
+                raise PostureLabError(f"cannot write {str(path)!r}: {exc.strerror}") from None
+        while temporaries:
+            tmp, path = temporaries[0]
+            try:
+                os.replace(tmp, path)
+            except OSError as exc:
+                raise PostureLabError(f"cannot write {str(path)!r}: {exc.strerror}") from None
+            temporaries.pop(0)
+    finally:
+        for tmp, _ in temporaries:
+            try:
+                os.unlink(tmp)
+            except OSError:
+                pass
 
 
 def atomic_write_text(path: str | Path, text: str) -> None:

@@ -64,6 +64,7 @@ __all__ = [
     "SweepResult",
     "run_sweep",
     "ProgressBar",
+    "SweepInterrupted",
 ]
 
 #: The joints whose torque limit a sweep can vary on the paper's body, in joint order.
@@ -279,6 +280,13 @@ class SweepGrid:
     def n_runs(self) -> int:
         """Number of runs M. [-]"""
         return int(self.values.shape[0])
+
+    def head(self, count: int) -> SweepGrid:
+        """The grid of the first ``count`` runs (what an interrupted sweep finished)."""
+        from dataclasses import fields
+
+        return SweepGrid(**{f.name: (value[:count] if isinstance(value, np.ndarray) else value)
+                            for f in fields(self) for value in [getattr(self, f.name)]})
 
     @property
     def shape(self) -> tuple[int, ...]:
@@ -648,12 +656,16 @@ class ProgressBar:
         Where to draw; ``sys.stderr`` by default.
     width : int
         Characters of the bar itself. [-]
+    unit : str
+        What is counted ("runs", "sets", ...).
     """
 
-    def __init__(self, total: int, stream: IO[str] | None = None, width: int = 30):
+    def __init__(self, total: int, stream: IO[str] | None = None, width: int = 30,
+                 unit: str = "runs"):
         self.total = max(int(total), 1)
         self.stream = sys.stderr if stream is None else stream
         self.width = width
+        self.unit = unit
         self.start = time.perf_counter()
         self.done = 0
         self._draw()
@@ -676,7 +688,7 @@ class ProgressBar:
         eta = elapsed * (1 - frac) / frac if frac > 0 else math.nan
         eta_text = f", {eta:.1f} s left" if frac < 1 and math.isfinite(eta) else ""
         self.stream.write(f"\r[{'#' * filled}{'.' * (self.width - filled)}] {frac:4.0%} "
-                          f"{self.done}/{self.total} runs, {elapsed:.1f} s{eta_text} ")
+                          f"{self.done}/{self.total} {self.unit}, {elapsed:.1f} s{eta_text} ")
         self.stream.flush()
 
 
@@ -726,9 +738,39 @@ def run_sweep(
         The same numbers whichever way the runs were spread.
     """
     grid = sweep_grid(scenario, varies, viscosity_ratio)
-    parts = run_chunks(_Task(scenario, rtol, atol), grid, workers=workers, scheduler=scheduler,
-                       client=client, chunk_size=chunk_size, progress=progress)
+    try:
+        parts = run_chunks(_Task(scenario, rtol, atol), grid, workers=workers,
+                           scheduler=scheduler, client=client, chunk_size=chunk_size,
+                           progress=progress)
+    except SweepInterrupted as exc:
+        if exc.parts:
+            exc.result = SweepResult(grid.head(exc.rows), _concatenate(exc.parts))
+        raise
     return SweepResult(grid, _concatenate(parts))
+
+
+class SweepInterrupted(KeyboardInterrupt):
+    """Ctrl-C (or SIGTERM) stopped a sweep: the chunks not started were dropped, those
+    running finished. ``parts`` are the finished chunks' results, a prefix of the grid's
+    rows (``rows`` of ``total``); ``terminated`` tells SIGTERM from Ctrl-C; the sweep
+    function sets ``result`` to the table of the finished rows."""
+
+    def __init__(self, parts: list, rows: int, total: int, terminated: bool) -> None:
+        super().__init__(f"interrupted after {rows} of {total} runs")
+        self.parts, self.rows, self.total, self.terminated = parts, rows, total, terminated
+        self.result: Any = None
+
+
+def _interrupted(exc: BaseException, parts: list, bounds: list, total: int
+                 ) -> SweepInterrupted:
+    """The SweepInterrupted of ``exc`` with the leading finished ``parts``."""
+    done = []
+    for part in parts:
+        if part is None:
+            break
+        done.append(part)
+    rows = bounds[len(done) - 1][1] if done else 0
+    return SweepInterrupted(done, rows, total, type(exc).__name__ == "Terminated")
 
 
 def run_chunks(task, grid: SweepGrid, *, workers: int | None = None, scheduler: str | None = None,
@@ -740,6 +782,8 @@ def run_chunks(task, grid: SweepGrid, *, workers: int | None = None, scheduler: 
     chunk per single-threaded worker task); the parts in row order.
 
     ``progress(done, total)`` after each finished chunk. The same parts whichever way.
+    Ctrl-C or SIGTERM drops the chunks not started, waits for those running and raises
+    :class:`SweepInterrupted` with the finished ones.
     """
     m = grid.n_runs
     distributed_run = client is not None or scheduler is not None or workers is not None
@@ -752,20 +796,31 @@ def run_chunks(task, grid: SweepGrid, *, workers: int | None = None, scheduler: 
     if chunk_size < 1:
         raise ParameterError(f"chunk size must be >= 1, got {chunk_size}")
     bounds = [(lo, min(m, lo + chunk_size)) for lo in range(0, m, chunk_size)]
-    if distributed_run:
-        return _run_on_dask(task, grid, bounds, workers, scheduler, client, progress)
     parts: list = [None] * len(bounds)
+    if distributed_run:
+        try:
+            return _run_on_dask(task, grid, bounds, workers, scheduler, client, progress,
+                                parts)
+        except SweepInterrupted:
+            raise
+        except KeyboardInterrupt as exc:
+            raise _interrupted(exc, parts, bounds, m) from None
     done = 0
     if threads <= 1:
-        for k, (lo, hi) in enumerate(bounds):
-            parts[k] = task.run(grid, lo, hi, parallel=True)
-            done += hi - lo
-            if progress is not None:
-                progress(done, m)
+        try:
+            for k, (lo, hi) in enumerate(bounds):
+                parts[k] = task.run(grid, lo, hi, parallel=True)
+                done += hi - lo
+                if progress is not None:
+                    progress(done, m)
+        except KeyboardInterrupt as exc:
+            raise _interrupted(exc, parts, bounds, m) from None
         return parts
     from concurrent.futures import ThreadPoolExecutor, as_completed
 
-    with ThreadPoolExecutor(threads) as pool:
+    pool = ThreadPoolExecutor(threads)
+    futures: dict = {}
+    try:
         futures = {pool.submit(task.run, grid, lo, hi, True): k
                    for k, (lo, hi) in enumerate(bounds)}
         for fut in as_completed(futures):
@@ -774,10 +829,20 @@ def run_chunks(task, grid: SweepGrid, *, workers: int | None = None, scheduler: 
             done += bounds[k][1] - bounds[k][0]
             if progress is not None:
                 progress(done, m)
+    except KeyboardInterrupt as exc:
+        pool.shutdown(wait=True, cancel_futures=True)  # the running chunks finish
+        for fut, k in futures.items():
+            if parts[k] is None and fut.done() and not fut.cancelled() \
+                    and fut.exception() is None:
+                parts[k] = fut.result()
+        raise _interrupted(exc, parts, bounds, m) from None
+    finally:
+        pool.shutdown(wait=True, cancel_futures=True)
     return parts
 
 
-def _run_on_dask(task, grid, bounds, workers, scheduler, client, progress) -> list[BatchResult]:
+def _run_on_dask(task, grid, bounds, workers, scheduler, client, progress,
+                 parts: list) -> list[BatchResult]:
     try:
         import distributed
     except ImportError:
@@ -804,7 +869,6 @@ def _run_on_dask(task, grid, bounds, workers, scheduler, client, progress) -> li
         futures = [client.submit(_run_chunk, shared, shared_grid, lo, hi, pure=False)
                    for lo, hi in bounds]
         index = {f.key: k for k, f in enumerate(futures)}
-        parts: list[BatchResult | None] = [None] * len(futures)
         done = 0
         for fut in distributed.as_completed(futures):
             k = index[fut.key]

@@ -147,12 +147,21 @@ const polesChart = new Chart(document.getElementById("poles-chart"), {
   options: {scales: {x: axis("real part [1/s]"), y: axis("imaginary part [rad/s]")}},
 });
 
+const FREQUENCY_TICKS = [0.01, 0.03, 0.1, 0.3, 1, 3, 10];  // [Hz], the labelled ones
+// the FRF's frequency axis: its whole range even when nothing is drawn, labels upright
+function frequencyAxis() {
+  return {...axis("frequency [Hz]", "logarithmic"), min: 0.01, max: 10,
+          ticks: {maxRotation: 0, autoSkip: false,
+                  callback: v => FREQUENCY_TICKS.some(f => Math.abs(v / f - 1) < 1e-6)
+                    ? String(Number(v.toPrecision(1))) : ""}};
+}
+
 const frfGain = new Chart(document.getElementById("frf-gain"), {
   type: "scatter",
   data: {datasets: [{label: "gain [-]", data: [], showLine: true, pointRadius: 0,
                      borderColor: "#1f77b4"}]},
   options: {plugins: {legend: {display: false}},
-            scales: {x: axis("frequency [Hz]", "logarithmic"), y: axis("gain [-]", "logarithmic")}},
+            scales: {x: frequencyAxis(), y: axis("gain [-]", "logarithmic")}},
 });
 
 const frfPhase = new Chart(document.getElementById("frf-phase"), {
@@ -160,7 +169,7 @@ const frfPhase = new Chart(document.getElementById("frf-phase"), {
   data: {datasets: [{label: "phase [deg]", data: [], showLine: true, pointRadius: 0,
                      borderColor: "#1f77b4"}]},
   options: {plugins: {legend: {display: false}},
-            scales: {x: axis("frequency [Hz]", "logarithmic"), y: axis("phase [deg]")}},
+            scales: {x: frequencyAxis(), y: axis("phase [deg]")}},
 });
 
 const responseChart = new Chart(document.getElementById("response-chart"), {
@@ -221,6 +230,9 @@ function draw(d) {
     body.appendChild(tr);
   }
 
+  const frfNote = document.getElementById("frf-note");
+  frfNote.textContent = d.frf.note || "";
+  frfNote.hidden = !d.frf.note;
   frfGain.data.datasets[0].data = points(d.frf.frequency, d.frf.gain);
   frfGain.update();
   frfPhase.data.datasets[0].data = points(d.frf.frequency, d.frf.phase);

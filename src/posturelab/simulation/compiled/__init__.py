@@ -263,6 +263,12 @@ def integrate_compiled(setup: RunSetup, method: str | None = None) -> Simulation
         time = setup.grid[:n_grid]
         if count > n_grid:
             time = np.append(time, t_reached)
+        if count == 0:  # the run ended before its first sample: the series is its initial state
+            time, count = np.zeros(1), 1
+            samples[:, 0] = setup.x0
+            locked[0] = setup.locked0
+            if delayed:
+                fb[:, 0] = setup.before
         switches = switches[:min(int(res[R_N_SWITCHES]), switches.size)]
         if delayed:
             feedback = fb[:, :count].T
