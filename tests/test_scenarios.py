@@ -116,19 +116,43 @@ def test_unknown_replace_field():
 
 
 def test_scenario_run_on_either_engine():
-    """Scenario.run(engine="fast") is the compiled simulator at the scenario's tolerances;
-    it agrees with the reference run to 1e-6 rad; an unknown engine is refused."""
+    """Scenario.run() is the compiled simulator (by default; "fast" is its former name) at the
+    scenario's tolerances; it agrees with the reference run to 1e-6 rad; an unknown engine is
+    refused."""
     import numpy as np
 
     from posturelab.errors import ParameterError
     from posturelab.scenarios import builtin_scenario
 
     sc = builtin_scenario("paper-forward-case2")
-    ref, fast = sc.run(), sc.run(engine="fast")
+    ref, fast = sc.run(engine="reference"), sc.run()
+    np.testing.assert_array_equal(sc.run(engine="fast").theta, fast.theta)
     assert fast.fell == ref.fell and abs(fast.fall_time - ref.fall_time) < 1e-6
     np.testing.assert_allclose(fast.theta, ref.theta, rtol=0, atol=1e-6)
     with pytest.raises(ParameterError, match="engine"):
         sc.run(engine="turbo")
+
+
+def test_scenario_method_is_honoured_or_refused_on_the_compiled_engine():
+    """solver.method reaches the compiled engine (RK45 runs RK45, not the default Radau); a
+    method it does not have is refused in one line naming it; none means the engine's own."""
+    import posturelab as pl
+    from posturelab.errors import ParameterError
+
+    sc = builtin_scenario("paper-forward-case1").replace(duration=1.0)
+    assert sc.method is None
+    args = (sc.body, sc.muscles, sc.disturbance, 1.0)
+    options = {"initial_state": sc.initial_state, "rtol": sc.rtol, "atol": sc.atol}
+    for method in ("RK45", "Radau"):
+        api = pl.simulate(*args, engine="compiled", method=method, **options)
+        np.testing.assert_array_equal(sc.replace(method=method).run().theta, api.theta)
+    assert not np.array_equal(sc.replace(method="RK45").run().theta, sc.run().theta)
+    np.testing.assert_array_equal(
+        sc.replace(method="RK45").run(engine="reference").theta,
+        pl.simulate(*args, engine="reference", method="RK45", **options).theta)
+    with pytest.raises(ParameterError, match="solver.method 'DOP853'") as err:
+        sc.replace(method="DOP853").run()
+    assert "\n" not in str(err.value)
 
 
 TILTED = """
