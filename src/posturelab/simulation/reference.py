@@ -35,8 +35,9 @@ from ..model import events as ev
 from .derived import derived_series
 from .results import SimulationResult
 from .setup import (
+    DELAY_BREAKPOINT_MULTIPLES,
     RunSetup,
-    cop_at,
+    ankle_moment_and_load,
     model_response,
     outcome_message,
     pair_pulls_value,
@@ -100,6 +101,13 @@ class _History:
         k = max(bisect.bisect_right(self.starts, t) - 1, 0)
         return self.pieces[k](min(t, self.ends[k]))
 
+    def left(self, t: float) -> np.ndarray:
+        """The state just before ``t`` (where the rates jump: the start, a knee impact)."""
+        k = bisect.bisect_left(self.starts, t) - 1
+        if t <= 0.0 or k < 0:
+            return self.before
+        return self.pieces[k](min(t, self.ends[k]))
+
 
 def integrate_reference(setup: RunSetup, method: str = "DOP853") -> SimulationResult:
     """Integrate one run with scipy.
@@ -155,12 +163,14 @@ def integrate_reference(setup: RunSetup, method: str = "DOP853") -> SimulationRe
             return lambda t, y: bos.toe - (a_coef @ np.sin(y[:n])) / mtot
         if k == ev.COG_HEEL:
             return lambda t, y: (a_coef @ np.sin(y[:n])) / mtot - bos.heel
-        if k == ev.COP_TOE:
-            return lambda t, y: bos.toe - cop_at(setup, t, y, feedback(t, y), _active, _locked,
-                                                 _sat)
-        if k == ev.COP_HEEL:
-            return lambda t, y: cop_at(setup, t, y, feedback(t, y), _active, _locked,
-                                       _sat) - bos.heel
+        if k in (ev.COP_TOE, ev.COP_HEEL):  # in moment form: toe F_y − τ, τ − heel F_y
+            edge, sign = (bos.toe, -1.0) if k == ev.COP_TOE else (bos.heel, 1.0)
+
+            def cop_event(t, y):
+                tau, fy = ankle_moment_and_load(setup, t, y, feedback(t, y), _active, _locked,
+                                                _sat)
+                return sign * (tau - edge * fy)
+            return cop_event
         if k in (ev.SATURATES, ev.LETS_GO):
             return lambda t, y: sd * raw_moments(setup, t, y, feedback(t, y), _active)[j] \
                 - limits[j] + offset
@@ -206,23 +216,31 @@ def integrate_reference(setup: RunSetup, method: str = "DOP853") -> SimulationRe
         message = outcome_message("fell", 0.0, setup, fall_reason=fall_reason)
         t = duration  # nothing to integrate
 
+    rate_jumps = [0.0]  # when the rates jump: the start (a velocity step), knee impacts
+    feedback_jumps: list[float] = []  # … and when the delayed feedback feels it (+ τ, > 0)
+
     def jumped_at_delay(listed, t: float, x: np.ndarray) -> int | None:
         """The first event of ``listed`` whose function jumps across zero in its direction at
-        t = τ, where the delayed feedback passes from the state before the run to the state
-        it starts from (a velocity step reaching the muscles); None if none does.
+        t, where the delayed feedback passes a jump of the rates (t − τ = 0, the velocity step,
+        or a knee impact); None if none does.
 
-        Such a jump is no crossing inside a segment: the first segment ends at τ seeing the
-        state before the run, the next starts at τ seeing the state after the step, so
-        without this check a moment that jumps past its limit (or a pull-only pair's torque
-        that jumps below 0, or a centre of pressure that jumps past the toe) is missed. The
-        compiled engine sees the jump at the end of its step landing on τ.
+        Such a jump is no crossing inside a segment (at τ the first segment ends seeing the
+        state before the run, the next starts seeing the state after the step), so without
+        this check a moment that jumps past its limit (or a pull-only pair's torque that
+        jumps below 0, or a centre of pressure that jumps past the toe) is missed. The
+        compiled engine sees the jump at the end of its step landing on t.
         """
-        if history is None or abs(t - delay) > 1e-12 * max(1.0, delay):
+        if history is None:
+            return None
+        tol = 1e-12 * max(1.0, t)
+        source = next((s for s in rate_jumps if abs(t - delay - s) <= tol), None)
+        if source is None:
             return None
         sat_now = saturation.copy() if limits is not None else None
+        left = history.left(source)
         for e, (k, j, sd) in enumerate(listed):
             before_jump = event_function(k, j, sd, active, locked, sat_now,
-                                         feedback=lambda tt, yy: history.before)(t, x)
+                                         feedback=lambda tt, yy: left)(t, x)
             after_jump = event_function(k, j, sd, active, locked, sat_now)(t, x)
             if (before_jump <= 0.0 < after_jump if ev.EVENT_DIRECTION[k] > 0
                     else before_jump >= 0.0 > after_jump):
@@ -236,7 +254,8 @@ def integrate_reference(setup: RunSetup, method: str = "DOP853") -> SimulationRe
             kind, j, sd = listed[e]
             seg_end = t
         else:
-            t_end = next((s for s in stops if s > t + 1e-12), duration)
+            t_end = min(next((s for s in stops if s > t + 1e-12), duration),
+                        next((s for s in feedback_jumps if s > t + 1e-12), duration))
             if delay > 0:
                 t_end = min(t_end, t + delay)  # the method of steps: the past is already known
             sat = saturation.copy() if limits is not None else None
@@ -331,6 +350,10 @@ def integrate_reference(setup: RunSetup, method: str = "DOP853") -> SimulationRe
             x[1] = x[0] + knee.stop_angle
             x[n:] = constrained_velocity(body, x[:n], x[n:], setup.knee_row)
             locked = True
+            if delay > 0:  # the muscles feel the impact τ later, its derivatives 2τ, … later
+                rate_jumps.append(seg_end)
+                feedback_jumps.extend(seg_end + k * delay
+                                      for k in range(1, DELAY_BREAKPOINT_MULTIPLES + 1))
         elif kind == ev.KNEE_LEAVES_STOP:
             locked = False
         else:  # SATURATES / LETS_GO

@@ -645,11 +645,21 @@ def tilt_torques(tilt: Tilt, tilt_gains: np.ndarray, delay: float, t) -> np.ndar
 
 def cop_at(setup: RunSetup, t: float, x: np.ndarray, feedback: np.ndarray, active, locked,
            saturation) -> float:
-    """Centre of pressure x_p at one state, relative to the ankle. [m]"""
+    """Centre of pressure x_p at one state, relative to the ankle (NaN when the foot is not
+    pressed on the platform, F_y <= 0). [m]"""
+    return float(centre_of_pressure(*ankle_moment_and_load(setup, t, x, feedback, active,
+                                                           locked, saturation)))
+
+
+def ankle_moment_and_load(setup: RunSetup, t: float, x: np.ndarray, feedback: np.ndarray,
+                          active, locked, saturation) -> tuple[float, float]:
+    """The net muscle moment at the ankle τ_ankle [N·m] and the vertical ground reaction F_y
+    [N] at one state: x_p = τ_ankle / F_y. The centre-of-pressure events use them in moment
+    form (:mod:`posturelab.model.events`), continuous where F_y passes 0."""
     n = setup.n_links
     tau, acc = model_response(setup, t, x, feedback, active, locked, saturation)
     fy = ground_reaction(setup.body, x[:n], x[n:], acc, platform_acceleration(setup, t))[1]
-    return float(centre_of_pressure(tau[0], fy))
+    return float(tau[0]), float(fy)
 
 
 def _fall_at_start(setup: RunSetup) -> str | None:
