@@ -155,6 +155,26 @@ def test_scenario_method_is_honoured_or_refused_on_the_compiled_engine():
     assert "\n" not in str(err.value)
 
 
+def test_a_sweep_honours_or_refuses_the_scenarios_method():
+    """A sweep runs on the compiled engine: with the scenario's method (a row equals its single
+    run with that method), or refused in one line before any run."""
+    import posturelab as pl
+    from posturelab.errors import ParameterError
+    from posturelab.studies.sweep import parse_vary, run_sweep
+
+    sc = builtin_scenario("paper-forward-case1").replace(duration=0.5, method="RK45")
+    ankle = sc.muscles.stiffnesses[0]  # varied over its own value: the row is the scenario
+    vary = [parse_vary(f"ankle={ankle}:{ankle}:1")]
+    result = run_sweep(sc, vary)
+    options = {"initial_state": sc.initial_state, "rtol": 1e-6, "atol": 1e-9}  # a sweep's
+    for method in ("RK45", "Radau"):
+        single = pl.simulate(sc.body, sc.muscles, sc.disturbance, 0.5, method=method, **options)
+        same = np.array_equal(result.outcomes.final_state[0], single.final_state)
+        assert same == (method == "RK45")
+    with pytest.raises(ParameterError, match="solver.method 'BDF'"):
+        run_sweep(sc.replace(method="BDF"), vary)
+
+
 TILTED = """
 duration = 1.0
 [muscles]

@@ -219,25 +219,35 @@ class Scenario:
         """
         name = engine_name(engine)
         sc = self.replace(**overrides) if overrides else self
-        if name == "compiled" and sc.method is not None:
-            from ..simulation.compiled import METHODS
-
-            if sc.method not in METHODS:
-                raise ParameterError(
-                    f"scenario {sc.name!r}: solver.method {sc.method!r} runs on the reference "
-                    f"engine only; the compiled engine integrates with {', '.join(METHODS)} "
-                    "(choose one of those, or run the reference engine: engine='reference', "
-                    "--engine reference)")
         return simulate(
             sc.body, sc.muscles, sc.disturbance, sc.duration,
             initial_state=sc.initial_state, rates_from=sc.rates_from, knee=sc.knee,
             fall=sc.fall, torque_limits=sc.torque_limits,
             feedback_delay=sc.feedback_delay, rtol=sc.rtol, atol=sc.atol,
             sample_rate=sc.sample_rate, description=sc.description,
-            method=sc.method, engine=name, tilt=sc.tilt,
+            method=sc.method_for(name), engine=name, tilt=sc.tilt,
             proprioceptive_weight=sc.proprioceptive_weight, tilt_axis_depth=sc.tilt_axis_depth,
             motor_noise=sc.motor_noise, max_steps=sc.max_steps, time_limit=sc.time_limit,
         )
+
+    def method_for(self, engine: str) -> str | None:
+        """The scenario's ``solver.method`` for ``engine`` (None: the engine's own).
+
+        Raises
+        ------
+        ParameterError
+            The compiled engine and a method it does not have (it has Radau, RK45, RK23).
+        """
+        if engine_name(engine) == "compiled" and self.method is not None:
+            from ..simulation.compiled import METHODS
+
+            if self.method not in METHODS:
+                raise ParameterError(
+                    f"scenario {self.name!r}: solver.method {self.method!r} runs on the "
+                    f"reference engine only; the compiled engine integrates with "
+                    f"{', '.join(METHODS)} (choose one of those, or run the reference engine: "
+                    "engine='reference', --engine reference)")
+        return self.method
 
     def replace(self, **changes: Any) -> Scenario:
         """A copy with some fields changed; unknown field names are rejected."""
