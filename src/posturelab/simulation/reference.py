@@ -219,7 +219,7 @@ def integrate_reference(setup: RunSetup, method: str = "DOP853") -> SimulationRe
     rate_jumps = [0.0]  # when the rates jump: the start (a velocity step), knee impacts
     feedback_jumps: list[float] = []  # … and when the delayed feedback feels it (+ τ, > 0)
 
-    def jumped_at_delay(listed, t: float, x: np.ndarray) -> int | None:
+    def jumped_event(listed, t: float, x: np.ndarray) -> int | None:
         """The first event of ``listed`` whose function jumps across zero in its direction at
         t, where the delayed feedback passes a jump of the rates (t − τ = 0, the velocity step,
         or a knee impact); None if none does.
@@ -233,6 +233,7 @@ def integrate_reference(setup: RunSetup, method: str = "DOP853") -> SimulationRe
         if history is None:
             return None
         tol = 1e-12 * max(1.0, t)
+        rate_jumps[:] = [s for s in rate_jumps if s >= t - delay - tol]  # (the past ones go)
         source = next((s for s in rate_jumps if abs(t - delay - s) <= tol), None)
         if source is None:
             return None
@@ -249,13 +250,14 @@ def integrate_reference(setup: RunSetup, method: str = "DOP853") -> SimulationRe
 
     while t < duration:
         listed = ev.segment_events(slots, saturation, active, locked)
-        e = jumped_at_delay(listed, t, x)
+        e = jumped_event(listed, t, x)
         if e is not None:  # an event at τ itself (x and t stay)
             kind, j, sd = listed[e]
             seg_end = t
         else:
+            feedback_jumps[:] = [s for s in feedback_jumps if s > t + 1e-12]
             t_end = min(next((s for s in stops if s > t + 1e-12), duration),
-                        next((s for s in feedback_jumps if s > t + 1e-12), duration))
+                        min(feedback_jumps, default=duration))
             if delay > 0:
                 t_end = min(t_end, t + delay)  # the method of steps: the past is already known
             sat = saturation.copy() if limits is not None else None
