@@ -67,7 +67,8 @@ __all__ = [
 
 #: With a feedback delay τ the motion is not smooth at t = kτ (the step at t = 0 reaches
 #: the muscles at τ, its derivative at 2τ, …); every engine ends a step exactly at kτ for
-#: k = 1 … this many (the order of the default integrators). [-]
+#: k = 1 … this many (the order of the default integrators), and at t_i + kτ after each knee
+#: impact t_i (the impact changes the rates at once). [-]
 DELAY_BREAKPOINT_MULTIPLES = 5
 #: Largest neural feedback delay a run accepts. [s]
 MAX_FEEDBACK_DELAY = 1.0
