@@ -210,7 +210,7 @@ def main() -> int:
     body, muscles, dist = sc.body, sc.muscles, sc.disturbance
     duration = sc.duration
     ref = pl.simulate(body, muscles, dist, duration, initial_state=sc.initial_state,
-                      rtol=REF_RTOL, atol=REF_ATOL)
+                      rtol=REF_RTOL, atol=REF_ATOL, engine="reference")
     x0 = initial_state_for(body, dist, sc.initial_state, sc.rates_from)
     rhs = numpy_rhs(body, muscles)
     grid = ref.time
@@ -274,7 +274,7 @@ def main() -> int:
                           and np.array_equal(one.final_state, out.final_state[r])
                           and one.fell == out.fell[r])
         reference = pl.simulate(body, m, step, duration, initial_state=posture,
-                                rtol=REF_RTOL, atol=REF_ATOL)
+                                rtol=REF_RTOL, atol=REF_ATOL, engine="reference")
         k = min(one.time.size, reference.time.size)
         err_batch = max(err_batch, float(np.max(np.abs(one.theta[:k] - reference.theta[:k]))))
 

@@ -113,7 +113,7 @@ def test_cli_budgets(tmp_path):
     assert len(err) == 1 and "step budget of 10 integrator steps" in err[0]
     assert "Traceback" not in p.stderr
     p = cli("simulate", "--stiffness", "3e7,300,3e7,300,818", "--disturbance", "backward",
-            "--duration", "10", "--time-limit", "0.5", "--json")
+            "--duration", "10", "--time-limit", "0.5", "--json", "--engine", "reference")
     assert p.returncode == 1 and "Traceback" not in p.stderr
     assert '"outcome": "failed"' in p.stdout and "time limit of 0.5 s" in p.stdout
     p = cli("simulate", "--case", "1", "--max-steps", "0")

@@ -27,9 +27,10 @@ def test_simulate_csv_and_json(tmp_path, capsys):
     assert set(summary) == {"outcome", "settling_time", "fall_time", "fall_reason",
                             "final_lean", "final_rate", "outcome_message", "fell", "status",
                             "message", "max_abs_theta", "final_state", "hip_fraction",
-                            "linear_stability", "perturbation_end", "steady_from",
+                            "engine", "linear_stability", "perturbation_end", "steady_from",
                             "steady_rms_theta", "steady_peak_theta", "steady_rms_cop",
                             "steady_peak_cop"}
+    assert summary["engine"] == "compiled"  # the default
     assert summary["outcome"] == "recovered" and 0 < summary["settling_time"] < 5
     assert summary["linear_stability"]["stable"] is True
     assert 0.0 <= summary["hip_fraction"] <= 1.0
@@ -144,3 +145,47 @@ def test_subprocess_error_has_no_traceback(tmp_path):
     assert proc.returncode == 2
     assert "Traceback" not in proc.stderr
     assert len(proc.stderr.strip().splitlines()) == 1
+
+
+def _simulate(*args):
+    return subprocess.run([sys.executable, "-m", "posturelab", "simulate", *args],
+                          capture_output=True, text=True, timeout=300)
+
+
+def test_simulate_says_which_engine_ran():
+    """The compiled engine is the default; --engine reference is the independent check, and
+    both say which one ran, in JSON and in words, with the same outcome."""
+    common = ["--case", "2", "--disturbance", "forward", "--duration", "2"]
+    runs = {}
+    for engine in ("compiled", "reference"):
+        proc = _simulate(*common, "--json", *(["--engine", engine] if engine == "reference"
+                                               else []))
+        assert proc.returncode == 0, proc.stderr
+        runs[engine] = json.loads(proc.stdout)
+        assert runs[engine]["engine"] == engine
+    assert runs["compiled"]["fell"] and runs["reference"]["fell"]
+    # both at the scenario's tolerances (rtol 1e-8): the same fall within 1e-6 s
+    assert runs["compiled"]["fall_time"] == pytest.approx(runs["reference"]["fall_time"],
+                                                          abs=1e-6)
+    text = _simulate(*common)
+    assert text.returncode == 0 and "engine: compiled" in text.stdout.splitlines()
+
+
+def test_scenario_method_the_compiled_engine_lacks_is_refused(tmp_path):
+    """A scenario that names DOP853 runs on the reference engine; on the compiled engine (the
+    default) it is refused in one line naming the method, instead of being dropped."""
+    from importlib import resources
+
+    text = (resources.files("posturelab.scenarios") / "builtin" / "paper-forward-case2.toml"
+            ).read_text(encoding="utf-8")
+    path = tmp_path / "dop.toml"
+    path.write_text(text + '\n[solver]\nmethod = "DOP853"\n', encoding="utf-8")
+    proc = _simulate("--scenario", str(path), "--duration", "0.5")
+    assert proc.returncode == 2 and proc.stdout == ""
+    assert len(proc.stderr.strip().splitlines()) == 1
+    assert "solver.method 'DOP853'" in proc.stderr and "--engine reference" in proc.stderr
+    proc = _simulate("--scenario", str(path), "--duration", "0.5", "--engine", "reference")
+    assert proc.returncode == 0, proc.stderr
+    path.write_text(text + '\n[solver]\nmethod = "RK45"\n', encoding="utf-8")
+    proc = _simulate("--scenario", str(path), "--duration", "0.5", "--json")
+    assert proc.returncode == 0 and json.loads(proc.stdout)["engine"] == "compiled"

@@ -40,7 +40,8 @@ def test_largest_step_grid_brackets_the_reference_bisection(tmp_path):
         muscles = paper_muscles(stiffness=k, viscosity=0.25 * k)
 
         def run(v, muscles=muscles):
-            return simulate(paper_body(), muscles, VelocityStep.backward(v), 3.0, fall=fall)
+            return simulate(paper_body(), muscles, VelocityStep.backward(v), 3.0, fall=fall,
+                            engine="reference")
 
         # raises if the reference disagrees at either end of the grid's bracket
         boundary = largest_recoverable(run, lo, hi, tolerance=0.02)

@@ -57,7 +57,7 @@ def test_large_torque_limits_change_nothing():
     body, muscles = sc.body, sc.muscles
     limited = pl.simulate(body, muscles, sc.disturbance, sc.duration,
                           initial_state=sc.initial_state, torque_limits=[1e4, 1e4, 1e4],
-                          sample_rate=100)
+                          sample_rate=100, rtol=sc.rtol, atol=sc.atol)  # (the scenario's)
     np.testing.assert_allclose(limited.theta, free.theta, atol=1e-9)
 
 

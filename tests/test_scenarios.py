@@ -116,19 +116,63 @@ def test_unknown_replace_field():
 
 
 def test_scenario_run_on_either_engine():
-    """Scenario.run(engine="fast") is the compiled simulator at the scenario's tolerances;
-    it agrees with the reference run to 1e-6 rad; an unknown engine is refused."""
+    """Scenario.run() is the compiled simulator (by default; "fast" is its former name) at the
+    scenario's tolerances; it agrees with the reference run to 1e-6 rad; an unknown engine is
+    refused."""
     import numpy as np
 
     from posturelab.errors import ParameterError
     from posturelab.scenarios import builtin_scenario
 
     sc = builtin_scenario("paper-forward-case2")
-    ref, fast = sc.run(), sc.run(engine="fast")
+    ref, fast = sc.run(engine="reference"), sc.run()
+    np.testing.assert_array_equal(sc.run(engine="fast").theta, fast.theta)
     assert fast.fell == ref.fell and abs(fast.fall_time - ref.fall_time) < 1e-6
     np.testing.assert_allclose(fast.theta, ref.theta, rtol=0, atol=1e-6)
     with pytest.raises(ParameterError, match="engine"):
         sc.run(engine="turbo")
+
+
+def test_scenario_method_is_honoured_or_refused_on_the_compiled_engine():
+    """solver.method reaches the compiled engine (RK45 runs RK45, not the default Radau); a
+    method it does not have is refused in one line naming it; none means the engine's own."""
+    import posturelab as pl
+    from posturelab.errors import ParameterError
+
+    sc = builtin_scenario("paper-forward-case1").replace(duration=1.0)
+    assert sc.method is None
+    args = (sc.body, sc.muscles, sc.disturbance, 1.0)
+    options = {"initial_state": sc.initial_state, "rtol": sc.rtol, "atol": sc.atol}
+    for method in ("RK45", "Radau"):
+        api = pl.simulate(*args, engine="compiled", method=method, **options)
+        np.testing.assert_array_equal(sc.replace(method=method).run().theta, api.theta)
+    assert not np.array_equal(sc.replace(method="RK45").run().theta, sc.run().theta)
+    np.testing.assert_array_equal(
+        sc.replace(method="RK45").run(engine="reference").theta,
+        pl.simulate(*args, engine="reference", method="RK45", **options).theta)
+    with pytest.raises(ParameterError, match="solver.method 'DOP853'") as err:
+        sc.replace(method="DOP853").run()
+    assert "\n" not in str(err.value)
+
+
+def test_a_sweep_honours_or_refuses_the_scenarios_method():
+    """A sweep runs on the compiled engine: with the scenario's method (a row equals its single
+    run with that method), or refused in one line before any run."""
+    import posturelab as pl
+    from posturelab.errors import ParameterError
+    from posturelab.studies.sweep import parse_vary, run_sweep
+
+    sc = builtin_scenario("paper-forward-case1").replace(duration=0.5, method="RK45")
+    ankle = sc.muscles.stiffnesses[0]  # varied over its own value: the row is the scenario
+    vary = [parse_vary(f"ankle={ankle}:{ankle}:1")]
+    result = run_sweep(sc, vary)
+    options = {"initial_state": sc.initial_state, "rtol": 1e-6, "atol": 1e-9}  # a sweep's
+    for method in ("RK45", "Radau"):
+        single = pl.simulate(sc.body, sc.muscles, sc.disturbance, 0.5, method=method, **options)
+        same = np.array_equal(result.outcomes.final_state[0], single.final_state)
+        assert same == (method == "RK45")
+    with pytest.raises(ParameterError, match="solver.method 'BDF'"):
+        run_sweep(sc.replace(method="BDF"), vary)
 
 
 TILTED = """

@@ -45,8 +45,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    + f"), {VISCOSITY_RATIO}, feedback_delay, proprioceptive_weight, "
                    "active_PAIR and active_viscosity_PAIR.")
     g.add_argument("--engine", choices=ENGINES, default="compiled",
-                   help="engine inside the fit: compiled (default; the scenario's "
-                   "tolerances) or reference (scipy, the scenario's solver); fast is a "
+                   help="engine inside the fit: compiled (default) or reference (scipy); "
+                   "either at the scenario's tolerances and solver.method; fast is a "
                    "former name of compiled.")
     g.add_argument("--residual-model", choices=RESIDUAL_MODELS, default="ar1",
                    help="residuals of the standard errors: ar1 (default: correlated from "

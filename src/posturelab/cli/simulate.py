@@ -31,7 +31,8 @@ from ._common import (
 
 DESCRIPTION = """\
 Simulate the paper's three-link biped (or a scenario file) under muscle-pair feedback
-and platform motion, with adaptive Runge–Kutta integration (scipy DOP853).
+and platform motion, on the compiled C engine (Radau, or RK45 with a feedback delay;
+--engine reference integrates the numpy model with scipy's DOP853 instead).
 
 Disturbances: --disturbance backward|forward is the paper's "unit impulse", a sudden
 platform velocity change of --speed m/s (default 1); the link rates jump by
@@ -77,17 +78,19 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                      '"steady_from", "steady_rms_theta", "steady_peak_theta" [rad], '
                      '"steady_rms_cop", "steady_peak_cop" [m] (null unless a steady sway), '
                      '"fell", "status", "message", '
-                     '"max_abs_theta", "final_state", "hip_fraction", "linear_stability" '
+                     '"max_abs_theta", "final_state", "hip_fraction", "engine" (compiled or '
+                     'reference), "linear_stability" '
                      '(the verdict about upright, as posturelab poles: {"status": stable, '
                      'unstable, marginal or "depends on the side" of a one-sided pair\'s '
                      'switch, "stable", "rightmost_root" [1/s], "feedback_delay" [s], '
                      '"sides", ...})}; hip_fraction [-] is the share of the anti-phase (hip) '
                      'mode of leg and trunk, null for one link.')
-    p.add_argument("--engine", choices=["reference", "compiled"], default="reference",
-                   help="reference (default): the numpy model integrated by scipy at the "
-                   "scenario's solver settings; compiled: the C engine (hundreds of times "
-                   "faster, its own integrator: Radau, or RK45 with a feedback delay), at "
-                   "the same tolerances.")
+    p.add_argument("--engine", choices=["compiled", "reference"], default="compiled",
+                   help="compiled (default): the C engine, hundreds of times faster (Radau, "
+                   "or RK45 with a feedback delay); reference: the numpy model integrated by "
+                   "scipy (DOP853), the independent check. Either runs at the tolerances of "
+                   "--rtol/--atol (default: the scenario's, 1e-8 and 1e-10) and with the "
+                   "scenario's solver.method if it names one.")
 
 
 def add_experiment_arguments(p: argparse.ArgumentParser) -> None:
@@ -155,11 +158,11 @@ def add_experiment_arguments(p: argparse.ArgumentParser) -> None:
     run = p.add_argument_group("integration")
     run.add_argument("--duration", type=float, default=None, help="simulated time [s] (default 5).")
     run.add_argument("--rtol", type=float, default=None,
-                     help="relative tolerance (default: the engine's, 1e-8 for the reference "
-                     "engine, 1e-6 for the compiled one and for sweeps).")
+                     help="relative tolerance (default: the scenario's, 1e-8 unless it says "
+                     "otherwise, on either engine; sweep: 1e-6).")
     run.add_argument("--atol", type=float, default=None,
-                     help="absolute tolerance [rad, rad/s] (default: 1e-10 reference, 1e-9 "
-                     "compiled and sweeps).")
+                     help="absolute tolerance [rad, rad/s] (default: the scenario's, 1e-10 "
+                     "unless it says otherwise; sweep: 1e-9).")
     run.add_argument("--sample-rate", type=float, default=None,
                      help="output samples per second [Hz] (default 1000).")
     run.add_argument("--max-steps", type=int, default=None, metavar="N",
@@ -377,12 +380,14 @@ def run(args: argparse.Namespace) -> int:
     verdict = upright_verdict(sc.body, sc.muscles, sc.feedback_delay)
     outcome = result.outcome
     if args.json:
-        print_json({**result.summary(), "linear_stability": verdict.to_dict()})
+        print_json({**result.summary(), "engine": args.engine,
+                    "linear_stability": verdict.to_dict()})
     else:
         peaks = ", ".join(f"{x:.4f}" for x in result.max_abs_theta)
         print(f"{sc.description}")
         print(f"outcome: {outcome.message}")
         print(f"status: {result.status} ({result.message})")
+        print(f"engine: {args.engine}")
         print(f"linear model: {verdict.describe()}")
         print(f"peak |θ| [rad]: {peaks}")
         if sc.body.n_links >= 2:

@@ -18,8 +18,8 @@ knee angle [rad], κ̈_free the knee acceleration with the knee free [rad/s²]):
     LINK_ANGLE        max_link_angle − |θ_i|        falling   (a fall)
     COG_TOE           toe − x_c                      falling   (a fall)
     COG_HEEL          x_c − heel                     falling   (a fall)
-    COP_TOE           toe − x_p                      falling   (a fall: the foot tips)
-    COP_HEEL          x_p − heel                     falling   (a fall: the foot tips)
+    COP_TOE           toe·F_y − τ_ankle              falling   (a fall: the foot tips)
+    COP_HEEL          τ_ankle − heel·F_y             falling   (a fall: the foot tips)
     SATURATES         side·τ_j − limit_j − h         rising    (joint j saturates at side ±1)
     LETS_GO           side·τ_j − limit_j + h         falling   (a saturated joint lets go)
     PAIR_SLACKENS     s_p + h                        falling   (an acting one-sided pair)
@@ -28,6 +28,11 @@ knee angle [rad], κ̈_free the knee acceleration with the knee free [rad/s²]):
     KNEE_LEAVES_STOP  κ̈_free + h_release             falling   (a locked knee lets go)
     PAIR_PUSHES       M_p + h_M                      falling   (a pull-only pair would push)
     PAIR_PULLS        min(M_p, k_p s_p) − h_M        rising    (a slack pull-only pair pulls)
+
+The centre-of-pressure events are toe − x_p and x_p − heel multiplied by the vertical
+ground reaction F_y [N] (x_p = τ_ankle / F_y): the same sign while the foot is pressed on the
+platform, and continuous where F_y passes 0 and x_p runs off to infinity, so that a foot that
+unloads within one integrator step still falls where x_p passes the edge.
 
 M_p = k_p s_p + l_p ṡ_p is the torque pair p would have, on the state the muscles respond
 to (k_p its stiffness). After PAIR_SLACKENS or PAIR_ENGAGES a pair acts if its stretch is

@@ -77,7 +77,7 @@ Schema (every table optional except where noted; units in brackets)::
     rtol = 1e-8
     atol = 1e-10
     sample_rate = 1000.0                 # [Hz]
-    method = "DOP853"
+    method = "Radau"                     # default: the engine's own (DOP853 on the reference)
 """
 
 from __future__ import annotations
@@ -155,8 +155,10 @@ class Scenario:
         Integrator tolerances. [-], [rad, rad/s]
     sample_rate : float
         [Hz]
-    method : str
-        scipy solve_ivp method.
+    method : str or None
+        The integrator (``solver.method``); None (the default) for the engine's own:
+        DOP853 on the reference engine, Radau or RK45 on the compiled one
+        (:func:`posturelab.simulate`). The compiled engine has Radau, RK45 and RK23 only.
     case : str or None
         The Table I case, when the muscles come from one.
     torque_limits : tuple of float or None
@@ -193,7 +195,7 @@ class Scenario:
     rtol: float = 1e-8
     atol: float = 1e-10
     sample_rate: float = 1000.0
-    method: str = "DOP853"
+    method: str | None = None
     case: str | None = None
     torque_limits: tuple[float, ...] | None = None
     feedback_delay: float = 0.0
@@ -204,13 +206,19 @@ class Scenario:
     max_steps: int | None = None
     time_limit: float | None = None
 
-    def run(self, *, engine: str = "reference", **overrides: Any) -> SimulationResult:
+    def run(self, *, engine: str = "compiled", **overrides: Any) -> SimulationResult:
         """Simulate this scenario; keyword ``overrides`` replace fields first.
 
-        ``engine="reference"`` (default) runs the reference engine with the
-        scenario's ``solver.method``; ``engine="compiled"`` (or its former name
-        ``"fast"``) runs the compiled engine (its default integrator); both at the
-        scenario's tolerances (:func:`posturelab.simulate`).
+        ``engine="compiled"`` (the default; ``"fast"`` is its former name) runs the C
+        engine, ``engine="reference"`` the numpy model integrated by scipy; both at the
+        scenario's tolerances and with its ``solver.method`` (the engine's own integrator
+        when it names none; :func:`posturelab.simulate`).
+
+        Raises
+        ------
+        ParameterError
+            ``solver.method`` names an integrator the engine does not have (the compiled
+            engine has Radau, RK45 and RK23).
         """
         name = engine_name(engine)
         sc = self.replace(**overrides) if overrides else self
@@ -220,10 +228,29 @@ class Scenario:
             fall=sc.fall, torque_limits=sc.torque_limits,
             feedback_delay=sc.feedback_delay, rtol=sc.rtol, atol=sc.atol,
             sample_rate=sc.sample_rate, description=sc.description,
-            method=sc.method if name == "reference" else None, engine=name, tilt=sc.tilt,
+            method=sc.method_for(name), engine=name, tilt=sc.tilt,
             proprioceptive_weight=sc.proprioceptive_weight, tilt_axis_depth=sc.tilt_axis_depth,
             motor_noise=sc.motor_noise, max_steps=sc.max_steps, time_limit=sc.time_limit,
         )
+
+    def method_for(self, engine: str) -> str | None:
+        """The scenario's ``solver.method`` for ``engine`` (None: the engine's own).
+
+        Raises
+        ------
+        ParameterError
+            The compiled engine and a method it does not have (it has Radau, RK45, RK23).
+        """
+        if engine_name(engine) == "compiled" and self.method is not None:
+            from ..simulation.compiled import METHODS
+
+            if self.method not in METHODS:
+                raise ParameterError(
+                    f"scenario {self.name!r}: solver.method {self.method!r} runs on the "
+                    f"reference engine only; the compiled engine integrates with "
+                    f"{', '.join(METHODS)} (choose one of those, or run the reference engine: "
+                    "engine='reference', --engine reference)")
+        return self.method
 
     def replace(self, **changes: Any) -> Scenario:
         """A copy with some fields changed; unknown field names are rejected."""
@@ -370,8 +397,8 @@ def _parse(data: dict, base_dir: Path, origin: str) -> Scenario:
 
     st = _table(data, "solver", ("rtol", "atol", "sample_rate", "method", "max_steps",
                                  "time_limit"), origin)
-    method = st.get("method", "DOP853")
-    if method not in ("DOP853", "RK45", "RK23", "Radau", "BDF", "LSODA"):
+    method = st.get("method")
+    if method is not None and method not in ("DOP853", "RK45", "RK23", "Radau", "BDF", "LSODA"):
         raise ScenarioError(f"{origin}: solver.method must be one of DOP853, RK45, RK23, Radau, "
                             f"BDF, LSODA; got {method!r}")
     return Scenario(

@@ -61,7 +61,7 @@ def simulate(
     method: str | None = None,
     max_switches: int = 10_000,
     description: str = "",
-    engine: str = "reference",
+    engine: str = "compiled",
     tilt: Tilt | None = None,
     proprioceptive_weight: float = 1.0,
     tilt_axis_depth: float = 0.0,
@@ -113,10 +113,12 @@ def simulate(
         Guard against chattering: more switches than this fail the run.
     description : str
         Words stored in the result.
-    engine : {"reference", "compiled"}
-        ``reference``: the numpy model integrated by scipy (slow, obvious, the check);
-        ``compiled``: the C engine (hundreds of times faster, built when posturelab is
-        installed). Same model, events and result.
+    engine : {"compiled", "reference"}
+        ``compiled`` (the default): the C engine (hundreds of times faster, built when
+        posturelab is installed); ``reference``: the numpy model integrated by scipy
+        (slow, obvious, the independent check). Same model, events and result; each at
+        its own default tolerances and integrator unless ``rtol``, ``atol``, ``method``
+        say otherwise (``docs/simulators.md``).
     tilt : Tilt, optional
         Support-surface tilt α(t), positive toes-up, about the ankle axis
         (:mod:`posturelab.model.tilt`); none by default. [rad]
@@ -150,7 +152,8 @@ def simulate(
 
     Examples
     --------
-    The paper's Fig. 3 run: a 1 m/s backward platform step, case 1, from the flexed posture:
+    The paper's Fig. 3 run: a 1 m/s backward platform step, case 1, from the flexed posture
+    (on the compiled engine, the default):
 
     >>> import posturelab as pl
     >>> run = pl.simulate(pl.paper_body(), pl.paper_muscles("1"), pl.VelocityStep.backward(1.0),
@@ -162,11 +165,11 @@ def simulate(
     >>> [round(float(a), 3) for a in run.max_abs_theta]  # [rad]
     [0.217, 0.216, 0.288]
 
-    Fig. 9: forward, case 2 (no gastrocnemius) falls, here on the compiled engine:
+    Fig. 9: forward, case 2 (no gastrocnemius) falls, here on the reference engine:
 
     >>> fall = pl.simulate(pl.paper_body(), pl.paper_muscles("2"), pl.VelocityStep.forward(1.0),
     ...                    duration=5.0, initial_state=[0.1, -0.1, 0.1, 0, 0, 0],
-    ...                    engine="compiled")
+    ...                    engine="reference")
     >>> fall.outcome.kind, round(fall.fall_time, 2)  # [s]
     ('fell', 1.19)
     """

@@ -36,8 +36,9 @@ from .derived import derived_series
 from .outcome import stimulus_timing
 from .results import SimulationResult
 from .setup import (
+    DELAY_BREAKPOINT_MULTIPLES,
     RunSetup,
-    cop_at,
+    ankle_moment_and_load,
     model_response,
     outcome_message,
     pair_pulls_value,
@@ -101,6 +102,13 @@ class _History:
         k = max(bisect.bisect_right(self.starts, t) - 1, 0)
         return self.pieces[k](min(t, self.ends[k]))
 
+    def left(self, t: float) -> np.ndarray:
+        """The state just before ``t`` (where the rates jump: the start, a knee impact)."""
+        k = bisect.bisect_left(self.starts, t) - 1
+        if t <= 0.0 or k < 0:
+            return self.before
+        return self.pieces[k](min(t, self.ends[k]))
+
 
 def integrate_reference(setup: RunSetup, method: str = "DOP853") -> SimulationResult:
     """Integrate one run with scipy.
@@ -146,8 +154,9 @@ def integrate_reference(setup: RunSetup, method: str = "DOP853") -> SimulationRe
     slots = ev.event_slots(n, bos is not None, fall.centre_of_pressure, limited,
                            muscles.one_sided_mask, knee.mode == "stop", muscles.pull_only_mask)
 
-    def event_function(k: int, j: int, sd: float, _active, _locked, _sat):
-        """The event function g(t, x) of event kind k (index j, side sd) in this segment."""
+    def event_function(k: int, j: int, sd: float, _active, _locked, _sat, feedback=feedback):
+        """The event function g(t, x) of event kind k (index j, side sd) in this segment;
+        ``feedback(t, x)`` is the state the muscles respond to (by default the run's)."""
         offset = ev.EVENT_OFFSET[k]
         if k == ev.LINK_ANGLE:
             return lambda t, y: fall.max_link_angle - abs(y[j])
@@ -155,12 +164,14 @@ def integrate_reference(setup: RunSetup, method: str = "DOP853") -> SimulationRe
             return lambda t, y: bos.toe - (a_coef @ np.sin(y[:n])) / mtot
         if k == ev.COG_HEEL:
             return lambda t, y: (a_coef @ np.sin(y[:n])) / mtot - bos.heel
-        if k == ev.COP_TOE:
-            return lambda t, y: bos.toe - cop_at(setup, t, y, feedback(t, y), _active, _locked,
-                                                 _sat)
-        if k == ev.COP_HEEL:
-            return lambda t, y: cop_at(setup, t, y, feedback(t, y), _active, _locked,
-                                       _sat) - bos.heel
+        if k in (ev.COP_TOE, ev.COP_HEEL):  # in moment form: toe F_y − τ, τ − heel F_y
+            edge, sign = (bos.toe, -1.0) if k == ev.COP_TOE else (bos.heel, 1.0)
+
+            def cop_event(t, y):
+                tau, fy = ankle_moment_and_load(setup, t, y, feedback(t, y), _active, _locked,
+                                                _sat)
+                return sign * (tau - edge * fy)
+            return cop_event
         if k in (ev.SATURATES, ev.LETS_GO):
             return lambda t, y: sd * raw_moments(setup, t, y, feedback(t, y), _active)[j] \
                 - limits[j] + offset
@@ -206,67 +217,107 @@ def integrate_reference(setup: RunSetup, method: str = "DOP853") -> SimulationRe
         message = outcome_message("fell", 0.0, setup, fall_reason=fall_reason)
         t = duration  # nothing to integrate
 
+    rate_jumps = [0.0]  # when the rates jump: the start (a velocity step), knee impacts
+    feedback_jumps: list[float] = []  # … and when the delayed feedback feels it (+ τ, > 0)
+
+    def jumped_event(listed, t: float, x: np.ndarray) -> int | None:
+        """The first event of ``listed`` whose function jumps across zero in its direction at
+        t, where the delayed feedback passes a jump of the rates (t − τ = 0, the velocity step,
+        or a knee impact); None if none does.
+
+        Such a jump is no crossing inside a segment (at τ the first segment ends seeing the
+        state before the run, the next starts seeing the state after the step), so without
+        this check a moment that jumps past its limit (or a pull-only pair's torque that
+        jumps below 0, or a centre of pressure that jumps past the toe) is missed. The
+        compiled engine sees the jump at the end of its step landing on t.
+        """
+        if history is None:
+            return None
+        tol = 1e-12 * max(1.0, t)
+        rate_jumps[:] = [s for s in rate_jumps if s >= t - delay - tol]  # (the past ones go)
+        source = next((s for s in rate_jumps if abs(t - delay - s) <= tol), None)
+        if source is None:
+            return None
+        sat_now = saturation.copy() if limits is not None else None
+        left = history.left(source)
+        for e, (k, j, sd) in enumerate(listed):
+            before_jump = event_function(k, j, sd, active, locked, sat_now,
+                                         feedback=lambda tt, yy: left)(t, x)
+            after_jump = event_function(k, j, sd, active, locked, sat_now)(t, x)
+            if (before_jump <= 0.0 < after_jump if ev.EVENT_DIRECTION[k] > 0
+                    else before_jump >= 0.0 > after_jump):
+                return e
+        return None
+
     while t < duration:
-        t_end = next((s for s in stops if s > t + 1e-12), duration)
-        if delay > 0:
-            t_end = min(t_end, t + delay)  # the method of steps: the past is already known
-        sat = saturation.copy() if limits is not None else None
-
-        def rhs(tt, xx, _active=active, _locked=locked, _sat=sat):
-            acc = model_response(setup, tt, xx, feedback(tt, xx), _active, _locked, _sat)[1]
-            return np.concatenate([xx[n:], acc])
-
         listed = ev.segment_events(slots, saturation, active, locked)
-        events = []
-        for k, j, sd in listed:
-            g = event_function(k, j, sd, active, locked, sat)
-            g.terminal = True
-            g.direction = int(ev.EVENT_DIRECTION[k])
-            events.append(g)
+        e = jumped_event(listed, t, x)
+        if e is not None:  # an event at τ itself (x and t stay)
+            kind, j, sd = listed[e]
+            seg_end = t
+        else:
+            feedback_jumps[:] = [s for s in feedback_jumps if s > t + 1e-12]
+            t_end = min(next((s for s in stops if s > t + 1e-12), duration),
+                        min(feedback_jumps, default=duration))
+            if delay > 0:
+                t_end = min(t_end, t + delay)  # the method of steps: the past is already known
+            sat = saturation.copy() if limits is not None else None
 
-        try:
-            sol = solve_ivp(rhs, (t, t_end), x, method=solver, rtol=setup.rtol,
-                            atol=setup.atol, dense_output=True, events=events,
-                            max_step=max_step)
-        except (ValueError, np.linalg.LinAlgError, FloatingPointError) as exc:
-            status = "failed"
-            message = outcome_message("failed", t, setup,
-                                      detail=f"integrator error at t = {t:.6g} s: {exc}")
-            break
-        seg_end = float(sol.t[-1])
-        if history is not None:
-            history.add(t, seg_end, sol.sol)
-        last_segment = sol.status == 0 and t_end >= duration
-        sel = (grid >= t - 1e-12) & ((grid <= seg_end + 1e-12) if last_segment or sol.status == 1
-                                      else (grid < seg_end - 1e-12))
-        if sel.any():
-            times.append(grid[sel])
-            states.append(sol.sol(grid[sel]).T)
-            locked_flags.append(np.full(int(sel.sum()), locked))
-            grid = grid[~sel | (grid > seg_end + 1e-12)]
-            grid = grid[grid > seg_end - 1e-12] if sol.status == 1 else grid
-        if sol.status == -1:
-            status = "failed"
-            message = outcome_message(
-                budget.spent or "failed", seg_end, setup,
-                detail=f"integrator failed at t = {seg_end:.6g} s: {sol.message}")
-            break
-        x = sol.y[:, -1].copy()
-        if not np.all(np.isfinite(x)):
-            status = "failed"
-            message = outcome_message("non-finite", seg_end, setup)
-            break
-        if sol.status != 1:
-            t = t_end
-            continue
-        fired = [k for k, te in enumerate(sol.t_events) if len(te) and
-                 abs(te[-1] - seg_end) <= 1e-12 * max(1.0, seg_end)]
-        if not fired:
-            fired = [k for k, te in enumerate(sol.t_events) if len(te)]
-        e = fired[0]
-        kind, j, sd = listed[e]
-        x = sol.y_events[e][-1].copy()
-        t = seg_end
+            def rhs(tt, xx, _active=active, _locked=locked, _sat=sat):
+                acc = model_response(setup, tt, xx, feedback(tt, xx), _active, _locked, _sat)[1]
+                return np.concatenate([xx[n:], acc])
+
+            events = []
+            for k, j, sd in listed:
+                g = event_function(k, j, sd, active, locked, sat)
+                g.terminal = True
+                g.direction = int(ev.EVENT_DIRECTION[k])
+                events.append(g)
+
+            try:
+                sol = solve_ivp(rhs, (t, t_end), x, method=solver, rtol=setup.rtol,
+                                atol=setup.atol, dense_output=True, events=events,
+                                max_step=max_step)
+            except (ValueError, np.linalg.LinAlgError, FloatingPointError) as exc:
+                status = "failed"
+                message = outcome_message("failed", t, setup,
+                                          detail=f"integrator error at t = {t:.6g} s: {exc}")
+                break
+            seg_end = float(sol.t[-1])
+            if history is not None:
+                history.add(t, seg_end, sol.sol)
+            last_segment = sol.status == 0 and t_end >= duration
+            sel = (grid >= t - 1e-12) & ((grid <= seg_end + 1e-12)
+                                          if last_segment or sol.status == 1
+                                          else (grid < seg_end - 1e-12))
+            if sel.any():
+                times.append(grid[sel])
+                states.append(sol.sol(grid[sel]).T)
+                locked_flags.append(np.full(int(sel.sum()), locked))
+                grid = grid[~sel | (grid > seg_end + 1e-12)]
+                grid = grid[grid > seg_end - 1e-12] if sol.status == 1 else grid
+            if sol.status == -1:
+                status = "failed"
+                message = outcome_message(
+                    budget.spent or "failed", seg_end, setup,
+                    detail=f"integrator failed at t = {seg_end:.6g} s: {sol.message}")
+                break
+            x = sol.y[:, -1].copy()
+            if not np.all(np.isfinite(x)):
+                status = "failed"
+                message = outcome_message("non-finite", seg_end, setup)
+                break
+            if sol.status != 1:
+                t = t_end
+                continue
+            fired = [k for k, te in enumerate(sol.t_events) if len(te) and
+                     abs(te[-1] - seg_end) <= 1e-12 * max(1.0, seg_end)]
+            if not fired:
+                fired = [k for k, te in enumerate(sol.t_events) if len(te)]
+            e = fired[0]
+            kind, j, sd = listed[e]
+            x = sol.y_events[e][-1].copy()
+            t = seg_end
         if ev.EVENT_ENDS_RUN[kind]:
             # the state at the fall itself closes the series (it is off the sample grid)
             if not times or times[-1][-1] < seg_end - 1e-12:
@@ -302,6 +353,10 @@ def integrate_reference(setup: RunSetup, method: str = "DOP853") -> SimulationRe
             x[1] = x[0] + knee.stop_angle
             x[n:] = constrained_velocity(body, x[:n], x[n:], setup.knee_row)
             locked = True
+            if delay > 0:  # the muscles feel the impact τ later, its derivatives 2τ, … later
+                rate_jumps.append(seg_end)
+                feedback_jumps.extend(seg_end + k * delay
+                                      for k in range(1, DELAY_BREAKPOINT_MULTIPLES + 1))
         elif kind == ev.KNEE_LEAVES_STOP:
             locked = False
         else:  # SATURATES / LETS_GO

@@ -67,7 +67,8 @@ __all__ = [
 
 #: With a feedback delay τ the motion is not smooth at t = kτ (the step at t = 0 reaches
 #: the muscles at τ, its derivative at 2τ, …); every engine ends a step exactly at kτ for
-#: k = 1 … this many (the order of the default integrators). [-]
+#: k = 1 … this many (the order of the default integrators), and at t_i + kτ after each knee
+#: impact t_i (the impact changes the rates at once). [-]
 DELAY_BREAKPOINT_MULTIPLES = 5
 #: Largest neural feedback delay a run accepts. [s]
 MAX_FEEDBACK_DELAY = 1.0
@@ -645,11 +646,21 @@ def tilt_torques(tilt: Tilt, tilt_gains: np.ndarray, delay: float, t) -> np.ndar
 
 def cop_at(setup: RunSetup, t: float, x: np.ndarray, feedback: np.ndarray, active, locked,
            saturation) -> float:
-    """Centre of pressure x_p at one state, relative to the ankle. [m]"""
+    """Centre of pressure x_p at one state, relative to the ankle (NaN when the foot is not
+    pressed on the platform, F_y <= 0). [m]"""
+    return float(centre_of_pressure(*ankle_moment_and_load(setup, t, x, feedback, active,
+                                                           locked, saturation)))
+
+
+def ankle_moment_and_load(setup: RunSetup, t: float, x: np.ndarray, feedback: np.ndarray,
+                          active, locked, saturation) -> tuple[float, float]:
+    """The net muscle moment at the ankle τ_ankle [N·m] and the vertical ground reaction F_y
+    [N] at one state: x_p = τ_ankle / F_y. The centre-of-pressure events use them in moment
+    form (:mod:`posturelab.model.events`), continuous where F_y passes 0."""
     n = setup.n_links
     tau, acc = model_response(setup, t, x, feedback, active, locked, saturation)
     fy = ground_reaction(setup.body, x[:n], x[n:], acc, platform_acceleration(setup, t))[1]
-    return float(centre_of_pressure(tau[0], fy))
+    return float(tau[0]), float(fy)
 
 
 def _fall_at_start(setup: RunSetup) -> str | None:

@@ -189,7 +189,8 @@ def fit_stiffness(
         Budget of simulations for the optimiser.
     engine : {"compiled", "reference"}
         Which engine runs the model: the compiled one (default) or the reference
-        (scipy, the scenario's ``solver.method``); "fast" is a former name of "compiled".
+        (scipy); either at the scenario's tolerances and ``solver.method``
+        (:meth:`posturelab.Scenario.run`); "fast" is a former name of "compiled".
     residual_model : {"ar1", "independent"}
         The residuals' correlation model of the standard errors and intervals: a
         first-order autoregression per link, estimated from the residuals (default), or

@@ -616,7 +616,7 @@ class _Task:
             sample_rate=sc.sample_rate, settle_tolerance=SETTLE_TOLERANCE, parallel=parallel,
             disturbance_scale=_rows(grid.disturbance_scale, lo, hi),
             tilt=sc.tilt, tilt_axis_depth=sc.tilt_axis_depth, motor_noise=sc.motor_noise,
-            max_steps=sc.max_steps, time_limit=sc.time_limit,
+            max_steps=sc.max_steps, time_limit=sc.time_limit, method=sc.method,
             proprioceptive_weight=(sc.proprioceptive_weight if grid.proprioceptive_weight is None
                                    else grid.proprioceptive_weight[lo:hi]),
             active_stiffness=_rows(grid.active_stiffness, lo, hi),
@@ -737,6 +737,7 @@ def run_sweep(
     SweepResult
         The same numbers whichever way the runs were spread.
     """
+    scenario.method_for("compiled")  # a solver.method the compiled engine lacks: one line
     grid = sweep_grid(scenario, varies, viscosity_ratio)
     try:
         parts = run_chunks(_Task(scenario, rtol, atol), grid, workers=workers,

@@ -103,11 +103,45 @@ static int64_t segment_events(const pl_run *run, const double *sat, const double
     return k;
 }
 
-static double next_stop(const pl_run *run, int64_t bi, int64_t di, double duration)
+/* Times at which the delayed feedback is not smooth after the start: kτ after each knee
+ * impact, k = 1 … delay_multiples (the impact changes the rates at once, the muscles feel it
+ * τ later, its derivatives 2τ, … later), sorted. Steps land on them as on the breakpoints. */
+typedef struct {
+    double *t;
+    int64_t n, cap, next;
+} jump_list;
+
+static int jump_add(jump_list *j, double t)
+{
+    if (j->n == j->cap) {
+        const int64_t cap = j->cap ? 2 * j->cap : 16;
+        double *q = realloc(j->t, sizeof(double) * cap);
+        if (!q)
+            return 0;
+        j->t = q;
+        j->cap = cap;
+    }
+    int64_t k = j->n++;
+    for (; k > j->next && j->t[k - 1] > t; k--)
+        j->t[k] = j->t[k - 1];
+    j->t[k] = t;
+    return 1;
+}
+
+static void jump_pass(jump_list *j, double t)
+{
+    while (j->next < j->n && j->t[j->next] <= t + 1e-12)
+        j->next++;
+}
+
+static double next_stop(const pl_run *run, int64_t bi, int64_t di, const jump_list *jumps,
+                        double duration)
 {
     double t_stop = bi < run->n_bps ? run->bps[bi] : duration;
     if (run->delay > 0.0 && di <= run->delay_multiples)
         t_stop = fmin(t_stop, di * run->delay);
+    if (jumps->next < jumps->n)
+        t_stop = fmin(t_stop, jumps->t[jumps->next]);
     return t_stop;
 }
 
@@ -136,6 +170,7 @@ int64_t pl_integrate(const pl_run *run, pl_out *out)
     pl_method me = {0};
     buffers b;
     pl_history hist = {0};
+    jump_list jumps = {0};
     memset(&b, 0, sizeof(b));
     int ok = run->method == METHOD_RADAU ? pl_radau_init(&me, n)
                                          : pl_explicit_init(&me, run, n);
@@ -173,6 +208,7 @@ int64_t pl_integrate(const pl_run *run, pl_out *out)
                 bi++;
             while (delay > 0.0 && di <= run->delay_multiples && di * delay <= t + 1e-12)
                 di++;
+            jump_pass(&jumps, t);
             pl_moment_gains(run->E, run->C, run->gains, run->gains + run->p, b.active, run->p,
                             n, b.tm, b.tm + n * n);
             pl_moment_gains(run->E, run->C, run->gains + 2 * run->p, run->gains + 3 * run->p,
@@ -187,11 +223,11 @@ int64_t pl_integrate(const pl_run *run, pl_out *out)
                 b.g_old[e] = pl_event_value(&cx, b.ev_kind[e], b.ev_index[e], b.ev_side[e], t,
                                             x, locked);
             pl_inputs_at(&cx, t, inp);
-            h = me.start(&me, &md, t, x, next_stop(run, bi, di, duration), max_step, rtol,
-                         atol, locked, inp, &n_evals);
+            h = me.start(&me, &md, t, x, next_stop(run, bi, di, &jumps, duration), max_step,
+                         rtol, atol, locked, inp, &n_evals);
             restart = 0;
         }
-        const double t_stop = next_stop(run, bi, di, duration);
+        const double t_stop = next_stop(run, bi, di, &jumps, duration);
         h = me.limit(&me, h, max_step);
         int landing = 0;
         if (t + 1.01 * h >= t_stop) {
@@ -392,6 +428,14 @@ int64_t pl_integrate(const pl_run *run, pl_out *out)
                 x[1] = x[0] + stop_angle;
                 pl_project_velocity(x, run->bp, b.work, n);
                 locked = 1;
+                int stored = 1;
+                for (int64_t k = 1; delay > 0.0 && k <= run->delay_multiples; k++)
+                    if (t_ev + k * delay < duration)
+                        stored = stored && jump_add(&jumps, t_ev + k * delay);
+                if (!stored) {
+                    status = PL_NO_MEMORY;
+                    break;
+                }
             } else if (kind == EV_KNEE_LEAVES_STOP) {
                 locked = 0;
             } else if (kind == EV_SATURATES) {
@@ -427,6 +471,7 @@ int64_t pl_integrate(const pl_run *run, pl_out *out)
                 bi++;
             while (delay > 0.0 && di <= run->delay_multiples && di * delay <= t + 1e-12)
                 di++;
+            jump_pass(&jumps, t);
         }
         h = h_next;
     }
@@ -448,5 +493,6 @@ int64_t pl_integrate(const pl_run *run, pl_out *out)
     me.release(&me);
     free_buffers(&b);
     pl_history_free(&hist);
+    free(jumps.t);
     return status;
 }

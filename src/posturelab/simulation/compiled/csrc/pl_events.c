@@ -114,13 +114,15 @@ double pl_event_value(const pl_ctx *cx, int64_t kind, int64_t idx, double side, 
         } else if (kind == EV_KNEE_LEAVES_STOP) {
             pl_rhs(md, y, cx->sc_out, cx->sc_inp, 0);
             g = cx->sc_out[n + 1] - cx->sc_out[n];
-        } else {  /* centre of pressure x_p = τ_ankle / F_y */
+        } else {  /* centre of pressure x_p = τ_ankle / F_y, in moment form: toe F_y − τ_ankle
+                   * and τ_ankle − heel F_y, of the sign of toe − x_p and x_p − heel while the
+                   * foot is pressed (F_y > 0) and continuous where F_y passes 0 */
             pl_rhs(md, y, cx->sc_out, cx->sc_inp, locked);
             double fy = bp[2 * n + n * n + 1] * (bp[2 * n + n * n] + cx->sc_inp[1]);
             for (int64_t i = 0; i < n; i++)
                 fy -= bp[i] * (cx->sc_out[n + i] * sin(y[i]) + y[n + i] * y[n + i] * cos(y[i]));
-            const double xp = fy > 0.0 ? md->tau[0] / fy : NAN;
-            g = kind == EV_COP_TOE ? fpar[F_TOE] - xp : xp - fpar[F_HEEL];
+            g = kind == EV_COP_TOE ? fpar[F_TOE] * fy - md->tau[0]
+                                   : md->tau[0] - fpar[F_HEEL] * fy;
         }
     }
     return g + cx->ev_offset[kind];
