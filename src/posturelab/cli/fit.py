@@ -4,16 +4,15 @@ from __future__ import annotations
 
 import argparse
 
-from ..model.muscles import PAPER_PAIR_NAMES
+from ..parameters import PAPER_PAIRS
+from ..parameters import unit as parameter_unit
 from ..simulation.results import atomic_write_text
 from ..studies.identification import (
     ENGINES,
     RESIDUAL_MODELS,
-    VISCOSITY_RATIO,
     fit_stiffness,
     read_trajectory_csv,
 )
-from ..studies.sweep import parameter_unit
 from ._common import check_writable, print_json
 from .simulate import add_experiment_arguments, scenario_from_args
 
@@ -40,9 +39,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     g.add_argument("--data", required=True, metavar="ANGLES.csv",
                    help="measured angles: columns t [s], theta1..theta3 [rad].")
     g.add_argument("--free", required=True, metavar="NAME[,NAME…]",
-                   help="parameters to fit: pair names (" + ", ".join(PAPER_PAIR_NAMES)
-                   + f"), {VISCOSITY_RATIO}, feedback_delay, proprioceptive_weight, "
-                   "active_PAIR and active_viscosity_PAIR.")
+                   help="parameters to fit, named as in the parameter table (the same "
+                   "as sweep --vary and fit-frf --free): stiffness:PAIR, viscosity:PAIR, "
+                   "active_stiffness:PAIR, active_viscosity:PAIR (PAIR " + ", ".join(PAPER_PAIRS)
+                   + " on the paper's body), viscosity_ratio, feedback_delay, "
+                   "proprioceptive_weight.")
     g.add_argument("--engine", choices=ENGINES, default="compiled",
                    help="engine inside the fit: compiled (default; the scenario's "
                    "tolerances) or reference (scipy, the scenario's solver); fast is a "
@@ -82,7 +83,7 @@ def run(args: argparse.Namespace) -> int:
     for name, e, se, (lo, hi) in zip(fit.parameter_names, fit.estimates, fit.standard_errors,
                                      fit.confidence_intervals, strict=True):
         unit = parameter_unit(name)
-        print(f"  {name:<16} {e:10.4g} ± {se:.3g} {unit}   (95 % CI {lo:.4g} … {hi:.4g})")
+        print(f"  {name:<22} {e:10.4g} ± {se:.3g} {unit}   (95 % CI {lo:.4g} … {hi:.4g})")
     if not fit.success:
         print(f"warning: the optimiser did not converge: {fit.message}")
     return 0

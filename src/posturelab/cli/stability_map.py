@@ -6,6 +6,7 @@ import argparse
 import io
 import math
 import os
+import re
 import sys
 import tempfile
 from concurrent.futures import ThreadPoolExecutor, wait
@@ -14,18 +15,21 @@ from typing import IO
 
 from ..errors import ParameterError, UnknownNameError
 from ..model.muscles import PAPER_PAIR_NAMES
+from ..parameters import PAPER_PAIRS, check_value, names_for, resolve
 from . import CONVENTIONS_EPILOG
 from ._common import load_compiled
 
-#: Axis names: the paper's five pairs (stiffness [N·m/rad]) and the viscosity ratio [s]
-#: (the same as posturelab.batch_linear.GRID_PARAMETERS, which imports numba).
-PARAMETER_NAMES: tuple[str, ...] = (*PAPER_PAIR_NAMES, "viscosity_ratio")
+#: Axis names, the parameter table's: the paper's five pair stiffnesses stiffness:PAIR
+#: [N·m/rad] and the viscosity ratio [s] (posturelab.linear.batch.GRID_PARAMETERS).
+PARAMETER_NAMES: tuple[str, ...] = names_for(PAPER_PAIRS, (), ("stiffness", "viscosity_ratio"))
 
 DESCRIPTION = """\
 Map the stability of the paper's three-link biped linearised about upright over two
-parameters. Each axis is NAME:LO:HI with NAME one of
-  ankle, knee, hip, quadriceps, gastrocnemius   a muscle pair's stiffness [N·m/rad]
-  viscosity_ratio                               pair viscosity / pair stiffness [s]
+parameters. Each axis is NAME:LO:HI with NAME one of (the parameter table's names, as for
+sweep --vary)
+  stiffness:PAIR     a muscle pair's stiffness [N·m/rad]; PAIR ankle, knee, hip,
+                     quadriceps or gastrocnemius
+  viscosity_ratio    pair viscosity / pair stiffness [s]
 Every other parameter is taken from a Table I case (--case, default 1), with
 viscosity = 0.25 × stiffness unless --viscosity-ratio is given.
 
@@ -35,14 +39,15 @@ stem (columns: x name, y name, max_real_part [1/s], stable [1 or 0]). Stable mea
 pole has real part < -δ, δ = 1e-9 × the poles' magnitude scale [1/s] (a set with
 undamped poles on the imaginary axis is not stable; see posturelab.batch_linear).
 
-Example: posturelab stability-map --x ankle:0:2000 --y gastrocnemius:0:1000 --out map.png
+Example: posturelab stability-map --x stiffness:ankle:0:2000 --y stiffness:gastrocnemius:0:1000 \
+             --out map.png
 
-With a feedback delay, the D-subdivision map: --x active_stiffness:LO:HI --y
-active_viscosity:LO:HI [N·m/rad, N·m·s/rad] of one pair (--pair, default the ankle) at
---feedback-delay S, for any body and gains (--body, --height/--mass, --stiffness,
---controller, ...: the other gains as in posturelab simulate). Colour is the real part of the
-rightmost characteristic root; the CSV has active_stiffness, active_viscosity,
-max_real_part [1/s], stable [1 or 0].
+With a feedback delay, the D-subdivision map: --x active_stiffness:PAIR:LO:HI --y
+active_viscosity:PAIR:LO:HI [N·m/rad, N·m·s/rad] of one pair (:PAIR may be left out on a
+one-pair body) at --feedback-delay S, for any body and gains (--body, --height/--mass,
+--stiffness, --controller, ...: the other gains as in posturelab simulate). Colour is the
+real part of the rightmost characteristic root; the CSV has active_stiffness:PAIR,
+active_viscosity:PAIR, max_real_part [1/s], stable [1 or 0].
 
 Example: posturelab stability-map --body paper-1link --stiffness 28 --viscosity 11 \
              --x active_stiffness:0:1700 --y active_viscosity:0:680 --feedback-delay 0.15 \
@@ -62,9 +67,10 @@ def add_parser(sub, name: str) -> argparse.ArgumentParser:
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument("--x", required=True, metavar="NAME:LO:HI",
-                   help="horizontal axis: parameter name and range (e.g. ankle:0:2000).")
+                   help="horizontal axis: parameter name and range (e.g. stiffness:ankle:0:2000).")
     p.add_argument("--y", required=True, metavar="NAME:LO:HI",
-                   help="vertical axis: parameter name and range (e.g. gastrocnemius:0:1000).")
+                   help="vertical axis: parameter name and range (e.g. "
+                   "stiffness:gastrocnemius:0:1000).")
     p.add_argument("--resolution", default="200", metavar="R",
                    help=f"grid points per axis, 2..{MAX_RESOLUTION} (default 200).")
     p.add_argument("--out", required=True, metavar="FILE",
@@ -78,8 +84,8 @@ def add_parser(sub, name: str) -> argparse.ArgumentParser:
     p.add_argument("--progress", action="store_true",
                    help="show a progress bar on standard error even when it is not a terminal.")
     p.add_argument("--pair", metavar="NAME",
-                   help="with active_stiffness × active_viscosity axes: the pair whose active "
-                   "gains vary (default the first, the ankle).")
+                   help="former option: the pair is now part of the axis names "
+                   "(active_stiffness:PAIR:LO:HI).")
     from ._common import add_muscle_arguments
 
     add_muscle_arguments(p, own_case=True)
@@ -94,14 +100,22 @@ def parse_axis(text: str, flag: str):
     from ..linear.batch import ParameterRange
 
     parts = str(text).split(":")
-    if len(parts) != 3:
-        raise ParameterError(f"{flag} must be NAME:LO:HI (e.g. ankle:0:2000), got {text!r}")
-    name = parts[0].strip().lower().replace("-", "_")
-    if name not in PARAMETER_NAMES:
+    if len(parts) not in (3, 4):
+        raise ParameterError(f"{flag} must be NAME:LO:HI (e.g. stiffness:ankle:0:2000), got "
+                             f"{text!r}")
+    if len(parts) == 3 and re.fullmatch(r"\s*[A-Za-z_]+\s*", parts[1]):  # a name, no HI
+        raise ParameterError(f"{flag} must be NAME:LO:HI (e.g. stiffness:ankle:0:2000), got "
+                             f"{text!r}")
+    given = ":".join(parts[:-2]).strip().lower().replace("-", "_")
+    parts = [given, *parts[-2:]]
+    try:
+        name = resolve(given, PAPER_PAIRS, (), accepts=("stiffness", "viscosity_ratio"),
+                       what=f"{flag} parameter")
+    except UnknownNameError:
         raise UnknownNameError(
-            f"{flag}: unknown parameter {parts[0].strip()!r}; known parameters: "
+            f"{flag}: unknown parameter {given!r}; known parameters: "
             f"{', '.join(PARAMETER_NAMES)}"
-        )
+        ) from None
     bounds = []
     for label, value in (("LO", parts[1]), ("HI", parts[2])):
         try:
@@ -115,6 +129,8 @@ def parse_axis(text: str, flag: str):
         bounds.append(number)
     low, high = bounds
     unit = "s" if name == "viscosity_ratio" else "N·m/rad"
+    if low >= 0:
+        check_value(name, high, f"{flag} HI")  # the parameter table's bound
     if low < 0:
         raise ParameterError(f"{flag} LO must be >= 0 [{unit}], got {low:g}")
     if not low < high:
@@ -266,7 +282,7 @@ def plot_stability_map(smap, figure_file, fmt: str) -> None:
     if "viscosity_ratio" not in (grid.x.name, grid.y.name):
         fixed.append(f"viscosity ratio {grid.base_viscosity_ratio:g} s")
     others = [f"{n} {v:g}" for n, v in zip(PAPER_PAIR_NAMES, grid.base_stiffness, strict=True)
-              if n not in (grid.x.name, grid.y.name)]
+              if f"stiffness:{n}" not in (grid.x.name, grid.y.name)]
     ax.set_title(
         f"Linearised stability about upright; others from Table I case {grid.base_case}\n"
         f"({', '.join(others)} N·m/rad{'; ' + fixed[0] if fixed else ''}); "

@@ -24,11 +24,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._validation import finite_array, float_in_range
+from .._validation import finite_array
 from ..errors import ParameterError, UnknownNameError
 from ..model.body import Body
 from ..model.dynamics import mass_matrix
 from ..model.muscles import MuscleSet, feedback_gains
+from ..parameters import check_value
 
 __all__ = ["model_frf", "model_frf_batch", "output_vector", "output_names", "INPUTS"]
 
@@ -160,8 +161,8 @@ def model_frf(body: Body, muscles: MuscleSet, frequencies, *, input: str = "tilt
               proprioceptive_weight: float = 1.0) -> np.ndarray:
     """The model FRF of one body and muscle set (its own intrinsic and active gains) at
     ``frequencies`` [Hz]; shape (F,). See :func:`model_frf_batch`."""
-    float_in_range("feedback_delay [s]", feedback_delay, 0.0, 10.0, unit="s")
-    float_in_range("proprioceptive_weight [-]", proprioceptive_weight, 0.0, 1.0)
+    check_value("feedback_delay", feedback_delay)
+    check_value("proprioceptive_weight", proprioceptive_weight)
     active = muscles.has_active_feedback
     return model_frf_batch(
         body, muscles, frequencies, muscles.stiffnesses[None], muscles.viscosities[None],

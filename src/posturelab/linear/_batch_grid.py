@@ -18,7 +18,7 @@ from typing import IO
 import numpy as np
 
 from .._validation import nonnegative_float
-from ..errors import ParameterError, UnknownNameError
+from ..errors import ParameterError
 from ..model.body import Body, paper_body
 from ..model.muscles import (
     DEFAULT_VISCOSITY_RATIO,
@@ -26,6 +26,7 @@ from ..model.muscles import (
     STIFFNESS_CASES,
     get_stiffness_case,
 )
+from ..parameters import check_value, names_for, resolve, unit
 
 __all__ = [
     "GRID_PARAMETERS",
@@ -37,23 +38,19 @@ __all__ = [
     "stability_map",
 ]
 
-#: Parameters a grid can sweep: the paper's five pair stiffnesses [N·m/rad] and
-#: the viscosity ratio [s].
-GRID_PARAMETERS: tuple[str, ...] = (*PAPER_PAIR_NAMES, "viscosity_ratio")
+#: The parameter table's quantities a grid can sweep (:mod:`posturelab.parameters`).
+GRID_QUANTITIES: tuple[str, ...] = ("stiffness", "viscosity_ratio")
+#: Parameters a grid can sweep, by the parameter table's names: the paper's five pair
+#: stiffnesses ``stiffness:PAIR`` [N·m/rad] and the viscosity ratio [s].
+GRID_PARAMETERS: tuple[str, ...] = names_for(PAPER_PAIR_NAMES, (), GRID_QUANTITIES)
 
 #: Unit of each grid parameter.
-GRID_PARAMETER_UNITS: dict[str, str] = {
-    **{name: "N·m/rad" for name in PAPER_PAIR_NAMES},
-    "viscosity_ratio": "s",
-}
+GRID_PARAMETER_UNITS: dict[str, str] = {name: unit(name) for name in GRID_PARAMETERS}
 
 
 def _check_parameter_name(name: str) -> str:
-    if name not in GRID_PARAMETERS:
-        raise UnknownNameError(
-            f"unknown parameter {name!r}; known parameters: {', '.join(GRID_PARAMETERS)}"
-        )
-    return name
+    """The table's one spelling of a grid parameter (a former one is refused naming it)."""
+    return resolve(name, PAPER_PAIR_NAMES, (), accepts=GRID_QUANTITIES, what="grid parameter")
 
 
 @dataclass(frozen=True)
@@ -63,7 +60,7 @@ class ParameterRange:
     Parameters
     ----------
     name : str
-        One of :data:`GRID_PARAMETERS`: a pair name (stiffness [N·m/rad]) or
+        One of :data:`GRID_PARAMETERS`: ``"stiffness:PAIR"`` [N·m/rad] or
         ``"viscosity_ratio"`` [s].
     low, high : float
         Range ends, 0 <= low < high. [N·m/rad] or [s]
@@ -74,7 +71,7 @@ class ParameterRange:
     high: float
 
     def __post_init__(self) -> None:
-        _check_parameter_name(self.name)
+        object.__setattr__(self, "name", _check_parameter_name(self.name))
         unit = GRID_PARAMETER_UNITS[self.name]
         low = nonnegative_float(f"{self.name} low [{unit}]", self.low)
         high = nonnegative_float(f"{self.name} high [{unit}]", self.high)
@@ -82,6 +79,7 @@ class ParameterRange:
             raise ParameterError(
                 f"{self.name} range must satisfy low < high [{unit}], got {low:g} .. {high:g}"
             )
+        check_value(self.name, high, f"{self.name} high")  # the parameter table's bound
         object.__setattr__(self, "low", low)
         object.__setattr__(self, "high", high)
 
@@ -95,7 +93,7 @@ class ParameterRange:
         """Axis label with unit, e.g. ``"ankle pair stiffness [N·m/rad]"``."""
         if self.name == "viscosity_ratio":
             return "viscosity ratio (viscosity / stiffness) [s]"
-        return f"{self.name} pair stiffness [N·m/rad]"
+        return f"{self.name.partition(':')[2]} pair stiffness [N·m/rad]"
 
     def values(self, count: int) -> np.ndarray:
         """``count`` evenly spaced values from low to high inclusive. [unit]"""
@@ -175,7 +173,7 @@ class ParameterGrid:
             if rng.name == "viscosity_ratio":
                 ratio[:] = vals
             else:
-                stiffness[:, PAPER_PAIR_NAMES.index(rng.name)] = vals
+                stiffness[:, PAPER_PAIR_NAMES.index(rng.name.partition(":")[2])] = vals
         return stiffness, ratio
 
     @property
@@ -196,7 +194,7 @@ class ParameterGrid:
         and its two swept values fall within the ranges.
         """
         points = []
-        names = list(PAPER_PAIR_NAMES)
+        names = [f"stiffness:{p}" for p in PAPER_PAIR_NAMES]
         for case, stiffness in STIFFNESS_CASES.items():
             params = dict(zip(names, stiffness, strict=True))
             params["viscosity_ratio"] = DEFAULT_VISCOSITY_RATIO

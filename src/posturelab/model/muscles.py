@@ -36,6 +36,7 @@ import numpy as np
 
 from .._validation import finite_array, float_in_range, nonnegative_float
 from ..errors import ParameterError, UnknownNameError
+from ..parameters import MAX_PAIR_STIFFNESS, MAX_PAIR_VISCOSITY
 
 __all__ = [
     "MusclePair",
@@ -64,10 +65,8 @@ DEFAULT_VISCOSITY_RATIO = 0.25
 Gastrocnemius = Literal["two-sided", "one-sided"]
 
 
-#: Largest pair stiffness, intrinsic or active: 10⁵ times a standing adult's mgh. [N·m/rad]
-MAX_PAIR_STIFFNESS = 1e8
-#: Largest pair viscosity, intrinsic or active. [N·m·s/rad]
-MAX_PAIR_VISCOSITY = 1e7
+# Largest pair stiffness [N·m/rad] and viscosity [N·m·s/rad], intrinsic or active: the
+# parameter table's (posturelab.parameters)
 
 
 @dataclass(frozen=True)

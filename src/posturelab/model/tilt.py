@@ -559,6 +559,8 @@ def axis_translation(tilt: Tilt, depth: float, t) -> tuple[np.ndarray, np.ndarra
 
 
 def check_proprioceptive_weight(value) -> float:
-    """W in [0, 1], a finite number. [-]"""
-    return float_in_range("proprioceptive_weight [-]", value, 0.0, 1.0)
+    """W in [0, 1] (the parameter table's bounds), a finite number. [-]"""
+    from ..parameters import check_value
+
+    return check_value("proprioceptive_weight", value)
 
