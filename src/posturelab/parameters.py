@@ -149,13 +149,16 @@ QUANTITIES: dict[str, Quantity] = {q.name: q for q in (
              "displacement, sine amplitudes, measured accelerations)"),
 )}
 
-#: Former spellings -> their names (PAIR / JOINT stand for any pair or joint name).
-RENAMED: dict[str, str] = {
-    "PAIR": "stiffness:PAIR",                              # sweep --vary, fit --free, maps
-    "active_PAIR": "active_stiffness:PAIR",                # sweep --vary, fit --free
-    "active_viscosity_PAIR": "active_viscosity:PAIR",      # sweep --vary, fit --free
-    "JOINT_torque_limit": "torque_limit:JOINT",            # sweep --vary
-    "stiffness_PAIR": "stiffness:PAIR",                    # the explorer's fields
+#: Former spellings -> (their names, where they were used); PAIR / JOINT stand for any pair
+#: or joint name (:func:`renamed` applies it).
+RENAMED: dict[str, tuple[str, str]] = {
+    "PAIR": ("stiffness:PAIR", "sweep --vary, fit --free, stability-map --x/--y"),
+    "active_PAIR": ("active_stiffness:PAIR", "sweep --vary, fit --free, the explorer"),
+    "active_viscosity_PAIR": ("active_viscosity:PAIR", "sweep --vary, fit --free, the explorer"),
+    "JOINT_torque_limit": ("torque_limit:JOINT", "sweep --vary"),
+    "stiffness_PAIR": ("stiffness:PAIR", "the explorer"),
+    "stiffness, viscosity, active_stiffness, active_viscosity (no pair, several pairs)": (
+        "QUANTITY:PAIR", "fit-frf (meant the first pair), stability-map's delayed map"),
 }
 
 _NAME = re.compile(r"[a-z][a-z0-9_]*(?::[a-z][a-z0-9_]*)?")
@@ -313,8 +316,8 @@ def markdown_table() -> str:
     rows = ["| name | unit | accepted | fit searches | meaning |",
             "|---|---|---|---|---|"]
     for q in QUANTITIES.values():
-        fit = f"up to {_g(q.fit_high)}" if not math.isnan(q.fit_high) else "—"
-        rows.append(f"| `{q.form}` | {q.unit} | {q.range_text()} | {fit} | {q.meaning} |")
-    rows += ["", "| former spelling | name |", "|---|---|"]
-    rows += [f"| `{old}` | `{new}` |" for old, new in RENAMED.items()]
+        fit = f"[{_g(q.low)}, {_g(q.fit_high)}]" if not math.isnan(q.fit_high) else "—"
+        rows.append(f"| `{q.form}` | {q.unit} | {q.interval()} | {fit} | {q.meaning} |")
+    rows += ["", "| former spelling | name | where |", "|---|---|---|"]
+    rows += [f"| `{old}` | `{new}` | {where} |" for old, (new, where) in RENAMED.items()]
     return "\n".join(rows) + "\n"

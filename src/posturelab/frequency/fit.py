@@ -155,9 +155,6 @@ def fit_frf(body: Body, muscles: MuscleSet, data, free, *, input: str = "tilt",
     from scipy.optimize import least_squares
     from scipy.stats import t as student
 
-    conditions = [data] if isinstance(data, FRFEstimate) else list(data)
-    if not conditions or not all(isinstance(c, FRFEstimate) for c in conditions):
-        raise ParameterError("data must be one FRFEstimate or a list of them")
     free = [_name(n, muscles) for n in ([free] if isinstance(free, str) else free)]
     per = [_name(n, muscles) for n in ([per_condition] if isinstance(per_condition, str)
                                        else per_condition)]
@@ -168,6 +165,9 @@ def fit_frf(body: Body, muscles: MuscleSet, data, free, *, input: str = "tilt",
                              "per condition")
     specs = [_parse(n, muscles) for n in free + per]
     bounds = _checked_bounds(bounds, muscles)
+    conditions = [data] if isinstance(data, FRFEstimate) else list(data)
+    if not conditions or not all(isinstance(c, FRFEstimate) for c in conditions):
+        raise ParameterError("data must be one FRFEstimate or a list of them")
     base = np.stack([muscles.stiffnesses, muscles.viscosities, muscles.active_stiffnesses,
                      muscles.active_viscosities])
     C = len(conditions)

@@ -29,7 +29,7 @@ from ..errors import ParameterError, UnknownNameError
 from ..model.body import Body
 from ..model.dynamics import mass_matrix
 from ..model.muscles import MuscleSet, feedback_gains
-from ..parameters import check_value
+from ..parameters import QUANTITIES, check_value
 
 __all__ = ["model_frf", "model_frf_batch", "output_vector", "output_names", "INPUTS"]
 
@@ -109,10 +109,10 @@ def model_frf_batch(body: Body, muscles: MuscleSet, frequencies, stiffness, visc
     M = k.shape[0]
     tau = np.broadcast_to(np.asarray(feedback_delay, dtype=float), (M,))
     w = np.broadcast_to(np.asarray(proprioceptive_weight, dtype=float), (M,))
-    if np.any(tau < 0) or np.any(~np.isfinite(tau)):
-        raise ParameterError("feedback_delay [s] must be finite and >= 0")
-    if np.any((w < 0) | (w > 1)):
-        raise ParameterError("proprioceptive_weight [-] must be in [0, 1]")
+    for name, values in (("feedback_delay", tau), ("proprioceptive_weight", w)):
+        bad = ~((values >= QUANTITIES[name].low) & (values <= QUANTITIES[name].high))
+        if np.any(bad):  # the parameter table's bounds (NaN fails too)
+            check_value(name, float(values[np.argmax(bad)]))
     g = feedback_gains(k, viscosity, active_stiffness, active_viscosity, np.ones(M))
     if M > _CHUNK:  # bound the memory of one evaluation
         return np.concatenate([

@@ -259,7 +259,7 @@ def parameter_grid(
             raise ParameterError(
                 "viscosity_ratio is swept along an axis; do not also give it as a fixed value"
             )
-        ratio = nonnegative_float("viscosity_ratio [s]", viscosity_ratio)
+        ratio = check_value("viscosity_ratio", viscosity_ratio)
     base.setflags(write=False)
     xv, yv = x.values(nx), y.values(ny)
     xv.setflags(write=False)

@@ -280,9 +280,8 @@ class SweepGrid:
 def _base_ratios(scenario: Scenario, viscosity_ratio: float | None) -> np.ndarray:
     """Viscosity/stiffness of each pair of the base experiment (or the given ratio). [s]"""
     if viscosity_ratio is not None:
-        if not (math.isfinite(viscosity_ratio) and viscosity_ratio >= 0):
-            raise ParameterError(f"viscosity ratio [s] must be >= 0, got {viscosity_ratio!r}")
-        return np.full(len(scenario.muscles.pairs), float(viscosity_ratio))
+        return np.full(len(scenario.muscles.pairs), check_value("viscosity_ratio",
+                                                                viscosity_ratio))
     k = np.asarray(scenario.muscles.stiffnesses, dtype=float)
     v = np.asarray(scenario.muscles.viscosities, dtype=float)
     with np.errstate(divide="ignore", invalid="ignore"):
