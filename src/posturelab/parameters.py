@@ -36,6 +36,7 @@ __all__ = [
     "MAX_PAIR_VISCOSITY",
     "MAX_VISCOSITY_RATIO",
     "MAX_DISTURBANCE_SCALE",
+    "FIT_MAX_GAIN",
     "PAPER_PAIRS",
     "PAPER_JOINTS",
     "RENAMED",

@@ -50,8 +50,6 @@ __all__ = ["FRFFit", "fit_frf", "PARAMETERS"]
 
 PARAMETERS = ("stiffness", "viscosity", "active_stiffness", "active_viscosity",
               "feedback_delay", "proprioceptive_weight")
-#: Unit of each parameter (the parameter table's).
-_UNITS = {name: QUANTITIES[name].unit for name in PARAMETERS}
 #: The default search interval of each parameter: the table's lower bound to its fit_high.
 _DEFAULT_BOUNDS = {name: (QUANTITIES[name].low, QUANTITIES[name].fit_high)
                    for name in PARAMETERS}
@@ -163,6 +161,10 @@ def fit_frf(body: Body, muscles: MuscleSet, data, free, *, input: str = "tilt",
     if set(free) & set(per):
         raise ParameterError(f"{sorted(set(free) & set(per))[0]!r} is both shared and "
                              "per condition")
+    for names in (free, per):  # by their one spelling: stiffness and stiffness:ankle alike
+        if len(set(names)) != len(names):
+            twice = sorted({n for n in names if names.count(n) > 1})[0]
+            raise ParameterError(f"{twice!r} is named more than once")
     specs = [_parse(n, muscles) for n in free + per]
     bounds = _checked_bounds(bounds, muscles)
     conditions = [data] if isinstance(data, FRFEstimate) else list(data)
