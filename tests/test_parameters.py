@@ -271,6 +271,17 @@ def test_sweep_vary_refuses_in_one_line_and_writes_nothing(tmp_path, vary, words
     assert not out.exists()
 
 
+def test_prts_sweep_fit_names_are_the_table_s(tmp_path):
+    """sweep --experiment prts --fit: the table's names, columns fit_NAME; a former spelling
+    is refused before any experiment runs."""
+    base = ["sweep", "--experiment", "prts", "--controller", "peterka-2002", "--tilt",
+            "prts:0.035", "--vary", "feedback_delay=0.15:0.15:1", "--out",
+            str(tmp_path / "p.csv")]
+    one_line_exit_2(cli(*base, "--fit", "active_ankle"),
+                    "'active_ankle' is now called 'active_stiffness:ankle'")
+    assert not (tmp_path / "p.csv").exists()
+
+
 def test_explorer_names_and_bounds_are_the_table_s():
     from posturelab.explore.views import CONTROLS, parse_parameters
 

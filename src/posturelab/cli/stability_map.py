@@ -39,8 +39,8 @@ stem (columns: x name, y name, max_real_part [1/s], stable [1 or 0]). Stable mea
 pole has real part < -δ, δ = 1e-9 × the poles' magnitude scale [1/s] (a set with
 undamped poles on the imaginary axis is not stable; see posturelab.batch_linear).
 
-Example: posturelab stability-map --x stiffness:ankle:0:2000 --y stiffness:gastrocnemius:0:1000 \
-             --out map.png
+Example: posturelab stability-map --x stiffness:ankle:0:2000 \\
+             --y stiffness:gastrocnemius:0:1000 --out map.png
 
 With a feedback delay, the D-subdivision map: --x active_stiffness:PAIR:LO:HI --y
 active_viscosity:PAIR:LO:HI [N·m/rad, N·m·s/rad] of one pair (:PAIR may be left out on a
@@ -49,9 +49,9 @@ one-pair body) at --feedback-delay S, for any body and gains (--body, --height/-
 real part of the rightmost characteristic root; the CSV has active_stiffness:PAIR,
 active_viscosity:PAIR, max_real_part [1/s], stable [1 or 0].
 
-Example: posturelab stability-map --body paper-1link --stiffness 28 --viscosity 11 \
-             --x active_stiffness:0:1700 --y active_viscosity:0:680 --feedback-delay 0.15 \
-             --out dmap.png
+Example: posturelab stability-map --body paper-1link --stiffness 28 --viscosity 11 \\
+             --x active_stiffness:ankle:0:1700 --y active_viscosity:ankle:0:680 \\
+             --feedback-delay 0.15 --out dmap.png
 """
 
 MAX_RESOLUTION = 5000
