@@ -36,6 +36,10 @@ __all__ = [
     "MAX_PAIR_VISCOSITY",
     "MAX_VISCOSITY_RATIO",
     "MAX_DISTURBANCE_SCALE",
+    "MAX_PLATFORM_SPEED",
+    "MAX_TILT",
+    "HEIGHT_RANGE",
+    "MASS_RANGE",
     "FIT_MAX_GAIN",
     "PAPER_PAIRS",
     "PAPER_JOINTS",
@@ -62,6 +66,13 @@ MAX_PAIR_VISCOSITY = 1e7
 MAX_VISCOSITY_RATIO = 10.0
 #: Largest factor on a base experiment's platform motion: posturelab's bound. [-]
 MAX_DISTURBANCE_SCALE = 100.0
+#: Largest platform velocity step: ten times the fastest perturbation of the field. [m/s]
+MAX_PLATFORM_SPEED = 20.0
+#: Largest |tilt| of the support surface. [rad]
+MAX_TILT = 0.5
+#: Standing heights and body masses a body can be scaled to (Winter's table). [m], [kg]
+HEIGHT_RANGE = (0.5, 2.5)
+MASS_RANGE = (10.0, 300.0)
 #: Largest gain a fit searches by default (a search box, inside the bounds). [N·m/rad]
 FIT_MAX_GAIN = 1e5
 #: The paper's five muscle pairs, in the order of its stiffness arrays.
@@ -148,6 +159,13 @@ QUANTITIES: dict[str, Quantity] = {q.name: q for q in (
     Quantity("disturbance_scale", "-", 0.0, MAX_DISTURBANCE_SCALE,
              "factor on the base experiment's platform motion (step speed, pulse peak, ramp "
              "displacement, sine amplitudes, measured accelerations)"),
+    Quantity("height", "m", *HEIGHT_RANGE,
+             "standing height of a body scaled by Winter's anthropometric table"),
+    Quantity("mass", "kg", *MASS_RANGE, "body mass of a body scaled by Winter's table"),
+    Quantity("step_speed", "m/s", 0.0, MAX_PLATFORM_SPEED,
+             "speed of a platform velocity step (its sign is the direction)", low_open=True),
+    Quantity("tilt_amplitude", "rad", 0.0, MAX_TILT,
+             "amplitude of a support-surface tilt (a PRTS's peak to peak: up to twice it)"),
 )}
 
 #: Former spellings -> (their names, where they were used); PAIR / JOINT stand for any pair

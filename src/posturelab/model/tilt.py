@@ -34,6 +34,7 @@ import numpy as np
 
 from .._validation import finite_array, finite_float, float_in_range
 from ..errors import ParameterError
+from ..parameters import MAX_TILT
 
 __all__ = [
     "Tilt",
@@ -51,8 +52,7 @@ __all__ = [
     "PETERKA_2002_CITATION",
 ]
 
-#: Largest |α| a profile may reach. [rad]
-MAX_TILT = 0.5
+# MAX_TILT [rad], the largest |α| a profile may reach: the parameter table's
 #: Largest distance of the tilt axis below the ankle. [m]
 MAX_AXIS_DEPTH = 1.0
 
