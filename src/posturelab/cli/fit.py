@@ -4,11 +4,12 @@ from __future__ import annotations
 
 import argparse
 
-from ..parameters import PAPER_PAIRS
+from ..parameters import PAPER_PAIRS, resolve
 from ..parameters import unit as parameter_unit
 from ..simulation.results import atomic_write_text
 from ..studies.identification import (
     ENGINES,
+    FIT_QUANTITIES,
     RESIDUAL_MODELS,
     fit_stiffness,
     read_trajectory_csv,
@@ -62,9 +63,11 @@ def run(args: argparse.Namespace) -> int:
     if args.report:
         check_writable([args.report], {args.report: (".json",)})
     sc = scenario_from_args(args, "fit")
+    free = [s.strip() for s in args.free.split(",") if s.strip()]
+    for name in free:  # the names first, before the data are read
+        resolve(name, sc.muscles.names, (), accepts=FIT_QUANTITIES)
     time, theta = read_trajectory_csv(args.data, sc.body.n_links)
     sc = sc.replace(duration=max(float(time[-1]), 1e-3))
-    free = [s.strip() for s in args.free.split(",") if s.strip()]
     ratio = 0.25 if args.viscosity_ratio is None else args.viscosity_ratio
     fit = fit_stiffness(sc, time, theta, free, viscosity_ratio=ratio,
                         engine=args.engine, residual_model=args.residual_model)

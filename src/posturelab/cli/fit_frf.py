@@ -126,6 +126,10 @@ def run(args: argparse.Namespace) -> int:
     body = body_from_args(args)
     muscles = muscles_from_args(args, body)
     options = feedback_options_from_args(args)
+    from ..frequency.fit import _name
+
+    for name in [*_names(args.free), *_names(args.per_condition), *_bounds(args.bounds)]:
+        _name(name, muscles)  # the names first, before any FRF is estimated
     conditions = [_condition(path, args) for path in args.data]
     fit = fit_frf(body, muscles, conditions, _names(args.free), input=args.input,
                   output=args.output.strip().lower(),
