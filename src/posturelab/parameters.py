@@ -158,7 +158,9 @@ QUANTITIES: dict[str, Quantity] = {q.name: q for q in (
              "largest net muscle moment at a joint (inf: none)", "joint", low_open=True),
     Quantity("disturbance_scale", "-", 0.0, MAX_DISTURBANCE_SCALE,
              "factor on the base experiment's platform motion (step speed, pulse peak, ramp "
-             "displacement, sine amplitudes, measured accelerations)"),
+             "displacement, sine amplitudes, measured accelerations); simulate_batch's "
+             "per-run factor may also be negative (reversing the motion), each scaled motion "
+             "then within its own bounds"),
     Quantity("height", "m", *HEIGHT_RANGE,
              "standing height of a body scaled by Winter's anthropometric table"),
     Quantity("mass", "kg", *MASS_RANGE, "body mass of a body scaled by Winter's table"),
