@@ -34,7 +34,7 @@ def browser_round_trips(page, delay: float) -> list[float]:
     times = []
     for k in range(CHANGES):
         done = int(page.evaluate("document.body.dataset.updates"))
-        page.locator('input[type=range][data-for="stiffness_ankle"]').fill(
+        page.locator('input[type=range][data-for="stiffness:ankle"]').fill(
             str(400 + 10 * (k % 2) + k))
         page.wait_for_function(f"Number(document.body.dataset.updates) > {done}")
         times.append(float(page.evaluate("document.body.dataset.roundTrip")) / 1000)
@@ -44,7 +44,7 @@ def browser_round_trips(page, delay: float) -> list[float]:
 def in_process(delay: float) -> list[float]:
     times = []
     for k in range(CHANGES):
-        p = parse_parameters({"stiffness_ankle": 400 + 10 * (k % 2) + k,
+        p = parse_parameters({"stiffness:ankle": 400 + 10 * (k % 2) + k,
                               "feedback_delay": delay})
         t0 = time.perf_counter()
         compute_views(p)
@@ -54,9 +54,9 @@ def in_process(delay: float) -> list[float]:
 
 def screenshot(page, path: str) -> None:
     """The page with intrinsic gains at 60 % and active ankle and hip gains, τ = 0.12 s."""
-    for name, value in (("stiffness_ankle", 300), ("active_ankle", 450),
-                        ("active_viscosity_ankle", 120), ("active_hip", 200),
-                        ("active_viscosity_hip", 50), ("feedback_delay", 0.12),
+    for name, value in (("stiffness:ankle", 300), ("active_stiffness:ankle", 450),
+                        ("active_viscosity:ankle", 120), ("active_stiffness:hip", 200),
+                        ("active_viscosity:hip", 50), ("feedback_delay", 0.12),
                         ("step_speed", 0.5)):
         done = int(page.evaluate("document.body.dataset.updates"))
         page.fill(f"#{name}", str(value))

@@ -123,7 +123,8 @@ def first_call_times(cache_dir: str, runs: int) -> list[tuple[float, float, floa
     return out
 
 
-COMMAND = ["stability-map", "--x", "ankle:0:2000", "--y", "gastrocnemius:0:1000",
+COMMAND = ["stability-map", "--x", "stiffness:ankle:0:2000", "--y",
+           "stiffness:gastrocnemius:0:1000",
            "--resolution", "1000"]
 COMMAND_SETS = 1000 * 1000
 

@@ -84,7 +84,7 @@ def main() -> None:
           f"{', '.join(f'{v:.2f}' for v in os.getloadavg())}")
     with tempfile.TemporaryDirectory() as tmp:
         sweep = ["sweep", "--case", "1", "--disturbance", "backward", "--speed", "1",
-                 "--foot", "literature", "--vary", "ankle=300:2000:40",
+                 "--foot", "literature", "--vary", "stiffness:ankle=300:2000:40",
                  "--vary", "disturbance_scale=0.05:1.5:30",
                  "--out", os.path.join(tmp, "how-large.csv")]
         whole, out = command_seconds(sweep, tmp)

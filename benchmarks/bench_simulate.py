@@ -135,7 +135,8 @@ STABILITY_MAP_KERNELS = """
     t0 = time.perf_counter()
     from posturelab.linear import batch
     t1 = time.perf_counter()
-    batch.stability_map(("ankle", 0.0, 2000.0), ("gastrocnemius", 0.0, 1000.0), 8)
+    batch.stability_map(("stiffness:ankle", 0.0, 2000.0), ("stiffness:gastrocnemius", 0.0, 1000.0),
+                        8)
     t2 = time.perf_counter()
     print("import =", t1 - t0)
     print("first_map =", t2 - t1)
@@ -358,11 +359,13 @@ def main() -> int:
         commands = {
             "posturelab --help": command_seconds(["--help"], REPEATS_COMMAND, tmp),
             "stability-map, resolution 1000": command_seconds(
-                ["stability-map", "--x", "ankle:0:2000", "--y", "gastrocnemius:0:1000",
+                ["stability-map", "--x", "stiffness:ankle:0:2000", "--y",
+                 "stiffness:gastrocnemius:0:1000",
                  "--resolution", "1000", "--out", "map.png"], REPEATS_COMMAND, tmp),
             "sweep, 10,000 runs (README)": command_seconds(
                 ["sweep", "--case", "1", "--disturbance", "backward", "--duration", "5",
-                 "--vary", "ankle=0:2000:100", "--vary", "gastrocnemius=0:1000:100",
+                 "--vary", "stiffness:ankle=0:2000:100",
+                 "--vary", "stiffness:gastrocnemius=0:1000:100",
                  "--out", "sweep.csv"], REPEATS_COMMAND, tmp),
             "reproduce": command_seconds(["reproduce", "--out", "paper-out"],
                                          1 if QUICK else 2, tmp),

@@ -25,7 +25,7 @@ import posturelab as pl
 from posturelab.identify import fit_stiffness
 
 #: The fitted parameters and their true values. [N·m/rad], [N·m/rad], [s]
-FREE = ("ankle", "gastrocnemius", "viscosity_ratio")
+FREE = ("stiffness:ankle", "stiffness:gastrocnemius", "viscosity_ratio")
 TRUTH = np.array([500.0, 300.0, 0.25])
 #: Standard deviation of the sensor noise. [rad]
 NOISE = 0.002
@@ -68,11 +68,11 @@ def main() -> None:
     args = parser.parse_args()
     print(f"coverage of the 95 % intervals, {args.trials} seeded trials per row")
     print(f"{'noise lag-1 correlation':>24}  {'residual model':>14}  "
-          + "  ".join(f"{name:>15}" for name in FREE))
+          + "  ".join(f"{name:>23}" for name in FREE))
     for phi in (0.0, 0.5, 0.8):
         for model in ("ar1", "independent"):
             c = coverage(phi, args.trials, model)
-            print(f"{phi:>24.1f}  {model:>14}  " + "  ".join(f"{v:>15.3f}" for v in c))
+            print(f"{phi:>24.1f}  {model:>14}  " + "  ".join(f"{v:>23.3f}" for v in c))
 
 
 if __name__ == "__main__":

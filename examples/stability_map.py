@@ -5,9 +5,9 @@ The paper's three-link biped linearised about upright, over a grid of the ankle 
 gastrocnemius pair stiffnesses [N·m/rad]; every other gain is Table I case 1's, each pair's
 viscosity 0.25 s × its stiffness. The colour is the largest real part of the six poles
 [1/s] (blue decays, red grows), the stable region is outlined and the Table I cases that
-lie in this plane are marked: what ``posturelab stability-map --x ankle:0:2000
---y gastrocnemius:0:1000`` draws (:func:`posturelab.linear.batch.stability_map`, the batched
-numba evaluator; its first use compiles or loads its kernels).
+lie in this plane are marked: what ``posturelab stability-map --x stiffness:ankle:0:2000
+--y stiffness:gastrocnemius:0:1000`` draws (:func:`posturelab.linear.batch.stability_map`,
+the batched numba evaluator; its first use compiles or loads its kernels).
 
 Usage: python examples/stability_map.py [OUTPUT_DIR]   (default: current directory)
 """
@@ -25,7 +25,8 @@ RESOLUTION = 300  # grid points per axis [-]
 
 def compute(resolution: int = RESOLUTION):
     """The map over ankle 0–2000 × gastrocnemius 0–1000 N·m/rad, others from case 1."""
-    return stability_map(("ankle", 0.0, 2000.0), ("gastrocnemius", 0.0, 1000.0), resolution,
+    return stability_map(("stiffness:ankle", 0.0, 2000.0),
+                         ("stiffness:gastrocnemius", 0.0, 1000.0), resolution,
                          case="1")
 
 

@@ -237,7 +237,8 @@ def test_body_and_muscles_must_agree():
 
 def test_parameter_grid_layout():
     """Row-major grid: set iy·nx + ix has x_values[ix], y_values[iy]; the rest from case 1."""
-    grid = parameter_grid(("ankle", 0, 2000), ("gastrocnemius", 0, 1000), (5, 3), case="1")
+    grid = parameter_grid(("stiffness:ankle", 0, 2000), ("stiffness:gastrocnemius", 0, 1000),
+                          (5, 3), case="1")
     assert grid.shape == (3, 5) and grid.size == 15
     np.testing.assert_allclose(grid.x_values, [0, 500, 1000, 1500, 2000])
     np.testing.assert_allclose(grid.y_values, [0, 500, 1000])
@@ -253,27 +254,31 @@ def test_parameter_grid_layout():
 
 def test_parameter_grid_viscosity_axis_and_table_i_points():
     """A viscosity-ratio axis; Table I cases in the plane are found, others are not."""
-    grid = parameter_grid(ParameterRange("viscosity_ratio", 0.1, 0.5), ("ankle", 0, 1200), 3,
+    grid = parameter_grid(ParameterRange("viscosity_ratio", 0.1, 0.5), ("stiffness:ankle", 0,
+                                                                        1200), 3,
                           case="2")
     np.testing.assert_allclose(grid.viscosity_ratio[:3], [0.1, 0.3, 0.5])
     np.testing.assert_array_equal(grid.pair_stiffness[:, 4], 0.0)
     # case 2 (ankle 500) and case 3 (ankle 1000) share every other value with case 2
     assert grid.table_i_points() == [("2", 0.25, 500.0), ("3", 0.25, 1000.0)]
-    plane = parameter_grid(("ankle", 0, 2000), ("gastrocnemius", 0, 1000), 2, case="1")
+    plane = parameter_grid(("stiffness:ankle", 0, 2000), ("stiffness:gastrocnemius", 0, 1000), 2,
+                           case="1")
     assert plane.table_i_points() == [("1", 500.0, 300.0), ("2", 500.0, 0.0),
                                       ("3", 1000.0, 0.0)]
-    off_ratio = parameter_grid(("ankle", 0, 2000), ("gastrocnemius", 0, 1000), 2,
+    off_ratio = parameter_grid(("stiffness:ankle", 0, 2000), ("stiffness:gastrocnemius", 0, 1000),
+                               2,
                                viscosity_ratio=0.3)
     assert off_ratio.table_i_points() == []
 
 
 @pytest.mark.parametrize("args,error,match", [
-    ((("ankel", 0, 1), ("hip", 0, 1)), UnknownNameError, "known parameters: ankle"),
-    ((("ankle", 2, 1), ("hip", 0, 1)), ParameterError, "low < high"),
-    ((("ankle", -1, 1), ("hip", 0, 1)), ParameterError, ">= 0"),
-    ((("ankle", 0, 1), ("ankle", 0, 1)), ParameterError, "different"),
-    ((("ankle", 0, 1), ("hip", 0, 1), 1), ParameterError, r"\[2, 5000\]"),
-    ((("ankle", 0, 1), ("hip", 0, 1), 5001), ParameterError, r"\[2, 5000\]"),
+    ((("ankel", 0, 1), ("stiffness:hip", 0, 1)), UnknownNameError, "known: stiffness:ankle"),
+    ((("ankle", 0, 1), ("stiffness:hip", 0, 1)), ParameterError, "now called 'stiffness:ankle'"),
+    ((("stiffness:ankle", 2, 1), ("stiffness:hip", 0, 1)), ParameterError, "low < high"),
+    ((("stiffness:ankle", -1, 1), ("stiffness:hip", 0, 1)), ParameterError, ">= 0"),
+    ((("stiffness:ankle", 0, 1), ("stiffness:ankle", 0, 1)), ParameterError, "different"),
+    ((("stiffness:ankle", 0, 1), ("stiffness:hip", 0, 1), 1), ParameterError, r"\[2, 5000\]"),
+    ((("stiffness:ankle", 0, 1), ("stiffness:hip", 0, 1), 5001), ParameterError, r"\[2, 5000\]"),
 ])
 def test_parameter_grid_rejects_bad_input(args, error, match):
     with pytest.raises(error, match=match):
@@ -282,19 +287,20 @@ def test_parameter_grid_rejects_bad_input(args, error, match):
 
 def test_parameter_grid_rejects_unknown_case_and_double_ratio():
     with pytest.raises(UnknownNameError, match="known cases"):
-        parameter_grid(("ankle", 0, 1), ("hip", 0, 1), 2, case="8")
+        parameter_grid(("stiffness:ankle", 0, 1), ("stiffness:hip", 0, 1), 2, case="8")
     with pytest.raises(ParameterError, match="swept"):
-        parameter_grid(("viscosity_ratio", 0, 1), ("hip", 0, 1), 2, viscosity_ratio=0.3)
+        parameter_grid(("viscosity_ratio", 0, 1), ("stiffness:hip", 0, 1), 2, viscosity_ratio=0.3)
 
 
 def test_grid_parameter_names():
-    assert GRID_PARAMETERS == (*PAPER_PAIR_NAMES, "viscosity_ratio")
+    assert GRID_PARAMETERS == (*(f"stiffness:{p}" for p in PAPER_PAIR_NAMES), "viscosity_ratio")
 
 
 def test_stability_map_matches_single_case(body):
     """A small map: each point equals analyse of its own parameter set; progress reported."""
     calls = []
-    smap = stability_map(("ankle", 0, 2000), ("gastrocnemius", 0, 1000), (4, 3), case="1",
+    smap = stability_map(("stiffness:ankle", 0, 2000), ("stiffness:gastrocnemius", 0, 1000),
+                         (4, 3), case="1",
                          progress=lambda done, total: calls.append((done, total)))
     assert smap.max_real_part.shape == smap.stable.shape == (3, 4)
     assert calls[0] == (0, 12) and calls[-1] == (12, 12)
@@ -385,7 +391,7 @@ def test_write_csv_is_the_percent_format_text(rng, tmp_path, rows_per_block):
 
     from posturelab.linear.batch import StabilityMap
 
-    grid = parameter_grid(("ankle", 0, 1999.9), ("viscosity_ratio", 1e-5, 0.6), (9, 6))
+    grid = parameter_grid(("stiffness:ankle", 0, 1999.9), ("viscosity_ratio", 1e-5, 0.6), (9, 6))
     values = awkward_values(rng, 2)[:54].reshape(6, 9)
     smap = StabilityMap(grid, values, rng.random((6, 9)) < 0.5)
     expected = reference_csv(smap)
@@ -405,7 +411,8 @@ def test_write_csv_is_the_percent_format_text(rng, tmp_path, rows_per_block):
 def test_write_csv_of_a_computed_map_is_the_percent_format_text():
     import io
 
-    smap = stability_map(("ankle", 0, 2000), ("gastrocnemius", 0, 1000), (23, 17))
+    smap = stability_map(("stiffness:ankle", 0, 2000), ("stiffness:gastrocnemius", 0, 1000), (23,
+                                                                                              17))
     stream = io.StringIO()
     smap.write_csv(stream, rows_per_block=50)
     assert stream.getvalue() == reference_csv(smap)

@@ -36,8 +36,9 @@ def test_huge_gains_and_grids_are_refused():
     p = cli("simulate", "--stiffness", "1e12,1e12,1e12,1e12,1e12", "--disturbance", "backward")
     assert p.returncode == 2
     assert "stiffness must be in [0, 1e+08] N·m/rad, got 1000000000000.0" in p.stderr
-    p = cli("sweep", "--case", "1", "--disturbance", "backward", "--vary", "ankle=0:1:10000",
-            "--vary", "knee=0:1:10000", "--out", "never.csv")
+    p = cli("sweep", "--case", "1", "--disturbance", "backward", "--vary",
+            "stiffness:ankle=0:1:10000",
+            "--vary", "stiffness:knee=0:1:10000", "--out", "never.csv")
     assert p.returncode == 2 and "100,000,000 runs" in p.stderr and "at most 10,000,000" in p.stderr
 
 
@@ -79,7 +80,7 @@ def test_fit_data_spanning_a_million_seconds_is_refused(tmp_path):
     path = tmp_path / "long.csv"
     path.write_text("t,theta1,theta2,theta3\n0,0.1,-0.1,0.1\n1,0,0,0\n1000000,0,0,0\n")
     p = cli("fit", "--case", "1", "--disturbance", "backward", "--data", str(path), "--free",
-            "ankle")
+            "stiffness:ankle")
     err = p.stderr.strip()
     assert p.returncode == 2 and len(err.splitlines()) == 1
     assert "duration [s] must be in (0, 86400] s, got 1000000.0" in err

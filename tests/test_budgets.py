@@ -122,7 +122,7 @@ def test_cli_budgets(tmp_path):
     # a sweep row that spends its budget says so in its failure column
     out = tmp_path / "rows.csv"
     p = cli("sweep", "--scenario", str(_scenario(tmp_path, "max_steps = 40")), "--vary",
-            "ankle=600:900:2", "--out", str(out))
+            "stiffness:ankle=600:900:2", "--out", str(out))
     assert p.returncode == 0, p.stderr
     header, *rows = [line.split(",") for line in out.read_text().splitlines()]
     at = header.index("failure")

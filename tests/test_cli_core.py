@@ -376,4 +376,4 @@ def test_help_and_printed_numbers_say_one_thing(capsys):
     from posturelab.studies.sweep import parse_vary
 
     assert parse_vary("viscosity_ratio=0.1:1:10").values.tolist()[4] == 0.5
-    assert repr(parse_vary("x=0:1.1:3").values.tolist()[1]) == "0.55"
+    assert repr(parse_vary("viscosity_ratio=0:1.1:3").values.tolist()[1]) == "0.55"

@@ -161,11 +161,19 @@ def test_stability_map_with_a_delay_is_the_d_subdivision_map(capsys, tmp_path):
 
 
 @pytest.mark.parametrize("argv,needle", [
-    (["--x", "active_stiffness:0:1", "--y", "active_viscosity:0:1"], "needs --feedback-delay"),
-    (["--x", "ankle:0:1", "--y", "hip:0:1", "--feedback-delay", "0.1"],
+    (["--x", "active_stiffness:ankle:0:1", "--y", "active_viscosity:ankle:0:1"],
+     "needs --feedback-delay"),
+    (["--x", "stiffness:ankle:0:1", "--y", "stiffness:hip:0:1", "--feedback-delay", "0.1"],
      "--feedback-delay is for the delayed map"),
-    (["--x", "active_stiffness:0:1", "--y", "hip:0:1", "--feedback-delay", "0.1"],
-     "both axes are active_stiffness and active_viscosity"),
+    (["--x", "active_stiffness:ankle:0:1", "--y", "stiffness:hip:0:1", "--feedback-delay",
+      "0.1"], "both axes are active_stiffness:PAIR and active_viscosity:PAIR"),
+    # the paper's body has five pairs: the axis names one
+    (["--x", "active_stiffness:0:1", "--y", "active_viscosity:0:1", "--feedback-delay", "0.1"],
+     "'active_stiffness' needs its pair: active_stiffness:ankle, active_stiffness:knee"),
+    (["--x", "active_stiffness:ankle:0:1", "--y", "active_viscosity:hip:0:1",
+      "--feedback-delay", "0.1"], "must name the same pair, got 'ankle' and 'hip'"),
+    (["--x", "active_stiffness:0:1", "--y", "active_viscosity:0:1", "--feedback-delay", "0.1",
+      "--pair", "hip"], "--pair is now part of the axis names: --x active_stiffness:hip:LO:HI"),
 ])
 def test_bad_delayed_maps(capsys, tmp_path, argv, needle):
     code, out, err = run(capsys, "stability-map", *argv, "--out", str(tmp_path / "e.png"))

@@ -116,8 +116,8 @@ def test_fit_frf_recovers_the_preset_from_a_simulated_trial(capsys, trial, tmp_p
     assert code == 0, err
     got = {p["name"]: p["estimate"] for p in json.loads(out)["parameters"]}
     mgh = pl.get_body("paper-1link").load_stiffness
-    assert got["active_stiffness"] == pytest.approx(1.35 * mgh, rel=0.01)
-    assert got["active_viscosity"] == pytest.approx(0.47 * mgh, rel=0.01)
+    assert got["active_stiffness:ankle"] == pytest.approx(1.35 * mgh, rel=0.01)
+    assert got["active_viscosity:ankle"] == pytest.approx(0.47 * mgh, rel=0.01)
     assert got["feedback_delay"] == pytest.approx(0.15, rel=0.01)
     frf_json = tmp_path / "frf.json"
     frf_json.write_text(_frf_json(trial))

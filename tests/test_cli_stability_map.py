@@ -32,15 +32,15 @@ def read_csv(path):
 
 def test_small_map_writes_png_and_csv(tmp_path, capsys, body):
     out = tmp_path / "map.png"
-    code, stdout, stderr = run(capsys, "stability-map", "--x", "ankle:0:2000",
-                               "--y", "gastrocnemius:0:1000", "--resolution", "6",
+    code, stdout, stderr = run(capsys, "stability-map", "--x", "stiffness:ankle:0:2000",
+                               "--y", "stiffness:gastrocnemius:0:1000", "--resolution", "6",
                                "--out", str(out))
     assert code == 0, stderr
     assert stderr == ""  # no progress bar: stderr is not a terminal
     assert "map.png" in stdout and "map.csv" in stdout
     assert out.read_bytes()[:8] == PNG_MAGIC
     header, rows = read_csv(tmp_path / "map.csv")
-    assert header == ["ankle", "gastrocnemius", "max_real_part", "stable"]
+    assert header == ["stiffness:ankle", "stiffness:gastrocnemius", "max_real_part", "stable"]
     assert len(rows) == 36
     assert sorted(p.name for p in tmp_path.iterdir()) == ["map.csv", "map.png"]
     plain = tmp_path / "plain"
@@ -57,18 +57,19 @@ def test_small_map_writes_png_and_csv(tmp_path, capsys, body):
 def test_viscosity_axis_case_and_svg(tmp_path, capsys):
     out = tmp_path / "ratio.svg"
     code, _, stderr = run(capsys, "stability-map", "--x", "viscosity_ratio:0.05:0.5",
-                          "--y", "hip:0:1000", "--resolution", "3", "--case", "6a",
+                          "--y", "stiffness:hip:0:1000", "--resolution", "3", "--case", "6a",
                           "--out", str(out), "--progress")
     assert code == 0, stderr
     assert "100.0%" in stderr  # --progress draws the bar even off a terminal
     assert out.read_text(encoding="utf-8").lstrip().startswith("<?xml")
     header, rows = read_csv(tmp_path / "ratio.csv")
-    assert header == ["viscosity_ratio", "hip", "max_real_part", "stable"]
+    assert header == ["viscosity_ratio", "stiffness:hip", "max_real_part", "stable"]
     assert np.allclose(sorted({float(r[0]) for r in rows}), [0.05, 0.275, 0.5])
 
 
 def test_fixed_viscosity_ratio(tmp_path, capsys):
-    code, _, stderr = run(capsys, "stability-map", "--x", "ankle:0:2000", "--y", "knee:0:500",
+    code, _, stderr = run(capsys, "stability-map", "--x", "stiffness:ankle:0:2000", "--y",
+                          "stiffness:knee:0:500",
                           "--resolution", "2", "--viscosity-ratio", "0",
                           "--out", str(tmp_path / "m.png"))
     assert code == 0, stderr
@@ -77,21 +78,25 @@ def test_fixed_viscosity_ratio(tmp_path, capsys):
 
 
 @pytest.mark.parametrize("argv,message", [
-    (["--x", "ankel:0:1", "--y", "hip:0:1"],
-     "unknown parameter 'ankel'; known parameters: ankle, knee, hip, quadriceps, "
-     "gastrocnemius, viscosity_ratio"),
-    (["--x", "ankle:2000:0", "--y", "hip:0:1"], "LO < HI"),
-    (["--x", "ankle:0:abc", "--y", "hip:0:1"], "HI must be a number"),
-    (["--x", "ankle:0", "--y", "hip:0:1"], "NAME:LO:HI"),
-    (["--x", "ankle:-5:10", "--y", "hip:0:1"], "LO must be >= 0"),
-    (["--x", "ankle:0:nan", "--y", "hip:0:1"], "finite"),
-    (["--x", "hip:0:1", "--y", "hip:0:1"], "different parameters"),
-    (["--x", "ankle:0:1", "--y", "hip:0:1", "--resolution", "1"], "[2, 5000]"),
-    (["--x", "ankle:0:1", "--y", "hip:0:1", "--resolution", "5001"], "[2, 5000]"),
-    (["--x", "ankle:0:1", "--y", "hip:0:1", "--resolution", "ten"], "integer"),
-    (["--x", "ankle:0:1", "--y", "hip:0:1", "--case", "8"], "known cases"),
-    (["--x", "ankle:0:1", "--y", "hip:0:1", "--viscosity-ratio", "-1"], ">= 0"),
-    (["--x", "viscosity_ratio:0:1", "--y", "hip:0:1", "--viscosity-ratio", "0.3"], "axis"),
+    (["--x", "ankel:0:1", "--y", "stiffness:hip:0:1"],
+     "unknown parameter 'ankel'; known parameters: stiffness:ankle, stiffness:knee, "
+     "stiffness:hip, stiffness:quadriceps, stiffness:gastrocnemius, viscosity_ratio"),
+    (["--x", "ankle:0:1", "--y", "stiffness:hip:0:1"],
+     "--x parameter 'ankle' is now called 'stiffness:ankle'"),
+    (["--x", "stiffness:ankle:2000:0", "--y", "stiffness:hip:0:1"], "LO < HI"),
+    (["--x", "stiffness:ankle:0:abc", "--y", "stiffness:hip:0:1"], "HI must be a number"),
+    (["--x", "stiffness:ankle:0", "--y", "stiffness:hip:0:1"], "NAME:LO:HI"),
+    (["--x", "stiffness:ankle:-5:10", "--y", "stiffness:hip:0:1"], "LO must be >= 0"),
+    (["--x", "stiffness:ankle:0:nan", "--y", "stiffness:hip:0:1"], "finite"),
+    (["--x", "stiffness:hip:0:1", "--y", "stiffness:hip:0:1"], "different parameters"),
+    (["--x", "stiffness:ankle:0:1", "--y", "stiffness:hip:0:1", "--resolution", "1"], "[2, 5000]"),
+    (["--x", "stiffness:ankle:0:1", "--y", "stiffness:hip:0:1", "--resolution", "5001"],
+     "[2, 5000]"),
+    (["--x", "stiffness:ankle:0:1", "--y", "stiffness:hip:0:1", "--resolution", "ten"], "integer"),
+    (["--x", "stiffness:ankle:0:1", "--y", "stiffness:hip:0:1", "--case", "8"], "known cases"),
+    (["--x", "stiffness:ankle:0:1", "--y", "stiffness:hip:0:1", "--viscosity-ratio", "-1"], ">= 0"),
+    (["--x", "viscosity_ratio:0:1", "--y", "stiffness:hip:0:1", "--viscosity-ratio", "0.3"],
+     "axis"),
 ])
 def test_bad_input_one_line_exit_2(tmp_path, capsys, argv, message):
     code, stdout, stderr = run(capsys, "stability-map", *argv,
@@ -112,7 +117,8 @@ def test_bad_input_one_line_exit_2(tmp_path, capsys, argv, message):
 ])
 def test_bad_out_one_line_exit_2(tmp_path, capsys, out, message):
     (tmp_path / "a_file.txt").write_text("not a directory")
-    code, _, stderr = run(capsys, "stability-map", "--x", "ankle:0:1", "--y", "hip:0:1",
+    code, _, stderr = run(capsys, "stability-map", "--x", "stiffness:ankle:0:1", "--y",
+                          "stiffness:hip:0:1",
                           "--resolution", "2", "--out", str(tmp_path / out))
     assert code == 2
     assert stderr.count("\n") == 1 and message in stderr
@@ -128,7 +134,8 @@ def test_write_failure_leaves_nothing_and_keeps_old_files(tmp_path, capsys, monk
         raise OSError(28, "No space left on device")
 
     monkeypatch.setattr(cli_map, "plot_stability_map", disk_full)
-    code, _, stderr = run(capsys, "stability-map", "--x", "ankle:0:1", "--y", "hip:0:1",
+    code, _, stderr = run(capsys, "stability-map", "--x", "stiffness:ankle:0:1", "--y",
+                          "stiffness:hip:0:1",
                           "--resolution", "2", "--out", str(tmp_path / "map.png"))
     assert code == 2
     assert stderr.count("\n") == 1 and "No space left on device" in stderr
@@ -142,7 +149,8 @@ def test_interrupt_leaves_nothing(tmp_path, capsys, monkeypatch):
         raise KeyboardInterrupt
 
     monkeypatch.setattr(cli_map, "plot_stability_map", interrupted)
-    code, _, _ = run(capsys, "stability-map", "--x", "ankle:0:1", "--y", "hip:0:1",
+    code, _, _ = run(capsys, "stability-map", "--x", "stiffness:ankle:0:1", "--y",
+                     "stiffness:hip:0:1",
                      "--resolution", "2", "--out", str(tmp_path / "map.png"))
     assert code == 130
     assert list(tmp_path.iterdir()) == []
@@ -166,8 +174,8 @@ def test_real_subprocess_bad_axis_is_one_line(tmp_path):
     import sys
 
     proc = subprocess.run(
-        [sys.executable, "-m", "posturelab", "stability-map", "--x", "ankle:5:1",
-         "--y", "hip:0:1", "--out", str(tmp_path / "m.png")],
+        [sys.executable, "-m", "posturelab", "stability-map", "--x", "stiffness:ankle:5:1",
+         "--y", "stiffness:hip:0:1", "--out", str(tmp_path / "m.png")],
         capture_output=True, encoding="utf-8", timeout=120, check=False,
     )
     assert proc.returncode == 2

@@ -67,7 +67,8 @@ def test_shared_and_per_condition_parameters():
                                             "feedback_delay"],
                   per_condition=["proprioceptive_weight"], feedback_delay=0.12,
                   proprioceptive_weight=0.7)
-    assert fit.names == ("active_stiffness", "active_viscosity", "feedback_delay",
+    # a one-pair body: a pair gain without :PAIR is its pair's, named in full
+    assert fit.names == ("active_stiffness:ankle", "active_viscosity:ankle", "feedback_delay",
                          "proprioceptive_weight#1", "proprioceptive_weight#2")
     np.testing.assert_allclose(fit.estimates, [TRUTH["active_stiffness"],
                                                TRUTH["active_viscosity"],
@@ -92,6 +93,11 @@ def test_a_parameter_the_data_cannot_determine_is_reported():
     (dict(free=["elbow"]), "unknown FRF fit parameter 'elbow'"),
     (dict(free=["stiffness:knee"]), "unknown pair 'knee'"),
     (dict(free=[]), "at least one parameter"),
+    (dict(free=["active_ankle"]), "'active_ankle' is now called 'active_stiffness:ankle'"),
+    (dict(free=["feedback_delay"], bounds={"feedback_delay": (0.0, 1.0001)}),
+     r"bound feedback_delay HI \[s\] must be in \[0, 1\], got 1.0001"),
+    (dict(free=["feedback_delay"], bounds={"feedback_dely": (0.0, 0.5)}),
+     "unknown FRF fit parameter 'feedback_dely'"),
     (dict(free=["feedback_delay"], per_condition=["feedback_delay"]), "both shared"),
 ])
 def test_bad_fit_requests(kwargs, needle):

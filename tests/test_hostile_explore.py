@@ -75,7 +75,7 @@ def test_brackets_inside_strings_are_not_nesting(port):
     status, _, answer = _exchange(port, _post(port, b'{"x": "' + b"[" * 50 + b'"}'))
     assert status == 422 and json.loads(answer) == {"error": "unknown control 'x'",
                                                     "field": "x"}
-    status, _, answer = _exchange(port, _post(port, b'{"stiffness_hip": 350}'))
+    status, _, answer = _exchange(port, _post(port, b'{"stiffness:hip": 350}'))
     assert status == 200 and "stable" in json.loads(answer)
 
 
@@ -100,7 +100,7 @@ def test_an_unstable_loop_gets_a_notice_instead_of_an_frf():
     stable = compute_views(parse_parameters({}))
     assert stable["stable"] and stable["frf"]["note"] is None
     assert len(stable["frf"]["gain"]) == len(stable["frf"]["frequency"]) > 100
-    unstable = compute_views(parse_parameters({"stiffness_ankle": 100}))
+    unstable = compute_views(parse_parameters({"stiffness:ankle": 100}))
     assert not unstable["stable"]
     assert unstable["frf"]["gain"] == unstable["frf"]["frequency"] == []
     assert unstable["frf"]["note"].startswith(
@@ -128,7 +128,7 @@ def test_the_page_shows_the_notice_and_gives_the_frf_room(tmp_path):
         gain = page.locator("#frf-gain").bounding_box()
         poles = page.locator("#poles-chart").bounding_box()
         assert gain["width"] >= poles["width"] and gain["height"] >= 200
-        page.fill("#stiffness_ankle", "100")
+        page.fill('[id="stiffness:ankle"]', "100")
         page.wait_for_function("Number(document.body.dataset.updates) >= 2", timeout=60_000)
         assert page.is_visible("#frf-note")
         assert "an FRF cannot be measured" in page.inner_text("#frf-note")

@@ -46,7 +46,7 @@ def test_a_device_as_a_profile_or_data_file_is_refused_at_once(tmp_path):
     out = tmp_path / "x.csv"
     one_line_exit_2(cli("simulate", "--case", "1", "--platform-profile", "/dev/zero",
                         "--out", str(out)), "not a regular file")
-    one_line_exit_2(cli("fit", "--case", "1", "--data", "/dev/zero", "--free", "ankle"),
+    one_line_exit_2(cli("fit", "--case", "1", "--data", "/dev/zero", "--free", "stiffness:ankle"),
                     "not a regular file")
     one_line_exit_2(cli("frf", "--data", "/dev/zero", "--stimulus", "tilt", "--response",
                         "com_angle", "--cycle-length", "20"), "not a regular file")
@@ -60,13 +60,13 @@ def test_a_non_utf8_byte_in_the_fit_data_names_its_offset(tmp_path):
     data[40] = 0xFF
     path.write_bytes(bytes(data))
     one_line_exit_2(cli("fit", "--case", "1", "--disturbance", "backward", "--data", str(path),
-                        "--free", "ankle"), "is not UTF-8 text (byte 0xff at offset 40)")
+                        "--free", "stiffness:ankle"), "is not UTF-8 text (byte 0xff at offset 40)")
 
 
 def test_a_byte_order_mark_is_read_as_utf8(tmp_path):
     path = trajectory(tmp_path, bom=True)
     p = cli("fit", "--case", "1", "--disturbance", "backward", "--data", str(path), "--free",
-            "ankle", "--json")
+            "stiffness:ankle", "--json")
     assert p.returncode == 0, p.stderr
     profile = tmp_path / "profile.csv"
     profile.write_bytes(b"\xef\xbb\xbftime,x_acceleration\n0,0\n0.5,-1\n1,0\n")

@@ -118,7 +118,7 @@ def _commands(tmp_path):
     run_csv = _run_csv(tmp_path, "x.csv")
     return [
         (["simulate", "--scenario", "s.toml", "--out", "s.toml"], scenario),
-        (["sweep", "--scenario", "s.toml", "--vary", "ankle=1:2:2", "--out", "s.toml"],
+        (["sweep", "--scenario", "s.toml", "--vary", "stiffness:ankle=1:2:2", "--out", "s.toml"],
          scenario),
         (["compare", "x.csv", "--plot", "x.csv"], run_csv),
         (["fit", "--data", "x.csv", "--case", "1", "--disturbance", "backward", "--free",
@@ -128,7 +128,7 @@ def _commands(tmp_path):
         (["simulate", "--case", "1", "--platform-profile", "link.csv", "--out", "p.csv"],
          profile),
         (["sweep", "--case", "1", "--platform-profile", "p.csv", "--vary",
-          "ankle=100:200:2", "--out", "p.csv"], profile),
+          "stiffness:ankle=100:200:2", "--out", "p.csv"], profile),
         (["compare", "a.png", "--plot", "a.png"], run_png),
         (["fit", "--data", "d.json", "--case", "1", "--disturbance", "backward", "--free",
           "ankle", "--report", "d.json"], run_json),
@@ -236,7 +236,7 @@ def test_compare_gives_the_differences_against_the_first_run(tmp_path):
     (["simulate", "--height", "9", "--mass", "80", "--stiffness", "100,100,100,100,100"],
      "--height: height [m] must be in [0.5, 2.5]"),
     (["poles", "--stiffness", "-5,1,1,1,1"], "--stiffness: "),
-    (["sweep", "--case", "1", "--disturbance", "backward", "--vary", "ankle=100:200:2",
+    (["sweep", "--case", "1", "--disturbance", "backward", "--vary", "stiffness:ankle=100:200:2",
       "--out", "never.csv", "--duration", "1e9"], "--duration: duration [s]"),
     (["sweep", "--experiment", "prts", "--controller", "peterka-2002", "--tilt", "prts:0.035",
       "--vary", "feedback_delay=0.1:0.2:2", "--out", "never.csv", "--cycles", "0"],

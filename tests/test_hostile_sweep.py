@@ -15,7 +15,7 @@ PRTS = ["sweep", "--experiment", "prts", "--controller", "peterka-2002", "--tilt
         "prts:0.035", "--vary", "feedback_delay=0.12:0.18:40", "--vary",
         "active_stiffness:ankle=650:850:40"]
 SIMULATION = ["sweep", "--case", "1", "--disturbance", "backward", "--duration", "30",
-              "--vary", "ankle=100:2000:400", "--vary", "hip=100:1000:400", "--chunk-size",
+              "--vary", "stiffness:ankle=100:2000:400", "--vary", "stiffness:hip=100:1000:400", "--chunk-size",
               "64"]
 
 
@@ -93,7 +93,7 @@ def test_options_a_sweep_does_not_use_are_named_and_refused(tmp_path, prts_names
                               capture_output=True, text=True, timeout=120)
 
     _one_line(sweep("sweep", "--case", "1", "--disturbance", "backward", "--vary",
-                    "ankle=100:200:2", "--cycles", "3", "--sensor-noise", "0.001"),
+                    "stiffness:ankle=100:200:2", "--cycles", "3", "--sensor-noise", "0.001"),
               "--cycles, --sensor-noise are not used by a simulation sweep")
     _one_line(sweep(*prts_names[:7], "--vary", "feedback_delay=0.12:0.18:2", "--duration",
                     "9", "--disturbance", "backward"),

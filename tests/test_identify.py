@@ -20,7 +20,8 @@ def experiment():
 def test_noise_free_data_recovers_gains_exactly(experiment):
     sc, truth = experiment
     start = sc.replace(muscles=pl.paper_muscles(stiffness=[800, 300, 300, 300, 100]))
-    fit = fit_stiffness(start, truth.time, truth.theta, ["ankle", "gastrocnemius"])
+    fit = fit_stiffness(start, truth.time, truth.theta, ["stiffness:ankle",
+                                                         "stiffness:gastrocnemius"])
     assert fit.success
     np.testing.assert_allclose(fit.estimates, [500.0, 300.0], rtol=1e-5)
     assert fit.residual_rms < 1e-7
@@ -33,13 +34,14 @@ def test_fast_and_reference_engines_give_the_same_fit(experiment):
     rng = np.random.default_rng(7)
     noisy = truth.theta + rng.normal(0.0, 0.001, truth.theta.shape)
     start = sc.replace(muscles=pl.paper_muscles(stiffness=[800, 300, 300, 300, 100]))
-    fits = {engine: fit_stiffness(start, truth.time, noisy, ["ankle", "gastrocnemius"],
+    fits = {engine: fit_stiffness(start, truth.time, noisy, ["stiffness:ankle",
+                                                             "stiffness:gastrocnemius"],
                                   engine=engine) for engine in ("fast", "reference")}
     np.testing.assert_allclose(fits["fast"].estimates, fits["reference"].estimates, rtol=1e-5)
     np.testing.assert_allclose(fits["fast"].standard_errors,
                                fits["reference"].standard_errors, rtol=1e-3)
     with pytest.raises(pl.PostureLabError, match="engine"):
-        fit_stiffness(start, truth.time, noisy, ["ankle"], engine="turbo")
+        fit_stiffness(start, truth.time, noisy, ["stiffness:ankle"], engine="turbo")
 
 
 def test_noisy_data_true_values_inside_confidence_intervals(experiment):
@@ -48,7 +50,8 @@ def test_noisy_data_true_values_inside_confidence_intervals(experiment):
     rng = np.random.default_rng(20261122)
     noisy = truth.theta + rng.normal(0.0, 0.002, truth.theta.shape)
     start = sc.replace(muscles=pl.paper_muscles(stiffness=[700, 300, 300, 300, 200]))
-    fit = fit_stiffness(start, truth.time, noisy, ["ankle", "gastrocnemius", "viscosity_ratio"])
+    fit = fit_stiffness(start, truth.time, noisy, ["stiffness:ankle", "stiffness:gastrocnemius",
+                                                   "viscosity_ratio"])
     truth_values = np.array([500.0, 300.0, 0.25])
     lo, hi = fit.confidence_intervals.T
     assert np.all(lo <= truth_values) and np.all(truth_values <= hi)
@@ -66,23 +69,26 @@ def test_unidentifiable_parameter_reported():
         muscles=pl.paper_muscles("1", gastrocnemius="one-sided"), duration=1.0, sample_rate=50)
     data = sc.run()
     assert np.all(data.theta[:, 1] < 0)
-    fit = fit_stiffness(sc, data.time, data.theta, ["ankle", "gastrocnemius"])
+    fit = fit_stiffness(sc, data.time, data.theta, ["stiffness:ankle", "stiffness:gastrocnemius"])
     assert fit.estimates[0] == pytest.approx(500.0, rel=1e-5)
     assert np.isfinite(fit.standard_errors[0])
     assert not np.isfinite(fit.standard_errors[1])
-    assert fit.to_dict()["parameters"]["gastrocnemius"]["ci95"] is None
+    assert fit.to_dict()["parameters"]["stiffness:gastrocnemius"]["ci95"] is None
 
 
 @pytest.mark.parametrize("kwargs,needle", [
     ({"free": ["ankel"]}, "unknown parameter"),
+    ({"free": ["active_ankle"]}, "'active_ankle' is now called 'active_stiffness:ankle'"),
+    ({"free": ["stiffness"]}, "needs its pair: stiffness:ankle, stiffness:knee"),
+    ({"free": ["torque_limit:ankle"]}, "cannot be 'torque_limit:ankle'"),
     ({"free": []}, "at least one"),
-    ({"free": ["ankle", "ankle"]}, "unique"),
+    ({"free": ["stiffness:ankle", "stiffness:ankle"]}, "unique"),
     ({"theta": np.zeros((5, 2))}, "theta"),
     ({"time": [0.0, 3.0, 9.0]}, "duration"),
 ])
 def test_bad_fit_input(experiment, kwargs, needle):
     sc, truth = experiment
-    args = {"time": truth.time, "theta": truth.theta, "free": ["ankle"]} | kwargs
+    args = {"time": truth.time, "theta": truth.theta, "free": ["stiffness:ankle"]} | kwargs
     if "time" in kwargs and "theta" not in kwargs:
         args["theta"] = np.zeros((len(args["time"]), 3))
     with pytest.raises(pl.PostureLabError, match=needle):
@@ -96,12 +102,12 @@ def test_cli_fit_round_trip(tmp_path, capsys):
     capsys.readouterr()
     report = tmp_path / "fit.json"
     code = main(["fit", "--data", str(data), "--stiffness", "700,300,300,300,300",
-                 "--disturbance", "backward", "--free", "ankle", "--json",
+                 "--disturbance", "backward", "--free", "stiffness:ankle", "--json",
                  "--report", str(report)])
     out = json.loads(capsys.readouterr().out)
     assert code == 0
-    assert out["parameters"]["ankle"]["estimate"] == pytest.approx(500.0, rel=1e-4)
-    assert json.loads(report.read_text())["parameters"]["ankle"]["unit"] == "N·m/rad"
+    assert out["parameters"]["stiffness:ankle"]["estimate"] == pytest.approx(500.0, rel=1e-4)
+    assert json.loads(report.read_text())["parameters"]["stiffness:ankle"]["unit"] == "N·m/rad"
     t, theta = read_trajectory_csv(data, 3)
     assert theta.shape == (t.size, 3)
 
@@ -110,7 +116,7 @@ def test_cli_fit_bad_input_one_line(tmp_path, capsys):
     data = tmp_path / "m.csv"
     data.write_text("t,theta1,theta2\n0,0,0\n0.1,0,0\n")
     code = main(["fit", "--data", str(data), "--case", "1", "--disturbance", "backward",
-                 "--free", "ankle"])
+                 "--free", "stiffness:ankle"])
     err = capsys.readouterr().err
     assert code == 2 and "theta3" in err and len(err.strip().splitlines()) == 1
 
@@ -136,7 +142,7 @@ def test_the_time_domain_fit_learns_delay_active_gain_and_weight(rng):
     theta = r.theta + rng.normal(0.0, 2e-4, r.theta.shape)
     start = sc.replace(muscles=true.with_active_feedback([700.0], true.active_viscosities),
                        feedback_delay=0.12, proprioceptive_weight=0.6)
-    fit = fit_stiffness(start, r.time, theta, ["active_ankle", "feedback_delay",
+    fit = fit_stiffness(start, r.time, theta, ["active_stiffness:ankle", "feedback_delay",
                                                "proprioceptive_weight"],
                         viscosity_ratio=true.viscosities[0] / true.stiffnesses[0])
     truth = [true.active_stiffnesses[0], 0.097, 0.8]
@@ -203,8 +209,8 @@ def test_fit_reports_its_residual_model(experiment):
     rng = np.random.default_rng(5)
     noisy = truth.theta + rng.normal(0.0, 0.002, truth.theta.shape)
     start = sc.replace(muscles=pl.paper_muscles(stiffness=[700, 300, 300, 300, 200]))
-    a = fit_stiffness(start, truth.time, noisy, ["ankle", "gastrocnemius"])
-    b = fit_stiffness(start, truth.time, noisy, ["ankle", "gastrocnemius"],
+    a = fit_stiffness(start, truth.time, noisy, ["stiffness:ankle", "stiffness:gastrocnemius"])
+    b = fit_stiffness(start, truth.time, noisy, ["stiffness:ankle", "stiffness:gastrocnemius"],
                       residual_model="independent")
     np.testing.assert_array_equal(a.estimates, b.estimates)  # the model only sets the errors
     assert a.residual_model == "ar1" and b.residual_model == "independent"
@@ -212,9 +218,9 @@ def test_fit_reports_its_residual_model(experiment):
     np.testing.assert_allclose(a.standard_errors, b.standard_errors, rtol=0.3)
     d = a.to_dict()
     assert d["residual_model"] == "ar1" and len(d["residual_autocorrelation"]) == 3
-    assert d["parameters"]["ankle"]["unit"] == "N·m/rad"
+    assert d["parameters"]["stiffness:ankle"]["unit"] == "N·m/rad"
     with pytest.raises(pl.PostureLabError, match="residual_model 'white'; known: ar1"):
-        fit_stiffness(start, truth.time, noisy, ["ankle"], residual_model="white")
+        fit_stiffness(start, truth.time, noisy, ["stiffness:ankle"], residual_model="white")
 
 
 def test_a_fit_never_uses_a_run_that_stopped_short(experiment, tmp_path):
@@ -228,14 +234,14 @@ def test_a_fit_never_uses_a_run_that_stopped_short(experiment, tmp_path):
     sc, truth = experiment
     start = sc.replace(muscles=pl.paper_muscles(stiffness=[800, 300, 300, 300, 100]),
                        max_steps=20)
-    with pytest.raises(FitError, match="a simulation inside the fit failed at ankle = 800: "
-                                       "stopped at t = .* the step budget of 20"):
-        fit_stiffness(start, truth.time, truth.theta, ["ankle"])
+    with pytest.raises(FitError, match="a simulation inside the fit failed at stiffness:ankle = "
+                                       "800: stopped at t = .* the step budget of 20"):
+        fit_stiffness(start, truth.time, truth.theta, ["stiffness:ankle"])
     data = tmp_path / "m.csv"
     truth.to_csv(data)
     p = subprocess.run([sys.executable, "-m", "posturelab", "fit", "--data", str(data),
                         "--stiffness", "800,300,300,300,100", "--disturbance", "backward",
-                        "--free", "ankle", "--max-steps", "20"],
+                        "--free", "stiffness:ankle", "--max-steps", "20"],
                        capture_output=True, text=True, timeout=120)
     assert p.returncode == 2 and len(p.stderr.strip().splitlines()) == 1
     assert "a simulation inside the fit failed" in p.stderr and "Traceback" not in p.stderr
@@ -259,7 +265,7 @@ def test_cli_fit_prints_the_residual_correlation_it_used(tmp_path, capsys):
     data.write_text("\n".join(noisy) + "\n")
     capsys.readouterr()
     args = ["fit", "--data", str(data), "--stiffness", "700,300,300,300,300", "--disturbance",
-            "backward", "--free", "ankle"]
+            "backward", "--free", "stiffness:ankle"]
     assert main([*args, "--json"]) == 0
     summary = json.loads(capsys.readouterr().out)
     assert main(args) == 0

@@ -37,7 +37,8 @@ def scenario():
 
 
 def test_each_row_is_the_experiment_run_on_its_own(scenario):
-    varies = [parse_vary("active_ankle=800:1200:2"), parse_vary("feedback_delay=0.12:0.18:2")]
+    varies = [parse_vary("active_stiffness:ankle=800:1200:2"),
+              parse_vary("feedback_delay=0.12:0.18:2")]
     protocol = PRTSProtocol(cycles=3, sensor_noise=5e-4, seed=8)
     res = prts_sweep(scenario, varies, protocol)
     assert res.frf.shape == (4, 11) and not res.fell.any()
@@ -70,7 +71,8 @@ def test_the_table_does_not_depend_on_how_the_runs_are_spread(scenario):
 def test_the_fit_finds_each_subjects_delay_and_gain(scenario):
     """Six virtual subjects, each fitted from the base experiment's values: the delay and the
     active stiffness come back within 3 standard errors (and 10 %) of the simulated ones."""
-    varies = [parse_vary("active_ankle=800:1200:3"), parse_vary("feedback_delay=0.12:0.18:2")]
+    varies = [parse_vary("active_stiffness:ankle=800:1200:3"),
+              parse_vary("feedback_delay=0.12:0.18:2")]
     res = prts_sweep(scenario, varies,
                      PRTSProtocol(fit=("active_stiffness", "feedback_delay"), seed=3))
     truth = res.grid.values  # columns: active_ankle, feedback_delay

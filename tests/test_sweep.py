@@ -43,12 +43,12 @@ def test_cli_sweep_csv_equals_batch_and_single_runs(tmp_path, capsys):
     also equals simulate_fast's single run."""
     out = tmp_path / "sweep.csv"
     code = main(["sweep", "--case", "1", "--disturbance", "backward", "--duration", "2",
-                 "--vary", "ankle=0:1200:3", "--vary", "gastrocnemius=0:600:2",
+                 "--vary", "stiffness:ankle=0:1200:3", "--vary", "stiffness:gastrocnemius=0:600:2",
                  "--out", str(out)])
     assert code == 0
     assert "wrote" in capsys.readouterr().out
     header, rows = read_csv(out)
-    assert header == ["ankle", "gastrocnemius", *OUTCOME_COLUMNS]
+    assert header == ["stiffness:ankle", "stiffness:gastrocnemius", *OUTCOME_COLUMNS]
     assert len(rows) == 6
     # the grid: first parameter slowest, LO and HI included
     values = np.array([[float(r[0]), float(r[1])] for r in rows])
@@ -82,13 +82,13 @@ def test_cli_sweep_csv_equals_batch_and_single_runs(tmp_path, capsys):
 def test_parquet_round_trip(tmp_path):
     pq = pytest.importorskip("pyarrow.parquet")
     sc = builtin_scenario("paper-forward-case2")
-    result = run_sweep(sc.replace(duration=1.5), [parse_vary("ankle=300:900:3"),
+    result = run_sweep(sc.replace(duration=1.5), [parse_vary("stiffness:ankle=300:900:3"),
                                                   parse_vary("viscosity_ratio=0.1:0.3:2")])
     path = tmp_path / "sweep.parquet"
     result.write(path)
     table = pq.read_table(path)
-    assert table.column_names == ["ankle", "viscosity_ratio", *OUTCOME_COLUMNS]
-    assert table.schema.field("ankle").metadata[b"unit"] == "N·m/rad".encode()
+    assert table.column_names == ["stiffness:ankle", "viscosity_ratio", *OUTCOME_COLUMNS]
+    assert table.schema.field("stiffness:ankle").metadata[b"unit"] == "N·m/rad".encode()
     for name, values in result.columns():
         col = table.column(name).to_numpy(zero_copy_only=False)
         if name in ("fell", "outcome", "failure"):
@@ -101,13 +101,13 @@ def test_parquet_round_trip(tmp_path):
 def test_viscosity_follows_the_ratio():
     """A varied ratio sets every pair's viscosity; otherwise the base's ratio (0.25) holds."""
     sc = builtin_scenario("paper-backward-case1")
-    g = sweep_grid(sc, [VaryRange("hip", 0.0, 100.0, 2), VaryRange("viscosity_ratio", 0.1,
+    g = sweep_grid(sc, [VaryRange("stiffness:hip", 0.0, 100.0, 2), VaryRange("viscosity_ratio", 0.1,
                                                                       0.5, 3)])
     assert g.n_runs == 6 and g.shape == (2, 3)
     np.testing.assert_allclose(g.viscosity, g.values[:, 1:2] * g.stiffness)
-    g = sweep_grid(sc, [VaryRange("knee", 50.0, 50.0, 1)])
+    g = sweep_grid(sc, [VaryRange("stiffness:knee", 50.0, 50.0, 1)])
     np.testing.assert_allclose(g.viscosity, 0.25 * g.stiffness)
-    g = sweep_grid(sc, [VaryRange("knee", 50.0, 50.0, 1)], viscosity_ratio=0.4)
+    g = sweep_grid(sc, [VaryRange("stiffness:knee", 50.0, 50.0, 1)], viscosity_ratio=0.4)
     np.testing.assert_allclose(g.viscosity, 0.4 * g.stiffness)
 
 
@@ -115,7 +115,7 @@ def test_disturbance_scale_sweeps_the_perturbation_size():
     """disturbance_scale multiplies the base step's speed: each row equals a single run with
     the scaled step; a weak ankle that recovers from a small step falls from a large one."""
     sc = builtin_scenario("paper-backward-case1").replace(duration=3.0)
-    varies = [parse_vary("ankle=300:900:2"), parse_vary("disturbance_scale=0.5:4:3")]
+    varies = [parse_vary("stiffness:ankle=300:900:2"), parse_vary("disturbance_scale=0.5:4:3")]
     result = run_sweep(sc, varies)
     assert result.grid.disturbance_scale.tolist() == [0.5, 2.25, 4.0] * 2
     o = result.outcomes
@@ -143,7 +143,7 @@ def test_dask_path_equals_the_local_path():
     """Chunks on a Dask LocalCluster (2 workers, threads, started here) give the same numbers."""
     distributed = pytest.importorskip("distributed")
     sc = builtin_scenario("paper-backward-case1").replace(duration=1.0)
-    varies = [parse_vary("ankle=200:1400:4"), parse_vary("quadriceps=0:600:3"),
+    varies = [parse_vary("stiffness:ankle=200:1400:4"), parse_vary("stiffness:quadriceps=0:600:3"),
               parse_vary("disturbance_scale=0.5:2:2")]
     local = run_sweep(sc, varies)
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=False,
@@ -162,12 +162,13 @@ def test_cli_scenario_base_and_progress_bar(tmp_path, capsys):
                     'viscosity_ratio = 0.3\n[disturbance]\ntype = "velocity-step"\n'
                     'velocity = -0.5\n[initial]\nposture = [0.1, -0.1, 0.1]\n')
     out = tmp_path / "s.csv"
-    assert main(["sweep", "--scenario", str(toml), "--vary", "knee=0:300:2", "--out", str(out),
+    assert main(["sweep", "--scenario", str(toml), "--vary", "stiffness:knee=0:300:2", "--out",
+                 str(out),
                  "--progress"]) == 0
     err = capsys.readouterr().err
     assert "100%" in err and "2/2 runs" in err
     header, rows = read_csv(out)
-    assert header[0] == "knee" and len(rows) == 2
+    assert header[0] == "stiffness:knee" and len(rows) == 2
     m = paper_muscles("1", gastrocnemius="one-sided", viscosity_ratio=0.3)
     one = simulate_fast(paper_body(), m.with_stiffness(knee=300.0), VelocityStep(-0.5), 1.0,
                         initial_state=POSTURE)
@@ -178,12 +179,12 @@ def test_cli_scenario_base_and_progress_bar(tmp_path, capsys):
 
 @pytest.mark.parametrize("vary, words", [
     ("elbow=0:1:2", "unknown sweep parameter 'elbow'"),
-    ("ankle=900:100:3", "LO (900) must be <= HI"),
-    ("ankle=0:100:0", "N must be an integer >= 1"),
-    ("ankle=0:100", "NAME=LO:HI:N"),
-    ("ankle=0:100:2.5", "N must be an integer"),
-    ("ankle=-5:100:3", "must be >= 0"),
-    ("ankle=0:100:1", "LO must equal HI"),
+    ("stiffness:ankle=900:100:3", "LO (900) must be <= HI"),
+    ("stiffness:ankle=0:100:0", "N must be an integer >= 1"),
+    ("stiffness:ankle=0:100", "NAME=LO:HI:N"),
+    ("stiffness:ankle=0:100:2.5", "N must be an integer"),
+    ("stiffness:ankle=-5:100:3", "must be in [0, 1e+08] N·m/rad, got -5.0"),
+    ("stiffness:ankle=0:100:1", "LO must equal HI"),
 ])
 def test_bad_vary_is_one_line_and_exit_2(tmp_path, capsys, vary, words):
     code = main(["sweep", "--case", "1", "--disturbance", "backward", "--vary", vary,
@@ -193,14 +194,15 @@ def test_bad_vary_is_one_line_and_exit_2(tmp_path, capsys, vary, words):
     assert len(err.splitlines()) == 1 and err.startswith("posturelab: error:")
     assert words in err
     if "unknown" in words:
-        assert "ankle, knee, hip, quadriceps, gastrocnemius, viscosity_ratio" in err
+        assert "stiffness:ankle, stiffness:knee, stiffness:hip, stiffness:quadriceps" in err
     assert not (tmp_path / "x.csv").exists()
 
 
 @pytest.mark.parametrize("extra, words", [
-    (["--vary", "ankle=0:1:2", "--vary", "ankle=0:1:2"], "more than once"),
-    (["--vary", "ankle=0:1:100000", "--vary", "knee=0:1:1000"], "at most 10,000,000"),
-    (["--vary", "ankle=0:1:2", "--out-format"], "unrecognized"),
+    (["--vary", "stiffness:ankle=0:1:2", "--vary", "stiffness:ankle=0:1:2"], "more than once"),
+    (["--vary", "stiffness:ankle=0:1:100000", "--vary", "stiffness:knee=0:1:1000"],
+     "at most 10,000,000"),
+    (["--vary", "stiffness:ankle=0:1:2", "--out-format"], "unrecognized"),
 ])
 def test_other_bad_input_exit_2(tmp_path, capsys, extra, words):
     code = main(["sweep", "--case", "1", "--disturbance", "backward", *extra,
@@ -211,18 +213,18 @@ def test_other_bad_input_exit_2(tmp_path, capsys, extra, words):
 
 
 def test_bad_output_suffix_and_missing_dask(tmp_path, capsys, monkeypatch):
-    assert main(["sweep", "--case", "1", "--vary", "ankle=0:1:2",
+    assert main(["sweep", "--case", "1", "--vary", "stiffness:ankle=0:1:2",
                  "--out", str(tmp_path / "x.xlsx")]) == 2
     assert ".csv or .parquet" in capsys.readouterr().err
     monkeypatch.setitem(sys.modules, "distributed", None)  # as if Dask were not installed
-    assert main(["sweep", "--case", "1", "--vary", "ankle=0:1:2", "--workers", "2",
+    assert main(["sweep", "--case", "1", "--vary", "stiffness:ankle=0:1:2", "--workers", "2",
                  "--out", str(tmp_path / "x.csv")]) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and "need Dask" in err
 
 
 def test_parse_vary_values():
-    v = parse_vary(" ankle = 0 : 2000 : 5 ")
+    v = parse_vary(" stiffness:ankle = 0 : 2000 : 5 ")
     np.testing.assert_array_equal(v.values, [0.0, 500.0, 1000.0, 1500.0, 2000.0])
     assert v.unit == "N·m/rad"
     assert parse_vary("viscosity_ratio=0.25:0.25:1").values.tolist() == [0.25]
@@ -235,9 +237,9 @@ def test_sweep_over_feedback_delay_equals_single_runs():
     without delay chooses Radau, the others RK45, as their single runs do)."""
     sc = builtin_scenario("paper-backward-case1").replace(duration=1.0)
     result = run_sweep(sc, [parse_vary("feedback_delay=0:0.04:5"),
-                            parse_vary("ankle=400:800:2")])
+                            parse_vary("stiffness:ankle=400:800:2")])
     o = result.outcomes
-    assert result.grid.names == ("feedback_delay", "ankle")
+    assert result.grid.names == ("feedback_delay", "stiffness:ankle")
     for r, (delay, ankle) in enumerate(result.grid.values):
         k = result.grid.stiffness[r]
         assert k[0] == ankle
@@ -253,17 +255,17 @@ def test_sweep_over_a_joint_torque_limit_equals_single_runs(tmp_path):
     """--vary ankle_torque_limit keeps the base experiment's other limits (here the hip's)."""
     sc = builtin_scenario("paper-backward-case1").replace(
         duration=1.0, torque_limits=(math.inf, math.inf, 40.0))
-    result = run_sweep(sc, [parse_vary("ankle_torque_limit=30:120:4")])
+    result = run_sweep(sc, [parse_vary("torque_limit:ankle=30:120:4")])
     for r, (limit,) in enumerate(result.grid.values):
         one = sc.run(engine="compiled", torque_limits=(float(limit), math.inf, 40.0),
                      rtol=1e-6, atol=1e-9)
         assert one.fell == result.outcomes.fell[r]
         np.testing.assert_array_equal(one.final_state, result.outcomes.final_state[r])
     assert main(["sweep", "--case", "1", "--disturbance", "backward", "--duration", "0.5",
-                 "--vary", "knee_torque_limit=20:60:3", "--torque-limits", "inf,inf,30",
+                 "--vary", "torque_limit:knee=20:60:3", "--torque-limits", "inf,inf,30",
                  "--out", str(tmp_path / "limits.csv")]) == 0
     header = (tmp_path / "limits.csv").read_text().splitlines()[0]
-    assert header.startswith("knee_torque_limit,outcome,failure,fell")
+    assert header.startswith("torque_limit:knee,outcome,failure,fell")
 
 
 def test_a_one_link_sweep_over_delay_active_gain_and_weight_equals_single_runs(tmp_path,
@@ -279,7 +281,8 @@ def test_a_one_link_sweep_over_delay_active_gain_and_weight_equals_single_runs(t
     out = tmp_path / "one.csv"
     code = main(["sweep", "--controller", "peterka-2002", "--tilt", "sine:0.02:0.5",
                  "--duration", "4", "--vary", "feedback_delay=0.1:0.3:3",
-                 "--vary", "active_ankle=600:900:2", "--vary", "proprioceptive_weight=0.5:1:2",
+                 "--vary", "active_stiffness:ankle=600:900:2",
+                 "--vary", "proprioceptive_weight=0.5:1:2",
                  "--out", str(out)])
     assert code == 0, capsys.readouterr().err
     rows = list(csv.DictReader(out.open()))
@@ -288,7 +291,7 @@ def test_a_one_link_sweep_over_delay_active_gain_and_weight_equals_single_runs(t
     body = pl.get_body("paper-1link")
     base = get_controller("peterka-2002").muscles(body)
     for row in rows:
-        ka = float(row["active_ankle"])
+        ka = float(row["active_stiffness:ankle"])
         muscles = base.with_active_feedback([ka], base.active_viscosities)
         one = pl.simulate(body, muscles, None, 4.0, tilt=SineTilt(0.02, 0.5),
                           feedback_delay=float(row["feedback_delay"]),
@@ -310,7 +313,7 @@ def test_a_one_link_sweep_over_delay_active_gain_and_weight_equals_single_runs(t
 
 def test_a_sweep_refuses_a_name_its_experiment_lacks(tmp_path, capsys):
     code = main(["sweep", "--body", "paper-1link", "--stiffness", "900", "--disturbance",
-                 "backward", "--vary", "knee=0:10:2", "--out", str(tmp_path / "x.csv")])
+                 "backward", "--vary", "stiffness:knee=0:10:2", "--out", str(tmp_path / "x.csv")])
     err = capsys.readouterr().err
-    assert code == 2 and "unknown sweep parameter 'knee' for this experiment (1 link," in err
-    assert "known: ankle, viscosity_ratio" in err
+    assert code == 2 and "unknown pair 'knee' in sweep parameter 'stiffness:knee'; pairs: " \
+        "ankle" in err

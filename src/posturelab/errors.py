@@ -31,3 +31,8 @@ class ScenarioError(PostureLabError, ValueError):
 
 class DataFileError(PostureLabError, ValueError):
     """A data file (platform profile, measurement) cannot be read or fails validation."""
+
+
+class UnknownParameterError(UnknownNameError, ParameterError):
+    """A parameter name that is not in the parameter table (:mod:`posturelab.parameters`),
+    or names a pair or joint the body lacks; the message lists the known ones."""

@@ -10,6 +10,7 @@ import sys
 
 from ..errors import ParameterError
 from ..model.muscles import PAPER_PAIR_NAMES, STIFFNESS_CASES
+from ..parameters import MAX_FEEDBACK_DELAY
 
 GASTROCNEMIUS_HELP = (
     "two-sided (default): the paper's artificial antagonist added, the gastrocnemius pair "
@@ -109,9 +110,9 @@ def add_muscle_arguments(p: argparse.ArgumentParser, *, require: bool = False,
     fb.add_argument("--active-viscosity-ratio", type=float, default=None, metavar="R",
                     help="active viscosity = R × active stiffness [s] (default 0).")
     fb.add_argument("--feedback-delay", type=float, default=None, metavar="SECONDS",
-                    help="neural delay τ [s], in [0, 1]. With active gains it delays their "
-                    "part only (the intrinsic gains act at once); without any, it delays "
-                    "every pair's whole feedback (the paper's gains read as neural).")
+                    help=f"neural delay τ [s], in [0, {MAX_FEEDBACK_DELAY:g}]. With active gains "
+                    "it delays their part only (the intrinsic gains act at once); without any, it "
+                    "delays every pair's whole feedback (the paper's gains read as neural).")
     fb.add_argument("--proprioceptive-weight", type=float, default=None, metavar="W",
                     help="W in [0, 1]: the active error of pairs that span the foot is "
                     "θ + W·α under a tilt α (1, the default: relative to the foot; 0: to the "
@@ -227,20 +228,18 @@ def feedback_options_from_args(args: argparse.Namespace) -> dict:
     """``feedback_delay`` [s] and ``proprioceptive_weight`` [-] given on the command line (or
     by --controller), checked; keys absent when not given."""
     from ..model.controllers import get_controller
+    from ..parameters import check_value
 
     out = {}
     if getattr(args, "controller", None) is not None:
         out.update(get_controller(args.controller).run_options())
     delay = getattr(args, "feedback_delay", None)
     if delay is not None:
-        if not (math.isfinite(delay) and 0 <= delay <= 1):
-            raise ParameterError(f"--feedback-delay [s] must be in [0, 1], got {delay:g}")
-        out["feedback_delay"] = float(delay)
+        out["feedback_delay"] = check_value("feedback_delay", delay, "--feedback-delay")
     weight = getattr(args, "proprioceptive_weight", None)
     if weight is not None:
-        if not (math.isfinite(weight) and 0 <= weight <= 1):
-            raise ParameterError(f"--proprioceptive-weight [-] must be in [0, 1], got {weight:g}")
-        out["proprioceptive_weight"] = float(weight)
+        out["proprioceptive_weight"] = check_value("proprioceptive_weight", weight,
+                                                   "--proprioceptive-weight")
     return out
 
 

@@ -7,24 +7,38 @@ import io
 import math
 
 from ..errors import ParameterError
+from ..parameters import check_value
 from ._common import body_from_args, feedback_options_from_args, muscles_from_args
 
 
-def _axis(text: str, flag: str) -> tuple[str, float, float]:
+def _axis(text: str, flag: str, pairs) -> tuple[str, str, float, float]:
+    """``QUANTITY[:PAIR]:LO:HI`` -> (quantity, pair, LO, HI), the name the table's."""
+    from ..parameters import resolve
+
     parts = str(text).split(":")
-    if len(parts) != 3:
-        raise ParameterError(f"{flag} must be NAME:LO:HI, got {text!r}")
-    name = parts[0].strip().lower()
-    if name not in ("active_stiffness", "active_viscosity"):
-        raise ParameterError(f"{flag}: with a delayed map both axes are active_stiffness and "
-                             f"active_viscosity, got {parts[0].strip()!r}")
+    if len(parts) not in (3, 4):
+        raise ParameterError(f"{flag} must be NAME:LO:HI (e.g. active_stiffness:ankle:0:1700), "
+                             f"got {text!r}")
+    given = ":".join(parts[:-2]).strip().lower()
+    if given.partition(":")[0] not in ("active_stiffness", "active_viscosity"):
+        raise ParameterError(f"{flag}: with a delayed map both axes are active_stiffness:PAIR "
+                             f"and active_viscosity:PAIR, got {given!r}")
+    name, _, pair = resolve(given, pairs, (), what=f"{flag} parameter").partition(":")
     try:
-        low, high = float(parts[1]), float(parts[2])
+        low, high = float(parts[-2]), float(parts[-1])
     except ValueError:
         raise ParameterError(f"{flag} LO and HI must be numbers, got {text!r}") from None
     if not (math.isfinite(low) and math.isfinite(high) and 0 <= low < high):
         raise ParameterError(f"{flag} must have 0 <= LO < HI, got {low:g}:{high:g}")
-    return name, low, high
+    check_value(name, high, f"{flag} HI")  # the parameter table's bound
+    return name, pair, low, high
+
+
+def muscles_for_names(body) -> tuple[str, ...]:
+    """The pair names of the layout a body's gains have (the paper's five on three links)."""
+    from ..model.muscles import PAPER_PAIR_NAMES, joint_pair_names
+
+    return PAPER_PAIR_NAMES if body.n_links == 3 else joint_pair_names(body.n_links)
 
 
 def run_delay_map(args: argparse.Namespace) -> int:
@@ -40,17 +54,26 @@ def run_delay_map(args: argparse.Namespace) -> int:
     from ._common import ExpectedTime
     from .stability_map import output_paths, parse_resolution, parse_viscosity_ratio
 
-    axes = {name: (low, high) for name, low, high in
-            (_axis(a, f) for a, f in ((args.x, "--x"), (args.y, "--y")))}
+    if args.pair is not None:
+        raise ParameterError(f"--pair is now part of the axis names: --x active_stiffness:"
+                             f"{args.pair}:LO:HI --y active_viscosity:{args.pair}:LO:HI")
+    body = body_from_args(args)
+    pairs = muscles_for_names(body)
+    parsed = [_axis(a, f, pairs) for a, f in ((args.x, "--x"), (args.y, "--y"))]
+    axes = {name: (low, high) for name, _, low, high in parsed}
     if len(axes) != 2:
-        raise ParameterError("--x and --y must be active_stiffness and active_viscosity")
+        raise ParameterError("--x and --y must be active_stiffness:PAIR and "
+                             "active_viscosity:PAIR")
+    if parsed[0][1] != parsed[1][1]:
+        raise ParameterError(f"--x and --y must name the same pair, got {parsed[0][1]!r} and "
+                             f"{parsed[1][1]!r}")
+    pair = parsed[0][1]
     resolution = parse_resolution(args.resolution, MAX_DELAY_MAP_RESOLUTION,
                                   "with a feedback delay")
     delay = feedback_options_from_args(args).get("feedback_delay")
     if delay is None:
         raise ParameterError("a map over active gains needs --feedback-delay S [s]")
     figure_path, csv_path, fmt = output_paths(args.out)
-    body = body_from_args(args)
     if args.stiffness is None and args.controller is None:
         if body.n_links != 3:
             raise ParameterError("give --stiffness (the intrinsic gains) or --controller for "
@@ -68,19 +91,20 @@ def run_delay_map(args: argparse.Namespace) -> int:
         bar, progress = None, ExpectedTime("stability-map", "sets", min_total=2500)
     try:
         dmap = delay_stability_map(body, muscles, delay, axes["active_stiffness"],
-                                   axes["active_viscosity"], resolution, pair=args.pair,
+                                   axes["active_viscosity"], resolution, pair=pair,
                                    progress=progress)
     finally:
         if bar is not None:
             bar.close()
-    x_first = str(args.x).split(":")[0].strip().lower() == "active_stiffness"
+    x_first = parsed[0][0] == "active_stiffness"
     fig = plot_delay_stability_map(dmap)
     kx, vy = np.meshgrid(dmap.active_stiffness, dmap.active_viscosity)
     table = np.column_stack([kx.ravel(), vy.ravel(), dmap.max_real_part.ravel(),
                              dmap.stable.ravel()])
     buf = io.StringIO()
     np.savetxt(buf, table, delimiter=",", fmt=["%.17g", "%.17g", "%.17g", "%d"],
-               header="active_stiffness,active_viscosity,max_real_part,stable", comments="")
+               header=f"active_stiffness:{pair},active_viscosity:{pair},max_real_part,stable",
+               comments="")
     image = io.BytesIO()
     fig.savefig(image, format=fmt, dpi=110)
     atomic_write_files({csv_path: buf.getvalue().encode("utf-8"), figure_path: image.getvalue()})

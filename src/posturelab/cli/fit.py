@@ -4,16 +4,16 @@ from __future__ import annotations
 
 import argparse
 
-from ..model.muscles import PAPER_PAIR_NAMES
+from ..parameters import PAPER_PAIRS, resolve
+from ..parameters import unit as parameter_unit
 from ..simulation.results import atomic_write_text
 from ..studies.identification import (
     ENGINES,
+    FIT_QUANTITIES,
     RESIDUAL_MODELS,
-    VISCOSITY_RATIO,
     fit_stiffness,
     read_trajectory_csv,
 )
-from ..studies.sweep import parameter_unit
 from . import UsageError
 from ._common import check_writable, print_json
 from .simulate import add_experiment_arguments, experiment_inputs, scenario_from_args
@@ -41,9 +41,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     g.add_argument("--data", required=True, metavar="ANGLES.csv",
                    help="measured angles: columns t [s], theta1..theta3 [rad].")
     g.add_argument("--free", required=True, metavar="NAME[,NAME…]",
-                   help="parameters to fit: pair names (" + ", ".join(PAPER_PAIR_NAMES)
-                   + f"), {VISCOSITY_RATIO}, feedback_delay, proprioceptive_weight, "
-                   "active_PAIR and active_viscosity_PAIR.")
+                   help="parameters to fit, named as in the parameter table (the same "
+                   "as sweep --vary and fit-frf --free): stiffness:PAIR, viscosity:PAIR, "
+                   "active_stiffness:PAIR, active_viscosity:PAIR (PAIR " + ", ".join(PAPER_PAIRS)
+                   + " on the paper's body), viscosity_ratio, feedback_delay, "
+                   "proprioceptive_weight.")
     g.add_argument("--engine", choices=ENGINES, default="compiled",
                    help="engine inside the fit: compiled (default) or reference (scipy); "
                    "either at the scenario's tolerances and solver.method; fast is a "
@@ -68,9 +70,11 @@ def run(args: argparse.Namespace) -> int:
     if args.duration is not None:
         raise UsageError("fit: --duration is set by --data (its last time); leave it out")
     sc = scenario_from_args(args, "fit")
+    free = [s.strip() for s in args.free.split(",") if s.strip()]
+    for name in free:  # the names first, before the data are read
+        resolve(name, sc.muscles.names, (), accepts=FIT_QUANTITIES)
     time, theta = read_trajectory_csv(args.data, sc.body.n_links)
     sc = sc.replace(duration=max(float(time[-1]), 1e-3))
-    free = [s.strip() for s in args.free.split(",") if s.strip()]
     ratio = 0.25 if args.viscosity_ratio is None else args.viscosity_ratio
     fit = fit_stiffness(sc, time, theta, free, viscosity_ratio=ratio,
                         engine=args.engine, residual_model=args.residual_model)
@@ -89,7 +93,7 @@ def run(args: argparse.Namespace) -> int:
     for name, e, se, (lo, hi) in zip(fit.parameter_names, fit.estimates, fit.standard_errors,
                                      fit.confidence_intervals, strict=True):
         unit = parameter_unit(name)
-        print(f"  {name:<16} {e:10.4g} ± {se:.3g} {unit}   (95 % CI {lo:.4g} … {hi:.4g})")
+        print(f"  {name:<22} {e:10.4g} ± {se:.3g} {unit}   (95 % CI {lo:.4g} … {hi:.4g})")
     if not fit.success:
         print(f"warning: the optimiser did not converge: {fit.message}")
     return 0

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 
 from ..errors import ParameterError
+from ..parameters import MAX_FEEDBACK_DELAY
 from ._common import (
     add_muscle_arguments,
     body_from_args,
@@ -15,15 +16,17 @@ from ._common import (
 
 HELP = "fit controller gains, delay and sensory weight to FRFs (one or several conditions)"
 
-DESCRIPTION = """\
+DESCRIPTION = f"""\
 Fit the linearised model's FRF to one or several measured FRFs. Each --data is a condition:
 a trial CSV (then --stimulus, --response and --cycle-length say how to estimate its FRF, as
 posturelab frf does) or the JSON that posturelab frf --json writes. --free NAMES (comma
 separated) are shared by the conditions, --per-condition NAMES take one value per condition.
-Names: stiffness, viscosity (intrinsic), active_stiffness, active_viscosity (a :PAIR suffix
-names a pair other than the first), feedback_delay, proprioceptive_weight. The body and the
+Names (the parameter table's, as for sweep --vary and fit --free): stiffness:PAIR,
+viscosity:PAIR (intrinsic), active_stiffness:PAIR, active_viscosity:PAIR (:PAIR may be left
+out on a body with one pair), feedback_delay, proprioceptive_weight. The body and the
 starting values come from the options below (as in posturelab simulate); --bounds
-NAME=LO:HI,... narrows the defaults (gains 0 … 1e5, delay 0 … 1 s, W 0 … 1).
+NAME=LO:HI,... narrows the defaults (gains 0 … 1e5, delay 0 … {MAX_FEEDBACK_DELAY:g} s,
+W 0 … 1) within the table's bounds (docs/parameters.md).
 
 Objective: the complex error against each band, weighted by its 95 % bound (posturelab.
 frequency.fit); a trial's model FRF is averaged over each band's harmonics with the
@@ -125,6 +128,10 @@ def run(args: argparse.Namespace) -> int:
     body = body_from_args(args)
     muscles = muscles_from_args(args, body)
     options = feedback_options_from_args(args)
+    from ..frequency.fit import _name
+
+    for name in [*_names(args.free), *_names(args.per_condition), *_bounds(args.bounds)]:
+        _name(name, muscles)  # the names first, before any FRF is estimated
     conditions = [_condition(path, args) for path in args.data]
     fit = fit_frf(body, muscles, conditions, _names(args.free), input=args.input,
                   output=args.output.strip().lower(),

@@ -6,6 +6,7 @@ import argparse
 import io
 import math
 import os
+import re
 import sys
 import tempfile
 from concurrent.futures import ThreadPoolExecutor, wait
@@ -13,23 +14,26 @@ from pathlib import Path
 from typing import IO
 
 from ..errors import ParameterError, UnknownNameError
-from ..model.muscles import PAPER_PAIR_NAMES
+from ..parameters import PAPER_PAIRS, check_value, names_for, resolve
 from . import CONVENTIONS_EPILOG
 from ._common import ExpectedTime, load_compiled
 
-#: Axis names: the paper's five pairs (stiffness [N·m/rad]) and the viscosity ratio [s]
-#: (the same as posturelab.batch_linear.GRID_PARAMETERS, which imports numba).
-PARAMETER_NAMES: tuple[str, ...] = (*PAPER_PAIR_NAMES, "viscosity_ratio")
+#: Axis names, the parameter table's: the paper's five pair stiffnesses stiffness:PAIR
+#: [N·m/rad] and the viscosity ratio [s] (posturelab.linear.batch.GRID_PARAMETERS).
+PARAMETER_NAMES: tuple[str, ...] = names_for(PAPER_PAIRS, (), ("stiffness", "viscosity_ratio"))
 
 DESCRIPTION = """\
 Map the stability of the paper's three-link biped (or any body: --body, --height/--mass)
 linearised about upright over two parameters. Each axis is NAME:LO:HI with NAME one of
-  ankle, knee, hip, quadriceps, gastrocnemius   a muscle pair's stiffness [N·m/rad]
-  viscosity_ratio                               pair viscosity / pair stiffness [s]
-(for a body of other than three links, its pairs: ankle for one link, ankle and hip for
-two, ankle, knee, hip, joint4, ... beyond). Every other parameter is taken from a Table I
-case (--case, default 1; three links) or from --stiffness (one value per pair, any body),
-with viscosity = 0.25 × stiffness unless --viscosity-ratio is given.
+(the parameter table's names, as for sweep --vary)
+  stiffness:PAIR     a muscle pair's stiffness [N·m/rad]; PAIR ankle, knee, hip,
+                     quadriceps or gastrocnemius (for a body of other than three links,
+                     its pairs: ankle for one link, ankle and hip for two, ankle, knee,
+                     hip, joint4, ... beyond)
+  viscosity_ratio    pair viscosity / pair stiffness [s]
+Every other parameter is taken from a Table I case (--case, default 1; three links) or
+from --stiffness (one value per pair, any body), with viscosity = 0.25 × stiffness unless
+--viscosity-ratio is given.
 
 Writes the figure --out (colour = largest real part of the poles [1/s], stable region
 outlined, Table I cases that lie in the plane marked) and a CSV beside it with the same
@@ -37,18 +41,19 @@ stem (columns: x name, y name, max_real_part [1/s], stable [1 or 0]). Stable mea
 pole has real part < -δ, δ = 1e-9 × the poles' magnitude scale [1/s] (a set with
 undamped poles on the imaginary axis is not stable; see posturelab.batch_linear).
 
-Example: posturelab stability-map --x ankle:0:2000 --y gastrocnemius:0:1000 --out map.png
+Example: posturelab stability-map --x stiffness:ankle:0:2000 \\
+             --y stiffness:gastrocnemius:0:1000 --out map.png
 
-With a feedback delay, the D-subdivision map: --x active_stiffness:LO:HI --y
-active_viscosity:LO:HI [N·m/rad, N·m·s/rad] of one pair (--pair, default the ankle) at
---feedback-delay S, for any body and gains (--body, --height/--mass, --stiffness,
---controller, ...: the other gains as in posturelab simulate). Colour is the real part of the
-rightmost characteristic root; the CSV has active_stiffness, active_viscosity,
-max_real_part [1/s], stable [1 or 0].
+With a feedback delay, the D-subdivision map: --x active_stiffness:PAIR:LO:HI --y
+active_viscosity:PAIR:LO:HI [N·m/rad, N·m·s/rad] of one pair (:PAIR may be left out on a
+one-pair body) at --feedback-delay S, for any body and gains (--body, --height/--mass,
+--stiffness, --controller, ...: the other gains as in posturelab simulate). Colour is the
+real part of the rightmost characteristic root; the CSV has active_stiffness:PAIR,
+active_viscosity:PAIR, max_real_part [1/s], stable [1 or 0].
 
-Example: posturelab stability-map --body paper-1link --stiffness 28 --viscosity 11 \
-             --x active_stiffness:0:1700 --y active_viscosity:0:680 --feedback-delay 0.15 \
-             --out dmap.png
+Example: posturelab stability-map --body paper-1link --stiffness 28 --viscosity 11 \\
+             --x active_stiffness:ankle:0:1700 --y active_viscosity:ankle:0:680 \\
+             --feedback-delay 0.15 --out dmap.png
 """
 
 MAX_RESOLUTION = 5000
@@ -64,9 +69,10 @@ def add_parser(sub, name: str) -> argparse.ArgumentParser:
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument("--x", required=True, metavar="NAME:LO:HI",
-                   help="horizontal axis: parameter name and range (e.g. ankle:0:2000).")
+                   help="horizontal axis: parameter name and range (e.g. stiffness:ankle:0:2000).")
     p.add_argument("--y", required=True, metavar="NAME:LO:HI",
-                   help="vertical axis: parameter name and range (e.g. gastrocnemius:0:1000).")
+                   help="vertical axis: parameter name and range (e.g. "
+                   "stiffness:gastrocnemius:0:1000).")
     p.add_argument("--resolution", default="200", metavar="R",
                    help=f"grid points per axis, 2..{MAX_RESOLUTION} (default 200).")
     p.add_argument("--out", required=True, metavar="FILE",
@@ -80,8 +86,8 @@ def add_parser(sub, name: str) -> argparse.ArgumentParser:
     p.add_argument("--progress", action="store_true",
                    help="show a progress bar on standard error even when it is not a terminal.")
     p.add_argument("--pair", metavar="NAME",
-                   help="with active_stiffness × active_viscosity axes: the pair whose active "
-                   "gains vary (default the first, the ankle).")
+                   help="former option: the pair is now part of the axis names "
+                   "(active_stiffness:PAIR:LO:HI).")
     from ._common import add_muscle_arguments
 
     add_muscle_arguments(p, own_case=True)
@@ -91,20 +97,28 @@ def add_parser(sub, name: str) -> argparse.ArgumentParser:
 # ---- argument parsing -------------------------------------------------------
 
 
-def parse_axis(text: str, flag: str, names: tuple[str, ...] = PARAMETER_NAMES):
-    """Parse ``NAME:LO:HI`` into a :class:`posturelab.batch_linear.ParameterRange`; ``names``
-    are the parameters known (the body's pairs and viscosity_ratio)."""
+def parse_axis(text: str, flag: str, pairs: tuple[str, ...] = PAPER_PAIRS):
+    """Parse ``NAME:LO:HI`` into a :class:`posturelab.batch_linear.ParameterRange`; ``pairs``
+    are the body's pairs (NAME is ``stiffness:PAIR`` or ``viscosity_ratio``)."""
     from ..linear.batch import ParameterRange
 
     parts = str(text).split(":")
-    if len(parts) != 3:
-        raise ParameterError(f"{flag} must be NAME:LO:HI (e.g. ankle:0:2000), got {text!r}")
-    name = parts[0].strip().lower().replace("-", "_")
-    if name not in names:
+    if len(parts) not in (3, 4):
+        raise ParameterError(f"{flag} must be NAME:LO:HI (e.g. stiffness:ankle:0:2000), got "
+                             f"{text!r}")
+    if len(parts) == 3 and re.fullmatch(r"\s*[A-Za-z_]+\s*", parts[1]):  # a name, no HI
+        raise ParameterError(f"{flag} must be NAME:LO:HI (e.g. stiffness:ankle:0:2000), got "
+                             f"{text!r}")
+    given = ":".join(parts[:-2]).strip().lower().replace("-", "_")
+    parts = [given, *parts[-2:]]
+    try:
+        name = resolve(given, pairs, (), accepts=("stiffness", "viscosity_ratio"),
+                       what=f"{flag} parameter")
+    except UnknownNameError:
+        known = names_for(pairs, (), ("stiffness", "viscosity_ratio"))
         raise UnknownNameError(
-            f"{flag}: unknown parameter {parts[0].strip()!r}; known parameters: "
-            f"{', '.join(names)}"
-        )
+            f"{flag}: unknown parameter {given!r}; known parameters: {', '.join(known)}"
+        ) from None
     bounds = []
     for label, value in (("LO", parts[1]), ("HI", parts[2])):
         try:
@@ -118,6 +132,8 @@ def parse_axis(text: str, flag: str, names: tuple[str, ...] = PARAMETER_NAMES):
         bounds.append(number)
     low, high = bounds
     unit = "s" if name == "viscosity_ratio" else "N·m/rad"
+    if low >= 0:
+        check_value(name, high, f"{flag} HI")  # the parameter table's bound
     if low < 0:
         raise ParameterError(f"{flag} LO must be >= 0 [{unit}], got {low:g}")
     if not low < high:
@@ -273,7 +289,7 @@ def plot_stability_map(smap, figure_file, fmt: str) -> None:
     if "viscosity_ratio" not in (grid.x.name, grid.y.name):
         fixed.append(f"viscosity ratio {grid.base_viscosity_ratio:g} s")
     others = [f"{n} {v:g}" for n, v in zip(grid.pair_names, grid.base_stiffness, strict=True)
-              if n not in (grid.x.name, grid.y.name)]
+              if f"stiffness:{n}" not in (grid.x.name, grid.y.name)]
     if others:
         fixed.insert(0, f"{', '.join(others)} N·m/rad")
     source = (f"others from Table I case {grid.base_case}" if grid.base_case is not None
@@ -380,9 +396,9 @@ def run(args: argparse.Namespace) -> int:
 
     body = body_from_args(args)
     base = _base_muscles(args, body)
-    names = (PARAMETER_NAMES if base is None else (*base.names, "viscosity_ratio"))
-    x = parse_axis(args.x, "--x", names)
-    y = parse_axis(args.y, "--y", names)
+    pairs = PAPER_PAIRS if base is None else tuple(base.names)
+    x = parse_axis(args.x, "--x", pairs)
+    y = parse_axis(args.y, "--y", pairs)
     if x.name == y.name:
         raise ParameterError(f"--x and --y must be different parameters, both are {x.name!r}")
     resolution = parse_resolution(args.resolution)

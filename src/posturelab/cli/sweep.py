@@ -7,12 +7,12 @@ import sys
 import time
 
 from ..errors import ParameterError
-from ..model.muscles import DEFAULT_VISCOSITY_RATIO, PAPER_PAIR_NAMES
+from ..model.muscles import DEFAULT_VISCOSITY_RATIO
+from ..parameters import PAPER_JOINTS, PAPER_PAIRS
 from ..studies.sweep import (
     MAX_RUNS,
     OUTCOME_COLUMNS,
     SWEEP_PARAMETERS,
-    TORQUE_LIMIT_PARAMETERS,
     ProgressBar,
     SweepInterrupted,
     parse_vary,
@@ -28,22 +28,26 @@ Simulate the nonlinear model for every combination of the --vary values (the ful
 the first --vary varying slowest) with the compiled engine, and write one row per run.
 
 --vary NAME=LO:HI:N takes N evenly spaced values from LO to HI inclusive (N >= 1; N = 1
-needs LO = HI; at most {MAX_RUNS:,} runs in all). NAME is a pair stiffness [N·m/rad]
-({", ".join(PAPER_PAIR_NAMES)} on the paper's body; ankle, or ankle and hip, on one or
-two links): the intrinsic part when the base experiment has active gains, the whole pair
-feedback otherwise; active_PAIR [N·m/rad] and active_viscosity_PAIR [N·m·s/rad], a pair's
-active (delayed) gains; viscosity_ratio [s]; disturbance_scale [-], a factor on the base
-experiment's platform motion (velocity-step speed, pulse peak, ramp displacement, sine
-amplitudes, measured accelerations: --vary disturbance_scale=0.5:3:26 with a 1 m/s step
-sweeps 0.5-3 m/s); feedback_delay [s]; proprioceptive_weight [-]; or JOINT_torque_limit
-[N·m] ({", ".join(TORQUE_LIMIT_PARAMETERS)} on the paper's body), the largest net muscle
-moment at a joint; repeat --vary for each parameter. Every other gain comes from the
-base experiment: --case/--stiffness/--controller with --disturbance or --tilt (as in
-posturelab simulate), --scenario FILE.toml or --builtin NAME. A pair's viscosity is the
-ratio times its stiffness: the varied viscosity_ratio, else --viscosity-ratio, else the
-base experiment's (0.25, the paper's, for --case).
+needs LO = HI; at most {MAX_RUNS:,} runs in all; LO and HI within NAME's bounds). NAME
+is one of the parameter table's (docs/parameters.md; the same names as fit --free and
+fit-frf --free): stiffness:PAIR [N·m/rad] (PAIR {", ".join(PAPER_PAIRS)} on the paper's
+body; ankle, or ankle and hip, on one or two links; a one-pair body may leave out :PAIR),
+the intrinsic part when the base experiment has active gains, the whole pair feedback
+otherwise; viscosity:PAIR [N·m·s/rad]; active_stiffness:PAIR [N·m/rad] and
+active_viscosity:PAIR [N·m·s/rad], a pair's active (delayed) gains; viscosity_ratio [s];
+disturbance_scale [-], a factor on the base experiment's platform motion (velocity-step
+speed, pulse peak, ramp displacement, sine amplitudes, measured accelerations: --vary
+disturbance_scale=0.5:3:26 with a 1 m/s step sweeps 0.5-3 m/s); feedback_delay [s];
+proprioceptive_weight [-]; or torque_limit:JOINT [N·m] ({", ".join(PAPER_JOINTS)} on the
+paper's body), the largest net muscle moment at a joint; repeat --vary for each
+parameter. Every other gain comes from the base experiment: --case/--stiffness/--controller
+with --disturbance or --tilt (as in posturelab simulate), --scenario FILE.toml or --builtin
+NAME. A pair's viscosity is the varied viscosity:PAIR, else the ratio times its stiffness:
+the varied viscosity_ratio, else --viscosity-ratio, else the base experiment's (0.25, the
+paper's, for --case).
 
-Columns: the varied parameters, then {", ".join(OUTCOME_COLUMNS)} (one peak_theta
+Columns: the varied parameters (stiffness:ankle, ...), then
+{", ".join(OUTCOME_COLUMNS)} (one peak_theta
 per link). outcome is recovered (completed, ending within ±0.01 rad of upright and below
 0.05 rad/s), not recovered (completed but ending farther or still moving), steady sway
 (completed under a sustained stimulus: a sine or PRTS tilt, a sum of sines, motor noise),
@@ -76,7 +80,7 @@ white measurement noise (seeded per run from --seed), --motor-noise in the loop 
 run), the FRF of --output at the sequence's bands, and with --fit NAMES the FRF fit of those
 parameters (posturelab fit-frf's names) started from the base experiment's values. Its
 columns: the varied parameters, fell, gain_B, phase_deg_B [deg], coherence_B per band, then
-fit_NAME and se_NAME per fitted parameter and fit_error.
+fit_NAME and se_NAME per fitted parameter (fit_active_stiffness:ankle, ...) and fit_error.
 
 Parallelism: the runs use every CPU
 available (one thread each). --workers N sends chunks of runs to a Dask LocalCluster of N

@@ -1,8 +1,9 @@
 """What the explorer shows, as pure functions of its parameters.
 
-:data:`CONTROLS` states every control once: its name, words, unit, default, the range
-the package accepts and the range of its slider. The page is built from it and
-:func:`parse_parameters` checks a request against it, so the page and the server
+:data:`CONTROLS` states every control once: its name (the model's parameters by the
+parameter table's names, ``stiffness:ankle``, ``feedback_delay``, …), words, unit, default,
+the range the package accepts (the table's bounds) and the range of its slider. The page is
+built from it and :func:`parse_parameters` checks a request against it, so the page and the server
 cannot disagree. :func:`compute_views` turns checked parameters into the numbers and
 figures of the page with the public API only: :func:`posturelab.analyse`,
 :func:`posturelab.rightmost_roots`, :func:`posturelab.delay_margin`,
@@ -21,15 +22,10 @@ import numpy as np
 from ..errors import ParameterError
 from ..model.anthropometry import HEIGHT_RANGE, MASS_RANGE
 from ..model.controllers import CONTROLLERS
-from ..model.muscles import (
-    MAX_PAIR_STIFFNESS,
-    MAX_PAIR_VISCOSITY,
-    PAPER_PAIR_NAMES,
-    STIFFNESS_CASES,
-)
+from ..model.muscles import PAPER_PAIR_NAMES, STIFFNESS_CASES
 from ..model.platform import MAX_PLATFORM_SPEED
 from ..model.tilt import MAX_TILT
-from ..simulation.setup import MAX_FEEDBACK_DELAY
+from ..parameters import MAX_FEEDBACK_DELAY, MAX_PAIR_VISCOSITY, QUANTITIES, renamed
 
 __all__ = ["Control", "CONTROLS", "PAIRS", "BODIES", "OWN_GAINS", "parse_parameters",
            "build_body", "build_model", "compute_views", "controller_presets"]
@@ -75,18 +71,25 @@ class Control:
     choices: tuple[str, ...] = ()
 
 
+def _table(name: str, label: str, default: float, slider_high: float, step: float,
+           group: str) -> Control:
+    """A control of a model parameter: its name, unit and range the parameter table's."""
+    q = QUANTITIES[name.partition(":")[0]]
+    return Control(name, label, q.unit, default, q.low, q.high, q.low, slider_high, step, group)
+
+
 def _pair_controls() -> tuple[Control, ...]:
     out = []
     # the defaults: Table I, case 1, the paper's stable reference gains
     for name, k in zip(PAIRS, STIFFNESS_CASES["1"], strict=True):
-        out.append(Control(f"stiffness_{name}", f"{name} stiffness", "N·m/rad", float(k), 0.0,
-                           MAX_PAIR_STIFFNESS, 0.0, 3000.0, 10.0, "pairs"))
+        out.append(_table(f"stiffness:{name}", f"{name} stiffness", float(k), 3000.0, 10.0,
+                          "pairs"))
     for name in PAIRS:
-        out.append(Control(f"active_{name}", f"{name} active stiffness", "N·m/rad", 0.0, 0.0,
-                           MAX_PAIR_STIFFNESS, 0.0, 3000.0, 10.0, "active"))
+        out.append(_table(f"active_stiffness:{name}", f"{name} active stiffness", 0.0, 3000.0,
+                          10.0, "active"))
     for name in PAIRS:
-        out.append(Control(f"active_viscosity_{name}", f"{name} active viscosity", "N·m·s/rad",
-                           0.0, 0.0, MAX_PAIR_VISCOSITY, 0.0, 1000.0, 5.0, "active"))
+        out.append(_table(f"active_viscosity:{name}", f"{name} active viscosity", 0.0, 1000.0,
+                          5.0, "active"))
     return tuple(out)
 
 
@@ -105,13 +108,9 @@ CONTROLS: tuple[Control, ...] = (
     Control("height", "height", "m", 1.75, *HEIGHT_RANGE, 1.0, 2.2, 0.01, "body"),
     Control("mass", "mass", "kg", 75.0, *MASS_RANGE, 30.0, 150.0, 0.5, "body"),
     *_pair_controls(),
-    Control("viscosity_ratio", "viscosity ratio L/K", "s", 0.25, 0.0, 10.0, 0.0, 1.0, 0.01,
-            "pairs"),
-    Control("feedback_delay", "feedback delay τ", "s", 0.0, 0.0, MAX_FEEDBACK_DELAY, 0.0, 0.3,
-            0.005,
-            "neural"),
-    Control("proprioceptive_weight", "proprioceptive weight W", "-", 1.0, 0.0, 1.0, 0.0, 1.0,
-            0.05, "neural"),
+    _table("viscosity_ratio", "viscosity ratio L/K", 0.25, 1.0, 0.01, "pairs"),
+    _table("feedback_delay", "feedback delay τ", 0.0, 0.3, 0.005, "neural"),
+    _table("proprioceptive_weight", "proprioceptive weight W", 1.0, 1.0, 0.05, "neural"),
     Control("perturbation", "perturbation", "", "backward step", group="perturbation",
             choices=("backward step", "forward step", "tilt")),
     Control("step_speed", "step speed", "m/s", 0.3, 0.01, MAX_PLATFORM_SPEED, 0.01, 2.0, 0.01,
@@ -154,6 +153,10 @@ def parse_parameters(fields: dict) -> dict:
         raise ParameterError("the request must be a JSON object of control values")
     unknown = sorted(set(fields) - set(_BY_NAME))
     if unknown:
+        new = renamed(unknown[0], PAIRS)
+        if new in _BY_NAME:
+            raise _field_error(unknown[0], f"control {_shown(unknown[0])} is now called "
+                               f"{new!r}")
         raise _field_error(unknown[0], f"unknown control {_shown(unknown[0])}")
     out: dict = {}
     for c in CONTROLS:
@@ -178,9 +181,9 @@ def parse_parameters(fields: dict) -> dict:
                                f"[{_number(c.low)}, {_number(c.high)}], got {_number(value)}")
         out[c.name] = value
     for name in PAIRS:  # a pair's viscosity is ratio × stiffness: its bound, on the stiffness
-        viscosity = out["viscosity_ratio"] * out[f"stiffness_{name}"]
+        viscosity = out["viscosity_ratio"] * out[f"stiffness:{name}"]
         if viscosity > MAX_PAIR_VISCOSITY:
-            raise _field_error(f"stiffness_{name}", (
+            raise _field_error(f"stiffness:{name}", (
                 f"{name} viscosity = viscosity ratio × stiffness = {_number(viscosity)} "
                 f"N·m·s/rad must be at most {_number(MAX_PAIR_VISCOSITY)} (lower the "
                 f"{name} stiffness or the viscosity ratio)"))
@@ -236,10 +239,10 @@ def build_model(p: dict):
         muscles = CONTROLLERS[p["controller"]].muscles(body)
     else:
         names = PAIRS if body.n_links == 3 else ("ankle",)
-        active_k = [p[f"active_{n}"] for n in names]
-        active_l = [p[f"active_viscosity_{n}"] for n in names]
+        active_k = [p[f"active_stiffness:{n}"] for n in names]
+        active_l = [p[f"active_viscosity:{n}"] for n in names]
         active = any(v > 0 for v in active_k + active_l)
-        muscles = muscles_for(body.n_links, [p[f"stiffness_{n}"] for n in names],
+        muscles = muscles_for(body.n_links, [p[f"stiffness:{n}"] for n in names],
                               viscosity_ratio=p["viscosity_ratio"],
                               active_stiffness=active_k if active else None,
                               active_viscosity=active_l if active else None)
@@ -271,7 +274,8 @@ def _linear(body, muscles):
     the changes of delay, weight or perturbation that follow."""
     import posturelab as pl
 
-    return pl.analyse(body, muscles), pl.delay_margin(body, muscles, max_delay=1.0)
+    return pl.analyse(body, muscles), pl.delay_margin(body, muscles,
+                                                        max_delay=MAX_FEEDBACK_DELAY)
 #: Output samples per second of the simulated response. [Hz]
 SAMPLE_RATE = 100.0
 #: Stick-figure frames per second. [Hz]

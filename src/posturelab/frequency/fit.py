@@ -1,11 +1,13 @@
 """Fitting a controller to frequency response functions (``fit_frf``).
 
-The parameters (``PARAMETERS``; a ``:PAIR`` suffix names a pair other than the first):
+The parameters (``PARAMETERS``; their names, units and bounds are the parameter table's,
+:mod:`posturelab.parameters`; ``:PAIR`` names the pair, and may be left out on a body with
+one pair):
 
-    stiffness, viscosity                 intrinsic gains of the pair [N·m/rad], [N·m·s/rad]
-    active_stiffness, active_viscosity   active (delayed) gains [N·m/rad], [N·m·s/rad]
-    feedback_delay                       τ [s]
-    proprioceptive_weight                W [-]
+    stiffness:PAIR, viscosity:PAIR                 intrinsic gains [N·m/rad], [N·m·s/rad]
+    active_stiffness:PAIR, active_viscosity:PAIR   active (delayed) gains [N·m/rad], [N·m·s/rad]
+    feedback_delay                                 τ [s]
+    proprioceptive_weight                          W [-]
 
 Every other parameter keeps the value of the starting ``muscles`` and options. With several
 conditions (for example tilts of different amplitudes) the ``free`` parameters are shared
@@ -39,6 +41,8 @@ import numpy as np
 from ..errors import ParameterError
 from ..model.body import Body
 from ..model.muscles import MuscleSet
+from ..parameters import QUANTITIES, check_value, resolve
+from ..parameters import unit as parameter_unit
 from .estimate import FRFEstimate
 from .model import model_frf_batch
 
@@ -46,11 +50,9 @@ __all__ = ["FRFFit", "fit_frf", "PARAMETERS"]
 
 PARAMETERS = ("stiffness", "viscosity", "active_stiffness", "active_viscosity",
               "feedback_delay", "proprioceptive_weight")
-_UNITS = {"stiffness": "N·m/rad", "viscosity": "N·m·s/rad", "active_stiffness": "N·m/rad",
-          "active_viscosity": "N·m·s/rad", "feedback_delay": "s", "proprioceptive_weight": "-"}
-_DEFAULT_BOUNDS = {"stiffness": (0.0, 1e5), "viscosity": (0.0, 1e5),
-                   "active_stiffness": (0.0, 1e5), "active_viscosity": (0.0, 1e5),
-                   "feedback_delay": (0.0, 1.0), "proprioceptive_weight": (0.0, 1.0)}
+#: The default search interval of each parameter: the table's lower bound to its fit_high.
+_DEFAULT_BOUNDS = {name: (QUANTITIES[name].low, QUANTITIES[name].fit_high)
+                   for name in PARAMETERS}
 
 
 @dataclass(frozen=True)
@@ -90,7 +92,7 @@ class FRFFit:
 
     def unit(self, name: str) -> str:
         """Unit of a fitted parameter."""
-        return _UNITS[name.split("#")[0].split(":")[0]]
+        return parameter_unit(name)
 
     def to_dict(self) -> dict:
         """Plain-Python summary."""
@@ -104,19 +106,24 @@ class FRFFit:
             "message": self.message, "warnings": list(self.warnings)}
 
 
+def _name(name: str, muscles: MuscleSet) -> str:
+    """The one spelling of an FRF fit parameter (the parameter table's)."""
+    return resolve(name, muscles.names, (), accepts=PARAMETERS, what="FRF fit parameter")
+
+
 def _parse(name: str, muscles: MuscleSet) -> tuple[str, int | None]:
-    base, _, pair = name.partition(":")
-    if base not in PARAMETERS:
-        raise ParameterError(f"unknown FRF fit parameter {name!r}; known: {', '.join(PARAMETERS)}"
-                             " (a pair gain may end in :PAIR)")
-    if base in ("feedback_delay", "proprioceptive_weight"):
-        if pair:
-            raise ParameterError(f"{base} takes no pair, got {name!r}")
-        return base, None
-    names = muscles.names
-    if pair and pair not in names:
-        raise ParameterError(f"unknown pair {pair!r} in {name!r}; pairs: {', '.join(names)}")
-    return base, names.index(pair) if pair else 0
+    base, _, pair = _name(name, muscles).partition(":")
+    return base, muscles.names.index(pair) if pair else None
+
+
+def _checked_bounds(bounds, muscles: MuscleSet) -> dict:
+    """``bounds`` keyed by each name's one spelling, every end within the table's bounds."""
+    out = {}
+    for key, (low, high) in dict(bounds or {}).items():
+        name = _name(key, muscles)
+        out[name] = (check_value(name, low, f"bound {name} LO"),
+                     check_value(name, high, f"bound {name} HI"))
+    return out
 
 
 def fit_frf(body: Body, muscles: MuscleSet, data, free, *, input: str = "tilt",
@@ -140,22 +147,29 @@ def fit_frf(body: Body, muscles: MuscleSet, data, free, *, input: str = "tilt",
     per_condition : sequence of str
         Parameters fitted separately for each condition.
     bounds : dict of name -> (low, high), optional
-        Defaults: gains [0, 1e5], delay [0, 1] s, W [0, 1].
+        Within the parameter table's bounds; defaults: the table's search intervals (gains
+        [0, 1e5], delay [0, 1] s, W [0, 1]).
     """
     from scipy.optimize import least_squares
     from scipy.stats import t as student
 
-    conditions = [data] if isinstance(data, FRFEstimate) else list(data)
-    if not conditions or not all(isinstance(c, FRFEstimate) for c in conditions):
-        raise ParameterError("data must be one FRFEstimate or a list of them")
-    free, per = list(free), list(per_condition)
+    free = [_name(n, muscles) for n in ([free] if isinstance(free, str) else free)]
+    per = [_name(n, muscles) for n in ([per_condition] if isinstance(per_condition, str)
+                                       else per_condition)]
     if not free and not per:
         raise ParameterError("give at least one parameter to fit")
     if set(free) & set(per):
         raise ParameterError(f"{sorted(set(free) & set(per))[0]!r} is both shared and "
                              "per condition")
+    for names in (free, per):  # by their one spelling: stiffness and stiffness:ankle alike
+        if len(set(names)) != len(names):
+            twice = sorted({n for n in names if names.count(n) > 1})[0]
+            raise ParameterError(f"{twice!r} is named more than once")
     specs = [_parse(n, muscles) for n in free + per]
-    bounds = dict(bounds or {})
+    bounds = _checked_bounds(bounds, muscles)
+    conditions = [data] if isinstance(data, FRFEstimate) else list(data)
+    if not conditions or not all(isinstance(c, FRFEstimate) for c in conditions):
+        raise ParameterError("data must be one FRFEstimate or a list of them")
     base = np.stack([muscles.stiffnesses, muscles.viscosities, muscles.active_stiffnesses,
                      muscles.active_viscosities])
     C = len(conditions)

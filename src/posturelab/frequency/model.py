@@ -24,11 +24,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._validation import finite_array, float_in_range
+from .._validation import finite_array
 from ..errors import ParameterError, UnknownNameError
 from ..model.body import Body
 from ..model.dynamics import mass_matrix
 from ..model.muscles import MuscleSet, feedback_gains
+from ..parameters import QUANTITIES, check_value
 
 __all__ = ["model_frf", "model_frf_batch", "output_vector", "output_names", "INPUTS"]
 
@@ -108,10 +109,10 @@ def model_frf_batch(body: Body, muscles: MuscleSet, frequencies, stiffness, visc
     M = k.shape[0]
     tau = np.broadcast_to(np.asarray(feedback_delay, dtype=float), (M,))
     w = np.broadcast_to(np.asarray(proprioceptive_weight, dtype=float), (M,))
-    if np.any(tau < 0) or np.any(~np.isfinite(tau)):
-        raise ParameterError("feedback_delay [s] must be finite and >= 0")
-    if np.any((w < 0) | (w > 1)):
-        raise ParameterError("proprioceptive_weight [-] must be in [0, 1]")
+    for name, values in (("feedback_delay", tau), ("proprioceptive_weight", w)):
+        bad = ~((values >= QUANTITIES[name].low) & (values <= QUANTITIES[name].high))
+        if np.any(bad):  # the parameter table's bounds (NaN fails too)
+            check_value(name, float(values[np.argmax(bad)]))
     g = feedback_gains(k, viscosity, active_stiffness, active_viscosity, np.ones(M))
     if M > _CHUNK:  # bound the memory of one evaluation
         return np.concatenate([
@@ -160,8 +161,8 @@ def model_frf(body: Body, muscles: MuscleSet, frequencies, *, input: str = "tilt
               proprioceptive_weight: float = 1.0) -> np.ndarray:
     """The model FRF of one body and muscle set (its own intrinsic and active gains) at
     ``frequencies`` [Hz]; shape (F,). See :func:`model_frf_batch`."""
-    float_in_range("feedback_delay [s]", feedback_delay, 0.0, 10.0, unit="s")
-    float_in_range("proprioceptive_weight [-]", proprioceptive_weight, 0.0, 1.0)
+    check_value("feedback_delay", feedback_delay)
+    check_value("proprioceptive_weight", proprioceptive_weight)
     active = muscles.has_active_feedback
     return model_frf_batch(
         body, muscles, frequencies, muscles.stiffnesses[None], muscles.viscosities[None],

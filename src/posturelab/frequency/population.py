@@ -61,8 +61,9 @@ class PRTSProtocol:
         80-state sequence) becomes the sequence's own for another length
         (:func:`posturelab.frequency.bands.sequence_bands`).
     fit : tuple of str
-        Parameters for :func:`posturelab.frequency.fit_frf` to estimate per run (its names:
-        ``stiffness``, ``active_stiffness:PAIR``, ``feedback_delay``, …); none: no fit.
+        Parameters for :func:`posturelab.frequency.fit_frf` to estimate per run (the
+        parameter table's names: ``active_stiffness:ankle``, ``feedback_delay``, …); none:
+        no fit.
     """
 
     cycles: int = 5
@@ -207,14 +208,12 @@ class PRTSSweepResult:
 
     def units(self) -> dict[str, str]:
         """The unit of each column that has one."""
-        from ..studies.sweep import PARAMETER_UNITS
-        from .fit import _UNITS
+        from ..parameters import unit
 
-        units = {name: PARAMETER_UNITS.get(name, "") for name in self.grid.names}
+        units = {name: unit(name) for name in self.grid.names}
         units.update({f"phase_deg_{b + 1}": "deg" for b in range(self.frequency.size)})
         for name in self.fit_names:
-            unit = _UNITS[name.split(":")[0]]
-            units[f"fit_{name}"] = units[f"se_{name}"] = unit
+            units[f"fit_{name}"] = units[f"se_{name}"] = unit(name)
         return units
 
 
@@ -246,7 +245,7 @@ def prts_sweep(scenario: Scenario, varies: Sequence, protocol: PRTSProtocol | No
     from ..model.tilt import PRTSTilt
     from ..studies.sweep import SweepInterrupted, run_chunks, sweep_grid
     from .bands import band_frequencies, resolve_bands
-    from .fit import _parse
+    from .fit import _name
 
     protocol = PRTSProtocol() if protocol is None else protocol
     if not isinstance(scenario.tilt, PRTSTilt):
@@ -255,8 +254,8 @@ def prts_sweep(scenario: Scenario, varies: Sequence, protocol: PRTSProtocol | No
     if any(v.name == "disturbance_scale" for v in varies):
         raise ParameterError("disturbance_scale has no meaning in a PRTS experiment sweep "
                              "(the stimulus is the tilt)")
-    for name in protocol.fit:
-        _parse(name, scenario.muscles)
+    # each fit parameter by its one spelling (the parameter table's; columns fit_NAME)
+    protocol = replace(protocol, fit=tuple(_name(n, scenario.muscles) for n in protocol.fit))
     grid = sweep_grid(scenario, varies, viscosity_ratio)
     if grid.n_runs > MAX_EXPERIMENTS:
         raise ParameterError(f"the grid has {grid.n_runs:,} runs; a PRTS experiment sweep takes "

@@ -28,6 +28,7 @@ from ..model.muscles import (
     MuscleSet,
     get_stiffness_case,
 )
+from ..parameters import check_value, names_for, resolve, unit
 
 __all__ = [
     "GRID_PARAMETERS",
@@ -39,33 +40,35 @@ __all__ = [
     "stability_map",
 ]
 
-#: Parameters a grid can sweep: the paper's five pair stiffnesses [N·m/rad] and
-#: the viscosity ratio [s].
-GRID_PARAMETERS: tuple[str, ...] = (*PAPER_PAIR_NAMES, "viscosity_ratio")
+#: The parameter table's quantities a grid can sweep (:mod:`posturelab.parameters`).
+GRID_QUANTITIES: tuple[str, ...] = ("stiffness", "viscosity_ratio")
+#: Parameters a grid can sweep, by the parameter table's names: the paper's five pair
+#: stiffnesses ``stiffness:PAIR`` [N·m/rad] and the viscosity ratio [s].
+GRID_PARAMETERS: tuple[str, ...] = names_for(PAPER_PAIR_NAMES, (), GRID_QUANTITIES)
 
 #: Unit of each grid parameter.
-GRID_PARAMETER_UNITS: dict[str, str] = {
-    **{name: "N·m/rad" for name in PAPER_PAIR_NAMES},
-    "viscosity_ratio": "s",
-}
+GRID_PARAMETER_UNITS: dict[str, str] = {name: unit(name) for name in GRID_PARAMETERS}
 
 
-def _check_parameter_name(name: str, known: tuple[str, ...] = GRID_PARAMETERS) -> str:
-    if name not in known:
-        raise UnknownNameError(
-            f"unknown parameter {name!r}; known parameters: {', '.join(known)}"
-        )
-    return name
+def _check_parameter_name(name: str, pairs: tuple[str, ...] = PAPER_PAIR_NAMES) -> str:
+    """The table's one spelling of a grid parameter for a body with these pairs (a former
+    one is refused naming the new one)."""
+    return resolve(name, pairs, (), accepts=GRID_QUANTITIES, what="grid parameter")
 
 
 def _check_name_form(name) -> str:
-    """A pair name or "viscosity_ratio": a non-empty identifier (checked against the muscle
-    set by :func:`parameter_grid`)."""
-    if not isinstance(name, str) or not name.isidentifier():
+    """``"viscosity_ratio"`` or ``"stiffness:PAIR"`` with PAIR an identifier (checked against
+    the muscle set by :func:`parameter_grid`); a former spelling is refused naming the new
+    one, an unknown name listing the known ones."""
+    if not isinstance(name, str):
         raise UnknownNameError(
             f"unknown parameter {name!r}; known parameters: {', '.join(GRID_PARAMETERS)} "
-            "(or the pairs of the muscle set)")
-    return name
+            "(or stiffness:PAIR for the pairs of the muscle set)")
+    text = name.strip().lower()
+    quantity, _, pair = text.partition(":")
+    if text == "viscosity_ratio" or (quantity == "stiffness" and pair.isidentifier()):
+        return text
+    return _check_parameter_name(text)
 
 
 @dataclass(frozen=True)
@@ -75,8 +78,8 @@ class ParameterRange:
     Parameters
     ----------
     name : str
-        A pair name (stiffness [N·m/rad]: one of :data:`GRID_PARAMETERS`, or of the base
-        muscle set's pairs) or ``"viscosity_ratio"`` [s].
+        ``"stiffness:PAIR"`` [N·m/rad] (PAIR one of the paper's pairs, :data:`GRID_PARAMETERS`,
+        or of the base muscle set's pairs) or ``"viscosity_ratio"`` [s].
     low, high : float
         Range ends, 0 <= low < high. [N·m/rad] or [s]
     """
@@ -86,7 +89,7 @@ class ParameterRange:
     high: float
 
     def __post_init__(self) -> None:
-        _check_name_form(self.name)
+        object.__setattr__(self, "name", _check_name_form(self.name))
         unit = self.unit
         low = nonnegative_float(f"{self.name} low [{unit}]", self.low)
         high = nonnegative_float(f"{self.name} high [{unit}]", self.high)
@@ -94,6 +97,7 @@ class ParameterRange:
             raise ParameterError(
                 f"{self.name} range must satisfy low < high [{unit}], got {low:g} .. {high:g}"
             )
+        check_value(self.name, high, f"{self.name} high")  # the parameter table's bound
         object.__setattr__(self, "low", low)
         object.__setattr__(self, "high", high)
 
@@ -107,7 +111,7 @@ class ParameterRange:
         """Axis label with unit, e.g. ``"ankle pair stiffness [N·m/rad]"``."""
         if self.name == "viscosity_ratio":
             return "viscosity ratio (viscosity / stiffness) [s]"
-        return f"{self.name} pair stiffness [N·m/rad]"
+        return f"{self.name.partition(':')[2]} pair stiffness [N·m/rad]"
 
     def values(self, count: int) -> np.ndarray:
         """``count`` evenly spaced values from low to high inclusive. [unit]"""
@@ -191,7 +195,7 @@ class ParameterGrid:
             if rng.name == "viscosity_ratio":
                 ratio[:] = vals
             else:
-                stiffness[:, self.pair_names.index(rng.name)] = vals
+                stiffness[:, self.pair_names.index(rng.name.partition(":")[2])] = vals
         return stiffness, ratio
 
     @property
@@ -214,7 +218,7 @@ class ParameterGrid:
         points = []
         if self.base_case is None or tuple(self.pair_names) != PAPER_PAIR_NAMES:
             return points  # Table I is of the paper's five pairs
-        names = list(PAPER_PAIR_NAMES)
+        names = [f"stiffness:{p}" for p in PAPER_PAIR_NAMES]
         for case, stiffness in STIFFNESS_CASES.items():
             params = dict(zip(names, stiffness, strict=True))
             params["viscosity_ratio"] = DEFAULT_VISCOSITY_RATIO
@@ -275,7 +279,7 @@ def parameter_grid(
     else:
         pair_names = PAPER_PAIR_NAMES
     for rng in (x, y):
-        _check_parameter_name(rng.name, (*pair_names, "viscosity_ratio"))
+        _check_parameter_name(rng.name, pair_names)
     if x.name == y.name:
         raise ParameterError(f"x and y must be different parameters, both are {x.name!r}")
     if isinstance(resolution, int | np.integer):
@@ -303,7 +307,7 @@ def parameter_grid(
             raise ParameterError(
                 "viscosity_ratio is swept along an axis; do not also give it as a fixed value"
             )
-        ratio = nonnegative_float("viscosity_ratio [s]", viscosity_ratio)
+        ratio = check_value("viscosity_ratio", viscosity_ratio)
     base.setflags(write=False)
     xv, yv = x.values(nx), y.values(ny)
     xv.setflags(write=False)

@@ -47,6 +47,7 @@ from ..errors import ParameterError
 from ..model.body import Body
 from ..model.dynamics import mass_matrix
 from ..model.muscles import MuscleSet, muscle_set_gains
+from ..parameters import MAX_FEEDBACK_DELAY
 from .analysis import OneSided, _check_match, _effective
 
 __all__ = [
@@ -61,8 +62,8 @@ __all__ = [
     "MAX_DELAY_FOR_ROOTS",
 ]
 
-#: Largest delay :func:`rightmost_roots` accepts. [s]
-MAX_DELAY_FOR_ROOTS = 10.0
+#: Largest delay :func:`rightmost_roots` accepts: the parameter table's feedback delay bound. [s]
+MAX_DELAY_FOR_ROOTS = MAX_FEEDBACK_DELAY
 
 
 @dataclass(frozen=True, eq=False)

@@ -26,6 +26,7 @@ import numpy as np
 
 from .._validation import float_in_range
 from ..errors import ParameterError, UnknownNameError
+from ..parameters import HEIGHT_RANGE, MASS_RANGE
 from .body import Body, BodyPreset, paper_body, register_body_preset
 
 __all__ = ["WINTER_TABLE", "body_from_anthropometry", "lump", "one_link", "ANTHROPOMETRIC_TABLES"]
@@ -50,10 +51,8 @@ WINTER_TABLE: dict[str, tuple[float, float, float, float, int]] = {
 ANTHROPOMETRIC_TABLES = {"winter": (WINTER_TABLE, WINTER_CITATION)}
 
 
-#: Standing heights a body can be scaled to. [m]
-HEIGHT_RANGE = (0.5, 2.5)
-#: Body masses a body can be scaled to. [kg]
-MASS_RANGE = (10.0, 300.0)
+# HEIGHT_RANGE [m] and MASS_RANGE [kg], the heights and masses a body can be scaled to: the
+# parameter table's (posturelab.parameters)
 
 
 def body_from_anthropometry(height: float, mass: float, table: str = "winter",

@@ -34,8 +34,9 @@ from typing import Literal
 
 import numpy as np
 
-from .._validation import finite_array, float_in_range, nonnegative_float
+from .._validation import finite_array, float_in_range
 from ..errors import ParameterError, UnknownNameError
+from ..parameters import MAX_PAIR_STIFFNESS, MAX_PAIR_VISCOSITY, check_value
 
 __all__ = [
     "MusclePair",
@@ -77,10 +78,8 @@ GASTROCNEMIUS_FORMS: dict[str, tuple[bool, bool, str]] = {
 }
 
 
-#: Largest pair stiffness, intrinsic or active: 10⁵ times a standing adult's mgh. [N·m/rad]
-MAX_PAIR_STIFFNESS = 1e8
-#: Largest pair viscosity, intrinsic or active. [N·m·s/rad]
-MAX_PAIR_VISCOSITY = 1e7
+# Largest pair stiffness [N·m/rad] and viscosity [N·m·s/rad], intrinsic or active: the
+# parameter table's (posturelab.parameters)
 
 
 @dataclass(frozen=True)
@@ -602,7 +601,7 @@ def paper_muscles(
     else:
         k = _five("stiffness [N·m/rad]", stiffness)
     if viscosity is None:
-        ratio = nonnegative_float("viscosity_ratio [s]", viscosity_ratio)
+        ratio = check_value("viscosity_ratio", viscosity_ratio)
         v = ratio * k
     else:
         v = _five("viscosity [N·m·s/rad]", viscosity)
@@ -678,7 +677,7 @@ def muscles_for(n_links: int, stiffness: Sequence[float], viscosity: Sequence[fl
         return arr
 
     k = gains("stiffness [N·m/rad]", stiffness)
-    v = (nonnegative_float("viscosity_ratio [s]", viscosity_ratio) * k if viscosity is None
+    v = (check_value("viscosity_ratio", viscosity_ratio) * k if viscosity is None
          else gains("viscosity [N·m·s/rad]", viscosity))
     muscles = MuscleSet(tuple(MusclePair(name, j, j + 1, float(k[j]), float(v[j]))
                               for j, name in enumerate(names)), n_links)
@@ -700,7 +699,7 @@ def _with_active(muscles: MuscleSet, active_stiffness, active_viscosity,
     ka = (np.zeros(P) if active_stiffness is None
           else check("active stiffness [N·m/rad]", active_stiffness))
     if active_viscosity_ratio is not None:
-        va = nonnegative_float("active_viscosity_ratio [s]", active_viscosity_ratio) * ka
+        va = check_value("active_viscosity_ratio", active_viscosity_ratio) * ka
     else:
         va = (np.zeros(P) if active_viscosity is None
               else check("active viscosity [N·m·s/rad]", active_viscosity))

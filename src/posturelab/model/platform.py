@@ -36,6 +36,7 @@ from .._validation import (
     positive_float,
 )
 from ..errors import DataFileError, ParameterError
+from ..parameters import MAX_PLATFORM_SPEED
 
 __all__ = [
     "Primitive",
@@ -60,8 +61,8 @@ def _axis(axis: str) -> int:
     return 0 if axis == "x" else 1
 
 
-#: Largest platform velocity step: ten times the fastest perturbation of the field. [m/s]
-MAX_PLATFORM_SPEED = 20.0
+# MAX_PLATFORM_SPEED [m/s], the largest platform velocity step, is the parameter table's
+# (posturelab.parameters).
 #: Largest platform acceleration of a profile, pulse, ramp or sum of sines: posturelab's bound
 #: (not a source's), the largest velocity step (:data:`MAX_PLATFORM_SPEED`) reached in 20 ms,
 #: about 100 g. [m/s²]

@@ -36,6 +36,7 @@ import numpy as np
 
 from .._validation import finite_array, finite_float, float_in_range
 from ..errors import ParameterError
+from ..parameters import MAX_TILT
 
 __all__ = [
     "Tilt",
@@ -57,8 +58,7 @@ __all__ = [
     "get_prts_sequence",
 ]
 
-#: Largest |α| a profile may reach. [rad]
-MAX_TILT = 0.5
+# MAX_TILT [rad], the largest |α| a profile may reach: the parameter table's
 #: Largest distance of the tilt axis below the ankle. [m]
 MAX_AXIS_DEPTH = 1.0
 
@@ -691,6 +691,8 @@ def axis_translation(tilt: Tilt, depth: float, t) -> tuple[np.ndarray, np.ndarra
 
 
 def check_proprioceptive_weight(value) -> float:
-    """W in [0, 1], a finite number. [-]"""
-    return float_in_range("proprioceptive_weight [-]", value, 0.0, 1.0)
+    """W in [0, 1] (the parameter table's bounds), a finite number. [-]"""
+    from ..parameters import check_value
+
+    return check_value("proprioceptive_weight", value)
 

@@ -117,6 +117,7 @@ from ..model.tilt import (
     get_prts_sequence,
     read_tilt_csv,
 )
+from ..parameters import check_value
 from ..simulation.engines import engine_name, simulate
 from ..simulation.results import SimulationResult
 from ..simulation.setup import check_step_budget, check_time_limit
@@ -332,14 +333,13 @@ def _parse(data: dict, base_dir: Path, origin: str) -> Scenario:
                                   "proprioceptive_weight"), origin)
     mt = dict(mt)
     delay = finite_float("muscles.feedback_delay [s]", mt.pop("feedback_delay", 0.0))
-    if not 0.0 <= delay <= 1.0:
-        raise ScenarioError(f"{origin}: muscles.feedback_delay [s] must be in [0, 1], "
-                            f"got {delay:g}")
     weight = finite_float("muscles.proprioceptive_weight [-]",
                           mt.pop("proprioceptive_weight", 1.0))
-    if not 0.0 <= weight <= 1.0:
-        raise ScenarioError(f"{origin}: muscles.proprioceptive_weight [-] must be in [0, 1], "
-                            f"got {weight:g}")
+    for key, value in (("feedback_delay", delay), ("proprioceptive_weight", weight)):
+        try:  # the parameter table's bounds
+            check_value(key, value, f"muscles.{key}")
+        except ParameterError as exc:
+            raise ScenarioError(f"{origin}: {exc}") from None
     muscles, case = _parse_muscles(mt, body, origin)
     tilt_table = _table(data, "tilt", TILT_KEYS, origin)
     tilt = _parse_tilt(tilt_table, base_dir, origin)

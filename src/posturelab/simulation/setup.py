@@ -47,6 +47,7 @@ from ..model.tilt import (
     check_proprioceptive_weight,
     tilt_pair_gains,
 )
+from ..parameters import MAX_FEEDBACK_DELAY  # the parameter table's bound
 
 __all__ = [
     "RunSetup",
@@ -70,8 +71,6 @@ __all__ = [
 #: k = 1 … this many (the order of the default integrators), and at t_i + kτ after each knee
 #: impact t_i (the impact changes the rates at once). [-]
 DELAY_BREAKPOINT_MULTIPLES = 5
-#: Largest neural feedback delay a run accepts. [s]
-MAX_FEEDBACK_DELAY = 1.0
 #: Longest run (a day). [s]
 MAX_DURATION = 86_400.0
 #: Most output samples of one run (duration × sample_rate + 1). [-]

@@ -41,9 +41,10 @@ import numpy as np
 from .._validation import finite_array
 from ..errors import DataFileError, ParameterError, PostureLabError, UnknownNameError
 from ..model.muscles import MuscleSet
+from ..parameters import FIT_MAX_GAIN, QUANTITIES, resolve
+from ..parameters import unit as parameter_unit
 from ..scenarios import Scenario
 from ..simulation.results import SimulationResult
-from .sweep import parameter_unit
 
 __all__ = ["FitResult", "FitError", "fit_stiffness", "read_trajectory_csv"]
 
@@ -53,6 +54,9 @@ class FitError(PostureLabError):
     budget, a non-finite state, …)."""
 
 VISCOSITY_RATIO = "viscosity_ratio"
+#: The quantities of the parameter table a time-domain fit can free.
+FIT_QUANTITIES = ("stiffness", "viscosity", "active_stiffness", "active_viscosity",
+                  "viscosity_ratio", "feedback_delay", "proprioceptive_weight")
 #: How the uncertainty treats the residuals (:func:`fit_stiffness`).
 RESIDUAL_MODELS = ("ar1", "independent")
 #: The engines ``fit_stiffness`` can run the model on ("fast" is a former name of "compiled").
@@ -66,8 +70,8 @@ class FitResult:
     Attributes
     ----------
     parameter_names : tuple of str
-        Fitted parameters: pair names (stiffness [N·m/rad]) and possibly
-        ``"viscosity_ratio"`` [s].
+        Fitted parameters, by their names in the parameter table (``stiffness:ankle``
+        [N·m/rad], ``viscosity_ratio`` [s], ...).
     estimates : numpy.ndarray, shape (P,)
         Best-fit values. [N·m/rad] or [s]
     standard_errors : numpy.ndarray, shape (P,)
@@ -139,10 +143,12 @@ class FitResult:
         }
 
 
-def _muscles_with(muscles: MuscleSet, stiffness: dict[str, float], ratio: float) -> MuscleSet:
+def _muscles_with(muscles: MuscleSet, stiffness: dict[str, float], ratio: float,
+                  viscosity: dict[str, float] | None = None) -> MuscleSet:
+    viscosity = viscosity or {}
     pairs = tuple(
         replace(p, stiffness=stiffness.get(p.name, p.stiffness),
-                viscosity=ratio * stiffness.get(p.name, p.stiffness))
+                viscosity=viscosity.get(p.name, ratio * stiffness.get(p.name, p.stiffness)))
         for p in muscles.pairs
     )
     return MuscleSet(pairs, muscles.n_links)
@@ -156,7 +162,7 @@ def fit_stiffness(
     *,
     viscosity_ratio: float = 0.25,
     initial_guess: Sequence[float] | None = None,
-    upper_bound: float = 1e5,
+    upper_bound: float = FIT_MAX_GAIN,
     max_simulations: int = 400,
     engine: str = "compiled",
     residual_model: str = "ar1",
@@ -173,10 +179,12 @@ def fit_stiffness(
     theta : array_like, shape (S, N)
         Measured link angles. [rad]
     free : sequence of str
-        Pair names whose stiffness (intrinsic, with active gains) is fitted, and
-        optionally ``"viscosity_ratio"``, ``"feedback_delay"`` [s],
-        ``"proprioceptive_weight"`` [-], ``"active_<pair>"`` [N·m/rad] and
-        ``"active_viscosity_<pair>"`` [N·m·s/rad].
+        Names from the parameter table (:mod:`posturelab.parameters`):
+        ``"stiffness:PAIR"`` [N·m/rad] (intrinsic, with active gains),
+        ``"viscosity:PAIR"`` [N·m·s/rad] (else ratio × stiffness),
+        ``"active_stiffness:PAIR"`` [N·m/rad], ``"active_viscosity:PAIR"`` [N·m·s/rad],
+        ``"viscosity_ratio"`` [s], ``"feedback_delay"`` [s], ``"proprioceptive_weight"``
+        [-]; a former spelling (``"ankle"``, ``"active_ankle"``) is refused naming the new.
     viscosity_ratio : float
         Viscosity / stiffness for every pair when the ratio is not fitted,
         and its starting value when it is. [s]
@@ -184,7 +192,7 @@ def fit_stiffness(
         Starting values in the order of ``free``; default: the scenario's
         stiffness (or 500 N·m/rad where that is 0) and ``viscosity_ratio``.
     upper_bound : float
-        Largest stiffness allowed. [N·m/rad]
+        Largest pair gain searched (at most the table's bound). [N·m/rad], [N·m·s/rad]
     max_simulations : int
         Budget of simulations for the optimiser.
     engine : {"compiled", "reference"}
@@ -214,15 +222,13 @@ def fit_stiffness(
     if residual_model not in RESIDUAL_MODELS:
         raise UnknownNameError(f"unknown residual_model {residual_model!r}; known: "
                                f"{', '.join(RESIDUAL_MODELS)}")
-    names = list(free)
-    if not names:
-        raise ParameterError("free must name at least one pair or 'viscosity_ratio'")
+    if isinstance(free, str):
+        free = [free]
+    if not list(free):
+        raise ParameterError("free must name at least one parameter (stiffness:PAIR, ...)")
     pairs = scenario.muscles.names
-    known = pairs + [VISCOSITY_RATIO, "feedback_delay", "proprioceptive_weight",
-                     *(f"active_{p}" for p in pairs), *(f"active_viscosity_{p}" for p in pairs)]
-    for name in names:
-        if name not in known:
-            raise UnknownNameError(f"unknown parameter {name!r}; known: {', '.join(known)}")
+    names = [resolve(nm, pairs, (), accepts=FIT_QUANTITIES)
+             for nm in free]
     if len(set(names)) != len(names):
         raise ParameterError(f"free names must be unique, got {names}")
     n = scenario.body.n_links
@@ -238,19 +244,25 @@ def fit_stiffness(
             f"[{t[0]:g}, {t[-1]:g}]"
         )
     m0 = scenario.muscles
-    current = {**dict(zip(pairs, m0.stiffnesses, strict=True)),
-               **{f"active_{p}": v for p, v in zip(pairs, m0.active_stiffnesses, strict=True)},
-               **{f"active_viscosity_{p}": v
+    current = {**{f"stiffness:{p}": v for p, v in zip(pairs, m0.stiffnesses, strict=True)},
+               **{f"viscosity:{p}": viscosity_ratio * v
+                  for p, v in zip(pairs, m0.stiffnesses, strict=True)},
+               **{f"active_stiffness:{p}": v
+                  for p, v in zip(pairs, m0.active_stiffnesses, strict=True)},
+               **{f"active_viscosity:{p}": v
                   for p, v in zip(pairs, m0.active_viscosities, strict=True)}}
-    special = {VISCOSITY_RATIO: (viscosity_ratio, 5.0),
-               "feedback_delay": (scenario.feedback_delay or 0.1, 1.0),
-               "proprioceptive_weight": (scenario.proprioceptive_weight, 1.0)}
+    special = {VISCOSITY_RATIO: viscosity_ratio,
+               "feedback_delay": scenario.feedback_delay or 0.1,
+               "proprioceptive_weight": scenario.proprioceptive_weight}
     if initial_guess is None:
-        x0 = [special[nm][0] if nm in special else (current[nm] or 500.0) for nm in names]
+        x0 = [special[nm] if nm in special else (current[nm] or 500.0) for nm in names]
     else:
         x0 = list(finite_array("initial_guess", initial_guess, (len(names),)))
-    lower = np.zeros(len(names))
-    upper = np.array([special[nm][1] if nm in special else upper_bound for nm in names])
+    lower = np.array([QUANTITIES[nm.partition(":")[0]].low for nm in names])
+    # the search box: the table's fit interval (pair gains: upper_bound, within the table's)
+    upper = np.array([QUANTITIES[nm].fit_high if nm in special
+                      else min(upper_bound, QUANTITIES[nm.partition(":")[0]].high)
+                      for nm in names])
     x0 = np.clip(np.asarray(x0, dtype=float), lower + 1e-9, upper)
     sc = scenario.replace(duration=float(t[-1]) if t[-1] > 0 else scenario.duration)
     count = [0]
@@ -258,12 +270,16 @@ def fit_stiffness(
     def run(params: np.ndarray) -> SimulationResult:
         count[0] += 1
         value = dict(zip(names, params, strict=True))
-        stiff = {nm: v for nm, v in value.items() if nm in pairs}
+        stiff = {nm.removeprefix("stiffness:"): v for nm, v in value.items()
+                 if nm.startswith("stiffness:")}
+        visc = {nm.removeprefix("viscosity:"): v for nm, v in value.items()
+                if nm.startswith("viscosity:")}
         ratio = value.get(VISCOSITY_RATIO, viscosity_ratio)
-        muscles = _muscles_with(scenario.muscles, stiff, ratio)
+        muscles = _muscles_with(scenario.muscles, stiff, ratio, visc)
         if any(nm.startswith("active_") for nm in names):
-            ka = [value.get(f"active_{p}", current[f"active_{p}"]) for p in pairs]
-            va = [value.get(f"active_viscosity_{p}", current[f"active_viscosity_{p}"])
+            ka = [value.get(f"active_stiffness:{p}", current[f"active_stiffness:{p}"])
+                  for p in pairs]
+            va = [value.get(f"active_viscosity:{p}", current[f"active_viscosity:{p}"])
                   for p in pairs]
             muscles = muscles.with_active_feedback(ka, va)
         options = {k: value[k] for k in ("feedback_delay", "proprioceptive_weight")

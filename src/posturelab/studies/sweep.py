@@ -9,20 +9,22 @@ slowest) with the compiled simulator (:func:`posturelab.simulation.compiled.simu
 and returns one row per run: the varied values, then the outcomes (fell,
 fall time, peak |θ_i|, settling time).
 
-Parameters that can vary (:data:`SWEEP_PARAMETERS`): the stiffness of the
-paper's pairs ``ankle``, ``knee``, ``hip``, ``quadriceps``, ``gastrocnemius``
-[N·m/rad], ``viscosity_ratio`` [s], ``disturbance_scale`` [-], which
-multiplies the base experiment's platform motion (the velocity step's speed,
-a pulse's peak, a ramp's displacement, the sines' amplitudes, a measured
-profile's accelerations; see :meth:`posturelab.model.platform.Disturbance.scaled`),
-so that a sweep over it finds how large a perturbation each gain set
-absorbs, ``feedback_delay`` [s], the neural delay of the muscle feedback, and
-``ankle_torque_limit``, ``knee_torque_limit``, ``hip_torque_limit`` [N·m], the
+Parameters that can vary (:data:`SWEEP_PARAMETERS`; names, units and bounds from the
+parameter table, :mod:`posturelab.parameters`): a pair's ``stiffness:PAIR``,
+``viscosity:PAIR``, ``active_stiffness:PAIR`` and ``active_viscosity:PAIR`` (the paper's
+pairs ankle, knee, hip, quadriceps, gastrocnemius), ``viscosity_ratio`` [s],
+``disturbance_scale`` [-], which multiplies the base experiment's platform motion (the
+velocity step's speed, a pulse's peak, a ramp's displacement, the sines' amplitudes, a
+measured profile's accelerations; see :meth:`posturelab.model.platform.Disturbance.scaled`),
+so that a sweep over it finds how large a perturbation each gain set absorbs,
+``feedback_delay`` [s], the neural delay of the muscle feedback,
+``proprioceptive_weight`` [-], and ``torque_limit:JOINT`` [N·m] (ankle, knee, hip), the
 largest net muscle moment at each joint (the others keep the base experiment's
 limits; none by default). Every feature of the base experiment (torque limits, a
 delay, centre-of-pressure falls) carries into the sweep. The viscosity of a pair is
-the ratio times its stiffness: the varied ratio, else the one given, else the base
-experiment's own ratio for that pair (0.25, the paper's, where its stiffness is 0).
+the varied ``viscosity:PAIR``, else the ratio times its stiffness: the varied ratio, else
+the one given, else the base experiment's own ratio for that pair (0.25, the paper's,
+where its stiffness is 0). The table's columns are named by the parameters verbatim.
 
 Work can go to a Dask distributed cluster (:func:`run_sweep` with
 ``workers``/``scheduler``/``client``) in chunks; the results are identical to
@@ -45,8 +47,11 @@ from typing import IO, Any
 import numpy as np
 
 from ..errors import ParameterError, PostureLabError
-from ..model.muscles import DEFAULT_VISCOSITY_RATIO, PAPER_PAIR_NAMES
+from ..model.muscles import DEFAULT_VISCOSITY_RATIO
 from ..model.platform import NoDisturbance
+from ..parameters import PAPER_JOINTS, PAPER_PAIRS, check_value, names_for, parse_name, renamed
+from ..parameters import resolve as resolve_name
+from ..parameters import unit as parameter_unit
 from ..scenarios import Scenario
 from ..simulation.compiled import DEFAULT_ATOL, DEFAULT_RTOL, BatchResult, simulate_batch
 from ..simulation.outcome import UPRIGHT_BAND
@@ -67,43 +72,28 @@ __all__ = [
     "SweepInterrupted",
 ]
 
+#: The quantities of the parameter table a sweep can vary (all but active_viscosity_ratio).
+SWEEP_QUANTITIES: tuple[str, ...] = (
+    "stiffness", "viscosity", "active_stiffness", "active_viscosity", "viscosity_ratio",
+    "feedback_delay", "proprioceptive_weight", "torque_limit", "disturbance_scale")
 #: The joints whose torque limit a sweep can vary on the paper's body, in joint order.
-TORQUE_LIMIT_PARAMETERS: tuple[str, ...] = ("ankle_torque_limit", "knee_torque_limit",
-                                            "hip_torque_limit")
-#: Parameters of every sweep besides the pairs and the joints.
-COMMON_PARAMETERS: tuple[str, ...] = ("viscosity_ratio", "disturbance_scale", "feedback_delay",
-                                      "proprioceptive_weight")
-#: Names a sweep of the paper's body can vary: each pair's stiffness (intrinsic, or without
-#: active gains the whole), its active stiffness ``active_<pair>`` and active viscosity
-#: ``active_viscosity_<pair>``, the common parameters and the joint torque limits. Another
-#: body's sweep has its own pairs and joints (:func:`sweep_parameters`).
-SWEEP_PARAMETERS: tuple[str, ...] = (
-    *PAPER_PAIR_NAMES, *COMMON_PARAMETERS, *TORQUE_LIMIT_PARAMETERS,
-    *(f"active_{n}" for n in PAPER_PAIR_NAMES),
-    *(f"active_viscosity_{n}" for n in PAPER_PAIR_NAMES))
-_UNITS = {"viscosity_ratio": "s", "disturbance_scale": "-", "feedback_delay": "s",
-          "proprioceptive_weight": "-"}
+TORQUE_LIMIT_PARAMETERS: tuple[str, ...] = tuple(f"torque_limit:{j}" for j in PAPER_JOINTS)
+#: Names a sweep of the paper's body can vary (:data:`SWEEP_QUANTITIES` over its pairs and
+#: joints). Another body's sweep has its own pairs and joints (:func:`sweep_parameters`).
+SWEEP_PARAMETERS: tuple[str, ...] = names_for(PAPER_PAIRS, PAPER_JOINTS, SWEEP_QUANTITIES)
 
 
-def parameter_unit(name: str) -> str:
-    """The unit of a sweep parameter (its name's form decides)."""
-    if name in _UNITS:
-        return _UNITS[name]
-    if name.endswith("_torque_limit"):
-        return "N·m"
-    if name.startswith("active_viscosity_"):
-        return "N·m·s/rad"
-    return "N·m/rad"
+def joints_of(n_links: int) -> tuple[str, ...]:
+    """The joint names of an N-link body (``torque_limit:JOINT``): ankle, knee, hip on the
+    paper's three links."""
+    from ..model.muscles import joint_pair_names
+
+    return PAPER_JOINTS if n_links == 3 else joint_pair_names(n_links)[:n_links]
 
 
 def sweep_parameters(muscles, n_links: int) -> tuple[str, ...]:
     """What a sweep of this pair layout and body can vary (see :data:`SWEEP_PARAMETERS`)."""
-    from ..model.muscles import joint_pair_names
-
-    pairs = tuple(muscles.names)
-    joints = ("ankle", "knee", "hip") if n_links == 3 else joint_pair_names(n_links)
-    return (*pairs, *COMMON_PARAMETERS, *(f"{j}_torque_limit" for j in joints[:n_links]),
-            *(f"active_{n}" for n in pairs), *(f"active_viscosity_{n}" for n in pairs))
+    return names_for(tuple(muscles.names), joints_of(n_links), SWEEP_QUANTITIES)
 
 
 #: Unit of each parameter of a sweep of the paper's body.
@@ -138,8 +128,8 @@ def _steady_unit(name: str) -> str:
 SETTLE_TOLERANCE = UPRIGHT_BAND
 
 _NUMBER = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
-_VARY_RE = re.compile(rf"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*=\s*({_NUMBER})\s*:\s*({_NUMBER})"
-                      rf"\s*:\s*([^:\s]+)\s*$")
+_VARY_RE = re.compile(rf"^\s*([A-Za-z_][A-Za-z0-9_]*(?::[A-Za-z_][A-Za-z0-9_]*)?)\s*=\s*"
+                      rf"({_NUMBER})\s*:\s*({_NUMBER})\s*:\s*([^:\s]+)\s*$")
 
 
 # ---------------------------------------------------------------------------
@@ -157,7 +147,8 @@ class VaryRange:
         A parameter name (:data:`SWEEP_PARAMETERS` for the paper's body; the base
         experiment decides which it has: :func:`sweep_parameters`).
     low, high : float
-        First and last value, low <= high, both >= 0. [N·m/rad], [s] or [-]
+        First and last value, low <= high, both within the parameter table's bounds.
+        [N·m/rad], [s] or [-]
     count : int
         Number of values, >= 1 (1 needs low = high). [-]
     """
@@ -168,16 +159,13 @@ class VaryRange:
     count: int
 
     def __post_init__(self) -> None:
-        if not re.fullmatch(r"[a-z][a-z0-9_]*", str(self.name)):
-            raise ParameterError(f"unknown sweep parameter {self.name!r}; known: "
-                                 f"{', '.join(SWEEP_PARAMETERS)}")
+        _check_vary_name(self.name)
         unit = parameter_unit(self.name)
         for label, v in (("LO", self.low), ("HI", self.high)):
             if not (isinstance(v, int | float | np.floating) and math.isfinite(v)):
                 raise ParameterError(f"{self.name} {label} [{unit}] must be a finite number, "
                                      f"got {v!r}")
-            if v < 0:
-                raise ParameterError(f"{self.name} {label} [{unit}] must be >= 0, got {v:g}")
+            check_value(self.name, v, f"{self.name} {label}")
         if self.low > self.high:
             raise ParameterError(f"{self.name}: LO ({self.low:g}) must be <= HI "
                                  f"({self.high:g}) [{unit}]")
@@ -207,6 +195,22 @@ class VaryRange:
         return parameter_unit(self.name)
 
 
+def _check_vary_name(name) -> None:
+    """A name a sweep can vary, on some body (its pair is checked by :func:`check_base`);
+    a former spelling gets one line naming the new one."""
+    new = renamed(str(name))
+    if new is not None:
+        raise ParameterError(f"sweep parameter {str(name)!r} is now called {new!r}")
+    try:
+        quantity, _ = parse_name(str(name))
+    except PostureLabError:
+        raise ParameterError(f"unknown sweep parameter {str(name)!r}; known: "
+                             f"{', '.join(SWEEP_PARAMETERS)}") from None
+    if quantity not in SWEEP_QUANTITIES:
+        raise ParameterError(f"a sweep cannot vary {str(name)!r}; it varies "
+                             f"{', '.join(SWEEP_PARAMETERS)}")
+
+
 def parse_vary(text: str) -> VaryRange:
     """Parse ``NAME=LO:HI:N`` (N evenly spaced values from LO to HI inclusive).
 
@@ -219,12 +223,14 @@ def parse_vary(text: str) -> VaryRange:
     m = _VARY_RE.match(str(text))
     if not m:
         name = str(text).split("=", 1)[0].strip()
-        if "=" in str(text) and name and not re.fullmatch(r"[a-z][a-z0-9_]*", name):
+        if "=" in str(text) and name and not re.fullmatch(r"[a-z][a-z0-9_:]*", name):
             raise ParameterError(f"unknown sweep parameter {name!r} in --vary {text!r}; known: "
                                  f"{', '.join(SWEEP_PARAMETERS)}")
         raise ParameterError(f"--vary must be NAME=LO:HI:N (N evenly spaced values from LO to "
                              f"HI inclusive), got {text!r}")
     name, low, high, count = m.groups()
+    name = name.lower()
+    _check_vary_name(name)
     if not re.fullmatch(r"\d+", count):
         raise ParameterError(f"--vary {text!r}: N must be an integer >= 1, got {count!r}")
     return VaryRange(name, float(low), float(high), int(count))
@@ -297,25 +303,20 @@ class SweepGrid:
 def _base_ratios(scenario: Scenario, viscosity_ratio: float | None) -> np.ndarray:
     """Viscosity/stiffness of each pair of the base experiment (or the given ratio). [s]"""
     if viscosity_ratio is not None:
-        if not (math.isfinite(viscosity_ratio) and viscosity_ratio >= 0):
-            raise ParameterError(f"viscosity ratio [s] must be >= 0, got {viscosity_ratio!r}")
-        return np.full(len(scenario.muscles.pairs), float(viscosity_ratio))
+        return np.full(len(scenario.muscles.pairs), check_value("viscosity_ratio",
+                                                                viscosity_ratio))
     k = np.asarray(scenario.muscles.stiffnesses, dtype=float)
     v = np.asarray(scenario.muscles.viscosities, dtype=float)
     with np.errstate(divide="ignore", invalid="ignore"):
         return np.where(k > 0, v / np.where(k > 0, k, 1.0), DEFAULT_VISCOSITY_RATIO)
 
 
-def check_base(scenario: Scenario, names: Sequence[str] = ()) -> None:
-    """Every varied name must be one the base experiment has (:func:`sweep_parameters`)."""
-    known = sweep_parameters(scenario.muscles, scenario.body.n_links)
-    for name in names:
-        if name not in known:
-            n = scenario.body.n_links
-            raise ParameterError(f"unknown sweep parameter {name!r} for this experiment "
-                                 f"({n} link{'s' if n != 1 else ''}, pairs "
-                                 f"{', '.join(scenario.muscles.names)}); known: "
-                                 f"{', '.join(known)}")
+def check_base(scenario: Scenario, names: Sequence[str] = ()) -> list[str]:
+    """Every varied name must be one the base experiment has (:func:`sweep_parameters`);
+    returns each name's one spelling (:func:`posturelab.parameters.resolve`)."""
+    joints = joints_of(scenario.body.n_links)
+    return [resolve_name(name, scenario.muscles.names, joints, accepts=SWEEP_QUANTITIES,
+                         what="sweep parameter") for name in names]
 
 
 def sweep_grid(scenario: Scenario, varies: Sequence[VaryRange],
@@ -335,8 +336,7 @@ def sweep_grid(scenario: Scenario, varies: Sequence[VaryRange],
     varies = list(varies)
     if not varies:
         raise ParameterError("give at least one --vary NAME=LO:HI:N")
-    names = [v.name for v in varies]
-    check_base(scenario, names)
+    names = check_base(scenario, [v.name for v in varies])
     dup = sorted({n for n in names if names.count(n) > 1})
     if dup:
         raise ParameterError(f"--vary names a parameter more than once: {', '.join(dup)}")
@@ -360,35 +360,38 @@ def sweep_grid(scenario: Scenario, varies: Sequence[VaryRange],
     limits = np.tile(base_limits, (m, 1))
     muscles = scenario.muscles
     pairs = list(muscles.names)
-    joints = [name.removesuffix("_torque_limit")
-              for name in sweep_parameters(muscles, n) if name.endswith("_torque_limit")]
+    joints = list(joints_of(n))
     varies_active = any(nm.startswith("active_") for nm in names)
     ka = va = weight = None
     if muscles.has_active_feedback or varies_active:
         ka = np.tile(muscles.active_stiffnesses, (m, 1))
         va = np.tile(muscles.active_viscosities, (m, 1))
+    viscosity: dict[int, np.ndarray] = {}
     for k, name in enumerate(names):
         column = values[:, k]
-        if name == "viscosity_ratio":
+        quantity, _, member = name.partition(":")
+        if quantity == "viscosity_ratio":
             ratios[:] = column[:, None]
-        elif name == "disturbance_scale":
+        elif quantity == "disturbance_scale":
             scale = np.ascontiguousarray(column)
-        elif name == "feedback_delay":
+        elif quantity == "feedback_delay":
             delay = np.ascontiguousarray(column)
-        elif name == "proprioceptive_weight":
-            if np.any(column > 1):
-                raise ParameterError(f"proprioceptive_weight [-] must be in [0, 1], got "
-                                     f"{column.max():g}")
+        elif quantity == "proprioceptive_weight":
             weight = np.ascontiguousarray(column)
-        elif name.endswith("_torque_limit"):
-            limits[:, joints.index(name.removesuffix("_torque_limit"))] = column
-        elif name.startswith("active_viscosity_"):
-            va[:, pairs.index(name.removeprefix("active_viscosity_"))] = column
-        elif name.startswith("active_"):
-            ka[:, pairs.index(name.removeprefix("active_"))] = column
+        elif quantity == "torque_limit":
+            limits[:, joints.index(member)] = column
+        elif quantity == "active_viscosity":
+            va[:, pairs.index(member)] = column
+        elif quantity == "active_stiffness":
+            ka[:, pairs.index(member)] = column
+        elif quantity == "viscosity":
+            viscosity[pairs.index(member)] = column
         else:
-            stiffness[:, pairs.index(name)] = column
-    return SweepGrid(tuple(names), values, stiffness, ratios * stiffness, scale, delay,
+            stiffness[:, pairs.index(member)] = column
+    pair_viscosity = ratios * stiffness
+    for j, column in viscosity.items():
+        pair_viscosity[:, j] = column
+    return SweepGrid(tuple(names), values, stiffness, pair_viscosity, scale, delay,
                      None if np.all(np.isinf(limits)) else limits, ka, va, weight)
 
 
@@ -438,7 +441,9 @@ class SweepResult:
 
     def units(self) -> dict[str, str]:
         """The unit of each column that has one."""
-        return {name: PARAMETER_UNITS.get(name, OUTCOME_UNITS.get(name, _steady_unit(name)))
+        varied = set(self.grid.names)
+        return {name: parameter_unit(name) if name in varied
+                else OUTCOME_UNITS.get(name, _steady_unit(name))
                 for name, _ in self.columns()}
 
     def to_csv_text(self) -> str:

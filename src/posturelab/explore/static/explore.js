@@ -62,7 +62,7 @@ function enableFields() {
   for (const box of form.querySelectorAll("#group-pairs input[name], #group-active input[name]")) {
     if (box.name === "viscosity_ratio") continue;
     // own gains only; on one link only the ankle pair's
-    fields.push([box.name, ownGains && (!oneLink || box.name.endsWith("_ankle"))]);
+    fields.push([box.name, ownGains && (!oneLink || box.name.endsWith(":ankle"))]);
   }
   for (const [name, on] of fields) {
     const box = document.getElementById(name);
