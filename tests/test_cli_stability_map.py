@@ -212,9 +212,9 @@ def _eig_max_real(body, n_links, stiffness, ratio):
 @pytest.mark.parametrize("argv,n_links,base,ratio", [
     (["--body", "paper-1link", "--stiffness", "700", "--y", "viscosity_ratio:0.01:0.6"],
      1, [700.0], None),
-    (["--body", "paper-2link", "--stiffness", "900,250", "--y", "hip:0:800"],
+    (["--body", "paper-2link", "--stiffness", "900,250", "--y", "stiffness:hip:0:800"],
      2, [900.0, 250.0], 0.25),
-    (["--height", "1.8", "--mass", "82", "--case", "1", "--y", "hip:0:800"],
+    (["--height", "1.8", "--mass", "82", "--case", "1", "--y", "stiffness:hip:0:800"],
      3, [500.0, 300.0, 300.0], 0.25),
 ])
 def test_pair_maps_for_any_body_are_numpy_s_eigenvalues(tmp_path, argv, n_links, base, ratio):
@@ -227,12 +227,12 @@ def test_pair_maps_for_any_body_are_numpy_s_eigenvalues(tmp_path, argv, n_links,
 
     out = tmp_path / "any.png"
     proc = subprocess.run([sys.executable, "-m", "posturelab", "stability-map",
-                           "--x", "ankle:0:2500", *argv, "--resolution", "5", "--out",
+                           "--x", "stiffness:ankle:0:2500", *argv, "--resolution", "5", "--out",
                            str(out)], capture_output=True, text=True, timeout=600)
     assert proc.returncode == 0, proc.stderr
     assert "parameter sets of body" in proc.stdout
     header, rows = read_csv(tmp_path / "any.csv")
-    assert header[0] == "ankle" and len(rows) == 25
+    assert header[0] == "stiffness:ankle" and len(rows) == 25
     body = (pl.body_from_anthropometry(1.8, 82.0) if "--height" in argv
             else pl.get_body(argv[1]))
     for row in rows:
@@ -250,13 +250,13 @@ def test_pair_maps_for_any_body_are_numpy_s_eigenvalues(tmp_path, argv, n_links,
 
 def test_pair_map_of_another_body_refuses_what_it_cannot_map(tmp_path, capsys):
     for argv, words in (
-            (["--body", "paper-1link", "--x", "ankle:0:1", "--y", "viscosity_ratio:0:1"],
+            (["--body", "paper-1link", "--x", "stiffness:ankle:0:1", "--y", "viscosity_ratio:0:1"],
              "give --stiffness (1 value: ankle)"),
-            (["--body", "paper-1link", "--stiffness", "600", "--x", "ankle:0:1", "--y",
-              "hip:0:1"], "unknown parameter 'hip'; known parameters: ankle, viscosity_ratio"),
-            (["--x", "ankle:0:1", "--y", "hip:0:1", "--gastrocnemius", "one-sided"],
+            (["--body", "paper-1link", "--stiffness", "600", "--x", "stiffness:ankle:0:1", "--y",
+              "stiffness:hip:0:1"], "unknown parameter 'stiffness:hip'; known parameters: stiffness:ankle, viscosity_ratio"),
+            (["--x", "stiffness:ankle:0:1", "--y", "stiffness:hip:0:1", "--gastrocnemius", "one-sided"],
              "switching point"),
-            (["--x", "ankle:0:1", "--y", "hip:0:1", "--controller", "peterka-2002"],
+            (["--x", "stiffness:ankle:0:1", "--y", "stiffness:hip:0:1", "--controller", "peterka-2002"],
              "--controller is for the delayed map")):
         code, _, err = run(capsys, "stability-map", *argv, "--out", str(tmp_path / "e.png"))
         assert code == 2 and words in err and err.count("\n") == 1, err

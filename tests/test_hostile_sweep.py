@@ -15,8 +15,8 @@ PRTS = ["sweep", "--experiment", "prts", "--controller", "peterka-2002", "--tilt
         "prts:0.035", "--vary", "feedback_delay=0.12:0.18:40", "--vary",
         "active_stiffness:ankle=650:850:40"]
 SIMULATION = ["sweep", "--case", "1", "--disturbance", "backward", "--duration", "30",
-              "--vary", "stiffness:ankle=100:2000:400", "--vary", "stiffness:hip=100:1000:400", "--chunk-size",
-              "64"]
+              "--vary", "stiffness:ankle=100:2000:400", "--vary", "stiffness:hip=100:1000:400",
+              "--chunk-size", "64"]
 
 
 def _interrupt_after_progress(argv, sig, out):
@@ -74,7 +74,7 @@ def test_an_ordinary_sweep_stops_at_once_and_keeps_what_finished(tmp_path):
     assert match, err
     kept = int(match.group(1).replace(",", ""))
     assert 0 < kept < 160_000 and len(rows) == 1 + kept and kept % 64 == 0
-    assert rows[0][:3] == ["ankle", "hip", "outcome"]
+    assert rows[0][:3] == ["stiffness:ankle", "stiffness:hip", "outcome"]
     assert float(rows[1][0]) == 100.0 and float(rows[1][1]) == 100.0  # the grid's first rows
 
 

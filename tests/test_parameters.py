@@ -318,7 +318,8 @@ def _entry_points(tmp_path):
     from posturelab.explore.views import parse_parameters
     from posturelab.frequency.fit import fit_frf
     from posturelab.frequency.model import model_frf, model_frf_batch
-    from posturelab.linear.delay import rightmost_roots, upright_stability
+    from posturelab.linear.delay import rightmost_roots
+    from posturelab.linear.verdict import upright_verdict
     from posturelab.linear.delay_batch import delay_stability_map
     from posturelab.simulation.compiled import simulate_batch
     from posturelab.studies.sweep import VaryRange
@@ -336,7 +337,7 @@ def _entry_points(tmp_path):
                                                    m1.viscosities[None],
                                                    feedback_delay=TOO_LONG),
         "rightmost_roots": lambda: rightmost_roots(body, m, TOO_LONG),
-        "upright_stability": lambda: upright_stability(body, m, TOO_LONG),
+        "upright_verdict": lambda: upright_verdict(body, m, TOO_LONG),
         "delay_stability_map": lambda: delay_stability_map(one, m1, TOO_LONG, (0, 1), (0, 1),
                                                            2),
         "scenario": lambda: pl.load_scenario(toml),

@@ -183,7 +183,7 @@ def test_cli_scenario_base_and_progress_bar(tmp_path, capsys):
     ("stiffness:ankle=0:100:0", "N must be an integer >= 1"),
     ("stiffness:ankle=0:100", "NAME=LO:HI:N"),
     ("stiffness:ankle=0:100:2.5", "N must be an integer"),
-    ("stiffness:ankle=-5:100:3", "must be in [0, 1e+08] N·m/rad, got -5.0"),
+    ("stiffness:ankle=-5:100:3", "LO [N·m/rad] must be in [0, 1e+08], got -5.0"),
     ("stiffness:ankle=0:100:1", "LO must equal HI"),
 ])
 def test_bad_vary_is_one_line_and_exit_2(tmp_path, capsys, vary, words):

@@ -233,7 +233,7 @@ def test_a_published_controller_on_a_body_from_height_and_mass_on_every_command(
                    "active_stiffness", "--json")
     assert p.returncode == 0, p.stderr
     fitted = {q["name"]: q["estimate"] for q in json.loads(p.stdout)["parameters"]}
-    assert fitted["active_stiffness"] == pytest.approx(1.35 * body.load_stiffness, rel=1e-3)
+    assert fitted["active_stiffness:ankle"] == pytest.approx(1.35 * body.load_stiffness, rel=1e-3)
 
     p = posturelab("fit", *c, "--data", str(run), "--disturbance", "backward", "--speed",
                    "0.1", "--free", "feedback_delay", "--json")
