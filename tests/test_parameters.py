@@ -319,8 +319,8 @@ def _entry_points(tmp_path):
     from posturelab.frequency.fit import fit_frf
     from posturelab.frequency.model import model_frf, model_frf_batch
     from posturelab.linear.delay import rightmost_roots
-    from posturelab.linear.verdict import upright_verdict
     from posturelab.linear.delay_batch import delay_stability_map
+    from posturelab.linear.verdict import upright_verdict
     from posturelab.simulation.compiled import simulate_batch
     from posturelab.studies.sweep import VaryRange
 
