@@ -14,7 +14,8 @@ from posturelab.frequency.bands import PETERKA_BAND_FREQUENCIES
 from posturelab.model.controllers import get_controller
 from posturelab.model.tilt import PRTSTilt
 
-KEYS = {"frequency", "frf", "gain", "phase_deg", "coherence", "gain_ci95", "phase_ci95_deg"}
+KEYS = {"frequency", "frf", "gain", "phase_deg", "coherence", "gain_ci95", "phase_ci95_deg",
+        "frf_se", "dof", "response_sign", "sign_convention", "warnings"}
 
 
 def run(capsys, *argv):

@@ -17,20 +17,30 @@ HELP = "fit controller gains, delay and sensory weight to FRFs (one or several c
 
 DESCRIPTION = """\
 Fit the linearised model's FRF to one or several measured FRFs. Each --data is a condition:
-a trial CSV (then --stimulus, --response and --cycle-length say how to estimate its FRF, as
-posturelab frf does) or the JSON that posturelab frf --json writes. --free NAMES (comma
+a trial CSV (then --stimulus, --response, --cycle-length and --response-sign say how to
+estimate its FRF, as posturelab frf does), the JSON that posturelab frf --json writes, or a
+table as JSON: {"frequency": [Hz], "gain": [...], "phase_deg": [...]} with optional
+"gain_se" and "phase_se_deg" (standard errors of gain [-] and phase [deg], as published
+group means give them), or "frf_se" (standard error of the complex value), "dof" and
+"coherence". --free NAMES (comma
 separated) are shared by the conditions, --per-condition NAMES take one value per condition.
 Names: stiffness, viscosity (intrinsic), active_stiffness, active_viscosity (a :PAIR suffix
 names a pair other than the first), feedback_delay, proprioceptive_weight. The body and the
 starting values come from the options below (as in posturelab simulate); --bounds
 NAME=LO:HI,... narrows the defaults (gains 0 … 1e5, delay 0 … 1 s, W 0 … 1).
 
-Objective: the complex error against each band, weighted by its 95 % bound (posturelab.
-frequency.fit); a trial's model FRF is averaged over each band's harmonics with the
-stimulus's power, as its estimate is (a JSON FRF has no harmonics: the model is taken at the
-band frequencies). Prints each parameter with its standard error and 95 % interval, the fit
-error (the RMS weighted residual, about 1 when the model explains the data within its
-noise), and parameters the data cannot determine; warns when a band's coherence is below 0.5.
+Weighting (printed, and "weighting" in --json; posturelab.frequency.fit): every band by
+its own precision: a trial's by the variance of its estimate from the scatter of its
+cycles (bands that share harmonics correlated), a table's by its standard errors; a table
+without them by 1/|H| (then said, and the fit error cannot test the model). A trial's
+model FRF is averaged over each band's harmonics with the stimulus's power, as its
+estimate is (a JSON FRF has no harmonics: the model is taken at the band frequencies).
+Prints each parameter with its standard error and 95 % interval, the fit error (√(χ²/dof),
+about 1 when the model explains the data within their noise), and parameters the data
+cannot determine; when the fit error is too large for chance (p < 0.001) it says the
+model does not describe the data and widens the intervals by a model error it states;
+warns when a band's coherence is below 0.5. Bounds must lie within each parameter's range;
+a name given twice or a bound for a parameter not fitted is refused.
 
 Example: posturelab fit-frf --data trial.csv --stimulus tilt --response com_angle \\
              --cycle-length 20 --discard-cycles 1 --controller peterka-2002 \\
@@ -46,6 +56,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--response", metavar="COLUMN", help="response column of a trial CSV.")
     p.add_argument("--cycle-length", type=float, metavar="SECONDS", help="of a trial CSV [s].")
     p.add_argument("--discard-cycles", type=int, default=0, metavar="N")
+    p.add_argument("--response-sign", choices=["-1", "+1", "1"], default="-1",
+                   help="multiply a trial's response by this (default -1: posturelab's tilt "
+                   "convention, as posturelab frf).")
     p.add_argument("--input", choices=["tilt", "translation"], default="tilt")
     p.add_argument("--output", default="com_angle", metavar="NAME",
                    help="the model output the response is (default com_angle).")
@@ -61,41 +74,23 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def _condition(path: str, args: argparse.Namespace):
-    import json
-
-    import numpy as np
-
-    from .._files import read_text
-    from ..frequency.estimate import FRFEstimate
-
     if path.lower().endswith(".json"):
-        try:
-            obj = json.loads(read_text(path, "FRF JSON"))
-            f = np.array(obj["frequency"], dtype=float)
-            H = np.array([complex(z["re"], z["im"]) for z in obj["frf"]])
-            coh = np.array(obj["coherence"], dtype=float)
-            gci = np.array([[np.nan if v is None else v for v in pair]
-                            for pair in obj["gain_ci95"]], dtype=float)
-        except (OSError, ValueError, KeyError, TypeError) as exc:
-            raise ParameterError(f"--data {path!r} is not an FRF JSON of posturelab frf: "
-                                 f"{exc}") from None
-        if not (f.size == H.size == coh.size == gci.shape[0]) or not np.all(np.isfinite(H)):
-            raise ParameterError(f"--data {path!r}: frequency, frf, coherence and gain_ci95 "
-                                 "must have one finite entry per band")
-        phase = np.degrees(np.unwrap(np.angle(H)))
-        return FRFEstimate(f, H, np.abs(H), phase, coh, gci, np.full(gci.shape, np.nan),
-                           np.zeros(f.size, int), (), 0, 0.0, np.zeros(0), np.zeros(0))
+        from ..frequency.table import read_frf_json
+
+        return read_frf_json(path, "--data FRF JSON")
+    from .._validation import float_in_range
     from ..frequency.data import read_series_csv
     from ..frequency.estimate import estimate_frf
     from .frf import response_sign, whole_cycles
 
     if args.stimulus is None or args.response is None or args.cycle_length is None:
         raise ParameterError("a trial CSV needs --stimulus, --response and --cycle-length")
+    float_in_range("--cycle-length [s]", args.cycle_length, 1e-3, 1e5, unit="s")
     stim, resp = args.stimulus.strip().lower(), args.response.strip().lower()
     fs, cols = read_series_csv(path, [stim, resp])
     x, y, _ = whole_cycles(cols[stim], cols[resp], fs, args.cycle_length)
     return estimate_frf(x, y, fs, args.cycle_length, discard_cycles=args.discard_cycles,
-                        response_sign=response_sign(stim, resp, "auto"))
+                        response_sign=response_sign(args.response_sign))
 
 
 def _names(text: str) -> list[str]:
@@ -108,9 +103,13 @@ def _bounds(text: str) -> dict:
         name, _, rng = item.partition("=")
         parts = rng.split(":")
         try:
+            if len(parts) != 2:
+                raise ValueError
             lo, hi = float(parts[0]), float(parts[1])
-        except (IndexError, ValueError):
+        except ValueError:
             raise ParameterError(f"--bounds must be NAME=LO:HI,..., got {item!r}") from None
+        if name in out:
+            raise ParameterError(f"--bounds names {name!r} twice")
         out[name] = (lo, hi)
     return out
 
@@ -138,11 +137,16 @@ def run(args: argparse.Namespace) -> int:
         curves = [(f, h, f"fit: {label}") for (f, h), label in zip(fit.curves, labels,
                                                                      strict=True)]
         save_figure(plot_bode(conditions, labels, model=curves), args.plot)
+    signs = sorted({int(c.response_sign) for c in conditions
+                    if getattr(c, "response_sign", None) is not None})
     if args.json:
-        print_json(fit.to_dict())
+        print_json({**fit.to_dict(), "response_sign": signs})
         return 0
     print(f"fitted {len(fit.names)} parameter(s) to {len(conditions)} condition(s); fit error "
-          f"{fit.fit_error:.3g} (weighted RMS; about 1 when the model explains the data)")
+          f"{fit.fit_error:.3g} (√(χ²/dof); about 1 when the model explains the data)")
+    print(f"weighting: {fit.weighting_text()}")
+    if signs:
+        print("response sign applied: " + ", ".join(f"{v:+d}" for v in signs))
     for name, e, se, (lo, hi), ok in zip(fit.names, fit.estimates, fit.standard_errors,
                                          fit.confidence_intervals, fit.determined,
                                          strict=True):

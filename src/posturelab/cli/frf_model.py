@@ -25,6 +25,9 @@ displacement, m); --output com_angle (Σ a_i θ_i / Σ a_i), theta1 … or a joi
 follows the surface has gain 1 and phase 0. At --frequencies LIST [Hz] or at the band
 frequencies of Peterka's 11 bands (--bands peterka, for --cycle-length s, default 20).
 
+A loop unstable about upright at its delay has no measurable FRF (a periodic-stimulus
+experiment on it would fall): frf-model refuses it (exit 2, the rightmost root named).
+
 --json prints one object: {"frequency": [Hz], "frf": [{"re", "im"}], "gain", "phase_deg"}.
 
 Example: posturelab frf-model --controller peterka-2002 --bands peterka --json
@@ -57,12 +60,20 @@ def run(args: argparse.Namespace) -> int:
     options = feedback_options_from_args(args)
     if args.frequencies is not None:
         f = np.array(parse_float_list(args.frequencies, "--frequencies [Hz]"))
-        if np.any(f <= 0) or f.size > 100_000:
-            raise ParameterError("--frequencies [Hz] must be 1 … 100,000 values > 0")
+        if np.any(f <= 0) or np.any(f > 1e4) or f.size > 100_000:
+            raise ParameterError("--frequencies [Hz] must be 1 … 100,000 values in (0, 1e4] Hz")
     else:
-        if not (np.isfinite(args.cycle_length) and args.cycle_length > 0):
-            raise ParameterError(f"--cycle-length [s] must be > 0, got {args.cycle_length:g}")
+        from .._validation import float_in_range
+
+        float_in_range("--cycle-length [s]", args.cycle_length, 1e-3, 1e5, unit="s")
         f = band_frequencies(PETERKA_BAND_HARMONICS, args.cycle_length)
+    from ..linear.delay import upright_stability
+
+    verdict = upright_stability(body, muscles, options.get("feedback_delay", 0.0))
+    if not verdict.stable:
+        raise ParameterError(f"the loop is {verdict.describe()}: its FRF is not measurable "
+                             "(a periodic-stimulus experiment would fall); change the gains "
+                             "or --feedback-delay")
     H = model_frf(body, muscles, f, input=args.input, output=args.output.strip().lower(),
                   feedback_delay=options.get("feedback_delay", 0.0),
                   proprioceptive_weight=options.get("proprioceptive_weight", 1.0))
