@@ -217,3 +217,102 @@ def test_fit_curves_are_the_fitted_models_frf(trial):
         [fit.estimates[0]], preset.muscles(body).active_viscosities)
     np.testing.assert_allclose(h, model_frf(body, muscles, f, **preset.run_options()),
                                rtol=1e-12)
+
+
+def cli(*args):
+    """posturelab as a real subprocess."""
+    import subprocess
+    import sys
+
+    return subprocess.run([sys.executable, "-m", "posturelab", *args], capture_output=True,
+                          text=True, timeout=300)
+
+
+@pytest.mark.parametrize("extra,needle", [
+    (["--bounds", "feedback_delay=0:1e308"], "0 <= low < high <= 1 [s], got 0:1e+308"),
+    (["--bounds", "feedback_delay=-0.1:0.3"], "got -0.1:0.3"),
+    (["--bounds", "feedback_delai=0:0.3"], "unknown FRF fit parameter 'feedback_delai'"),
+    (["--bounds", "feedback_delay=nan:0.3"], "must be finite, got nan:0.3"),
+    (["--bounds", "feedback_delay=0:inf"], "must be finite"),
+    (["--bounds", "active_viscosity=0:300"], "which is not fitted"),
+    (["--free", "active_stiffness,active_stiffness"], "named twice"),
+    (["--cycle-length", "inf"], "--cycle-length [s] must be a finite number"),
+    (["--cycle-length", "1e300"], "--cycle-length [s] must be in"),
+])
+def test_hostile_fit_frf_input_is_one_line_and_exit_2(trial, extra, needle):
+    args = ["fit-frf", "--data", str(trial), "--stimulus", "tilt", "--response", "com_angle",
+            "--cycle-length", "20", "--controller", "peterka-2002", "--free",
+            "active_stiffness,feedback_delay", *extra]
+    r = cli(*args)
+    assert r.returncode == 2 and r.stdout == "" and r.stderr.count("\n") == 1, r.stderr
+    assert needle in r.stderr, r.stderr
+
+
+@pytest.mark.parametrize("content,needle", [
+    ("{}", "has no 'frequency'"),
+    ("[" * 100000 + "]" * 100000, "nested too deeply"),
+    ('{"frequency": [0.1], "gain": [true], "phase_deg": [0]}', "must be a number, got True"),
+    ('{"frequency": [0.1], "gain": [1e300], "phase_deg": [0]}', "gain [-] entry 1 must be in"),
+    ('{"frequency": [0.1], "gain": [1], "phase_deg": [0], "coherence": [NaN]}',
+     "NaN is not a number JSON allows"),
+    ('{"frequency": [], "gain": [], "phase_deg": []}', "must have 1 … 10,000 entries"),
+    ('{"frequency": [0.1], "gain": [1], "phase_deg": [0], "gain_se": [0.1]}',
+     "gain_se and phase_se_deg together"),
+])
+def test_hostile_frf_json_is_one_line_and_exit_2(tmp_path, content, needle):
+    path = tmp_path / "frf.json"
+    path.write_text(content)
+    r = cli("fit-frf", "--data", str(path), "--controller", "peterka-2002", "--free",
+            "active_stiffness")
+    assert r.returncode == 2 and r.stdout == "" and r.stderr.count("\n") == 1, r.stderr
+    assert needle in r.stderr, r.stderr
+
+
+def test_frf_states_the_sign_and_warns_near_180_degrees(trial):
+    """The default sign is -1 (posturelab's tilt convention) and says so; +1 on posturelab's
+    own recording puts the lowest band near 180° with coherence 1: one warning line on
+    stderr and in the JSON."""
+    base = ["frf", "--data", str(trial), "--stimulus", "tilt", "--response", "com_angle",
+            "--cycle-length", "20", "--discard-cycles", "1"]
+    r = cli(*base, "--json")
+    obj = json.loads(r.stdout)
+    assert r.returncode == 0 and obj["response_sign"] == -1 and obj["warnings"] == []
+    assert "posturelab's tilt convention" in obj["sign_convention"] and r.stderr == ""
+    r = cli(*base, "--response-sign", "+1", "--json")
+    obj = json.loads(r.stdout)
+    assert obj["response_sign"] == 1 and len(obj["warnings"]) == 1
+    assert r.stderr.count("\n") == 1 and "check --response-sign" in r.stderr
+    r = cli(*base)
+    assert "response × −1" in r.stdout
+
+
+def test_frf_model_refuses_a_loop_unstable_at_its_delay():
+    r = cli("frf-model", "--controller", "peterka-2002", "--feedback-delay", "0.6")
+    assert r.returncode == 2 and r.stdout == "" and "not measurable" in r.stderr, r.stderr
+
+
+def test_fit_frf_takes_gain_and_phase_with_standard_errors(tmp_path):
+    """A table of gain and phase (the model's own, at Peterka's band frequencies) with
+    standard errors of 1 % and 0.6°: the stiffness comes back inside its interval, and the
+    output names the weighting; without standard errors it says 1/|H|."""
+    body = pl.get_body("paper-1link")
+    preset = get_controller("peterka-2002")
+    f = list(PETERKA_BAND_FREQUENCIES)
+    H = model_frf(body, preset.muscles(body), f, **preset.run_options())
+    table = {"frequency": f, "gain": np.abs(H).tolist(),
+             "phase_deg": np.degrees(np.unwrap(np.angle(H))).tolist(),
+             "gain_se": (0.01 * np.abs(H)).tolist(), "phase_se_deg": [0.6] * len(f)}
+    path = tmp_path / "table.json"
+    path.write_text(json.dumps(table))
+    start = ["--body", "paper-1link", "--stiffness", "0", "--viscosity", "0",
+             "--active-stiffness", "600", "--active-viscosity", "265.07135614",
+             "--feedback-delay", "0.15"]
+    r = cli("fit-frf", "--data", str(path), *start, "--free", "active_stiffness", "--json")
+    obj = json.loads(r.stdout)
+    (p,) = obj["parameters"]
+    true = preset.muscles(body).active_stiffnesses[0]
+    assert obj["weighting"] == "gain-phase" and p["ci95"][0] <= true <= p["ci95"][1]
+    del table["gain_se"], table["phase_se_deg"]
+    path.write_text(json.dumps(table))
+    r = cli("fit-frf", "--data", str(path), *start, "--free", "active_stiffness")
+    assert r.returncode == 0 and "relative: no per-band precision given" in r.stdout

@@ -151,3 +151,45 @@ def test_intervals_cover_over_seeded_prts_experiments(cycles):
             total += 1
     assert inside / total >= 0.9, (cycles, inside / total)
     assert 0.8 <= np.mean(errors) <= 1.25, (cycles, np.mean(errors))
+
+
+def test_a_model_mismatch_on_noise_free_data_is_reported():
+    """Noise-free, 0.035 rad PRTS on the nonlinear model (0.1 % from the linearised one):
+    the fit says the model does not describe the data and states the model error, instead
+    of a tight interval presented as sound."""
+    from posturelab.frequency.experiment import prts_experiment
+
+    preset = get_controller("peterka-2002")
+    muscles = preset.muscles(BODY)
+    exp = prts_experiment(BODY, muscles, cycles=3, **preset.run_options())
+    fit = fit_frf(BODY, muscles, exp.estimate, ["active_stiffness", "feedback_delay"],
+                  feedback_delay=0.15)
+    assert fit.mismatch and fit.fit_error > 5 and 0 < fit.model_error < 0.01
+    assert "does not describe the data" in fit.warnings[0]
+
+
+def test_periodic_bounds_are_defined_with_two_cycles():
+    """n_d = 2 (two cycles, one harmonic): r² = F(2, 2)·(1 − γ²)/γ², F(2, 2) = 19."""
+    from posturelab.frequency.estimate import confidence_radius
+
+    r = confidence_radius(0.5, 2)
+    assert r == pytest.approx(np.sqrt(19.0), rel=1e-9)
+    assert np.isnan(confidence_radius(0.5, 2, "otnes-enochson"))
+
+
+@pytest.mark.parametrize("call,needle", [
+    (lambda: model_frf(BODY, TRUE, [0.1], feedback_delay=5.0), "feedback_delay"),
+    (lambda: model_frf(BODY, TRUE, [1e9]), "frequencies"),
+    (lambda: model_frf(BODY, TRUE, "abc"), "frequencies"),
+    (lambda: __import__("posturelab.frequency.model", fromlist=["x"]).model_frf_batch(
+        BODY, TRUE, [0.1], [[-5.0]], [[1.0]]), "must be >= 0"),
+    (lambda: __import__("posturelab.frequency.model", fromlist=["x"]).model_frf_batch(
+        BODY, TRUE, [0.1], [[1.0, 2.0]], [[1.0]]), "shape"),
+    (lambda: fit_frf(BODY, TRUE, "not an FRF", ["feedback_delay"]), "FRFEstimate or FRFTable"),
+    (lambda: fit_frf(BODY, TRUE, [], ["feedback_delay"]), "FRFEstimate or FRFTable"),
+    (lambda: estimate_frf([1.0] * 8, [1.0] * 8, float("nan"), 1.0), "sample rate"),
+    (lambda: estimate_frf([True] * 8, [1.0] * 8, 8.0, 1.0), "stimulus"),
+])
+def test_the_frequency_api_raises_parameter_errors(call, needle):
+    with pytest.raises(ParameterError, match=needle):
+        call()

@@ -22,16 +22,14 @@ the model is taken at its frequencies.
 Weighting (``FRFFit.weighting`` says which was used), every band by its own precision:
 
 * ``"variance"`` (an :class:`FRFEstimate`, or a table with ``frf_se``): the complex error
-  e_k = H(f_k; p) − Ĥ_k of band k against var_k = E|Ĥ_k − H_k|² (:mod:`.estimate`: from the
-  scatter of the cycles at the band's own harmonics, ν_k degrees of freedom). The real and
-  imaginary parts have variance var_k/2, so q_k = 2|e_k|²/var_k; with var_k estimated,
-  |e_k|²/var_k follows F(2, ν_k), and the fit minimises the matching negative
-  log-likelihood Σ_k (ν_k + 2) ln(1 + q_k/ν_k) (a bivariate Student t; Lange, Little and
-  Taylor 1989, J Am Stat Assoc 84:881–896), which tends to Σ q_k, weighted least squares
-  with weights 2/var_k, for large ν_k and stays well-behaved at ν_k = 2 (two cycles of a
-  one-harmonic band), where inverse-variance weights would let a band whose scatter
-  happened to be small dominate. Covariance: the inverse Fisher information,
-  (Σ_k J_kᵀ (ν_k + 2)/(ν_k + 4) · 2/var_k J_k)⁻¹ (ibid.).
+  e = H(f; p) − Ĥ over the bands, whitened by the estimate's band covariance V
+  (:mod:`.estimate`: the noise about each harmonic from the scatter of the cycles, pooled
+  over neighbouring DFT bins to at least 20 degrees of freedom; Peterka's bands share
+  harmonics, so they are correlated): the real and imaginary parts each have covariance
+  V/2, and the fit is generalised least squares, Σ = eᵀ(V/2)⁻¹e over both parts, with the
+  covariance (JᵀJ)⁻¹ of the whitened Jacobian (e.g. Pintelon and Schoukens 2012, ch. 7,
+  weighted least squares with the FRF's sample covariance). A table's ``frf_se`` gives
+  V = diag(se²) (its bands taken as independent).
 * ``"gain-phase"`` (a table with ``gain_se`` and ``phase_se_deg``, as published group means
   come): the residuals (|H| − g)/se_g and wrap(arg H − φ)/se_φ, least squares (ν = ∞ unless
   the table gives ``dof``).
@@ -46,8 +44,10 @@ explains the data within their noise, whatever ν_k. When it is too large for ch
 (the χ² exceeds its 0.999 quantile) the model does not describe the data: the result says
 so (``mismatch``), and the fit is repeated with a relative model error δ added to every
 band's variance (var_k + δ²|Ĥ_k|², and so for gain and phase) with δ chosen so that the
-fit error is 1; the intervals are then those of that fit (wider, covering the parameters
-the model's demonstrated accuracy allows), and ``model_error`` is δ. The 95 % intervals
+fit error is 1; the intervals are then those of that fit, and ``model_error`` is δ. They
+treat the model error as random across bands: a systematic one (the nonlinear plant
+against the linearised model, 0.1 % at a 0.035 rad PRTS) can bias the estimates by more,
+so with a mismatch the intervals are a lower bound and are marked as such. The 95 % intervals
 are estimate ± 1.96 standard errors (t-based with the residual dof for ``"relative"``). A
 parameter the residuals do not depend on, whose relative standard error exceeds 1, or
 that the Jacobian cannot separate (condition number above 1e10), is reported as not
@@ -85,8 +85,8 @@ _DEFAULT_BOUNDS = {"stiffness": (0.0, 1e5), "viscosity": (0.0, 1e5),
                    "proprioceptive_weight": (0.0, 1.0)}
 #: The weightings (module notes).
 WEIGHTINGS = {
-    "variance": "each band by its own variance from the cycles' scatter (Student-t with its "
-                "degrees of freedom)",
+    "variance": "each band by its own variance (generalised least squares with the "
+                "estimate's band covariance, from the cycles' scatter)",
     "gain-phase": "each band's gain and phase by their given standard errors",
     "relative": "no per-band precision given: each band by 1/|H| (relative error); the noise "
                 "level estimated from the residuals, so the fit error cannot test the model",
