@@ -316,3 +316,31 @@ def test_fit_frf_takes_gain_and_phase_with_standard_errors(tmp_path):
     path.write_text(json.dumps(table))
     r = cli("fit-frf", "--data", str(path), *start, "--free", "active_stiffness")
     assert r.returncode == 0 and "relative: no per-band precision given" in r.stdout
+
+
+@pytest.mark.parametrize("extra,needle", [
+    (["--record-rate", "nan"], "--record-rate) [Hz] must be a finite number"),
+    (["--record-rate", "inf"], "--record-rate) [Hz] must be a finite number"),
+    (["--record-rate", "1e300"], "--record-rate) [Hz] must be in"),
+    (["--record-rate", "0.3"], "--record-rate) [Hz] must be in [1, 100000] Hz, got 0.3"),
+    (["--record-rate", "1.01"], "at least 8 samples per PRTS cycle"),
+    (["--sensor-noise", "1e300"], "sensor_noise [rad] must be in"),
+])
+def test_hostile_prts_sweeps_are_one_line_and_exit_2(tmp_path, extra, needle):
+    out = tmp_path / "pop.csv"
+    r = cli("sweep", "--experiment", "prts", "--controller", "peterka-2002", "--tilt",
+            "prts:0.035", "--vary", "feedback_delay=0.12:0.18:2", *extra, "--out", str(out))
+    assert r.returncode == 2 and r.stderr.count("\n") == 1 and needle in r.stderr, r.stderr
+    assert not out.exists()
+
+
+def test_json_is_built_whole_and_never_prints_nan(capsys):
+    """print_json writes nothing when the object cannot be written, and a non-finite number
+    as null."""
+    from posturelab.cli._common import print_json
+
+    print_json({"a": [1.0, float("nan")], "b": {"c": float("inf")}})
+    assert json.loads(capsys.readouterr().out) == {"a": [1.0, None], "b": {"c": None}}
+    with pytest.raises(TypeError):
+        print_json({"a": 1.0, "b": object()})
+    assert capsys.readouterr().out == ""

@@ -193,3 +193,38 @@ def test_periodic_bounds_are_defined_with_two_cycles():
 def test_the_frequency_api_raises_parameter_errors(call, needle):
     with pytest.raises(ParameterError, match=needle):
         call()
+
+
+@pytest.mark.parametrize("kwargs,needle", [
+    (dict(bands=[["a"]]), "whole odd-harmonic numbers"),
+    (dict(bands=5), "list of lists"),
+    (dict(response_sign=True), "response_sign"),
+    (dict(sample_rate="abc"), "sample rate"),
+    (dict(cycle_length=float("inf")), "cycle length"),
+])
+def test_estimate_frf_refuses_wrong_types(kwargs, needle):
+    x = np.sin(np.arange(800) * 0.1)
+    args = dict(sample_rate=20.0, cycle_length=20.0) | kwargs
+    with pytest.raises(ParameterError, match=needle):
+        estimate_frf(x, x, **args)
+    with pytest.raises(ParameterError, match="at most 1e\\+100"):
+        estimate_frf(x * 1e200, x, 20.0, 20.0)
+
+
+def test_fit_frf_refuses_nan_data_and_negative_bounds():
+    from dataclasses import replace
+
+    from posturelab.frequency.table import FRFTable
+
+    x1, y1 = steady_cycle(TRUE, PRESET.feedback_delay, PRESET.proprioceptive_weight)
+    est = estimate_frf(np.tile(x1, 3), np.tile(y1, 3), L / T, T)
+    with pytest.raises(ParameterError, match="non-finite"):
+        fit_frf(BODY, TRUE, replace(est, coherence=est.coherence * np.nan), ["feedback_delay"])
+    with pytest.raises(ParameterError, match="0 <= low < high <= 1"):
+        fit_frf(BODY, TRUE, est, ["feedback_delay"], bounds={"feedback_delay": (-1, 0.2)})
+    with pytest.raises(ParameterError, match="named twice"):
+        fit_frf(BODY, TRUE, est, ["active_stiffness", "active_stiffness:" + TRUE.names[0]])
+    with pytest.raises(ParameterError, match="must be a number, got True"):
+        FRFTable.from_gain_phase([0.1], [True], [0.0])
+    with pytest.raises(ParameterError, match="must be finite"):
+        FRFTable(np.array([0.1]), np.array([np.nan + 0j]))

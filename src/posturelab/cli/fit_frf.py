@@ -152,7 +152,7 @@ def run(args: argparse.Namespace) -> int:
                                          strict=True):
         note = "" if ok else "   (not determined by these data)"
         if fit.mismatch:
-            note += "   (model mismatch: the interval is a lower bound)"
+            note += "   (model mismatch: the interval includes the systematic part)"
         print(f"  {name:<24} {e:10.4g} ± {se:.3g} {fit.unit(name)}   (95 % CI {lo:.4g} … "
               f"{hi:.4g}){note}")
     for w in fit.warnings:

@@ -199,9 +199,22 @@ def confidence_radius(coherence, averages, bounds: str = "periodic") -> np.ndarr
     return out
 
 
+#: Largest |value| a stimulus or response sample may have (its spectra must stay finite).
+MAX_ABS_SAMPLE = 1e100
+
+
 def _trials(values, label: str) -> list[np.ndarray]:
-    arrays = values if isinstance(values, list | tuple) else [values]
-    out = [finite_array(label, a, (None,)) for a in arrays]
+    arrays = values if isinstance(values, list | tuple) and values and isinstance(
+        values[0], list | tuple | np.ndarray) else [values]
+    out = []
+    for a in arrays:
+        if np.asarray(a).dtype == bool:
+            raise ParameterError(f"{label} must be numbers, not booleans")
+        x = finite_array(label, a, (None,))
+        if x.size and np.max(np.abs(x)) > MAX_ABS_SAMPLE:
+            raise ParameterError(f"{label} has a value of {np.max(np.abs(x)):g}; at most "
+                                 f"{MAX_ABS_SAMPLE:g} in size")
+        out.append(x)
     if not out:
         raise ParameterError(f"{label}: give at least one trial")
     return out
@@ -237,7 +250,7 @@ def estimate_frf(stimulus, response, sample_rate: float, cycle_length: float, *,
     """
     fs = float_in_range("sample rate [Hz]", sample_rate, 1e-3, 1e7, unit="Hz")
     T = float_in_range("cycle length [s]", cycle_length, 1e-3, 1e5, unit="s")
-    if response_sign not in (1, -1, 1.0, -1.0):
+    if isinstance(response_sign, bool) or response_sign not in (1, -1, 1.0, -1.0):
         raise ParameterError(f"response_sign must be 1 or -1, got {response_sign!r}")
     if isinstance(discard_cycles, bool) or not isinstance(discard_cycles, int | np.integer) \
             or discard_cycles < 0:

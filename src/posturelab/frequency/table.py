@@ -65,6 +65,19 @@ class FRFTable:
     coherence: np.ndarray | None = None
     response_sign: int | None = None
 
+    def __post_init__(self) -> None:
+        f = np.asarray(self.frequency)
+        H = np.asarray(self.frf)
+        if f.ndim != 1 or H.shape != f.shape or f.dtype == bool or H.dtype == bool:
+            raise ParameterError("FRFTable: frequency and frf must be 1-D numbers of one "
+                                 "length (use FRFTable.from_gain_phase)")
+        if not (np.all(np.isfinite(f)) and np.all(f > 0) and np.all(np.isfinite(H))):
+            raise ParameterError("FRFTable: frequency must be finite and > 0, frf finite")
+        for name in ("gain_se", "phase_se_deg", "frf_se", "dof", "coherence"):
+            v = getattr(self, name)
+            if v is not None and (np.shape(v) != f.shape or not np.all(np.isfinite(v))):
+                raise ParameterError(f"FRFTable: {name} must be finite, one per band")
+
     @property
     def gain(self) -> np.ndarray:
         """|H|. [-]"""
