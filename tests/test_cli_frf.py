@@ -15,7 +15,8 @@ from posturelab.model.controllers import get_controller
 from posturelab.model.tilt import PRTSTilt
 
 KEYS = {"frequency", "frf", "gain", "phase_deg", "coherence", "gain_ci95", "phase_ci95_deg",
-        "frf_se", "dof", "response_sign", "sign_convention", "warnings"}
+        "frf_se", "dof", "response_sign", "sign_convention", "warnings", "harmonic_frequency",
+        "harmonic_weight", "frf_covariance"}
 
 
 def run(capsys, *argv):
@@ -344,3 +345,20 @@ def test_json_is_built_whole_and_never_prints_nan(capsys):
     with pytest.raises(TypeError):
         print_json({"a": 1.0, "b": object()})
     assert capsys.readouterr().out == ""
+
+
+def test_fit_frf_from_the_frf_json_equals_the_fit_from_the_trial(trial, tmp_path):
+    """frf --json carries the band harmonics, the standard errors and the band covariance,
+    so fitting its JSON gives the trial's fit (not the model at band centres, 2 % off)."""
+    frf_json = tmp_path / "frf.json"
+    frf_json.write_text(_frf_json(trial))
+    common = ["--controller", "peterka-2002", "--free", "active_stiffness,feedback_delay",
+              "--json"]
+    a = json.loads(cli("fit-frf", "--data", str(trial), "--stimulus", "tilt", "--response",
+                       "com_angle", "--cycle-length", "20", "--discard-cycles", "1",
+                       *common).stdout)
+    b = json.loads(cli("fit-frf", "--data", str(frf_json), *common).stdout)
+    assert a["weighting"] == b["weighting"] == "variance"
+    for pa, pb in zip(a["parameters"], b["parameters"], strict=True):
+        assert pa["estimate"] == pytest.approx(pb["estimate"], rel=1e-6)
+        assert pa["ci95"] == pytest.approx(pb["ci95"], rel=1e-4)

@@ -151,15 +151,24 @@ class FRFEstimate:
 
     def to_dict(self) -> dict:
         """The JSON of ``posturelab frf`` (frequency [Hz], FRF as {re, im}, gain, phase [deg],
-        coherence, 95 % bounds as [low, high] pairs, the standard error of the complex
-        estimate √var and its degrees of freedom; null where not defined)."""
+        coherence, 95 % bounds as [low, high] pairs, each band's harmonics [Hz] and their
+        share of the band's stimulus power (for a fit's band average), the standard error of
+        the complex estimate √var, its degrees of freedom and the bands' covariance; null
+        where not defined)."""
         def num(v):
             return None if not math.isfinite(v) else float(v)
 
         extra = {}
+        if self.harmonic_weight:
+            extra["harmonic_frequency"] = [[float(f) for f in fs]
+                                           for fs in self.harmonic_frequency]
+            extra["harmonic_weight"] = [[float(w / np.sum(ws)) for w in ws]
+                                        for ws in self.harmonic_weight]
         if self.variance.size:
-            extra = {"frf_se": [num(math.sqrt(v)) for v in self.variance],
-                     "dof": [num(v) for v in self.dof]}
+            extra.update({"frf_se": [num(math.sqrt(v)) for v in self.variance],
+                          "dof": [num(v) for v in self.dof]})
+        if self.covariance.shape == (self.frf.size,) * 2:
+            extra["frf_covariance"] = [[num(v) for v in row] for row in self.covariance]
         return {
             "frequency": [float(f) for f in self.frequency],
             "frf": [{"re": float(h.real), "im": float(h.imag)} for h in self.frf],

@@ -167,7 +167,8 @@ class PRTSSweepResult:
     fit_estimates, fit_standard_errors : numpy.ndarray, shape (M, K)
         In each parameter's unit (:data:`posturelab.frequency.fit.PARAMETERS`).
     fit_error : numpy.ndarray, shape (M,)
-        RMS weighted residual of each fit (≈ 1 when the model explains the data). [-]
+        √(χ²/dof) of each fit (:attr:`FRFFit.fit_error`; ≈ 1 when the model explains the
+        data). [-]
     """
 
     grid: Any

@@ -54,6 +54,12 @@ class FRFTable:
         [-]
     response_sign : int or None
         The sign the table's response was taken with, when it says. [-]
+    frf_covariance : numpy.ndarray, shape (B, B), or None
+        E[ΔĤ_a ΔĤ_b*] of bands that share harmonics (``posturelab frf --json`` writes it;
+        its diagonal is frf_se²). [-]
+    harmonic_frequency, harmonic_weight : tuple of numpy.ndarray
+        Per band, its harmonics [Hz] and their share of the band's stimulus power [-], when
+        given: the fit then averages the model over them as the estimate did.
     """
 
     frequency: np.ndarray
@@ -64,6 +70,21 @@ class FRFTable:
     dof: np.ndarray | None = None
     coherence: np.ndarray | None = None
     response_sign: int | None = None
+    harmonic_frequency: tuple = ()
+    harmonic_weight: tuple = ()
+    frf_covariance: np.ndarray | None = None
+
+    def band_average(self, frf_at) -> np.ndarray:
+        """Σ w H(f) / Σ w over each band's harmonics when the table gives them (``posturelab
+        frf --json`` does), else H at the band frequencies."""
+        if not self.harmonic_weight:
+            return np.asarray(frf_at(self.frequency))
+        values = np.asarray(frf_at(np.concatenate(self.harmonic_frequency)))
+        out, start = [], 0
+        for w in self.harmonic_weight:
+            out.append(np.sum(w * values[start:start + w.size]) / np.sum(w))
+            start += w.size
+        return np.array(out)
 
     def __post_init__(self) -> None:
         f = np.asarray(self.frequency)
@@ -148,7 +169,8 @@ def frf_table_from_json(obj, what: str = "FRF JSON") -> FRFTable:
         raise ParameterError(f"{what} must be one JSON object, got {type(obj).__name__}")
     known = {"frequency", "frf", "gain", "phase_deg", "gain_se", "phase_se_deg", "frf_se",
              "dof", "coherence", "gain_ci95", "phase_ci95_deg", "response_sign",
-             "sign_convention", "warnings"}
+             "sign_convention", "warnings", "harmonic_frequency", "harmonic_weight",
+             "frf_covariance"}
     if "frequency" not in obj:
         raise ParameterError(f"{what} has no 'frequency'; it needs frequency and either frf "
                              "or gain and phase_deg")
@@ -177,10 +199,41 @@ def frf_table_from_json(obj, what: str = "FRF JSON") -> FRFTable:
 
     def opt(key):  # null entries (an undefined bound or error) are not a precision
         v = obj.get(key)
-        return None if v is None or (isinstance(v, list) and any(x is None for x in v)) else v
+        if isinstance(v, list) and any(x is None or (isinstance(x, list) and None in x)
+                                       for x in v):
+            return None
+        return v
 
-    return FRFTable._with_precision(f, H, opt("gain_se"), opt("phase_se_deg"), opt("frf_se"),
-                                    opt("dof"), opt("coherence"), sign)
+    table = FRFTable._with_precision(f, H, opt("gain_se"), opt("phase_se_deg"),
+                                     opt("frf_se"), opt("dof"), opt("coherence"), sign)
+    if ("harmonic_frequency" in obj) != ("harmonic_weight" in obj):
+        raise ParameterError(f"{what}: give harmonic_frequency and harmonic_weight together")
+    if "harmonic_frequency" in obj:
+        hf, hw = obj["harmonic_frequency"], obj["harmonic_weight"]
+        if not (isinstance(hf, list) and isinstance(hw, list) and len(hf) == len(hw) == B):
+            raise ParameterError(f"{what}: harmonic_frequency and harmonic_weight need one "
+                                 "list per band")
+        freqs = tuple(_numbers(f"harmonic_frequency band {k + 1} [Hz]", v, None, 0.0,
+                               MAX_FREQUENCY, low_open=True) for k, v in enumerate(hf))
+        weights = tuple(_numbers(f"harmonic_weight band {k + 1} [-]", v, freqs[k].size, 0.0,
+                                 1.0, low_open=True) for k, v in enumerate(hw))
+        from dataclasses import replace
+
+        table = replace(table, harmonic_frequency=freqs, harmonic_weight=weights)
+    cov = opt("frf_covariance")
+    if cov is not None and table.frf_se is not None:
+        if not isinstance(cov, list) or len(cov) != B:
+            raise ParameterError(f"{what}: frf_covariance must be {B} rows of {B}")
+        V = np.array([_numbers(f"frf_covariance row {k + 1}", row, B, -MAX_GAIN ** 2,
+                               MAX_GAIN ** 2) for k, row in enumerate(cov)])
+        if not np.allclose(V, V.T, rtol=1e-9, atol=0) or not np.allclose(
+                np.diag(V), table.frf_se ** 2, rtol=1e-6):
+            raise ParameterError(f"{what}: frf_covariance must be symmetric with frf_se² on "
+                                 "its diagonal")
+        from dataclasses import replace
+
+        table = replace(table, frf_covariance=V)
+    return table
 
 
 def read_frf_json(path, what: str = "FRF JSON") -> FRFTable:
