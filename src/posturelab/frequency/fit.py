@@ -442,9 +442,10 @@ def fit_frf(body: Body, muscles: MuscleSet, data, free, *, input: str = "tilt",
         return least_squares(residuals, z0, bounds=(lo / scale, hi / scale), x_scale=1.0,
                              method="trf", args=(delta,), xtol=1e-12, ftol=1e-12, gtol=1e-12)
 
-    def chi2_sum(p: np.ndarray, delta: float) -> float:
-        return float(sum(np.sum(_chi2(u, t.dof)) for u, t in zip(standardised(p, delta),
-                                                                   targets, strict=True)))
+    def chi2_sum(p: np.ndarray, delta: float, values: list | None = None) -> float:
+        values = model(p) if values is None else values
+        return float(sum(np.sum(_chi2(t.standardised(v, delta), t.dof))
+                         for t, v in zip(targets, values, strict=True)))
 
     K = x0.size
     m = 2 * sum(t.frf.size for t in targets)
@@ -460,9 +461,10 @@ def fit_frf(body: Body, muscles: MuscleSet, data, free, *, input: str = "tilt",
     if mismatch:
         for _ in range(2):  # the model error that makes the fit error 1, then refit
             a, b = -14.0, 2.0
-            for _ in range(60):
+            values = model(p)
+            for _ in range(50):
                 mid = 0.5 * (a + b)
-                a, b = (mid, b) if chi2_sum(p, 10.0 ** mid) > dof else (a, mid)
+                a, b = (mid, b) if chi2_sum(p, 10.0 ** mid, values) > dof else (a, mid)
             delta = 10.0 ** b
             sol = solve(p / scale, delta)
             p = sol.x * scale
