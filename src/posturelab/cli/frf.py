@@ -21,21 +21,23 @@ The file has a header row and a uniform time column [s] (the sample rate comes f
 another cycle length the same harmonic numbers); --bands harmonics gives every odd harmonic.
 
 Sign (declared, never guessed from column names): the response is multiplied by
---response-sign before the ratio. The default, -1, is posturelab's convention for tilt: its
-angles are positive leaning forward and its tilt positive toes-up, and a tilt FRF is
-reported so that a body that follows the surface has gain 1 and phase 0 (so the sway is
-negated). Another lab's recording: if its sway is positive in the direction the surface
-turns it (a body that follows the surface reads +tilt), give --response-sign +1; if its
-sway is positive forward and its tilt toes-up, as posturelab's, keep -1; for a
-translation stimulus posturelab's model FRF is y/x, so give +1. Every output states the
-sign applied. Warning (stderr, and "warnings" in --json) when the lowest band's phase lies
-within 45 deg of +-180 deg with coherence >= 0.8: a response followed at low frequency
-reads near 0 deg, so the sign is then probably the other lab's.
+--response-sign before the ratio, and every output states the sign applied. A tilt FRF is
+reported so that a body that stays perpendicular to the surface has gain 1 and phase 0.
+The default, -1, is posturelab's convention: its files have sway positive leaning forward
+and tilt positive toes-up, so a body following a toes-up tilt reads negative sway. Another
+lab's recording: if a body following the surface reads sway of the same sign as the tilt
+(both in one rotational sense, e.g. both positive toes-up/backward), give --response-sign
++1; if it reads the opposite sign, as posturelab's files do, keep -1. A translation
+stimulus: posturelab's model FRF is y/x, so +1. Unsure: a response that follows a slow
+stimulus reads near 0 deg in the lowest band; a warning (stderr, and "warnings" in --json)
+says when that band's phase lies within 45 deg of +-180 deg with coherence >= 0.8.
 
 --json prints one object: {"frequency": [Hz], "frf": [{"re", "im"}], "gain", "phase_deg",
-"coherence", "gain_ci95": [[low, high]], "phase_ci95_deg": [[low, high]], "frf_se" (standard
-error of the complex estimate), "dof", "response_sign", "sign_convention", "warnings"};
-an undefined number is null.
+"coherence", "gain_ci95": [[low, high]], "phase_ci95_deg": [[low, high]],
+"harmonic_frequency" and "harmonic_weight" (each band's harmonics [Hz] and their share of
+its stimulus power), "frf_se" (standard error of the complex estimate), "dof",
+"frf_covariance" (of the bands), "response_sign", "sign_convention", "warnings"}; an
+undefined number is null. fit-frf reads it back.
 --ci periodic (default) gives bounds exact for a periodic stimulus; --ci otnes-enochson the
 form Peterka used (wider).
 
