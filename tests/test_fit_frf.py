@@ -169,7 +169,9 @@ def test_a_model_mismatch_on_noise_free_data_is_reported():
 
 
 def test_periodic_bounds_are_defined_with_two_cycles():
-    """n_d = 2 (two cycles, one harmonic): r² = F(2, 2)·(1 − γ²)/γ², F(2, 2) = 19."""
+    """n_d = 2 (two cycles, one harmonic): r² = F(2, 2)·(1 − γ²)/γ², F(2, 2) = 19.0 as
+    COMTEST tabulates it (github.com/VittorioFreiburg/COMTEST, ANALYSIS/MATLAB/PRTS2020.m,
+    ``F2`` for two cycles of a one-point band); Otnes–Enochson's form stays undefined."""
     from posturelab.frequency.estimate import confidence_radius
 
     r = confidence_radius(0.5, 2)

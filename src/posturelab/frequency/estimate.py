@@ -17,7 +17,10 @@ degrees of freedom, so (``bounds="periodic"``, the default; e.g. Pintelon and Sc
 
     r² = F_{0.95}(2, 2 n_d − 2) / (n_d − 1) · (1 − γ²) / γ²,
 
-defined from n_d = 2 on (two cycles of a one-harmonic band: F_{0.95}(2, 2) = 19).
+defined from n_d = 2 on (two cycles of a one-harmonic band: F_{0.95}(2, 2) = 19). The same
+form, with the same F quantiles tabulated (19.0 for two cycles of a one-point band), is
+the one of COMTEST's analysis (Eurobench; github.com/VittorioFreiburg/COMTEST,
+ANALYSIS/MATLAB/PRTS2020.m: r = √(2(1 − γ²) F / (dof − 2) · G_yy/G_xx), dof = 2 n_d).
 
 ``bounds="otnes-enochson"`` gives the form Peterka 2002 used (after Otnes and Enochson 1972;
 Bendat and Piersol, *Random Data*, 4th ed. 2010, §9.2.4), r² = 2/(n_d − 2) · F_{0.95}(2,

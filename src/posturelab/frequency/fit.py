@@ -51,10 +51,13 @@ random across bands; a systematic one (the nonlinear plant against the linearise
 0.1 % at a 0.035 rad PRTS) biases the estimates coherently, so the intervals are widened
 on each side by β_k = δ Σ_b |∂p_k/∂e_b| |Ĥ_b| (``systematic``), the most a model error of
 δ|Ĥ_b| at every band, in any direction, moves parameter k (linearised). The 95 % intervals
-are estimate ± 1.96 standard errors (t-based with the residual dof for ``"relative"``). A
-parameter the residuals do not depend on, whose relative standard error exceeds 1, or
-that the Jacobian cannot separate (condition number above 1e10), is reported as not
-determined. Bands with coherence below 0.5 raise a warning in ``warnings``.
+are estimate ± q standard errors (± β_k), q Student's t quantile with the residual dof for
+``"relative"``, else with the fewest degrees of freedom of any band's variance (∞ for known
+standard errors: q = 1.96), a conservative stand-in for the Satterthwaite dof of each
+estimate's variance. A parameter the residuals do not depend on, whose relative standard
+error exceeds 1, or that the Jacobian cannot separate (condition number above 1e10), is
+reported as not determined. Bands with coherence below 0.5 raise a warning in
+``warnings``.
 """
 
 from __future__ import annotations
@@ -497,7 +500,9 @@ def fit_frf(body: Body, muscles: MuscleSet, data, free, *, input: str = "tilt",
             se[seen_col] = np.sqrt(np.maximum(np.diag(cov), 0.0))
     if relative:
         fit_error = math.sqrt(s2)
-    q = float(student.ppf(0.975, dof)) if relative else 1.959963984540054
+    finite = [d for t in targets for d in np.asarray(t.dof, float) if np.isfinite(d)]
+    nu = dof if relative else (min(finite) if finite else np.inf)
+    q = float(student.ppf(0.975, nu))
     systematic = np.zeros(K)
     if mismatch and np.isfinite(cond) and seen_col.all():
         systematic = _systematic_bound(J, targets, delta, seen_col)
