@@ -271,6 +271,9 @@ def _target(c, k: int) -> _Target:
     """The :class:`_Target` of condition ``k`` (an FRFEstimate or an FRFTable)."""
     from .table import FRFTable
 
+    if np.all(np.abs(np.asarray(c.frf)) == 0):
+        raise ParameterError(f"condition {k + 1}: the FRF is zero at every band (no "
+                             "response): there is nothing to fit")
     if isinstance(c, FRFEstimate):
         if not (np.all(np.isfinite(c.frf)) and np.all(np.isfinite(c.frequency))
                 and np.all(np.isfinite(c.coherence))):
@@ -279,7 +282,7 @@ def _target(c, k: int) -> _Target:
         if c.variance.size != c.frf.size or not np.all(np.isfinite(c.variance)):
             raise ParameterError(f"condition {k + 1}: the estimate carries no variance per "
                                  "band (make it with estimate_frf)")
-        var = np.maximum(c.variance, (_SE_FLOOR * np.abs(c.frf)) ** 2)
+        var = np.maximum(c.variance, (_SE_FLOOR * np.abs(c.frf).max()) ** 2)
         sd = np.sqrt(var / 2)
         cov = c.covariance if c.covariance.shape == (c.frf.size,) * 2 else None
         return _Target(c.frf, "variance", np.stack([sd, sd]), np.asarray(c.dof, float), cov)
@@ -287,7 +290,7 @@ def _target(c, k: int) -> _Target:
         raise ParameterError(f"condition {k + 1} must be an FRFEstimate or an FRFTable, got "
                              f"{type(c).__name__}")
     dof = np.full(c.frf.size, np.inf) if c.dof is None else np.asarray(c.dof, float)
-    floor = _SE_FLOOR * np.abs(c.frf)
+    floor = _SE_FLOOR * np.abs(c.frf).max()
     if c.frf_se is not None:
         sd = np.sqrt(np.maximum(c.frf_se, floor) ** 2 / 2)
         return _Target(c.frf, "variance", np.stack([sd, sd]), dof, c.frf_covariance)
