@@ -179,6 +179,10 @@ def test_periodic_bounds_are_defined_with_two_cycles():
     assert np.isnan(confidence_radius(0.5, 2, "otnes-enochson"))
 
 
+_EST = estimate_frf(np.tile(np.sin(np.arange(1000) * 0.3), 3),
+                    np.tile(np.cos(np.arange(1000) * 0.3), 3), L / T, T, bands=[[1]])
+
+
 @pytest.mark.parametrize("call,needle", [
     (lambda: model_frf(BODY, TRUE, [0.1], feedback_delay=5.0), "feedback_delay"),
     (lambda: model_frf(BODY, TRUE, [1e9]), "frequencies"),
@@ -191,6 +195,14 @@ def test_periodic_bounds_are_defined_with_two_cycles():
     (lambda: fit_frf(BODY, TRUE, [], ["feedback_delay"]), "FRFEstimate or FRFTable"),
     (lambda: estimate_frf([1.0] * 8, [1.0] * 8, float("nan"), 1.0), "sample rate"),
     (lambda: estimate_frf([True] * 8, [1.0] * 8, 8.0, 1.0), "stimulus"),
+    (lambda: fit_frf(BODY, TRUE, _EST, None), "free must be a list"),
+    (lambda: fit_frf(BODY, TRUE, _EST, ["feedback_delay"], per_condition=5), "per_condition"),
+    (lambda: fit_frf(BODY, TRUE, _EST, ["feedback_delay"], bounds={"feedback_delay": "ab"}),
+     "must be \\(low, high\\)"),
+    (lambda: __import__("posturelab.frequency.estimate", fromlist=["x"]).confidence_radius(
+        "a", 2), "must be numbers"),
+    (lambda: __import__("posturelab.frequency.experiment", fromlist=["x"]).prts_experiment(
+        BODY, TRUE, output=5), "output must be"),
 ])
 def test_the_frequency_api_raises_parameter_errors(call, needle):
     with pytest.raises(ParameterError, match=needle):

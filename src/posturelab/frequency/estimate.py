@@ -196,8 +196,14 @@ def confidence_radius(coherence, averages, bounds: str = "periodic") -> np.ndarr
 
     if bounds not in BOUNDS:
         raise ParameterError(f"bounds must be one of {', '.join(BOUNDS)}, got {bounds!r}")
-    g = np.clip(np.asarray(coherence, dtype=float), 1e-300, 1.0)
-    n = np.asarray(averages, dtype=float)
+    try:
+        g = np.clip(np.asarray(coherence, dtype=float), 1e-300, 1.0)
+        n = np.asarray(averages, dtype=float)
+    except (TypeError, ValueError):
+        raise ParameterError(f"coherence and averages must be numbers, got {coherence!r}, "
+                             f"{averages!r}"[:200]) from None
+    if not (np.all(np.isfinite(g)) and np.all(np.isfinite(n))):
+        raise ParameterError("coherence and averages must be finite")
     out = np.full(np.broadcast(g, n).shape, np.nan)
     ok = np.broadcast_to(n, out.shape) >= (2 if bounds == "periodic" else 3)
     if np.any(ok):

@@ -76,6 +76,8 @@ def prts_experiment(body, muscles, *, tilt=None, cycles: int = 5, discard: int =
     from ..model.tilt import PRTSTilt
     from ..simulation.engines import simulate
 
+    if not isinstance(output, str):
+        raise ParameterError(f"output must be com_angle or thetaN, got {output!r}")
     tilt = PRTSTilt.peterka_2002(0.035) if tilt is None else tilt
     if not isinstance(tilt, PRTSTilt):
         raise ParameterError("tilt must be a PRTSTilt (a periodic stimulus)")

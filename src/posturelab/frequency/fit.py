@@ -363,8 +363,10 @@ def fit_frf(body: Body, muscles: MuscleSet, data, free, *, input: str = "tilt",
                                     MAX_FEEDBACK_DELAY, unit="s")
     proprioceptive_weight = float_in_range("proprioceptive_weight [-]", proprioceptive_weight,
                                            0.0, 1.0)
-    if isinstance(free, str) or isinstance(per_condition, str):
-        raise ParameterError("free and per_condition are lists of names, not one string")
+    for label, names in (("free", free), ("per_condition", per_condition)):
+        if isinstance(names, str) or not isinstance(names, list | tuple):
+            raise ParameterError(f"{label} must be a list of parameter names, got {names!r}"
+                                 [:200])
     free, per = list(free), list(per_condition)
     if not free and not per:
         raise ParameterError("give at least one parameter to fit")

@@ -87,6 +87,8 @@ class PRTSProtocol:
                        unit="rad")
         float_in_range("sample_rate (--record-rate) [Hz]", self.sample_rate, 1.0,
                        MAX_RECORD_RATE, unit="Hz")
+        if not isinstance(self.output, str):
+            raise ParameterError(f"output must be com_angle or thetaN, got {self.output!r}")
         if isinstance(self.fit, str):
             raise ParameterError("fit is a sequence of parameter names, not one string")
         object.__setattr__(self, "fit", tuple(self.fit))
