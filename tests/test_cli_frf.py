@@ -60,7 +60,9 @@ def test_frf_model_json_is_model_frf(capsys):
     code, out, _ = run(capsys, "frf-model", "--controller", "icm-pmc5664365", "--bands",
                        "peterka", "--json")
     obj = json.loads(out)
-    assert code == 0 and set(obj) == {"frequency", "frf", "gain", "phase_deg"}
+    assert code == 0 and set(obj) == {"frequency", "frf", "gain", "phase_deg",
+                                      "sign_convention"}
+    assert obj["sign_convention"].startswith("−y/α")
     body = pl.get_body("paper-1link")
     preset = get_controller("icm-pmc5664365")
     H = model_frf(body, preset.muscles(body), obj["frequency"], **preset.run_options())

@@ -28,7 +28,8 @@ frequencies of Peterka's 11 bands (--bands peterka, for --cycle-length s, defaul
 A loop unstable about upright at its delay has no measurable FRF (a periodic-stimulus
 experiment on it would fall): frf-model refuses it (exit 2, the rightmost root named).
 
---json prints one object: {"frequency": [Hz], "frf": [{"re", "im"}], "gain", "phase_deg"}.
+--json prints one object: {"frequency": [Hz], "frf": [{"re", "im"}], "gain", "phase_deg",
+"sign_convention"}.
 
 Example: posturelab frf-model --controller peterka-2002 --bands peterka --json
 """
@@ -78,14 +79,16 @@ def run(args: argparse.Namespace) -> int:
                   feedback_delay=options.get("feedback_delay", 0.0),
                   proprioceptive_weight=options.get("proprioceptive_weight", 1.0))
     phase = np.degrees(np.unwrap(np.angle(H)))
+    sign = ("−y/α (the literature's tilt sign: a body that follows the surface reads gain 1, "
+            "phase 0)" if args.input == "tilt" else "y/x (as the output is, per metre)")
     if args.json:
         print_json({"frequency": [float(v) for v in f],
                     "frf": [{"re": float(h.real), "im": float(h.imag)} for h in H],
                     "gain": [float(abs(h)) for h in H],
-                    "phase_deg": [float(p) for p in phase]})
+                    "phase_deg": [float(p) for p in phase], "sign_convention": sign})
         return 0
     unit = "" if args.input == "tilt" else " [rad/m]"
-    print(f"model FRF of {args.output} to {args.input}{unit}")
+    print(f"model FRF of {args.output} to {args.input}{unit}, {sign}")
     print(f"{'f [Hz]':>8} {'gain':>10} {'phase [deg]':>12}")
     for fk, h, p in zip(f, H, phase, strict=True):
         print(f"{fk:8.3f} {abs(h):10.4g} {p:12.1f}")
