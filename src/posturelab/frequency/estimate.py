@@ -35,8 +35,9 @@ Precision per band (what :func:`posturelab.frequency.fit_frf` weights by): the b
 Ĥ_j = Σ_c X̄_cj Y_cj / G_j) has, for noise of variance σ² in the response spectrum about the
 band, E|Ĥ − H|² = σ² / Σ_j G_j. σ² is estimated from the scatter of the cycles about the
 periodic response, s_j² = Σ_c |Y_cj − Ĥ_j X_cj|² / (C − 1) with 2(C − 1) degrees of
-freedom at each DFT bin j (the sample variance over periods of Pintelon and Schoukens,
-*System Identification*, 2nd ed. 2012, ch. 2), averaged over the bins from the band's
+freedom at each DFT bin j (the sample variance over periods: Pintelon and Schoukens,
+*System Identification*, 2nd ed. 2012, ch. 2; Schoukens, Godfrey and Schoukens 2018, IEEE
+Control Syst Mag 38(4):49–88), averaged over the bins from the band's
 first to its last harmonic, widened by neighbouring bins (excited or not) until they
 pool at least ``POOLED_DOF`` = 20 degrees of freedom: ``variance`` = mean s² / Σ_j G_j with
 ``dof`` ν = 2(C − 1) × bins. The pooling (posturelab's choice: it assumes the noise spectrum

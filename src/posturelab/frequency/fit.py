@@ -28,10 +28,10 @@ Weighting (``FRFFit.weighting`` says which was used), every band by its own prec
   (:mod:`.estimate`: the noise about each harmonic from the scatter of the cycles, pooled
   over neighbouring DFT bins to at least 20 degrees of freedom; Peterka's bands share
   harmonics, so they are correlated): the real and imaginary parts each have covariance
-  V/2, and the fit is generalised least squares, Σ = eᵀ(V/2)⁻¹e over both parts, with the
-  covariance (JᵀJ)⁻¹ of the whitened Jacobian (e.g. Pintelon and Schoukens 2012, ch. 7,
-  weighted least squares with the FRF's sample covariance). A table's ``frf_se`` gives
-  V = diag(se²), or its ``frf_covariance`` when it has one (``posturelab frf --json``).
+  V/2, and the fit is generalised least squares (Aitken 1935, Proc R Soc Edinb 55:42–48),
+  Σ = eᵀ(V/2)⁻¹e over both parts, with the covariance (JᵀJ)⁻¹ of the whitened Jacobian. A
+  table's ``frf_se`` gives V = diag(se²), or its ``frf_covariance`` when it has one
+  (``posturelab frf --json``).
 * ``"gain-phase"`` (a table with ``gain_se`` and ``phase_se_deg``, as published group means
   come): the residuals (|H| − g)/se_g and wrap(arg H − φ)/se_φ, least squares (ν = ∞ unless
   the table gives ``dof``).
