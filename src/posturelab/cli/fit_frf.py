@@ -138,13 +138,15 @@ def _bounds(text: str) -> dict:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..frequency.fit import fit_frf
+    from ..frequency.fit import check_fit_request, fit_frf
     from .frf import check_plot_path
 
     check_plot_path(args.plot)
     body = body_from_args(args)
     muscles = muscles_from_args(args, body)
     options = feedback_options_from_args(args)
+    check_fit_request(muscles, _names(args.free), _names(args.per_condition),
+                      _bounds(args.bounds))  # before any data are read
     conditions = [_condition(path, args) for path in args.data]
     fit = fit_frf(body, muscles, conditions, _names(args.free), input=args.input,
                   output=args.output.strip().lower(),

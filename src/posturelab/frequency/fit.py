@@ -74,7 +74,8 @@ from ..simulation.setup import MAX_FEEDBACK_DELAY
 from .estimate import FRFEstimate
 from .model import model_frf_batch
 
-__all__ = ["FRFFit", "fit_frf", "PARAMETERS", "WEIGHTINGS", "MISMATCH_P"]
+__all__ = ["FRFFit", "fit_frf", "check_fit_request", "PARAMETERS", "WEIGHTINGS",
+           "MISMATCH_P"]
 
 PARAMETERS = ("stiffness", "viscosity", "active_stiffness", "active_viscosity",
               "feedback_delay", "proprioceptive_weight")
@@ -313,6 +314,38 @@ def _chi2(u: np.ndarray, dof: np.ndarray) -> np.ndarray:
     return np.where(np.isfinite(dof) & np.isfinite(z), z, q)
 
 
+def check_fit_request(muscles: MuscleSet, free, per_condition=(), bounds=None) -> tuple:
+    """The names to fit and their bounds, checked (each known, none named twice, each bound
+    for a fitted parameter and within its range), before any data are read.
+
+    Returns
+    -------
+    (list, list, list, list, dict)
+        ``free``, ``per_condition``, each name's (base name, pair index), each name's one
+        spelling, and the bounds by that spelling.
+    """
+    for label, names in (("free", free), ("per_condition", per_condition)):
+        if isinstance(names, str) or not isinstance(names, list | tuple):
+            raise ParameterError(f"{label} must be a list of parameter names, got {names!r}"
+                                 [:200])
+    free, per = list(free), list(per_condition)
+    if not free and not per:
+        raise ParameterError("give at least one parameter to fit")
+    specs = [_parse(n, muscles) for n in free + per]
+    canon = [_canonical(n, s, muscles) for n, s in zip(free + per, specs, strict=True)]
+    seen: dict[str, tuple[str, bool]] = {}
+    for i, (given, name) in enumerate(zip(free + per, canon, strict=True)):
+        if name in seen:
+            first, shared = seen[name]
+            raise ParameterError(f"{name!r} is named twice ({first!r} and {given!r})"
+                                 if shared == (i < len(free))
+                                 else f"{name!r} is both shared and per condition")
+        seen[name] = (given, i < len(free))
+    bounds = _check_bounds(bounds, muscles, dict(zip(canon, (s[0] for s in specs),
+                                                     strict=True)))
+    return free, per, specs, canon, bounds
+
+
 def fit_frf(body: Body, muscles: MuscleSet, data, free, *, input: str = "tilt",
             output: str = "com_angle", feedback_delay: float = 0.0,
             proprioceptive_weight: float = 1.0, per_condition=(), bounds=None) -> FRFFit:
@@ -358,30 +391,12 @@ def fit_frf(body: Body, muscles: MuscleSet, data, free, *, input: str = "tilt",
         list(data) if isinstance(data, list | tuple) else None)
     if not conditions:
         raise ParameterError("data must be one FRFEstimate or FRFTable, or a list of them")
-    targets = [_target(c, k) for k, c in enumerate(conditions)]
     feedback_delay = float_in_range("feedback_delay [s]", feedback_delay, 0.0,
                                     MAX_FEEDBACK_DELAY, unit="s")
     proprioceptive_weight = float_in_range("proprioceptive_weight [-]", proprioceptive_weight,
                                            0.0, 1.0)
-    for label, names in (("free", free), ("per_condition", per_condition)):
-        if isinstance(names, str) or not isinstance(names, list | tuple):
-            raise ParameterError(f"{label} must be a list of parameter names, got {names!r}"
-                                 [:200])
-    free, per = list(free), list(per_condition)
-    if not free and not per:
-        raise ParameterError("give at least one parameter to fit")
-    specs = [_parse(n, muscles) for n in free + per]
-    canon = [_canonical(n, s, muscles) for n, s in zip(free + per, specs, strict=True)]
-    seen: dict[str, tuple[str, bool]] = {}
-    for i, (given, name) in enumerate(zip(free + per, canon, strict=True)):
-        if name in seen:
-            first, shared = seen[name]
-            raise ParameterError(f"{name!r} is named twice ({first!r} and {given!r})"
-                                 if shared == (i < len(free))
-                                 else f"{name!r} is both shared and per condition")
-        seen[name] = (given, i < len(free))
-    bounds = _check_bounds(bounds, muscles, dict(zip(canon, (s[0] for s in specs),
-                                                     strict=True)))
+    free, per, specs, canon, bounds = check_fit_request(muscles, free, per_condition, bounds)
+    targets = [_target(c, k) for k, c in enumerate(conditions)]
     base = np.stack([muscles.stiffnesses, muscles.viscosities, muscles.active_stiffnesses,
                      muscles.active_viscosities])
     C = len(conditions)
