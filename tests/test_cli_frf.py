@@ -287,6 +287,11 @@ def test_frf_states_the_sign_and_warns_near_180_degrees(trial):
     assert r.stderr.count("\n") == 1 and "check --response-sign" in r.stderr
     r = cli(*base)
     assert "response × −1" in r.stdout
+    r = cli("fit-frf", *base[1:], "--response-sign", "+1", "--controller", "peterka-2002",
+            "--free", "active_stiffness", "--json")
+    obj = json.loads(r.stdout)
+    assert obj["response_sign"] == [1] and "check --response-sign" in obj["warnings"][0]
+    assert "check --response-sign" in r.stderr
 
 
 def test_frf_model_refuses_a_loop_unstable_at_its_delay():

@@ -167,8 +167,19 @@ def run(args: argparse.Namespace) -> int:
                     args.plot)
     signs = sorted({int(c.response_sign) for c in conditions
                     if getattr(c, "response_sign", None) is not None})
+    from ..frequency.estimate import FRFEstimate, sign_warning
+
+    sign_warnings = [f"--data {p!r}: {w}" for p, c in zip(args.data, conditions, strict=True)
+                     if isinstance(c, FRFEstimate) and (w := sign_warning(c))]
+    if sign_warnings:
+        import sys
+
+        for w in sign_warnings:
+            print(f"warning: {w}", file=sys.stderr)
     if args.json:
-        print_json({**fit.to_dict(), "response_sign": signs})
+        out = fit.to_dict()
+        print_json({**out, "response_sign": signs,
+                    "warnings": sign_warnings + out["warnings"]})
         return 0
     print(f"fitted {len(fit.names)} parameter(s) to {len(conditions)} condition(s); fit error "
           f"{fit.fit_error:.3g} (√(χ²/dof); about 1 when the model explains the data)")
