@@ -261,7 +261,11 @@ class _Target:
 
             V = 0.5 * (self.cov + np.diag(2 * self.sd[0] ** 2 - np.diag(self.cov)
                                           + delta ** 2 * np.abs(t) ** 2))
-            low = cholesky(V, lower=True)
+            try:
+                low = cholesky(V, lower=True)
+            except np.linalg.LinAlgError:
+                raise ParameterError("the bands' covariance is not positive definite"
+                                     ) from None
             return np.stack([solve_triangular(low, e.real, lower=True),
                              solve_triangular(low, e.imag, lower=True)])
         sd = np.sqrt(self.sd ** 2 + 0.5 * delta ** 2 * np.abs(t) ** 2)
@@ -299,7 +303,7 @@ def _target(c, k: int) -> _Target:
         sd = np.stack([np.maximum(c.gain_se, floor),
                        np.maximum(np.radians(c.phase_se_deg), _SE_FLOOR)])
         return _Target(c.frf, "gain-phase", sd, dof)
-    g = np.abs(c.frf)
+    g = np.maximum(np.abs(c.frf), floor)
     return _Target(c.frf, "relative", np.stack([g, g]), np.full(g.size, np.inf))
 
 

@@ -230,6 +230,8 @@ def frf_table_from_json(obj, what: str = "FRF JSON") -> FRFTable:
                 np.diag(V), table.frf_se ** 2, rtol=1e-6):
             raise ParameterError(f"{what}: frf_covariance must be symmetric with frf_se² on "
                                  "its diagonal")
+        if np.linalg.eigvalsh(V).min() <= 0:
+            raise ParameterError(f"{what}: frf_covariance must be positive definite")
         from dataclasses import replace
 
         table = replace(table, frf_covariance=V)
