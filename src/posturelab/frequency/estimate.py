@@ -37,17 +37,20 @@ band, E|Ĥ − H|² = σ² / Σ_j G_j. σ² is estimated from the scatter of the
 periodic response, s_j² = Σ_c |Y_cj − Ĥ_j X_cj|² / (C − 1) with 2(C − 1) degrees of
 freedom at each DFT bin j (the sample variance over periods: Pintelon and Schoukens,
 *System Identification*, 2nd ed. 2012, ch. 2; Schoukens, Godfrey and Schoukens 2018, IEEE
-Control Syst Mag 38(4):49–88), averaged over the bins from the band's
-first to its last harmonic, widened by neighbouring bins (excited or not) until they
-pool at least ``POOLED_DOF`` = 20 degrees of freedom: ``variance`` = mean s² / Σ_j G_j with
-``dof`` ν = 2(C − 1) × bins. The pooling (posturelab's choice: it assumes the noise spectrum
-is nearly flat over those few bins) is what keeps the weights of the lowest bands usable
-with 2 or 3 cycles, where one harmonic alone gives 2 or 4 degrees of freedom. Unlike the
-band coherence, this does not count the FRF's variation across a band's harmonics as
-noise (noise-free, a multi-harmonic band has γ² < 1 but a variance of 0). Bands that share
-harmonics are correlated: ``covariance`` = Σ_{j in both} G_j σ_j² / (Σ_a G · Σ_b G), σ_j² the
-pooled noise about harmonic j (a fit that took Peterka's overlapping bands as independent
-gave intervals 1.25× too narrow).
+Control Syst Mag 38(4):49–88). σ² at harmonic j pools the bins about it (excited or not),
+widened until they hold at least ``POOLED_DOF`` = 20 degrees of freedom: a power law
+a·(f/f_j)^b fitted to ln s² over them (least squares; ln s² is biased by
+ψ(C − 1) − ln(C − 1), which is removed), so that a noise spectrum falling with frequency,
+as sway driven by motor noise does, is not averaged flat (with 2 cycles a flat mean put
+the lowest band's variance at half and the mid bands' at 1.5× their spread over 80 seeded
+runs). ``dof`` ν = 2(C − 1) × the bins about the band. The pooling (posturelab's choice:
+it assumes the noise spectrum is smooth over those few bins) is what keeps the weights of
+the lowest bands usable with 2 or 3 cycles, where one harmonic alone gives 2 or 4 degrees
+of freedom. Unlike the band coherence, this does not count the FRF's variation across a
+band's harmonics as noise (noise-free, a multi-harmonic band has γ² < 1 but a variance of
+0). Bands that share harmonics are correlated: ``covariance`` = Σ_{j in both} G_j σ_j² /
+(Σ_a G · Σ_b G), σ_j² the pooled noise about harmonic j (a fit that took Peterka's
+overlapping bands as independent gave intervals 1.25× too narrow).
 
 Sign: ``response_sign`` multiplies the response first. posturelab reports tilt FRFs so that a
 body that follows the surface has H = 1 (gain 1, phase 0): its angles are positive leaning
@@ -357,10 +360,20 @@ def band_variance(X: np.ndarray, Y: np.ndarray, bins) -> tuple[np.ndarray, ...]:
             lo, hi = (lo - 1 if lo > 1 else lo), (hi + 1 if hi < top else hi)
         return lo, hi
 
-    noise = {}  # σ² at each harmonic used, pooled about it
+    from scipy.special import digamma
+
+    # E[ln s²] = ln σ² + ψ(C − 1) − ln(C − 1) for s² ~ σ² χ²_{2(C−1)} / (2(C − 1))
+    log_bias = float(digamma(C - 1) - math.log(C - 1))
+    noise = {}  # σ² at each harmonic used: a power law in f fitted to ln s² about it
     for j in sorted({int(j) for b in bins for j in b}):
         lo, hi = window(j, j)
-        noise[j] = s2[lo:hi + 1].mean()
+        k = np.arange(lo, hi + 1)
+        ok = s2[k] > 0
+        if ok.sum() < 3:
+            noise[j] = s2[lo:hi + 1].mean()
+            continue
+        slope, level = np.polyfit(np.log(k[ok] / j), np.log(s2[k][ok]), 1)
+        noise[j] = math.exp(level - log_bias)
     B = len(bins)
     cov = np.zeros((B, B))
     dof = []
