@@ -145,8 +145,10 @@ def run(args: argparse.Namespace) -> int:
     print(f"{'f [Hz]':>8} {'gain':>10} {'phase [deg]':>12} {'coherence':>10}  gain 95 %")
     for k in range(est.frequency.size):
         lo, hi = est.gain_ci95[k]
+        bound = (f"{lo:.4g} … {hi:.4g}" if math.isfinite(lo) and math.isfinite(hi)
+                 else f"undefined (n_d = {est.averages[k]})")
         print(f"{est.frequency[k]:8.3f} {est.gain[k]:10.4g} {est.phase_deg[k]:12.1f} "
-              f"{est.coherence[k]:10.3f}  {lo:.4g} … {hi:.4g}")
+              f"{est.coherence[k]:10.3f}  {bound}")
     low = est.coherence < 0.5
     if low.any():
         print(f"warning: coherence below 0.5 at {int(low.sum())} band(s): those estimates are "

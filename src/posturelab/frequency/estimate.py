@@ -174,8 +174,9 @@ class FRFEstimate:
         if self.variance.size:
             extra.update({"frf_se": [num(math.sqrt(v)) for v in self.variance],
                           "dof": [num(v) for v in self.dof]})
-        if self.covariance.shape == (self.frf.size,) * 2:
-            extra["frf_covariance"] = [[num(v) for v in row] for row in self.covariance]
+        C = self.covariance
+        if C.shape == (self.frf.size,) * 2 and np.any(C - np.diag(np.diag(C))):
+            extra["frf_covariance"] = [[num(v) for v in row] for row in C]  # overlapping bands
         return {
             "frequency": [float(f) for f in self.frequency],
             "frf": [{"re": float(h.real), "im": float(h.imag)} for h in self.frf],
