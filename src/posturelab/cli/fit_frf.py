@@ -22,19 +22,21 @@ estimate its FRF, as posturelab frf does), the JSON that posturelab frf --json w
 table as JSON: {"frequency": [Hz], "gain": [...], "phase_deg": [...]} with optional
 "gain_se" and "phase_se_deg" (standard errors of gain [-] and phase [deg], as published
 group means give them), or "frf_se" (standard error of the complex value), "dof" and
-"coherence". --free NAMES (comma
-separated) are shared by the conditions, --per-condition NAMES take one value per condition.
+"coherence". --free NAMES (comma separated) are shared by the conditions, --per-condition
+NAMES take one value per condition.
 Names: stiffness, viscosity (intrinsic), active_stiffness, active_viscosity (a :PAIR suffix
 names a pair other than the first), feedback_delay, proprioceptive_weight. The body and the
 starting values come from the options below (as in posturelab simulate); --bounds
-NAME=LO:HI,... narrows the defaults (gains 0 … 1e5, delay 0 … 1 s, W 0 … 1).
+NAME=LO:HI,... replaces the defaults (gains 0 … 1e5, delay 0 … 1 s, W 0 … 1); each must
+lie within its parameter's own range (posturelab.frequency.fit states them).
 
 Weighting (printed, and "weighting" in --json; posturelab.frequency.fit): every band by
 its own precision: a trial's by the variance of its estimate from the scatter of its
 cycles (bands that share harmonics correlated), a table's by its standard errors; a table
 without them by 1/|H| (then said, and the fit error cannot test the model). A trial's
 model FRF is averaged over each band's harmonics with the stimulus's power, as its
-estimate is (a JSON FRF has no harmonics: the model is taken at the band frequencies).
+estimate is (frf --json carries them, so its JSON fits as its trial does; a table without
+them: the model at the band frequencies).
 Prints each parameter with its standard error and 95 % interval, the fit error (√(χ²/dof),
 about 1 when the model explains the data within their noise), and parameters the data
 cannot determine; when the fit error is too large for chance (p < 0.001) it says the
