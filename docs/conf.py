@@ -65,7 +65,7 @@ sphinx_gallery_conf = {
     "examples_dirs": str(HERE.parent / "examples"),
     "gallery_dirs": "auto_examples",
     # shown but not executed: the HTML report, the GIF and the two-minute coverage run
-    "filename_pattern": r"/(?!(reproduce_paper|animate_fig09_fall|fit_coverage)\.py)[^/]+\.py$",
+    "filename_pattern": r"/(?!(reproduce_paper|animate_fig09_fall|fit_coverage|frf_fit_coverage)\.py)[^/]+\.py$",
     "image_scrapers": ("pl_gallery.figure_scraper",),
     "reset_argv": "pl_gallery.reset_argv",
     "download_all_examples": False,

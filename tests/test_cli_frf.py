@@ -14,7 +14,9 @@ from posturelab.frequency.bands import PETERKA_BAND_FREQUENCIES
 from posturelab.model.controllers import get_controller
 from posturelab.model.tilt import PRTSTilt
 
-KEYS = {"frequency", "frf", "gain", "phase_deg", "coherence", "gain_ci95", "phase_ci95_deg"}
+KEYS = {"frequency", "frf", "gain", "phase_deg", "coherence", "gain_ci95", "phase_ci95_deg",
+        "frf_se", "dof", "response_sign", "sign_convention", "warnings", "harmonic_frequency",
+        "harmonic_weight", "frf_covariance"}
 
 
 def run(capsys, *argv):
@@ -58,7 +60,9 @@ def test_frf_model_json_is_model_frf(capsys):
     code, out, _ = run(capsys, "frf-model", "--controller", "icm-pmc5664365", "--bands",
                        "peterka", "--json")
     obj = json.loads(out)
-    assert code == 0 and set(obj) == {"frequency", "frf", "gain", "phase_deg"}
+    assert code == 0 and set(obj) == {"frequency", "frf", "gain", "phase_deg",
+                                      "sign_convention"}
+    assert obj["sign_convention"].startswith("−y/α")
     body = pl.get_body("paper-1link")
     preset = get_controller("icm-pmc5664365")
     H = model_frf(body, preset.muscles(body), obj["frequency"], **preset.run_options())
@@ -216,3 +220,152 @@ def test_fit_curves_are_the_fitted_models_frf(trial):
         [fit.estimates[0]], preset.muscles(body).active_viscosities)
     np.testing.assert_allclose(h, model_frf(body, muscles, f, **preset.run_options()),
                                rtol=1e-12)
+
+
+def cli(*args):
+    """posturelab as a real subprocess."""
+    import subprocess
+    import sys
+
+    return subprocess.run([sys.executable, "-m", "posturelab", *args], capture_output=True,
+                          text=True, timeout=300)
+
+
+@pytest.mark.parametrize("extra,needle", [
+    (["--bounds", "feedback_delay=0:1e308"], "0 <= low < high <= 1 [s], got 0:1e+308"),
+    (["--bounds", "feedback_delay=-0.1:0.3"], "got -0.1:0.3"),
+    (["--bounds", "feedback_delai=0:0.3"], "unknown FRF fit parameter 'feedback_delai'"),
+    (["--bounds", "feedback_delay=nan:0.3"], "must be finite, got nan:0.3"),
+    (["--bounds", "feedback_delay=0:inf"], "must be finite"),
+    (["--bounds", "active_viscosity=0:300"], "which is not fitted"),
+    (["--free", "active_stiffness,active_stiffness"], "named twice"),
+    (["--cycle-length", "inf"], "--cycle-length [s] must be a finite number"),
+    (["--cycle-length", "1e300"], "--cycle-length [s] must be in"),
+])
+def test_hostile_fit_frf_input_is_one_line_and_exit_2(trial, extra, needle):
+    args = ["fit-frf", "--data", str(trial), "--stimulus", "tilt", "--response", "com_angle",
+            "--cycle-length", "20", "--controller", "peterka-2002", "--free",
+            "active_stiffness,feedback_delay", *extra]
+    r = cli(*args)
+    assert r.returncode == 2 and r.stdout == "" and r.stderr.count("\n") == 1, r.stderr
+    assert needle in r.stderr, r.stderr
+
+
+@pytest.mark.parametrize("content,needle", [
+    ("{}", "has no 'frequency'"),
+    ("[" * 100000 + "]" * 100000, "nested too deeply"),
+    ('{"frequency": [0.1], "gain": [true], "phase_deg": [0]}', "must be a number, got True"),
+    ('{"frequency": [0.1], "gain": [1e300], "phase_deg": [0]}', "gain [-] entry 1 must be in"),
+    ('{"frequency": [0.1], "gain": [1], "phase_deg": [0], "coherence": [NaN]}',
+     "NaN is not a number JSON allows"),
+    ('{"frequency": [], "gain": [], "phase_deg": []}', "must have 1 … 10,000 entries"),
+    ('{"frequency": [0.1], "gain": [1], "phase_deg": [0], "gain_se": [0.1]}',
+     "gain_se and phase_se_deg together"),
+])
+def test_hostile_frf_json_is_one_line_and_exit_2(tmp_path, content, needle):
+    path = tmp_path / "frf.json"
+    path.write_text(content)
+    r = cli("fit-frf", "--data", str(path), "--controller", "peterka-2002", "--free",
+            "active_stiffness")
+    assert r.returncode == 2 and r.stdout == "" and r.stderr.count("\n") == 1, r.stderr
+    assert needle in r.stderr, r.stderr
+
+
+def test_frf_states_the_sign_and_warns_near_180_degrees(trial):
+    """The default sign is -1 (posturelab's tilt convention) and says so; +1 on posturelab's
+    own recording puts the lowest band near 180° with coherence 1: one warning line on
+    stderr and in the JSON."""
+    base = ["frf", "--data", str(trial), "--stimulus", "tilt", "--response", "com_angle",
+            "--cycle-length", "20", "--discard-cycles", "1"]
+    r = cli(*base, "--json")
+    obj = json.loads(r.stdout)
+    assert r.returncode == 0 and obj["response_sign"] == -1 and obj["warnings"] == []
+    assert "posturelab's tilt convention" in obj["sign_convention"] and r.stderr == ""
+    r = cli(*base, "--response-sign", "+1", "--json")
+    obj = json.loads(r.stdout)
+    assert obj["response_sign"] == 1 and len(obj["warnings"]) == 1
+    assert r.stderr.count("\n") == 1 and "check --response-sign" in r.stderr
+    r = cli(*base)
+    assert "response × −1" in r.stdout
+    r = cli("fit-frf", *base[1:], "--response-sign", "+1", "--controller", "peterka-2002",
+            "--free", "active_stiffness", "--json")
+    obj = json.loads(r.stdout)
+    assert obj["response_sign"] == [1] and "check --response-sign" in obj["warnings"][0]
+    assert "check --response-sign" in r.stderr
+
+
+def test_frf_model_refuses_a_loop_unstable_at_its_delay():
+    r = cli("frf-model", "--controller", "peterka-2002", "--feedback-delay", "0.6")
+    assert r.returncode == 2 and r.stdout == "" and "not measurable" in r.stderr, r.stderr
+
+
+def test_fit_frf_takes_gain_and_phase_with_standard_errors(tmp_path):
+    """A table of gain and phase (the model's own, at Peterka's band frequencies) with
+    standard errors of 1 % and 0.6°: the stiffness comes back inside its interval, and the
+    output names the weighting; without standard errors it says 1/|H|."""
+    body = pl.get_body("paper-1link")
+    preset = get_controller("peterka-2002")
+    f = list(PETERKA_BAND_FREQUENCIES)
+    H = model_frf(body, preset.muscles(body), f, **preset.run_options())
+    table = {"frequency": f, "gain": np.abs(H).tolist(),
+             "phase_deg": np.degrees(np.unwrap(np.angle(H))).tolist(),
+             "gain_se": (0.01 * np.abs(H)).tolist(), "phase_se_deg": [0.6] * len(f)}
+    path = tmp_path / "table.json"
+    path.write_text(json.dumps(table))
+    start = ["--body", "paper-1link", "--stiffness", "0", "--viscosity", "0",
+             "--active-stiffness", "600", "--active-viscosity", "265.07135614",
+             "--feedback-delay", "0.15"]
+    r = cli("fit-frf", "--data", str(path), *start, "--free", "active_stiffness", "--json")
+    obj = json.loads(r.stdout)
+    (p,) = obj["parameters"]
+    true = preset.muscles(body).active_stiffnesses[0]
+    assert obj["weighting"] == "gain-phase" and p["ci95"][0] <= true <= p["ci95"][1]
+    del table["gain_se"], table["phase_se_deg"]
+    path.write_text(json.dumps(table))
+    r = cli("fit-frf", "--data", str(path), *start, "--free", "active_stiffness")
+    assert r.returncode == 0 and "relative: no per-band precision given" in r.stdout
+
+
+@pytest.mark.parametrize("extra,needle", [
+    (["--record-rate", "nan"], "--record-rate) [Hz] must be a finite number"),
+    (["--record-rate", "inf"], "--record-rate) [Hz] must be a finite number"),
+    (["--record-rate", "1e300"], "--record-rate) [Hz] must be in"),
+    (["--record-rate", "0.3"], "--record-rate) [Hz] must be in [1, 100000] Hz, got 0.3"),
+    (["--record-rate", "1.01"], "at least 8 samples per PRTS cycle"),
+    (["--sensor-noise", "1e300"], "sensor_noise [rad] must be in"),
+])
+def test_hostile_prts_sweeps_are_one_line_and_exit_2(tmp_path, extra, needle):
+    out = tmp_path / "pop.csv"
+    r = cli("sweep", "--experiment", "prts", "--controller", "peterka-2002", "--tilt",
+            "prts:0.035", "--vary", "feedback_delay=0.12:0.18:2", *extra, "--out", str(out))
+    assert r.returncode == 2 and r.stderr.count("\n") == 1 and needle in r.stderr, r.stderr
+    assert not out.exists()
+
+
+def test_json_is_built_whole_and_never_prints_nan(capsys):
+    """print_json writes nothing when the object cannot be written, and a non-finite number
+    as null."""
+    from posturelab.cli._common import print_json
+
+    print_json({"a": [1.0, float("nan")], "b": {"c": float("inf")}})
+    assert json.loads(capsys.readouterr().out) == {"a": [1.0, None], "b": {"c": None}}
+    with pytest.raises(TypeError):
+        print_json({"a": 1.0, "b": object()})
+    assert capsys.readouterr().out == ""
+
+
+def test_fit_frf_from_the_frf_json_equals_the_fit_from_the_trial(trial, tmp_path):
+    """frf --json carries the band harmonics, the standard errors and the band covariance,
+    so fitting its JSON gives the trial's fit (not the model at band centres, 2 % off)."""
+    frf_json = tmp_path / "frf.json"
+    frf_json.write_text(_frf_json(trial))
+    common = ["--controller", "peterka-2002", "--free", "active_stiffness,feedback_delay",
+              "--json"]
+    a = json.loads(cli("fit-frf", "--data", str(trial), "--stimulus", "tilt", "--response",
+                       "com_angle", "--cycle-length", "20", "--discard-cycles", "1",
+                       *common).stdout)
+    b = json.loads(cli("fit-frf", "--data", str(frf_json), *common).stdout)
+    assert a["weighting"] == b["weighting"] == "variance"
+    for pa, pb in zip(a["parameters"], b["parameters"], strict=True):
+        assert pa["estimate"] == pytest.approx(pb["estimate"], rel=1e-6)
+        assert pa["ci95"] == pytest.approx(pb["ci95"], rel=1e-4)

@@ -252,12 +252,14 @@ def test_pair_map_of_another_body_refuses_what_it_cannot_map(tmp_path, capsys):
     for argv, words in (
             (["--body", "paper-1link", "--x", "stiffness:ankle:0:1", "--y", "viscosity_ratio:0:1"],
              "give --stiffness (1 value: ankle)"),
-            (["--body", "paper-1link", "--stiffness", "600", "--x", "stiffness:ankle:0:1", "--y",
-              "stiffness:hip:0:1"], "unknown parameter 'stiffness:hip'; known parameters: stiffness:ankle, viscosity_ratio"),
-            (["--x", "stiffness:ankle:0:1", "--y", "stiffness:hip:0:1", "--gastrocnemius", "one-sided"],
-             "switching point"),
-            (["--x", "stiffness:ankle:0:1", "--y", "stiffness:hip:0:1", "--controller", "peterka-2002"],
-             "--controller is for the delayed map")):
+            (["--body", "paper-1link", "--stiffness", "600", "--x", "stiffness:ankle:0:1",
+              "--y", "stiffness:hip:0:1"],
+             "unknown parameter 'stiffness:hip'; known parameters: stiffness:ankle, "
+             "viscosity_ratio"),
+            (["--x", "stiffness:ankle:0:1", "--y", "stiffness:hip:0:1", "--gastrocnemius",
+              "one-sided"], "switching point"),
+            (["--x", "stiffness:ankle:0:1", "--y", "stiffness:hip:0:1", "--controller",
+              "peterka-2002"], "--controller is for the delayed map")):
         code, _, err = run(capsys, "stability-map", *argv, "--out", str(tmp_path / "e.png"))
         assert code == 2 and words in err and err.count("\n") == 1, err
     assert list(tmp_path.iterdir()) == []

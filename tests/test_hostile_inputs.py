@@ -269,11 +269,17 @@ def test_a_run_that_fails_before_its_first_sample_keeps_its_initial_state(engine
     assert run.final_state.tolist() == [0.0] * 6
 
 
-def test_json_with_a_nan_prints_nothing_and_one_line(capsys):
+def test_json_with_a_nan_is_whole_and_says_null(capsys):
+    """A number JSON cannot hold (NaN, inf: an undefined bound, a CoP with the foot unloaded)
+    is written as null, in one whole object: never half an object, never bare NaN."""
+    import json
+
     from posturelab.cli._common import print_json
 
-    with pytest.raises(ParameterError, match="cannot be printed as JSON"):
-        print_json({"first": [1.0, 2.0] * 1000, "later": float("nan")})
-    assert capsys.readouterr().out == ""
+    print_json({"first": [1.0, 2.0] * 1000, "later": float("nan"), "far": float("inf")})
+    out = capsys.readouterr().out
+    assert out.count("\n") == 1 and "NaN" not in out and "Infinity" not in out
+    obj = json.loads(out)
+    assert obj["later"] is None and obj["far"] is None and len(obj["first"]) == 2000
     print_json({"fine": 1.0})
     assert capsys.readouterr().out == '{"fine": 1.0}\n'

@@ -338,14 +338,20 @@ def naming_given_options(args: argparse.Namespace,
 
 
 def print_json(obj) -> None:
-    """Print exactly one JSON object on standard output: all of it or, when a number in it
-    is NaN or infinite (which JSON cannot hold), nothing and one line (ParameterError)."""
-    try:
-        text = json.dumps(obj, allow_nan=False)
-    except ValueError as exc:
-        raise ParameterError(f"the result cannot be printed as JSON: {exc} (a NaN or "
-                             "infinite number; the text output shows it)") from None
-    sys.stdout.write(text + "\n")
+    """Print exactly one JSON object on standard output: built whole first (nothing is
+    printed if it cannot be), a non-finite number written as null, never as bare NaN."""
+    sys.stdout.write(json.dumps(_finite_or_null(obj), allow_nan=False) + "\n")
+
+
+def _finite_or_null(obj):
+    """``obj`` with every non-finite float replaced by None (JSON null)."""
+    if isinstance(obj, float):
+        return obj if math.isfinite(obj) else None
+    if isinstance(obj, dict):
+        return {k: _finite_or_null(v) for k, v in obj.items()}
+    if isinstance(obj, list | tuple):
+        return [_finite_or_null(v) for v in obj]
+    return obj
 
 
 #: The file types each kind of output may have (suffixes, lower case).

@@ -18,22 +18,33 @@ HELP = "fit controller gains, delay and sensory weight to FRFs (one or several c
 
 DESCRIPTION = f"""\
 Fit the linearised model's FRF to one or several measured FRFs. Each --data is a condition:
-a trial CSV (then --stimulus, --response and --cycle-length say how to estimate its FRF, as
-posturelab frf does) or the JSON that posturelab frf --json writes. --free NAMES (comma
-separated) are shared by the conditions, --per-condition NAMES take one value per condition.
+a trial CSV (then --stimulus, --response, --cycle-length and --response-sign say how to
+estimate its FRF, as posturelab frf does), the JSON that posturelab frf --json writes, or a
+table as JSON: {{"frequency": [Hz], "gain": [...], "phase_deg": [...]}} with optional
+"gain_se" and "phase_se_deg" (standard errors of gain [-] and phase [deg], as published
+group means give them), or "frf_se" (standard error of the complex value), "dof" and
+"coherence". --free NAMES (comma separated) are shared by the conditions, --per-condition
+NAMES take one value per condition.
 Names (the parameter table's, as for sweep --vary and fit --free): stiffness:PAIR,
 viscosity:PAIR (intrinsic), active_stiffness:PAIR, active_viscosity:PAIR (:PAIR may be left
 out on a body with one pair), feedback_delay, proprioceptive_weight. The body and the
 starting values come from the options below (as in posturelab simulate); --bounds
-NAME=LO:HI,... narrows the defaults (gains 0 … 1e5, delay 0 … {MAX_FEEDBACK_DELAY:g} s,
-W 0 … 1) within the table's bounds (docs/parameters.md).
+NAME=LO:HI,... replaces the defaults (gains 0 … 1e5, delay 0 … {MAX_FEEDBACK_DELAY:g} s,
+W 0 … 1); each must lie within the table's bounds (docs/parameters.md).
 
-Objective: the complex error against each band, weighted by its 95 % bound (posturelab.
-frequency.fit); a trial's model FRF is averaged over each band's harmonics with the
-stimulus's power, as its estimate is (a JSON FRF has no harmonics: the model is taken at the
-band frequencies). Prints each parameter with its standard error and 95 % interval, the fit
-error (the RMS weighted residual, about 1 when the model explains the data within its
-noise), and parameters the data cannot determine; warns when a band's coherence is below 0.5.
+Weighting (printed, and "weighting" in --json; posturelab.frequency.fit): every band by
+its own precision: a trial's by the variance of its estimate from the scatter of its
+cycles (bands that share harmonics correlated), a table's by its standard errors; a table
+without them by 1/|H| (then said, and the fit error cannot test the model). A trial's
+model FRF is averaged over each band's harmonics with the stimulus's power, as its
+estimate is (frf --json carries them, so its JSON fits as its trial does; a table without
+them: the model at the band frequencies).
+Prints each parameter with its standard error and 95 % interval, the fit error (√(χ²/dof),
+about 1 when the model explains the data within their noise), and parameters the data
+cannot determine; when the fit error is too large for chance (p < 0.001) it says the
+model does not describe the data and widens the intervals by a model error it states;
+warns when a band's coherence is below 0.5. Bounds must lie within each parameter's range;
+a name given twice or a bound for a parameter not fitted is refused.
 
 Example: posturelab fit-frf --data trial.csv --stimulus tilt --response com_angle \\
              --cycle-length 20 --discard-cycles 1 --controller peterka-2002 \\
@@ -49,6 +60,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--response", metavar="COLUMN", help="response column of a trial CSV.")
     p.add_argument("--cycle-length", type=float, metavar="SECONDS", help="of a trial CSV [s].")
     p.add_argument("--discard-cycles", type=int, default=0, metavar="N")
+    p.add_argument("--response-sign", choices=["-1", "+1", "1"], default="-1",
+                   help="multiply a trial's response by this (default -1: posturelab's tilt "
+                   "convention, as posturelab frf).")
     p.add_argument("--input", choices=["tilt", "translation"], default="tilt")
     p.add_argument("--output", default="com_angle", metavar="NAME",
                    help="the model output the response is (default com_angle).")
@@ -64,41 +78,46 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def _condition(path: str, args: argparse.Namespace):
-    import json
-
-    import numpy as np
-
-    from .._files import read_text
-    from ..frequency.estimate import FRFEstimate
-
     if path.lower().endswith(".json"):
-        try:
-            obj = json.loads(read_text(path, "FRF JSON"))
-            f = np.array(obj["frequency"], dtype=float)
-            H = np.array([complex(z["re"], z["im"]) for z in obj["frf"]])
-            coh = np.array(obj["coherence"], dtype=float)
-            gci = np.array([[np.nan if v is None else v for v in pair]
-                            for pair in obj["gain_ci95"]], dtype=float)
-        except (OSError, ValueError, KeyError, TypeError) as exc:
-            raise ParameterError(f"--data {path!r} is not an FRF JSON of posturelab frf: "
-                                 f"{exc}") from None
-        if not (f.size == H.size == coh.size == gci.shape[0]) or not np.all(np.isfinite(H)):
-            raise ParameterError(f"--data {path!r}: frequency, frf, coherence and gain_ci95 "
-                                 "must have one finite entry per band")
-        phase = np.degrees(np.unwrap(np.angle(H)))
-        return FRFEstimate(f, H, np.abs(H), phase, coh, gci, np.full(gci.shape, np.nan),
-                           np.zeros(f.size, int), (), 0, 0.0, np.zeros(0), np.zeros(0))
+        from ..frequency.table import read_frf_json
+
+        return read_frf_json(path, "--data FRF JSON")
+    from .._validation import float_in_range
     from ..frequency.data import read_series_csv
     from ..frequency.estimate import estimate_frf
     from .frf import response_sign, whole_cycles
 
     if args.stimulus is None or args.response is None or args.cycle_length is None:
         raise ParameterError("a trial CSV needs --stimulus, --response and --cycle-length")
+    float_in_range("--cycle-length [s]", args.cycle_length, 1e-3, 1e5, unit="s")
     stim, resp = args.stimulus.strip().lower(), args.response.strip().lower()
     fs, cols = read_series_csv(path, [stim, resp])
     x, y, _ = whole_cycles(cols[stim], cols[resp], fs, args.cycle_length)
     return estimate_frf(x, y, fs, args.cycle_length, discard_cycles=args.discard_cycles,
-                        response_sign=response_sign(stim, resp, "auto"))
+                        response_sign=response_sign(args.response_sign))
+
+
+def _plottable(c):
+    """What plot_bode draws of a condition: a table's 95 % bounds from its standard errors
+    (none without), its coherence NaN when not given."""
+    from types import SimpleNamespace
+
+    import numpy as np
+
+    from ..frequency.table import FRFTable
+
+    if not isinstance(c, FRFTable):
+        return c
+    nan = np.full(c.frequency.size, np.nan)
+    if c.gain_se is not None:
+        gci = np.stack([c.gain - 1.96 * c.gain_se, c.gain + 1.96 * c.gain_se], axis=1)
+        pci = np.stack([c.phase_deg - 1.96 * c.phase_se_deg,
+                        c.phase_deg + 1.96 * c.phase_se_deg], axis=1)
+    else:
+        gci = pci = np.stack([nan, nan], axis=1)
+    return SimpleNamespace(frequency=c.frequency, gain=c.gain, phase_deg=c.phase_deg,
+                           coherence=nan if c.coherence is None else c.coherence,
+                           gain_ci95=gci, phase_ci95_deg=pci)
 
 
 def _names(text: str) -> list[str]:
@@ -111,16 +130,20 @@ def _bounds(text: str) -> dict:
         name, _, rng = item.partition("=")
         parts = rng.split(":")
         try:
+            if len(parts) != 2:
+                raise ValueError
             lo, hi = float(parts[0]), float(parts[1])
-        except (IndexError, ValueError):
+        except ValueError:
             raise ParameterError(f"--bounds must be NAME=LO:HI,..., got {item!r}") from None
+        if name in out:
+            raise ParameterError(f"--bounds names {name!r} twice")
         out[name] = (lo, hi)
     return out
 
 
 def run(args: argparse.Namespace) -> int:
     from .._files import refuse_input_as_output
-    from ..frequency.fit import fit_frf
+    from ..frequency.fit import check_fit_request, fit_frf
     from .frf import check_plot_path
 
     refuse_input_as_output({"--data": args.data}, {"--plot": args.plot})
@@ -128,10 +151,8 @@ def run(args: argparse.Namespace) -> int:
     body = body_from_args(args)
     muscles = muscles_from_args(args, body)
     options = feedback_options_from_args(args)
-    from ..frequency.fit import _name
-
-    for name in [*_names(args.free), *_names(args.per_condition), *_bounds(args.bounds)]:
-        _name(name, muscles)  # the names first, before any FRF is estimated
+    check_fit_request(muscles, _names(args.free), _names(args.per_condition),
+                      _bounds(args.bounds))  # the names first, before any data are read
     conditions = [_condition(path, args) for path in args.data]
     fit = fit_frf(body, muscles, conditions, _names(args.free), input=args.input,
                   output=args.output.strip().lower(),
@@ -143,19 +164,40 @@ def run(args: argparse.Namespace) -> int:
 
         from ..viz.plots import plot_bode, save_figure
 
-        labels = [Path(p).name for p in args.data]
+        labels = [Path(p).name + ("" if getattr(c, "response_sign", None) is None
+                                  else f" (response × {int(c.response_sign):+d})")
+                  for p, c in zip(args.data, conditions, strict=True)]
         curves = [(f, h, f"fit: {label}") for (f, h), label in zip(fit.curves, labels,
                                                                      strict=True)]
-        save_figure(plot_bode(conditions, labels, model=curves), args.plot)
+        save_figure(plot_bode([_plottable(c) for c in conditions], labels, model=curves),
+                    args.plot)
+    signs = sorted({int(c.response_sign) for c in conditions
+                    if getattr(c, "response_sign", None) is not None})
+    from ..frequency.estimate import FRFEstimate, sign_warning
+
+    sign_warnings = [f"--data {p!r}: {w}" for p, c in zip(args.data, conditions, strict=True)
+                     if isinstance(c, FRFEstimate) and (w := sign_warning(c))]
+    if sign_warnings:
+        import sys
+
+        for w in sign_warnings:
+            print(f"warning: {w}", file=sys.stderr)
     if args.json:
-        print_json(fit.to_dict())
+        out = fit.to_dict()
+        print_json({**out, "response_sign": signs,
+                    "warnings": sign_warnings + out["warnings"]})
         return 0
     print(f"fitted {len(fit.names)} parameter(s) to {len(conditions)} condition(s); fit error "
-          f"{fit.fit_error:.3g} (weighted RMS; about 1 when the model explains the data)")
+          f"{fit.fit_error:.3g} (√(χ²/dof); about 1 when the model explains the data)")
+    print(f"weighting: {fit.weighting_text()}")
+    if signs:
+        print("response sign applied: " + ", ".join(f"{v:+d}" for v in signs))
     for name, e, se, (lo, hi), ok in zip(fit.names, fit.estimates, fit.standard_errors,
                                          fit.confidence_intervals, fit.determined,
                                          strict=True):
         note = "" if ok else "   (not determined by these data)"
+        if fit.mismatch:
+            note += "   (model mismatch: the interval includes the systematic part)"
         print(f"  {name:<24} {e:10.4g} ± {se:.3g} {fit.unit(name)}   (95 % CI {lo:.4g} … "
               f"{hi:.4g}){note}")
     for w in fit.warnings:

@@ -20,13 +20,24 @@ The file has a header row and a uniform time column [s] (the sample rate comes f
 --bands peterka (default) averages the 11 bands of an 80-state PRTS (20 s: 0.05 … 2.20 Hz; for
 another cycle length the same harmonic numbers); --bands harmonics gives every odd harmonic.
 
-Sign: a tilt FRF is reported so that a body that follows the surface has gain 1 and phase 0.
-posturelab's angles are positive leaning forward and its tilt positive toes-up, so with
---response-sign auto (default) a response named com_angle or thetaN against a stimulus named
-tilt is negated; otherwise the ratio is as it is. --response-sign 1 or -1 forces it.
+Sign (declared, never guessed from column names): the response is multiplied by
+--response-sign before the ratio, and every output states the sign applied. A tilt FRF is
+reported so that a body that stays perpendicular to the surface has gain 1 and phase 0.
+The default, -1, is posturelab's convention: its files have sway positive leaning forward
+and tilt positive toes-up, so a body following a toes-up tilt reads negative sway. Another
+lab's recording: if a body following the surface reads sway of the same sign as the tilt
+(both in one rotational sense, e.g. both positive toes-up/backward), give --response-sign
++1; if it reads the opposite sign, as posturelab's files do, keep -1. A translation
+stimulus: posturelab's model FRF is y/x, so +1. Unsure: a response that follows a slow
+stimulus reads near 0 deg in the lowest band; a warning (stderr, and "warnings" in --json)
+says when that band's phase lies within 45 deg of +-180 deg with coherence >= 0.8.
 
 --json prints one object: {"frequency": [Hz], "frf": [{"re", "im"}], "gain", "phase_deg",
-"coherence", "gain_ci95": [[low, high]], "phase_ci95_deg": [[low, high]]}.
+"coherence", "gain_ci95": [[low, high]], "phase_ci95_deg": [[low, high]],
+"harmonic_frequency" and "harmonic_weight" (each band's harmonics [Hz] and their share of
+its stimulus power), "frf_se" (standard error of the complex estimate), "dof",
+"frf_covariance" (of the bands), "response_sign", "sign_convention", "warnings"}; an
+undefined number is null. fit-frf reads it back.
 --ci periodic (default) gives bounds exact for a periodic stimulus; --ci otnes-enochson the
 form Peterka used (wider).
 
@@ -51,8 +62,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="frequency bands (default peterka: the 11 of an 80-state PRTS; "
                    "peterka-2002-242: 17 bands for Peterka 2002's 242-state sequence, "
                    "posturelab's placement).")
-    p.add_argument("--response-sign", choices=["auto", "1", "-1"], default="auto",
-                   help="multiply the response (default auto: see above).")
+    p.add_argument("--response-sign", choices=["-1", "+1", "1"], default="-1",
+                   help="multiply the response by this (default -1: posturelab's tilt "
+                   "convention; see above).")
     p.add_argument("--ci", choices=["periodic", "otnes-enochson"], default="periodic",
                    help="form of the 95 %% bounds (default periodic).")
     p.add_argument("--json", action="store_true", help="print one JSON object.")
@@ -68,12 +80,16 @@ def check_plot_path(*paths: str | None) -> None:
     check_writable(given, {p: FIGURE_SUFFIXES for p in given})
 
 
-def response_sign(stimulus: str, response: str, choice: str) -> int:
-    """The sign the response is taken with (``--response-sign``)."""
-    if choice != "auto":
-        return int(choice)
-    angle = response == "com_angle" or (response.startswith("theta") and response[5:].isdigit())
-    return -1 if stimulus == "tilt" and angle else 1
+def response_sign(choice: str) -> int:
+    """The sign the response is taken with (``--response-sign``, declared)."""
+    return -1 if str(choice).strip() == "-1" else 1
+
+
+def sign_convention(sign: int) -> str:
+    """One phrase stating the sign applied."""
+    return ("response × −1 (posturelab's tilt convention: sway forward positive, tilt "
+            "toes-up positive, following the surface reads gain 1, phase 0)" if sign < 0
+            else "response × +1 (as recorded)")
 
 
 def whole_cycles(x, y, sample_rate: float, cycle_length: float):
@@ -88,23 +104,27 @@ def whole_cycles(x, y, sample_rate: float, cycle_length: float):
 
 def run(args: argparse.Namespace) -> int:
     from .._files import refuse_input_as_output
+    from .._validation import float_in_range
     from ..frequency.data import read_series_csv
-    from ..frequency.estimate import estimate_frf
+    from ..frequency.estimate import estimate_frf, sign_warning
 
     refuse_input_as_output({"--data": args.data},
                            {"--plot": args.plot, "--plot-cycles": args.plot_cycles})
     check_plot_path(args.plot, args.plot_cycles)
+    float_in_range("--cycle-length [s]", args.cycle_length, 1e-3, 1e5, unit="s")
     stim, resp = args.stimulus.strip().lower(), args.response.strip().lower()
     fs, cols = read_series_csv(args.data, [stim, resp])
-    sign = response_sign(stim, resp, args.response_sign)
+    sign = response_sign(args.response_sign)
     x, y, trimmed = whole_cycles(cols[stim], cols[resp], fs, args.cycle_length)
     est = estimate_frf(x, y, fs, args.cycle_length,
                        discard_cycles=args.discard_cycles, bands=args.bands,
                        response_sign=sign, ci=args.ci)
+    warning = sign_warning(est)
+    label = f"{'−' if sign < 0 else ''}{resp} / {stim} (response × {sign:+d})"
     if args.plot:
         from ..viz.plots import plot_bode, save_figure
 
-        save_figure(plot_bode([est], [f"{resp} / {stim}"]), args.plot)
+        save_figure(plot_bode([est], [label]), args.plot)
     if args.plot_cycles:
         from ..viz.plots import plot_prts_cycles, save_figure
 
@@ -116,18 +136,25 @@ def run(args: argparse.Namespace) -> int:
                                      response_label=("−" if sign < 0 else "") + resp,
                                      stimulus_unit=unit(stim), response_unit=unit(resp)),
                     args.plot_cycles)
+    if warning:
+        import sys
+
+        print(f"warning: {warning}", file=sys.stderr)
     if args.json:
-        print_json(est.to_dict())
+        print_json({**est.to_dict(), "sign_convention": sign_convention(sign),
+                    "warnings": [warning] if warning else []})
         return 0
-    print(f"FRF of {resp}{' (negated)' if sign < 0 else ''} to {stim}: {est.n_cycles} cycles "
+    print(f"FRF of {resp} to {stim}, {sign_convention(sign)}: {est.n_cycles} cycles "
           f"of {est.cycle_length:g} s at {fs:g} Hz, {len(est.bands)} bands"
           + (" (the record's end point, one sample past the last cycle, left out)"
              if trimmed else ""))
     print(f"{'f [Hz]':>8} {'gain':>10} {'phase [deg]':>12} {'coherence':>10}  gain 95 %")
     for k in range(est.frequency.size):
         lo, hi = est.gain_ci95[k]
+        bound = (f"{lo:.4g} … {hi:.4g}" if math.isfinite(lo) and math.isfinite(hi)
+                 else f"undefined (n_d = {est.averages[k]})")
         print(f"{est.frequency[k]:8.3f} {est.gain[k]:10.4g} {est.phase_deg[k]:12.1f} "
-              f"{est.coherence[k]:10.3f}  {lo:.4g} … {hi:.4g}")
+              f"{est.coherence[k]:10.3f}  {bound}")
     low = est.coherence < 0.5
     if low.any():
         print(f"warning: coherence below 0.5 at {int(low.sum())} band(s): those estimates are "

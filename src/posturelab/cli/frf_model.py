@@ -27,7 +27,11 @@ frequencies of the 11 bands of an 80-state PRTS (--bands peterka, for --cycle-le
 default 20) or of a named sequence's bands (--bands peterka-2002-242: 17 bands of the 242-state
 sequence, cycle 60.5 s by default; posturelab.frequency.bands.SEQUENCE_BANDS).
 
---json prints one object: {"frequency": [Hz], "frf": [{"re", "im"}], "gain", "phase_deg"}.
+A loop unstable about upright at its delay has no measurable FRF (a periodic-stimulus
+experiment on it would fall): frf-model refuses it (exit 2, the rightmost root named).
+
+--json prints one object: {"frequency": [Hz], "frf": [{"re", "im"}], "gain", "phase_deg",
+"sign_convention"}.
 
 Example: posturelab frf-model --controller peterka-2002 --bands peterka --json
 """
@@ -56,6 +60,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     import numpy as np
 
+    from .._validation import float_in_range
     from ..frequency.bands import PETERKA_BAND_HARMONICS, SEQUENCE_BANDS, band_frequencies
     from ..frequency.model import model_frf
 
@@ -64,28 +69,36 @@ def run(args: argparse.Namespace) -> int:
     options = feedback_options_from_args(args)
     if args.frequencies is not None:
         f = np.array(parse_float_list(args.frequencies, "--frequencies [Hz]"))
-        if np.any(f <= 0) or f.size > 100_000:
-            raise ParameterError("--frequencies [Hz] must be 1 … 100,000 values > 0")
+        if np.any(f <= 0) or np.any(f > 1e4) or f.size > 100_000:
+            raise ParameterError("--frequencies [Hz] must be 1 … 100,000 values in (0, 1e4] Hz")
     else:
         bands = SEQUENCE_BANDS.get(args.bands, PETERKA_BAND_HARMONICS)
         cycle = args.cycle_length
         if cycle is None:
             cycle = 60.5 if args.bands == "peterka-2002-242" else 20.0
-        if not (np.isfinite(cycle) and cycle > 0):
-            raise ParameterError(f"--cycle-length [s] must be > 0, got {cycle:g}")
+        float_in_range("--cycle-length [s]", cycle, 1e-3, 1e5, unit="s")
         f = band_frequencies(bands, cycle)
+    from ..linear.verdict import upright_verdict
+
+    verdict = upright_verdict(body, muscles, options.get("feedback_delay", 0.0))
+    if not verdict.side(engaged=True).status == "stable":
+        raise ParameterError(f"the loop is {verdict.describe()}: its FRF is not measurable "
+                             "(a periodic-stimulus experiment would fall); change the gains "
+                             "or --feedback-delay")
     H = model_frf(body, muscles, f, input=args.input, output=args.output.strip().lower(),
                   feedback_delay=options.get("feedback_delay", 0.0),
                   proprioceptive_weight=options.get("proprioceptive_weight", 1.0))
     phase = np.degrees(np.unwrap(np.angle(H)))
+    sign = ("−y/α (the literature's tilt sign: a body that follows the surface reads gain 1, "
+            "phase 0)" if args.input == "tilt" else "y/x (as the output is, per metre)")
     if args.json:
         print_json({"frequency": [float(v) for v in f],
                     "frf": [{"re": float(h.real), "im": float(h.imag)} for h in H],
                     "gain": [float(abs(h)) for h in H],
-                    "phase_deg": [float(p) for p in phase]})
+                    "phase_deg": [float(p) for p in phase], "sign_convention": sign})
         return 0
     unit = "" if args.input == "tilt" else " [rad/m]"
-    print(f"model FRF of {args.output} to {args.input}{unit}")
+    print(f"model FRF of {args.output} to {args.input}{unit}, {sign}")
     print(f"{'f [Hz]':>8} {'gain':>10} {'phase [deg]':>12}")
     for fk, h, p in zip(f, H, phase, strict=True):
         print(f"{fk:8.3f} {abs(h):10.4g} {p:12.1f}")

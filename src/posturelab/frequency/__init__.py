@@ -2,12 +2,14 @@
 
 :mod:`.bands` states the stimulus harmonics and Peterka's frequency bands, :mod:`.estimate`
 estimates an FRF with coherence and 95 % bounds from measured series, :mod:`.model` computes
-the linearised model's FRF exactly (the delay as e^{−sτ}).
+the linearised model's FRF exactly (the delay as e^{−sτ}), :mod:`.table` holds FRFs given as
+gain and phase (published tables), :mod:`.fit` fits a controller to either.
 """
 
 from .bands import PETERKA_BAND_HARMONICS, band_frequencies, harmonic_bands, peterka_bands
 from .estimate import FRFEstimate, estimate_frf
 from .model import model_frf
+from .table import FRFTable
 
 __all__ = ["PETERKA_BAND_HARMONICS", "band_frequencies", "harmonic_bands", "peterka_bands",
-           "FRFEstimate", "estimate_frf", "model_frf"]
+           "FRFEstimate", "estimate_frf", "model_frf", "FRFTable"]

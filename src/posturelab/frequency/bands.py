@@ -105,8 +105,19 @@ def check_bands(bands, n_available: int) -> tuple[tuple[int, ...], ...]:
     """Bands as tuples of 1-based odd-harmonic numbers, each within the first ``n_available``
     (those below the Nyquist frequency of the record)."""
     out = []
+    try:
+        bands = list(bands)
+    except TypeError:
+        raise ParameterError(f"bands must be a list of lists of odd-harmonic numbers, got "
+                             f"{bands!r}"[:200]) from None
     for i, band in enumerate(bands):
-        members = tuple(int(k) for k in band)
+        try:
+            if any(isinstance(k, bool) or int(k) != k for k in band):
+                raise ValueError
+            members = tuple(int(k) for k in band)
+        except (TypeError, ValueError, OverflowError):
+            raise ParameterError(f"band {i + 1} must list whole odd-harmonic numbers, got "
+                                 f"{band!r}"[:200]) from None
         if not members or any(k < 1 or k > n_available for k in members):
             raise ParameterError(f"band {i + 1} must list odd-harmonic numbers in 1 … "
                                  f"{n_available}, got {list(band)}")

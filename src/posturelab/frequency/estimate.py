@@ -15,7 +15,12 @@ radius r·|H|. For a periodic stimulus (the same PRTS every cycle) and noise in 
 degrees of freedom, so (``bounds="periodic"``, the default; e.g. Pintelon and Schoukens,
 *System Identification: A Frequency Domain Approach*, 2nd ed. 2012, ch. 2)
 
-    r² = F_{0.95}(2, 2 n_d − 2) / (n_d − 1) · (1 − γ²) / γ².
+    r² = F_{0.95}(2, 2 n_d − 2) / (n_d − 1) · (1 − γ²) / γ²,
+
+defined from n_d = 2 on (two cycles of a one-harmonic band: F_{0.95}(2, 2) = 19). The same
+form, with the same F quantiles tabulated (19.0 for two cycles of a one-point band), is
+the one of COMTEST's analysis (Eurobench; github.com/VittorioFreiburg/COMTEST,
+ANALYSIS/MATLAB/PRTS2020.m: r = √(2(1 − γ²) F / (dof − 2) · G_yy/G_xx), dof = 2 n_d).
 
 ``bounds="otnes-enochson"`` gives the form Peterka 2002 used (after Otnes and Enochson 1972;
 Bendat and Piersol, *Random Data*, 4th ed. 2010, §9.2.4), r² = 2/(n_d − 2) · F_{0.95}(2,
@@ -24,6 +29,28 @@ wider (the tests measure 95 % coverage of the circle for the first, over 99.9 % 
 The gain bounds are |H|(1 ± r) (the lower clipped at 0), the phase bounds ±asin(r) (±180°
 when r >= 1). Phase [deg] is unwrapped across the bands from the first, which lies in
 (−180°, 180°].
+
+Precision per band (what :func:`posturelab.frequency.fit_frf` weights by): the band's
+Ĥ = Σ_j G_j Ĥ_j / Σ_j G_j over its harmonics j (G_j = Σ_c |X_cj|² over the C cycles,
+Ĥ_j = Σ_c X̄_cj Y_cj / G_j) has, for noise of variance σ² in the response spectrum about the
+band, E|Ĥ − H|² = σ² / Σ_j G_j. σ² is estimated from the scatter of the cycles about the
+periodic response, s_j² = Σ_c |Y_cj − Ĥ_j X_cj|² / (C − 1) with 2(C − 1) degrees of
+freedom at each DFT bin j (the sample variance over periods: Pintelon and Schoukens,
+*System Identification*, 2nd ed. 2012, ch. 2; Schoukens, Godfrey and Schoukens 2018, IEEE
+Control Syst Mag 38(4):49–88). σ² at harmonic j pools the bins about it (excited or not),
+widened until they hold at least ``POOLED_DOF`` = 20 degrees of freedom: a power law
+a·(f/f_j)^b fitted to ln s² over them (least squares; ln s² is biased by
+ψ(C − 1) − ln(C − 1), which is removed), so that a noise spectrum falling with frequency,
+as sway driven by motor noise does, is not averaged flat (with 2 cycles a flat mean put
+the lowest band's variance at half and the mid bands' at 1.5× their spread over 80 seeded
+runs). ``dof`` ν = 2(C − 1) × the bins about the band. The pooling (posturelab's choice:
+it assumes the noise spectrum is smooth over those few bins) is what keeps the weights of
+the lowest bands usable with 2 or 3 cycles, where one harmonic alone gives 2 or 4 degrees
+of freedom. Unlike the band coherence, this does not count the FRF's variation across a
+band's harmonics as noise (noise-free, a multi-harmonic band has γ² < 1 but a variance of
+0). Bands that share harmonics are correlated: ``covariance`` = Σ_{j in both} G_j σ_j² /
+(Σ_a G · Σ_b G), σ_j² the pooled noise about harmonic j (a fit that took Peterka's
+overlapping bands as independent gave intervals 1.25× too narrow).
 
 Sign: ``response_sign`` multiplies the response first. posturelab reports tilt FRFs so that a
 body that follows the surface has H = 1 (gain 1, phase 0): its angles are positive leaning
@@ -44,6 +71,8 @@ from .bands import band_frequencies, resolve_bands
 
 __all__ = ["FRFEstimate", "estimate_frf", "confidence_radius", "BOUNDS", "MAX_SAMPLES"]
 
+#: Degrees of freedom the noise estimate of a band pools at least (module notes). [-]
+POOLED_DOF = 20
 #: Most samples a record may have. [-]
 MAX_SAMPLES = 50_000_000
 
@@ -83,6 +112,16 @@ class FRFEstimate:
     harmonic_weight : tuple of numpy.ndarray
         Per band, the stimulus auto-spectrum at them: a noise-free linear system's band FRF
         is Σ w H(f) / Σ w over them (:meth:`band_average`). [stimulus unit²]
+    variance : numpy.ndarray, shape (B,)
+        E|Ĥ − H|² estimated from the cycle-to-cycle scatter (module notes); empty when not
+        known. [(response unit / stimulus unit)²]
+    dof : numpy.ndarray, shape (B,)
+        Its degrees of freedom ν. [-]
+    response_sign : float
+        The sign the response was multiplied by. [-]
+    covariance : numpy.ndarray, shape (B, B)
+        E[(Ĥ_a − H_a)(Ĥ_b − H_b)*]: bands that share harmonics (Peterka's do) are
+        correlated (module notes). [(response unit / stimulus unit)²]
     """
 
     frequency: np.ndarray
@@ -100,6 +139,10 @@ class FRFEstimate:
     cycle_response: np.ndarray = field(repr=False)
     harmonic_frequency: tuple = field(default=(), repr=False)
     harmonic_weight: tuple = field(default=(), repr=False)
+    variance: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
+    dof: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
+    response_sign: float = 1.0
+    covariance: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)), repr=False)
 
     def band_average(self, frf_at) -> np.ndarray:
         """The band FRF a noise-free linear system with FRF ``frf_at(f)`` [f in Hz, vectorised]
@@ -115,10 +158,25 @@ class FRFEstimate:
 
     def to_dict(self) -> dict:
         """The JSON of ``posturelab frf`` (frequency [Hz], FRF as {re, im}, gain, phase [deg],
-        coherence, 95 % bounds as [low, high] pairs; null where not defined)."""
+        coherence, 95 % bounds as [low, high] pairs, each band's harmonics [Hz] and their
+        share of the band's stimulus power (for a fit's band average), the standard error of
+        the complex estimate √var, its degrees of freedom and the bands' covariance; null
+        where not defined)."""
         def num(v):
             return None if not math.isfinite(v) else float(v)
 
+        extra = {}
+        if self.harmonic_weight:
+            extra["harmonic_frequency"] = [[float(f) for f in fs]
+                                           for fs in self.harmonic_frequency]
+            extra["harmonic_weight"] = [[float(w / np.sum(ws)) for w in ws]
+                                        for ws in self.harmonic_weight]
+        if self.variance.size:
+            extra.update({"frf_se": [num(math.sqrt(v)) for v in self.variance],
+                          "dof": [num(v) for v in self.dof]})
+        C = self.covariance
+        if C.shape == (self.frf.size,) * 2 and np.any(C - np.diag(np.diag(C))):
+            extra["frf_covariance"] = [[num(v) for v in row] for row in C]  # overlapping bands
         return {
             "frequency": [float(f) for f in self.frequency],
             "frf": [{"re": float(h.real), "im": float(h.imag)} for h in self.frf],
@@ -127,6 +185,8 @@ class FRFEstimate:
             "coherence": [float(c) for c in self.coherence],
             "gain_ci95": [[num(lo), num(hi)] for lo, hi in self.gain_ci95],
             "phase_ci95_deg": [[num(lo), num(hi)] for lo, hi in self.phase_ci95_deg],
+            **extra,
+            "response_sign": int(self.response_sign),
         }
 
 
@@ -135,15 +195,22 @@ BOUNDS = ("periodic", "otnes-enochson")
 
 
 def confidence_radius(coherence, averages, bounds: str = "periodic") -> np.ndarray:
-    """r of the 95 % circle about H relative to |H| (module notes); NaN where n_d <= 2."""
+    """r of the 95 % circle about H relative to |H| (module notes); NaN where n_d < 2
+    (periodic) or n_d <= 2 (otnes-enochson)."""
     from scipy.stats import f as fisher
 
     if bounds not in BOUNDS:
         raise ParameterError(f"bounds must be one of {', '.join(BOUNDS)}, got {bounds!r}")
-    g = np.clip(np.asarray(coherence, dtype=float), 1e-300, 1.0)
-    n = np.asarray(averages, dtype=float)
+    try:
+        g = np.clip(np.asarray(coherence, dtype=float), 1e-300, 1.0)
+        n = np.asarray(averages, dtype=float)
+    except (TypeError, ValueError):
+        raise ParameterError(f"coherence and averages must be numbers, got {coherence!r}, "
+                             f"{averages!r}"[:200]) from None
+    if not (np.all(np.isfinite(g)) and np.all(np.isfinite(n))):
+        raise ParameterError("coherence and averages must be finite")
     out = np.full(np.broadcast(g, n).shape, np.nan)
-    ok = np.broadcast_to(n, out.shape) > 2
+    ok = np.broadcast_to(n, out.shape) >= (2 if bounds == "periodic" else 3)
     if np.any(ok):
         nn = np.broadcast_to(n, out.shape)[ok]
         gg = np.broadcast_to(g, out.shape)[ok]
@@ -155,9 +222,22 @@ def confidence_radius(coherence, averages, bounds: str = "periodic") -> np.ndarr
     return out
 
 
+#: Largest |value| a stimulus or response sample may have (its spectra must stay finite).
+MAX_ABS_SAMPLE = 1e100
+
+
 def _trials(values, label: str) -> list[np.ndarray]:
-    arrays = values if isinstance(values, list | tuple) else [values]
-    out = [finite_array(label, a, (None,)) for a in arrays]
+    arrays = values if isinstance(values, list | tuple) and values and isinstance(
+        values[0], list | tuple | np.ndarray) else [values]
+    out = []
+    for a in arrays:
+        if np.asarray(a).dtype == bool:
+            raise ParameterError(f"{label} must be numbers, not booleans")
+        x = finite_array(label, a, (None,))
+        if x.size and np.max(np.abs(x)) > MAX_ABS_SAMPLE:
+            raise ParameterError(f"{label} has a value of {np.max(np.abs(x)):g}; at most "
+                                 f"{MAX_ABS_SAMPLE:g} in size")
+        out.append(x)
     if not out:
         raise ParameterError(f"{label}: give at least one trial")
     return out
@@ -193,7 +273,7 @@ def estimate_frf(stimulus, response, sample_rate: float, cycle_length: float, *,
     """
     fs = float_in_range("sample rate [Hz]", sample_rate, 1e-3, 1e7, unit="Hz")
     T = float_in_range("cycle length [s]", cycle_length, 1e-3, 1e5, unit="s")
-    if response_sign not in (1, -1, 1.0, -1.0):
+    if isinstance(response_sign, bool) or response_sign not in (1, -1, 1.0, -1.0):
         raise ParameterError(f"response_sign must be 1 or -1, got {response_sign!r}")
     if isinstance(discard_cycles, bool) or not isinstance(discard_cycles, int | np.integer) \
             or discard_cycles < 0:
@@ -248,6 +328,7 @@ def estimate_frf(stimulus, response, sample_rate: float, cycle_length: float, *,
         coh = np.where(Gyy > 0, np.abs(Gxy) ** 2 / (Gxx * Gyy), 0.0)
     coh = np.clip(coh, 0.0, 1.0)
     averages = np.array([n_cycles * b.size for b in bins])
+    variance, dof, covariance = band_variance(X, Y, bins)
     r = confidence_radius(coh, averages, ci)
     gain = np.abs(H)
     phase = np.degrees(np.unwrap(np.angle(H)))
@@ -257,4 +338,71 @@ def estimate_frf(stimulus, response, sample_rate: float, cycle_length: float, *,
     return FRFEstimate(band_frequencies(chosen, T), H, gain, phase, coh, gain_ci, phase_ci,
                        averages, chosen, int(n_cycles), T,
                        np.concatenate(cx).mean(axis=0), np.concatenate(cy).mean(axis=0),
-                       tuple(b / T for b in bins), tuple(Gxx_h[b] for b in bins))
+                       tuple(b / T for b in bins), tuple(Gxx_h[b] for b in bins),
+                       variance, dof, float(response_sign), covariance)
+
+
+def band_variance(X: np.ndarray, Y: np.ndarray, bins) -> tuple[np.ndarray, ...]:
+    """var of each band's Ĥ, its degrees of freedom and the bands' covariance (B, B), from
+    the scatter of the cycles' spectra ``X``, ``Y`` (C, bins) about the periodic response
+    at the DFT bins about each harmonic (module notes)."""
+    C, n = X.shape
+    G = np.sum(np.abs(X) ** 2, axis=0)
+    scale = max(float(G.max()), 1e-300)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        fit = np.where(G > 1e-20 * scale, np.sum(np.conj(X) * Y, axis=0) / G, 0.0)
+    periodic = np.where(G > 1e-20 * scale, fit * X, Y.mean(axis=0))
+    s2 = np.sum(np.abs(Y - periodic) ** 2, axis=0) / (C - 1)
+    least = int(math.ceil(POOLED_DOF / (2.0 * (C - 1))))
+    top = n - 2  # bins 1 … n − 2: neither the mean nor the Nyquist bin
+
+    def window(lo: int, hi: int) -> tuple[int, int]:
+        while hi - lo + 1 < least and (lo > 1 or hi < top):
+            lo, hi = (lo - 1 if lo > 1 else lo), (hi + 1 if hi < top else hi)
+        return lo, hi
+
+    from scipy.special import digamma
+
+    # E[ln s²] = ln σ² + ψ(C − 1) − ln(C − 1) for s² ~ σ² χ²_{2(C−1)} / (2(C − 1))
+    log_bias = float(digamma(C - 1) - math.log(C - 1))
+    noise = {}  # σ² at each harmonic used: a power law in f fitted to ln s² about it
+    for j in sorted({int(j) for b in bins for j in b}):
+        lo, hi = window(j, j)
+        k = np.arange(lo, hi + 1)
+        ok = s2[k] > 0
+        if ok.sum() < 3:
+            noise[j] = s2[lo:hi + 1].mean()
+            continue
+        slope, level = np.polyfit(np.log(k[ok] / j), np.log(s2[k][ok]), 1)
+        noise[j] = math.exp(level - log_bias)
+    B = len(bins)
+    cov = np.zeros((B, B))
+    dof = []
+    for a, ba in enumerate(bins):
+        lo, hi = window(int(ba.min()), int(ba.max()))
+        dof.append(2.0 * (C - 1) * (hi - lo + 1))
+        for c in range(a, B):
+            shared = set(map(int, ba)) & set(map(int, bins[c]))
+            cov[a, c] = cov[c, a] = sum(G[j] * noise[j] for j in shared) / (
+                G[ba].sum() * G[bins[c]].sum())
+    return np.diag(cov).copy(), np.array(dof), cov
+
+
+#: The sign warning's thresholds: the lowest band's phase within this of ±180° [deg] with
+#: at least this coherence [-] (:func:`sign_warning`).
+SIGN_WARNING_PHASE = 45.0
+SIGN_WARNING_COHERENCE = 0.8
+
+
+def sign_warning(est: FRFEstimate) -> str | None:
+    """A one-line warning when the lowest band's phase lies within ``SIGN_WARNING_PHASE`` of
+    ±180° with coherence at least ``SIGN_WARNING_COHERENCE``: a postural response follows a
+    slow stimulus near 0°, so the response is then probably in the opposite sign
+    convention; None otherwise."""
+    phase = float(np.degrees(np.angle(est.frf[0])))
+    if abs(phase) >= 180.0 - SIGN_WARNING_PHASE and est.coherence[0] >= SIGN_WARNING_COHERENCE:
+        return (f"the lowest band ({est.frequency[0]:.3g} Hz) has phase {phase:.0f} deg with "
+                f"coherence {est.coherence[0]:.2f}: the response sign "
+                f"({int(est.response_sign):+d}) is probably the opposite of this recording's "
+                "convention (check --response-sign)")
+    return None

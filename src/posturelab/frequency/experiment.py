@@ -78,14 +78,21 @@ def prts_experiment(body, muscles, *, tilt=None, cycles: int = 5, discard: int =
     from ..model.tilt import PRTSTilt
     from ..simulation.engines import simulate
 
+    if not isinstance(output, str):
+        raise ParameterError(f"output must be com_angle or thetaN, got {output!r}")
     tilt = PRTSTilt.named("posturelab-80", 0.035) if tilt is None else tilt
     if not isinstance(tilt, PRTSTilt):
         raise ParameterError("tilt must be a PRTSTilt (a periodic stimulus)")
     for name, value, least in (("cycles", cycles, 2), ("discard", discard, 0)):
         if isinstance(value, bool) or not isinstance(value, int) or value < least:
             raise ParameterError(f"{name} must be an integer >= {least}, got {value!r}")
-    if not (np.isfinite(sensor_noise) and sensor_noise >= 0):
-        raise ParameterError(f"sensor_noise [rad] must be >= 0, got {sensor_noise!r}")
+    from .._validation import float_in_range
+    from .population import MAX_RECORD_RATE, MAX_SENSOR_NOISE
+
+    float_in_range("sensor_noise [rad]", sensor_noise, 0.0, MAX_SENSOR_NOISE, unit="rad")
+    float_in_range("sample_rate [Hz]", sample_rate, 1.0, MAX_RECORD_RATE, unit="Hz")
+    if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0:
+        raise ParameterError(f"seed must be an integer >= 0, got {seed!r}")
     total = tilt.cycle * (cycles + discard)
     r = simulate(body, muscles, None, total, tilt=tilt, sample_rate=sample_rate,
                  engine="compiled", **run_options)

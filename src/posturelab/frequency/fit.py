@@ -12,28 +12,59 @@ one pair):
 Every other parameter keeps the value of the starting ``muscles`` and options. With several
 conditions (for example tilts of different amplitudes) the ``free`` parameters are shared
 and the ``per_condition`` ones take a value per condition (Peterka 2002 let W vary with the
-stimulus amplitude).
+stimulus amplitude). Names and bounds are the parameter table's
+(:mod:`posturelab.parameters`): a bound must lie within its parameter's range there; a name
+given twice (in any spelling), or a bound for a parameter not fitted, is refused.
 
 The model's band FRF is averaged over each band's harmonics with the stimulus's power, as
-the estimate is (:meth:`FRFEstimate.band_average`), so that band averaging adds no bias.
+the estimate is (:meth:`FRFEstimate.band_average`), so that band averaging adds no bias
+(taken at the band frequencies instead, the noise-free README trial's fit is off by 2 %
+with a 4 % RMS misfit); a table (:class:`~posturelab.frequency.table.FRFTable`) is averaged
+the same way when it gives its bands' harmonics (``posturelab frf --json`` writes them),
+else the model is taken at its frequencies.
 
-Objective: the complex error of the model against each band's estimate, weighted by that
-band's 95 % bound radius ρ_k = r_k |Ĥ_k| (:mod:`.estimate`), so that every band counts by its
-precision:  Σ_k |H(f_k; p) − Ĥ_k|² / ρ_k²  (real and imaginary parts as residuals; a band
-whose bound is undefined weighs as 1/|Ĥ_k|²). Since ρ ≈ 2.45 σ for the 95 % circle of a
-complex normal error, the weighted residuals have unit variance by construction, and the
-covariance is max(1, s²)(JᵀJ)⁻¹: s², the fit's own residual variance, only inflates it when
-the model does not explain the data (s² computed from the data's own weights runs below 1,
-about 0.5, because bands that happen to scatter more also get wider bounds; taking it at
-face value made the intervals 1.4× too narrow in the tests). The 95 % intervals are t-based.
-A parameter the residuals do not depend on, whose relative standard error exceeds 1, or
-that the Jacobian cannot separate (condition number above 1e10), is reported as not
-determined. Bands with coherence below 0.5 raise a
-warning in ``warnings``.
+Weighting (``FRFFit.weighting`` says which was used), every band by its own precision:
+
+* ``"variance"`` (an :class:`FRFEstimate`, or a table with ``frf_se``): the complex error
+  e = H(f; p) − Ĥ over the bands, whitened by the estimate's band covariance V
+  (:mod:`.estimate`: the noise about each harmonic from the scatter of the cycles, pooled
+  over neighbouring DFT bins to at least 20 degrees of freedom; Peterka's bands share
+  harmonics, so they are correlated): the real and imaginary parts each have covariance
+  V/2, and the fit is generalised least squares (Aitken 1935, Proc R Soc Edinb 55:42–48),
+  Σ = eᵀ(V/2)⁻¹e over both parts, with the covariance (JᵀJ)⁻¹ of the whitened Jacobian. A
+  table's ``frf_se`` gives V = diag(se²), or its ``frf_covariance`` when it has one
+  (``posturelab frf --json``).
+* ``"gain-phase"`` (a table with ``gain_se`` and ``phase_se_deg``, as published group means
+  come): the residuals (|H| − g)/se_g and wrap(arg H − φ)/se_φ, least squares (ν = ∞ unless
+  the table gives ``dof``).
+* ``"relative"`` (a table without standard errors): every band weighted by 1/|Ĥ_k| (its
+  relative error), the noise level then estimated from the residuals themselves
+  (covariance s²(JᵀJ)⁻¹ with s² the residual variance): no test of the model is possible.
+
+Fit error (with precision): each band's statistic is mapped through its own distribution
+(F(2, ν_k) for q_k/2) to the χ²₂ value of the same probability, and the fit error is
+√(Σ χ² / (2B − K)) (B bands over all conditions, K parameters): about 1 when the model
+explains the data within their noise, whatever ν_k. When it is too large for chance
+(the χ² exceeds its 0.999 quantile) the model does not describe the data: the result says
+so (``mismatch``), and the fit is repeated with a relative model error δ added to every
+band's variance (var_k + δ²|Ĥ_k|², and so for gain and phase) with δ chosen so that the
+fit error is 1, and ``model_error`` is δ. That fit's intervals treat the model error as
+random across bands; a systematic one (the nonlinear plant against the linearised model:
+0.1 % at a 0.035 rad PRTS) biases the estimates coherently, so the intervals are widened
+on each side by β_k = δ Σ_b |∂p_k/∂e_b| |Ĥ_b| (``systematic``), the most a model error of
+δ|Ĥ_b| at every band, in any direction, moves parameter k (linearised). The 95 % intervals
+are estimate ± q standard errors (± β_k), q Student's t quantile with the residual dof for
+``"relative"``, else with the fewest degrees of freedom of any band's variance (∞ for known
+standard errors: q = 1.96), a conservative stand-in for the Satterthwaite dof of each
+estimate's variance. A parameter the residuals do not depend on, whose relative standard
+error exceeds 1, or that the Jacobian cannot separate (condition number above 1e10), is
+reported as not determined. Bands with coherence below 0.5 raise a warning in
+``warnings``.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -41,18 +72,32 @@ import numpy as np
 from ..errors import ParameterError
 from ..model.body import Body
 from ..model.muscles import MuscleSet
-from ..parameters import QUANTITIES, check_value, resolve
+from ..parameters import MAX_FEEDBACK_DELAY, QUANTITIES, check_value, resolve
 from ..parameters import unit as parameter_unit
 from .estimate import FRFEstimate
 from .model import model_frf_batch
 
-__all__ = ["FRFFit", "fit_frf", "PARAMETERS"]
+__all__ = ["FRFFit", "fit_frf", "check_fit_request", "PARAMETERS", "WEIGHTINGS",
+           "MISMATCH_P"]
 
 PARAMETERS = ("stiffness", "viscosity", "active_stiffness", "active_viscosity",
               "feedback_delay", "proprioceptive_weight")
 #: The default search interval of each parameter: the table's lower bound to its fit_high.
 _DEFAULT_BOUNDS = {name: (QUANTITIES[name].low, QUANTITIES[name].fit_high)
                    for name in PARAMETERS}
+#: The weightings (module notes).
+WEIGHTINGS = {
+    "variance": "each band by its own variance (generalised least squares with the "
+                "estimate's band covariance, from the cycles' scatter)",
+    "gain-phase": "each band's gain and phase by their given standard errors",
+    "relative": "no per-band precision given: each band by 1/|H| (relative error); the noise "
+                "level estimated from the residuals, so the fit error cannot test the model",
+}
+#: The probability of a fit error this large by chance below which the model is said not to
+#: describe the data. [-]
+MISMATCH_P = 1e-3
+#: Relative floor of a band's standard error (a noise-free record). [-]
+_SE_FLOOR = 1e-12
 
 
 @dataclass(frozen=True)
@@ -70,13 +115,24 @@ class FRFFit:
     determined : numpy.ndarray of bool
         False for a parameter the data cannot determine.
     fit_error : float
-        RMS of the weighted residuals (≈ 1 when the model explains the data within its noise).
+        √(χ²/dof) of the band residuals (module notes; ≈ 1 when the model explains the data
+        within their noise), before any model error was allowed. [-]
     success : bool
     message : str
     warnings : tuple of str
     curves : tuple of (numpy.ndarray, numpy.ndarray)
         Per condition, the fitted model's FRF (complex) on 200 log-spaced frequencies [Hz]
         from a third below the lowest band to a half above the highest (for plots).
+    weighting : str
+        ``"variance"``, ``"gain-phase"`` or ``"relative"`` (module notes); with several
+        conditions weighted differently, their names joined by ``+``.
+    mismatch : bool
+        The fit error is too large for the data's noise: the model does not describe them.
+    model_error : float
+        δ, the relative model error the intervals allow (0 without a mismatch). [-]
+    systematic : numpy.ndarray, shape (K,)
+        β, the most a systematic model error of δ|Ĥ| per band moves each parameter; the
+        intervals are widened by it (0 without a mismatch). [its unit]
     """
 
     names: tuple[str, ...]
@@ -89,20 +145,35 @@ class FRFFit:
     message: str
     warnings: tuple[str, ...] = ()
     curves: tuple = field(default=(), repr=False)
+    weighting: str = "variance"
+    mismatch: bool = False
+    model_error: float = 0.0
+    systematic: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     def unit(self, name: str) -> str:
         """Unit of a fitted parameter."""
         return parameter_unit(name)
 
+    def weighting_text(self) -> str:
+        """One sentence on the weighting used."""
+        return "; ".join(f"{w}: {WEIGHTINGS[w]}" for w in self.weighting.split("+"))
+
     def to_dict(self) -> dict:
-        """Plain-Python summary."""
+        """Plain-Python summary (JSON-safe: a non-finite number is null)."""
+        def num(v):
+            return float(v) if math.isfinite(v) else None
+
         return {"parameters": [
-            {"name": n, "unit": self.unit(n), "estimate": float(e), "standard_error": float(s),
-             "ci95": [float(lo), float(hi)], "determined": bool(d)}
+            {"name": n, "unit": self.unit(n), "estimate": num(e), "standard_error": num(s),
+             "ci95": [num(lo), num(hi)], "determined": bool(d)}
             for n, e, s, (lo, hi), d in zip(self.names, self.estimates, self.standard_errors,
                                              self.confidence_intervals, self.determined,
                                              strict=True)],
-            "fit_error": float(self.fit_error), "success": bool(self.success),
+            "fit_error": num(self.fit_error), "weighting": self.weighting,
+            "weighting_description": self.weighting_text(), "mismatch": bool(self.mismatch),
+            "model_error": num(self.model_error),
+            "systematic": [num(v) for v in self.systematic],
+            "success": bool(self.success),
             "message": self.message, "warnings": list(self.warnings)}
 
 
@@ -116,28 +187,170 @@ def _parse(name: str, muscles: MuscleSet) -> tuple[str, int | None]:
     return base, muscles.names.index(pair) if pair else None
 
 
-def _checked_bounds(bounds, muscles: MuscleSet) -> dict:
-    """``bounds`` keyed by each name's one spelling, every end within the table's bounds."""
+def _canonical(name: str, spec, muscles: MuscleSet) -> str:
+    """The parameter table's one spelling of a parsed name."""
+    base, j = spec
+    return base if j is None else f"{base}:{muscles.names[j]}"
+
+
+def _check_bounds(bounds, muscles: MuscleSet, fitted: dict) -> dict:
+    """``bounds`` as {canonical name: (low, high)}, each for a fitted parameter (``fitted``:
+    canonical name -> base name) and within its range."""
+    if bounds is None:
+        return {}
+    if not isinstance(bounds, dict):
+        raise ParameterError(f"bounds must be a dict of name -> (low, high), got {bounds!r}")
     out = {}
-    for key, (low, high) in dict(bounds or {}).items():
-        name = _name(key, muscles)
-        out[name] = (check_value(name, low, f"bound {name} LO"),
-                     check_value(name, high, f"bound {name} HI"))
+    for given, value in bounds.items():
+        name = _canonical(given, _parse(given, muscles), muscles)
+        if name not in fitted:
+            raise ParameterError(f"bounds given for {given!r}, which is not fitted; fitted: "
+                                 f"{', '.join(fitted)}")
+        if name in out:
+            raise ParameterError(f"bounds given twice for {name!r}")
+        try:
+            lo, hi = (float(v) for v in value)
+        except (TypeError, ValueError):
+            raise ParameterError(f"bounds of {given} must be (low, high), got {value!r}"
+                                 ) from None
+        if any(isinstance(v, bool) for v in value):
+            raise ParameterError(f"bounds of {given} must be numbers, got {value!r}")
+        if not (math.isfinite(lo) and math.isfinite(hi)):
+            raise ParameterError(f"bounds of {given} must be finite, got {lo:g}:{hi:g}")
+        check_value(name, lo, f"bound {name} LO")  # the parameter table's bounds
+        check_value(name, hi, f"bound {name} HI")
+        if not lo < hi:
+            raise ParameterError(f"bounds of {given} must satisfy low < high "
+                                 f"[{parameter_unit(name)}], got {lo:g}:{hi:g}")
+        out[name] = (lo, hi)
     return out
+
+
+@dataclass(frozen=True)
+class _Target:
+    """One condition's data as the objective sees them (module notes)."""
+
+    frf: np.ndarray        # Ĥ, (B,)
+    kind: str              # "variance", "gain-phase" or "relative"
+    sd: np.ndarray         # (2, B): the standard deviations of the two residuals per band
+    dof: np.ndarray        # (B,), inf for known standard errors
+    cov: np.ndarray | None = None  # (B, B) E[ΔĤ ΔĤ*] when the bands are correlated
+
+    def standardised(self, model: np.ndarray, delta: float) -> np.ndarray:
+        """The two residuals per band, whitened, (2, B)."""
+        t = self.frf
+        if self.kind == "gain-phase":
+            g = np.abs(t)
+            sd = np.sqrt(self.sd ** 2 + delta ** 2 * np.stack([g ** 2, np.ones_like(g)]))
+            return np.stack([(np.abs(model) - g), np.angle(model * np.conj(t))]) / sd
+        e = model - t
+        if self.cov is not None:  # each part has covariance cov/2
+            from scipy.linalg import cholesky, solve_triangular
+
+            V = 0.5 * (self.cov + np.diag(2 * self.sd[0] ** 2 - np.diag(self.cov)
+                                          + delta ** 2 * np.abs(t) ** 2))
+            try:
+                low = cholesky(V, lower=True)
+            except np.linalg.LinAlgError:
+                raise ParameterError("the bands' covariance is not positive definite"
+                                     ) from None
+            return np.stack([solve_triangular(low, e.real, lower=True),
+                             solve_triangular(low, e.imag, lower=True)])
+        sd = np.sqrt(self.sd ** 2 + 0.5 * delta ** 2 * np.abs(t) ** 2)
+        return np.stack([e.real, e.imag]) / sd
+
+
+def _target(c, k: int) -> _Target:
+    """The :class:`_Target` of condition ``k`` (an FRFEstimate or an FRFTable)."""
+    from .table import FRFTable
+
+    if np.all(np.abs(np.asarray(c.frf)) == 0):
+        raise ParameterError(f"condition {k + 1}: the FRF is zero at every band (no "
+                             "response): there is nothing to fit")
+    if isinstance(c, FRFEstimate):
+        if not (np.all(np.isfinite(c.frf)) and np.all(np.isfinite(c.frequency))
+                and np.all(np.isfinite(c.coherence))):
+            raise ParameterError(f"condition {k + 1}: the estimate has a non-finite "
+                                 "frequency, FRF or coherence")
+        if c.variance.size != c.frf.size or not np.all(np.isfinite(c.variance)):
+            raise ParameterError(f"condition {k + 1}: the estimate carries no variance per "
+                                 "band (make it with estimate_frf)")
+        var = np.maximum(c.variance, (_SE_FLOOR * np.abs(c.frf).max()) ** 2)
+        sd = np.sqrt(var / 2)
+        cov = c.covariance if c.covariance.shape == (c.frf.size,) * 2 else None
+        return _Target(c.frf, "variance", np.stack([sd, sd]), np.asarray(c.dof, float), cov)
+    if not isinstance(c, FRFTable):
+        raise ParameterError(f"condition {k + 1} must be an FRFEstimate or an FRFTable, got "
+                             f"{type(c).__name__}")
+    dof = np.full(c.frf.size, np.inf) if c.dof is None else np.asarray(c.dof, float)
+    floor = _SE_FLOOR * np.abs(c.frf).max()
+    if c.frf_se is not None:
+        sd = np.sqrt(np.maximum(c.frf_se, floor) ** 2 / 2)
+        return _Target(c.frf, "variance", np.stack([sd, sd]), dof, c.frf_covariance)
+    if c.gain_se is not None:
+        sd = np.stack([np.maximum(c.gain_se, floor),
+                       np.maximum(np.radians(c.phase_se_deg), _SE_FLOOR)])
+        return _Target(c.frf, "gain-phase", sd, dof)
+    g = np.maximum(np.abs(c.frf), floor)
+    return _Target(c.frf, "relative", np.stack([g, g]), np.full(g.size, np.inf))
+
+
+def _chi2(u: np.ndarray, dof: np.ndarray) -> np.ndarray:
+    """Each band's statistic as a χ²₂ value of the same probability (module notes)."""
+    from scipy.stats import f as fisher
+
+    q = np.sum(u ** 2, axis=0)
+    nu = np.where(np.isfinite(dof), dof, 1.0)
+    with np.errstate(all="ignore"):
+        z = -2.0 * fisher.logsf(q / 2.0, 2, nu)
+    return np.where(np.isfinite(dof) & np.isfinite(z), z, q)
+
+
+def check_fit_request(muscles: MuscleSet, free, per_condition=(), bounds=None) -> tuple:
+    """The names to fit and their bounds, checked (each known, none named twice, each bound
+    for a fitted parameter and within its range), before any data are read.
+
+    Returns
+    -------
+    (list, list, list, list, dict)
+        ``free``, ``per_condition``, each name's (base name, pair index), each name's one
+        spelling, and the bounds by that spelling.
+    """
+    for label, names in (("free", free), ("per_condition", per_condition)):
+        if isinstance(names, str) or not isinstance(names, list | tuple):
+            raise ParameterError(f"{label} must be a list of parameter names, got {names!r}"
+                                 [:200])
+    free, per = list(free), list(per_condition)
+    if not free and not per:
+        raise ParameterError("give at least one parameter to fit")
+    specs = [_parse(n, muscles) for n in free + per]
+    canon = [_canonical(n, s, muscles) for n, s in zip(free + per, specs, strict=True)]
+    seen: dict[str, tuple[str, bool]] = {}
+    for i, (given, name) in enumerate(zip(free + per, canon, strict=True)):
+        if name in seen:
+            first, shared = seen[name]
+            raise ParameterError(f"{name!r} is named twice ({first!r} and {given!r})"
+                                 if shared == (i < len(free))
+                                 else f"{name!r} is both shared and per condition")
+        seen[name] = (given, i < len(free))
+    bounds = _check_bounds(bounds, muscles, dict(zip(canon, (s[0] for s in specs),
+                                                     strict=True)))
+    return canon[:len(free)], canon[len(free):], specs, canon, bounds
 
 
 def fit_frf(body: Body, muscles: MuscleSet, data, free, *, input: str = "tilt",
             output: str = "com_angle", feedback_delay: float = 0.0,
             proprioceptive_weight: float = 1.0, per_condition=(), bounds=None) -> FRFFit:
-    """Fit controller parameters to one or several FRF estimates (module notes).
+    """Fit controller parameters to one or several FRFs (module notes).
 
     Parameters
     ----------
     body : Body
     muscles : MuscleSet
         The starting gains (intrinsic and active).
-    data : FRFEstimate or sequence of FRFEstimate
-        One per condition.
+    data : FRFEstimate or FRFTable, or a sequence of them
+        One per condition (:func:`posturelab.frequency.estimate_frf`, or a table of gain and
+        phase, :class:`posturelab.frequency.table.FRFTable`).
     free : sequence of str
         Parameters shared by all conditions.
     input, output : str
@@ -147,62 +360,61 @@ def fit_frf(body: Body, muscles: MuscleSet, data, free, *, input: str = "tilt",
     per_condition : sequence of str
         Parameters fitted separately for each condition.
     bounds : dict of name -> (low, high), optional
-        Within the parameter table's bounds; defaults: the table's search intervals (gains
-        [0, 1e5], delay [0, 1] s, W [0, 1]).
+        Each within the parameter table's bounds (docs/parameters.md); defaults: the
+        table's search intervals (gains [0, 1e5], delay [0, 1] s, W [0, 1]).
+
+    Raises
+    ------
+    ParameterError
+        Unknown, repeated or not-fitted names, bounds outside a parameter's range, data
+        that are not FRFs.
     """
     from scipy.optimize import least_squares
+    from scipy.stats import chi2
     from scipy.stats import t as student
 
-    free = [_name(n, muscles) for n in ([free] if isinstance(free, str) else free)]
-    per = [_name(n, muscles) for n in ([per_condition] if isinstance(per_condition, str)
-                                       else per_condition)]
-    if not free and not per:
-        raise ParameterError("give at least one parameter to fit")
-    if set(free) & set(per):
-        raise ParameterError(f"{sorted(set(free) & set(per))[0]!r} is both shared and "
-                             "per condition")
-    for names in (free, per):  # by their one spelling: stiffness and stiffness:ankle alike
-        if len(set(names)) != len(names):
-            twice = sorted({n for n in names if names.count(n) > 1})[0]
-            raise ParameterError(f"{twice!r} is named more than once")
-    specs = [_parse(n, muscles) for n in free + per]
-    bounds = _checked_bounds(bounds, muscles)
-    conditions = [data] if isinstance(data, FRFEstimate) else list(data)
-    if not conditions or not all(isinstance(c, FRFEstimate) for c in conditions):
-        raise ParameterError("data must be one FRFEstimate or a list of them")
+    from .._validation import float_in_range
+    from .table import FRFTable
+
+    if not isinstance(body, Body) or not isinstance(muscles, MuscleSet):
+        raise ParameterError("fit_frf needs a Body and a MuscleSet")
+    kinds = (FRFEstimate, FRFTable)
+    conditions = [data] if isinstance(data, kinds) else (
+        list(data) if isinstance(data, list | tuple) else None)
+    if not conditions:
+        raise ParameterError("data must be one FRFEstimate or FRFTable, or a list of them")
+    feedback_delay = float_in_range("feedback_delay [s]", feedback_delay, 0.0,
+                                    MAX_FEEDBACK_DELAY, unit="s")
+    proprioceptive_weight = float_in_range("proprioceptive_weight [-]", proprioceptive_weight,
+                                           0.0, 1.0)
+    free, per, specs, canon, bounds = check_fit_request(muscles, free, per_condition, bounds)
+    targets = [_target(c, k) for k, c in enumerate(conditions)]
     base = np.stack([muscles.stiffnesses, muscles.viscosities, muscles.active_stiffnesses,
                      muscles.active_viscosities])
     C = len(conditions)
     slots = [(i, None) for i in range(len(free))] + [
         (len(free) + j, k) for j in range(len(per)) for k in range(C)]
     labels = free + [f"{per[j]}#{k + 1}" for j in range(len(per)) for k in range(C)]
+    rows = {"stiffness": 0, "viscosity": 1, "active_stiffness": 2, "active_viscosity": 3}
 
-    def start(name: str, spec) -> float:
+    def start(spec) -> float:
         b, j = spec
-        row = {"stiffness": 0, "viscosity": 1, "active_stiffness": 2, "active_viscosity": 3}
         if b == "feedback_delay":
             return feedback_delay
         if b == "proprioceptive_weight":
             return proprioceptive_weight
-        return float(base[row[b], j])
+        return float(base[rows[b], j])
 
-    names_all = free + per
-    x0 = np.array([start(names_all[i], specs[i]) for i, _ in slots])
-    lo = np.array([bounds.get(names_all[i], _DEFAULT_BOUNDS[specs[i][0]])[0] for i, _ in slots])
-    hi = np.array([bounds.get(names_all[i], _DEFAULT_BOUNDS[specs[i][0]])[1] for i, _ in slots])
-    if np.any(lo >= hi):
-        raise ParameterError("every bound needs low < high")
+    x0 = np.array([start(specs[i]) for i, _ in slots])
+    lo = np.array([bounds.get(canon[i], _DEFAULT_BOUNDS[specs[i][0]])[0] for i, _ in slots])
+    hi = np.array([bounds.get(canon[i], _DEFAULT_BOUNDS[specs[i][0]])[1] for i, _ in slots])
     x0 = np.clip(x0, lo + 1e-9 * (hi - lo), hi - 1e-9 * (hi - lo))
     scale = np.maximum(np.abs(x0), 1e-3 * np.maximum(hi - lo, 1e-12))
-    weights, targets = [], []
-    for c in conditions:
-        radius = (c.gain_ci95[:, 1] - c.gain) if np.all(np.isfinite(c.gain_ci95)) \
-            else np.full(c.gain.shape, np.nan)
-        rho = np.where(np.isfinite(radius) & (radius > 0), radius / 2.4477, np.abs(c.frf))
-        weights.append(1.0 / np.maximum(rho, 1e-300))
-        targets.append(c.frf)
-    warnings = tuple(f"condition {k + 1}: coherence below 0.5 at {int(np.sum(c.coherence < 0.5))}"
-                     " band(s)" for k, c in enumerate(conditions) if np.any(c.coherence < 0.5))
+    warnings = [f"condition {k + 1}: coherence below 0.5 at {int(np.sum(c.coherence < 0.5))}"
+                " band(s)" for k, c in enumerate(conditions)
+                if c.coherence is not None and np.any(c.coherence < 0.5)]
+    active = muscles.has_active_feedback or any(
+        specs[i][0].startswith("active") for i, _ in slots)
 
     def model(p: np.ndarray, dense: bool = False) -> list:
         out = []
@@ -218,11 +430,9 @@ def fit_frf(body: Body, muscles: MuscleSet, data, free, *, input: str = "tilt",
                 elif b == "proprioceptive_weight":
                     w = value
                 else:
-                    gains[("stiffness", "viscosity", "active_stiffness",
-                           "active_viscosity").index(b), j] = value
-            active = muscles.has_active_feedback or any(
-                specs[i][0].startswith("active") for i, _ in slots)
-            def frf_at(f, gains=gains, tau=tau, w=w, active=active):
+                    gains[rows[b], j] = value
+
+            def frf_at(f, gains=gains, tau=tau, w=w):
                 return model_frf_batch(body, muscles, f, gains[0][None], gains[1][None],
                                        gains[2][None] if active else None,
                                        gains[3][None] if active else None, tau, w,
@@ -231,39 +441,110 @@ def fit_frf(body: Body, muscles: MuscleSet, data, free, *, input: str = "tilt",
             if dense:
                 f = np.geomspace(c.frequency.min() / 1.5, c.frequency.max() * 1.5, 200)
                 out.append((f, frf_at(f)))
+            elif c.harmonic_weight:
+                out.append(c.band_average(frf_at))
             else:
-                out.append(c.band_average(frf_at) if c.harmonic_weight
-                           else frf_at(c.frequency))
+                out.append(frf_at(c.frequency))
         return out
 
-    def residuals(z: np.ndarray) -> np.ndarray:
-        H = model(z * scale)
-        parts = [w * (h - t) for w, h, t in zip(weights, H, targets, strict=True)]
-        r = np.concatenate(parts)
-        return np.concatenate([r.real, r.imag])
+    def standardised(p: np.ndarray, delta: float) -> list:
+        return [t.standardised(m, delta) for t, m in zip(targets, model(p), strict=True)]
 
-    sol = least_squares(residuals, x0 / scale, bounds=(lo / scale, hi / scale), x_scale=1.0,
-                        method="trf")
+    def residuals(z: np.ndarray, delta: float) -> np.ndarray:
+        return np.concatenate([np.concatenate(u) for u in standardised(z * scale, delta)])
+
+    def solve(z0: np.ndarray, delta: float):
+        return least_squares(residuals, z0, bounds=(lo / scale, hi / scale), x_scale=1.0,
+                             method="trf", args=(delta,), xtol=1e-12, ftol=1e-12, gtol=1e-12)
+
+    def chi2_sum(p: np.ndarray, delta: float, values: list | None = None) -> float:
+        values = model(p) if values is None else values
+        return float(sum(np.sum(_chi2(t.standardised(v, delta), t.dof))
+                         for t, v in zip(targets, values, strict=True)))
+
+    K = x0.size
+    m = 2 * sum(t.frf.size for t in targets)
+    dof = max(m - K, 1)
+    weighting = "+".join(dict.fromkeys(t.kind for t in targets))
+    relative = weighting == "relative"
+    sol = solve(x0 / scale, 0.0)
     p = sol.x * scale
-    m, k = sol.fun.size, p.size
-    dof = max(m - k, 1)
-    s2 = float(sol.fun @ sol.fun) / dof
-    J = sol.jac / scale[None, :]  # d residual / d parameter, in the parameters' units
-    # a parameter the residuals do not depend on cannot be determined; the rest are
-    # judged by the conditioning of their own columns
+    total = chi2_sum(p, 0.0)
+    fit_error = math.sqrt(total / dof)
+    mismatch = not relative and total > float(chi2.ppf(1.0 - MISMATCH_P, dof))
+    delta = 0.0
+    if mismatch:
+        for _ in range(2):  # the model error that makes the fit error 1, then refit
+            a, b = -14.0, 2.0
+            values = model(p)
+            for _ in range(50):
+                mid = 0.5 * (a + b)
+                a, b = (mid, b) if chi2_sum(p, 10.0 ** mid, values) > dof else (a, mid)
+            delta = 10.0 ** b
+            sol = solve(p / scale, delta)
+            p = sol.x * scale
+        warnings.insert(0, (
+            f"the model does not describe the data within their noise (fit error "
+            f"{fit_error:.3g}, chance p < {MISMATCH_P:g}): the estimates and intervals allow a "
+            f"model error of {100 * delta:.3g} % of |H| per band"))
+    # the Jacobian of the standardised residuals (central differences)
+    J = np.empty((m, K))
+    for k in range(K):
+        h = 1e-6 * scale[k]
+        up, dn = p.copy(), p.copy()
+        up[k] = min(p[k] + h, hi[k])
+        dn[k] = max(p[k] - h, lo[k])
+        J[:, k] = (np.concatenate([np.concatenate(u) for u in standardised(up, delta)])
+                   - np.concatenate([np.concatenate(u) for u in standardised(dn, delta)])
+                   ) / (up[k] - dn[k])
+    u_all = np.concatenate([np.concatenate(u) for u in standardised(p, delta)])
+    s2 = float(u_all @ u_all) / dof if relative else 1.0
     norms = np.linalg.norm(J, axis=0)
-    seen = norms > 1e-10 * max(float(norms.max()), 1e-300)
-    se = np.full(k, np.inf)
+    seen_col = norms > 1e-10 * max(float(norms.max()), 1e-300)
+    se = np.full(K, np.inf)
     cond = np.inf
-    if seen.any():
-        Js = J[:, seen]
+    if seen_col.any():
+        Js = J[:, seen_col]
         sv = np.linalg.svd(Js, compute_uv=False)
         cond = float(sv[0] / sv[-1]) if sv[-1] > 0 else np.inf
         if np.isfinite(cond):
-            cov = max(s2, 1.0) * np.linalg.inv(Js.T @ Js)
-            se[seen] = np.sqrt(np.maximum(np.diag(cov), 0.0))
-    q = float(student.ppf(0.975, dof))
-    ci = np.stack([p - q * se, p + q * se], axis=1)
-    determined = seen & np.isfinite(se) & (se <= np.abs(p)) & (cond < 1e10)
-    return FRFFit(tuple(labels), p, se, ci, determined, float(np.sqrt(s2)), bool(sol.success),
-                  str(sol.message), warnings, tuple(model(p, dense=True)))
+            cov = s2 * np.linalg.inv(Js.T @ Js)
+            se[seen_col] = np.sqrt(np.maximum(np.diag(cov), 0.0))
+    if relative:
+        fit_error = math.sqrt(s2)
+    finite = [d for t in targets for d in np.asarray(t.dof, float) if np.isfinite(d)]
+    nu = dof if relative else (min(finite) if finite else np.inf)
+    q = float(student.ppf(0.975, nu))
+    systematic = np.zeros(K)
+    if mismatch and np.isfinite(cond) and seen_col.all():
+        systematic = _systematic_bound(J, targets, delta, seen_col)
+    ci = np.stack([p - q * se - systematic, p + q * se + systematic], axis=1)
+    determined = seen_col & np.isfinite(se) & (se <= np.abs(p)) & (cond < 1e10)
+    return FRFFit(tuple(labels), p, se, ci, determined, float(fit_error), bool(sol.success),
+                  str(sol.message), tuple(warnings), tuple(model(p, dense=True)), weighting,
+                  bool(mismatch), float(delta), systematic)
+
+
+def _systematic_bound(J: np.ndarray, targets: list, delta: float, seen: np.ndarray
+                      ) -> np.ndarray:
+    """β_k = δ Σ_b |∂p_k/∂e_b| |Ĥ_b|: the most a model error of at most δ|Ĥ_b| at every band,
+    in any direction, moves each parameter (linearised: ∂p/∂u = −(JᵀJ)⁻¹Jᵀ, u the
+    standardised residuals, ∂u/∂e_b from a small real and imaginary step at band b)."""
+    P = np.linalg.solve(J.T @ J, J.T)  # (K, m)
+    out = np.zeros(J.shape[1])
+    offset = 0
+    for t in targets:
+        base = t.standardised(t.frf, delta).ravel()
+        size = base.size
+        for b in range(t.frf.size):
+            h = 1e-6 * max(abs(t.frf[b]), 1e-300)
+            g = []
+            for step in (h, 1j * h):
+                moved = t.frf.copy()
+                moved[b] += step
+                du = np.zeros(J.shape[0])
+                du[offset:offset + size] = (t.standardised(moved, delta).ravel() - base) / h
+                g.append(P @ du)
+            out += delta * abs(t.frf[b]) * np.hypot(g[0], g[1])
+        offset += size
+    return out

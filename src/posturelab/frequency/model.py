@@ -31,6 +31,9 @@ from ..model.dynamics import mass_matrix
 from ..model.muscles import MuscleSet, feedback_gains
 from ..parameters import QUANTITIES, check_value
 
+#: Highest frequency a model FRF is taken at. [Hz]
+MAX_FREQUENCY = 1e4
+
 __all__ = ["model_frf", "model_frf_batch", "output_vector", "output_names", "INPUTS"]
 
 #: Inputs of a model FRF.
@@ -102,11 +105,18 @@ def model_frf_batch(body: Body, muscles: MuscleSet, frequencies, stiffness, visc
     if input not in INPUTS:
         raise ParameterError(f"input must be one of {', '.join(INPUTS)}, got {input!r}")
     f = finite_array("frequencies [Hz]", frequencies, (None,))
-    if f.size == 0 or np.any(f <= 0):
-        raise ParameterError("frequencies [Hz] must be > 0")
+    if f.size == 0 or np.any(f <= 0) or np.any(f > MAX_FREQUENCY):
+        raise ParameterError(f"frequencies [Hz] must be in (0, {MAX_FREQUENCY:g}] Hz")
     c = output_vector(body, output)
-    k = np.atleast_2d(np.asarray(stiffness, dtype=float))
+    P = len(muscles.pairs)
+    k = _gains("stiffness [N·m/rad]", stiffness, P)
     M = k.shape[0]
+    viscosity = _gains("viscosity [N·m·s/rad]", viscosity, P, M)
+    if (active_stiffness is None) != (active_viscosity is None):
+        raise ParameterError("give active_stiffness and active_viscosity together")
+    if active_stiffness is not None:
+        active_stiffness = _gains("active_stiffness [N·m/rad]", active_stiffness, P, M)
+        active_viscosity = _gains("active_viscosity [N·m·s/rad]", active_viscosity, P, M)
     tau = np.broadcast_to(np.asarray(feedback_delay, dtype=float), (M,))
     w = np.broadcast_to(np.asarray(proprioceptive_weight, dtype=float), (M,))
     for name, values in (("feedback_delay", tau), ("proprioceptive_weight", w)):
@@ -115,10 +125,29 @@ def model_frf_batch(body: Body, muscles: MuscleSet, frequencies, stiffness, visc
             check_value(name, float(values[np.argmax(bad)]))
     g = feedback_gains(k, viscosity, active_stiffness, active_viscosity, np.ones(M))
     if M > _CHUNK:  # bound the memory of one evaluation
-        return np.concatenate([
+        H = np.concatenate([
             _frf(body, muscles, f, g[lo:lo + _CHUNK], tau[lo:lo + _CHUNK], w[lo:lo + _CHUNK],
                  input, c) for lo in range(0, M, _CHUNK)])
-    return _frf(body, muscles, f, g, tau, w, input, c)
+    else:
+        with np.errstate(all="ignore"):
+            H = _frf(body, muscles, f, g, tau, w, input, c)
+    if not np.all(np.isfinite(H)):
+        raise ParameterError("the model FRF is not finite at some frequency (a resonance "
+                             "exactly at it, or gains beyond what the model can take)")
+    return H
+
+
+def _gains(name: str, value, pairs: int, rows: int | None = None) -> np.ndarray:
+    """Gains as (M, P), finite and >= 0."""
+    if isinstance(value, bool):
+        raise ParameterError(f"{name} must be numbers, got {value!r}")
+    g = np.atleast_2d(finite_array(name, value))
+    if g.ndim != 2 or g.shape[1] != pairs or (rows is not None and g.shape[0] != rows):
+        want = f"({rows if rows is not None else 'M'}, {pairs})"
+        raise ParameterError(f"{name} must have shape {want}, got {g.shape}")
+    if np.any(g < 0):
+        raise ParameterError(f"{name} must be >= 0, got {float(g.min()):g}")
+    return g
 
 
 #: Parameter sets per evaluation of :func:`_frf`. [-]

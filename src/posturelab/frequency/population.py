@@ -23,7 +23,6 @@ The table has one row per run: the varied values, ``fell``, then per band b (1 �
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -38,6 +37,10 @@ __all__ = ["PRTSProtocol", "PRTSSweepResult", "prts_sweep", "MAX_EXPERIMENTS"]
 
 #: Most experiments one sweep may run (each is a simulation of minutes of stance). [-]
 MAX_EXPERIMENTS = 100_000
+#: Largest sensor noise (standard deviation) on a recorded angle. [rad]
+MAX_SENSOR_NOISE = 1.0
+#: Highest record rate of a PRTS experiment. [Hz]
+MAX_RECORD_RATE = 1e5
 
 
 @dataclass(frozen=True)
@@ -81,8 +84,16 @@ class PRTSProtocol:
             if isinstance(value, bool) or not isinstance(value, int | np.integer) \
                     or value < least:
                 raise ParameterError(f"{name} must be an integer >= {least}, got {value!r}")
-        if not (math.isfinite(self.sensor_noise) and self.sensor_noise >= 0):
-            raise ParameterError(f"sensor_noise [rad] must be >= 0, got {self.sensor_noise!r}")
+        from .._validation import float_in_range
+
+        float_in_range("sensor_noise [rad]", self.sensor_noise, 0.0, MAX_SENSOR_NOISE,
+                       unit="rad")
+        float_in_range("sample_rate (--record-rate) [Hz]", self.sample_rate, 1.0,
+                       MAX_RECORD_RATE, unit="Hz")
+        if not isinstance(self.output, str):
+            raise ParameterError(f"output must be com_angle or thetaN, got {self.output!r}")
+        if isinstance(self.fit, str):
+            raise ParameterError("fit is a sequence of parameter names, not one string")
         object.__setattr__(self, "fit", tuple(self.fit))
 
 
@@ -161,7 +172,8 @@ class PRTSSweepResult:
     fit_estimates, fit_standard_errors : numpy.ndarray, shape (M, K)
         In each parameter's unit (:data:`posturelab.frequency.fit.PARAMETERS`).
     fit_error : numpy.ndarray, shape (M,)
-        RMS weighted residual of each fit (≈ 1 when the model explains the data). [-]
+        √(χ²/dof) of each fit (:attr:`FRFFit.fit_error`; ≈ 1 when the model explains the
+        data). [-]
     """
 
     grid: Any
@@ -262,6 +274,10 @@ def prts_sweep(scenario: Scenario, varies: Sequence, protocol: PRTSProtocol | No
                              f"at most {MAX_EXPERIMENTS:,}")
     cycle = scenario.tilt.cycle
     samples = int(round(protocol.sample_rate * cycle))
+    if samples < 8 or abs(samples - protocol.sample_rate * cycle) > 1e-6 * samples:
+        raise ParameterError(f"the record rate {protocol.sample_rate:g} Hz must give a whole "
+                             f"number of at least 8 samples per PRTS cycle of {cycle:g} s, "
+                             f"got {protocol.sample_rate * cycle:g}")
     bands = protocol.bands
     if isinstance(bands, str) and bands == "peterka" and scenario.tilt.registers != 4:
         from .bands import sequence_bands  # the 11 bands are an 80-state sequence's
