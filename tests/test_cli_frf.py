@@ -232,8 +232,10 @@ def cli(*args):
 
 
 @pytest.mark.parametrize("extra,needle", [
-    (["--bounds", "feedback_delay=0:1e308"], "0 <= low < high <= 1 [s], got 0:1e+308"),
-    (["--bounds", "feedback_delay=-0.1:0.3"], "got -0.1:0.3"),
+    (["--bounds", "feedback_delay=0:1e308"],
+     "bound feedback_delay HI [s] must be in [0, 1], got 1e+308"),
+    (["--bounds", "feedback_delay=-0.1:0.3"],
+     "bound feedback_delay LO [s] must be in [0, 1], got -0.1"),
     (["--bounds", "feedback_delai=0:0.3"], "unknown FRF fit parameter 'feedback_delai'"),
     (["--bounds", "feedback_delay=nan:0.3"], "must be finite, got nan:0.3"),
     (["--bounds", "feedback_delay=0:inf"], "must be finite"),

@@ -241,7 +241,7 @@ def test_fit_frf_refuses_nan_data_and_negative_bounds():
     est = estimate_frf(np.tile(x1, 3), np.tile(y1, 3), L / T, T)
     with pytest.raises(ParameterError, match="non-finite"):
         fit_frf(BODY, TRUE, replace(est, coherence=est.coherence * np.nan), ["feedback_delay"])
-    with pytest.raises(ParameterError, match="0 <= low < high <= 1"):
+    with pytest.raises(ParameterError, match=r"bound feedback_delay LO \[s\] must be in \[0, 1\]"):
         fit_frf(BODY, TRUE, est, ["feedback_delay"], bounds={"feedback_delay": (-1, 0.2)})
     with pytest.raises(ParameterError, match="named twice"):
         fit_frf(BODY, TRUE, est, ["active_stiffness", "active_stiffness:" + TRUE.names[0]])

@@ -225,7 +225,7 @@ def test_fit_frf_takes_the_table_names(frf_json):
      "unknown FRF fit parameter 'feedback_dely'"),
     (["--free", "torque_limit:ankle"], "cannot be 'torque_limit:ankle'"),
     (["--free", "active_stiffness,active_stiffness:ankle"],
-     "'active_stiffness:ankle' is named more than once"),
+     "'active_stiffness:ankle' is named twice"),
 ])
 def test_fit_frf_refuses_in_one_line(frf_json, args, words):
     one_line_exit_2(cli("fit-frf", "--data", str(frf_json), "--controller", "peterka-2002",

@@ -378,6 +378,7 @@ def fit_frf(body: Body, muscles: MuscleSet, data, free, *, input: str = "tilt",
 
     if not isinstance(body, Body) or not isinstance(muscles, MuscleSet):
         raise ParameterError("fit_frf needs a Body and a MuscleSet")
+    free, per, specs, canon, bounds = check_fit_request(muscles, free, per_condition, bounds)
     kinds = (FRFEstimate, FRFTable)
     conditions = [data] if isinstance(data, kinds) else (
         list(data) if isinstance(data, list | tuple) else None)
@@ -387,7 +388,6 @@ def fit_frf(body: Body, muscles: MuscleSet, data, free, *, input: str = "tilt",
                                     MAX_FEEDBACK_DELAY, unit="s")
     proprioceptive_weight = float_in_range("proprioceptive_weight [-]", proprioceptive_weight,
                                            0.0, 1.0)
-    free, per, specs, canon, bounds = check_fit_request(muscles, free, per_condition, bounds)
     targets = [_target(c, k) for k, c in enumerate(conditions)]
     base = np.stack([muscles.stiffnesses, muscles.viscosities, muscles.active_stiffnesses,
                      muscles.active_viscosities])
