@@ -5,15 +5,7 @@ from __future__ import annotations
 import argparse
 
 from ..model.muscles import PAPER_PAIR_NAMES
-from ..simulation.results import atomic_write_text
-from ..studies.identification import (
-    ENGINES,
-    RESIDUAL_MODELS,
-    VISCOSITY_RATIO,
-    fit_stiffness,
-    read_trajectory_csv,
-)
-from ..studies.sweep import parameter_unit
+from ..studies.identification import ENGINES, RESIDUAL_MODELS, VISCOSITY_RATIO
 from ._common import check_writable, print_json
 from .simulate import add_experiment_arguments, scenario_from_args
 
@@ -28,9 +20,6 @@ estimate with its standard error and 95 % confidence interval; by default these
 allow for residuals correlated from sample to sample (a first-order autoregression
 per link, estimated from the residuals), which measured sway always has.
 """
-
-
-HELP = "fit pair stiffness to measured angles (with confidence intervals)"
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -57,6 +46,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     import json
+
+    from ..simulation.results import atomic_write_text
+    from ..studies.identification import fit_stiffness, read_trajectory_csv
+    from ..studies.sweep import parameter_unit
 
     if args.report:
         check_writable([args.report], {args.report: (".json",)})

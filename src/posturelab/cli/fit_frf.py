@@ -13,8 +13,6 @@ from ._common import (
     print_json,
 )
 
-HELP = "fit controller gains, delay and sensory weight to FRFs (one or several conditions)"
-
 DESCRIPTION = """\
 Fit the linearised model's FRF to one or several measured FRFs. Each --data is a condition:
 a trial CSV (then --stimulus, --response and --cycle-length say how to estimate its FRF, as

@@ -4,8 +4,6 @@ from __future__ import annotations
 
 import argparse
 
-from ..linear.analysis import analyse_both_sides
-from ..paper.compare import erratum, table2_comparison
 from ._common import (
     add_muscle_arguments,
     body_from_args,
@@ -29,9 +27,6 @@ the side θ2 >= 0 where it acts (the poles printed, identical to two-sided) and 
 side θ2 < 0 where it is slack (printed too; 'inactive_side_poles' in JSON). The
 system is reported stable only if both sides are.
 """
-
-
-HELP = "poles and stability of the linearised model (Table II)"
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -60,6 +55,8 @@ def run(args: argparse.Namespace) -> int:
 
             raise UsageError("poles: --all takes no --case or --stiffness")
         return _run_all(args)
+    from ..linear.analysis import analyse_both_sides
+
     body = body_from_args(args)
     muscles = muscles_from_args(args, body)
     active, inactive = analyse_both_sides(body, muscles)
@@ -121,6 +118,8 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _run_all(args: argparse.Namespace) -> int:
+    from ..paper.compare import erratum, table2_comparison
+
     rows = table2_comparison(viscosity_ratio=_ratio(args))
     if args.json:
         print_json({"table2": [

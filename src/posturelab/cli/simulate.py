@@ -50,7 +50,6 @@ line printed (outcome in --json) is recovered, not recovered, fell or failed.
 """
 
 
-HELP = "simulate a platform disturbance (nonlinear model)"
 #: The wall-clock budget of one `simulate` run when neither --time-limit nor the scenario
 #: gives one: nothing legitimate takes this long on either engine. [s]
 DEFAULT_TIME_LIMIT = 600.0

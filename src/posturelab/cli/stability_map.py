@@ -14,7 +14,7 @@ from typing import IO
 
 from ..errors import ParameterError, UnknownNameError
 from ..model.muscles import PAPER_PAIR_NAMES
-from . import CONVENTIONS_EPILOG
+from . import CONVENTIONS_EPILOG, SUBCOMMAND_HELP
 from ._common import load_compiled
 
 #: Axis names: the paper's five pairs (stiffness [N·m/rad]) and the viscosity ratio [s]
@@ -57,7 +57,7 @@ DELAYED_AXES = ("active_stiffness", "active_viscosity")
 
 def add_parser(sub, name: str) -> argparse.ArgumentParser:
     p = sub.add_parser(
-        name, help="stability map of the linearised model over two parameters",
+        name, help=SUBCOMMAND_HELP[name],
         description=DESCRIPTION, epilog=CONVENTIONS_EPILOG,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )

@@ -35,6 +35,7 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -42,8 +43,9 @@ from .._validation import finite_array
 from ..errors import DataFileError, ParameterError, PostureLabError, UnknownNameError
 from ..model.muscles import MuscleSet
 from ..scenarios import Scenario
-from ..simulation.results import SimulationResult
-from .sweep import parameter_unit
+
+if TYPE_CHECKING:  # (loaded when a fit runs: posturelab fit --help stays light)
+    from ..simulation.results import SimulationResult
 
 __all__ = ["FitResult", "FitError", "fit_stiffness", "read_trajectory_csv"]
 
@@ -114,6 +116,8 @@ class FitResult:
 
     def to_dict(self) -> dict:
         """Plain-Python summary for JSON: units as in the attribute docs."""
+        from .sweep import parameter_unit
+
         return {
             "parameters": {
                 name: {

@@ -40,7 +40,7 @@ import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import IO, Any
+from typing import IO, TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -48,9 +48,12 @@ from ..errors import ParameterError, PostureLabError
 from ..model.muscles import DEFAULT_VISCOSITY_RATIO, PAPER_PAIR_NAMES
 from ..model.platform import NoDisturbance
 from ..scenarios import Scenario
-from ..simulation.compiled import DEFAULT_ATOL, DEFAULT_RTOL, BatchResult, simulate_batch
 from ..simulation.outcome import UPRIGHT_BAND
 from ..simulation.results import atomic_write_bytes, atomic_write_text
+from ..simulation.tolerances import DEFAULT_ATOL, DEFAULT_RTOL
+
+if TYPE_CHECKING:  # (the engine loads when a sweep runs: posturelab --help stays light)
+    from ..simulation.compiled import BatchResult
 
 __all__ = [
     "SWEEP_PARAMETERS",
@@ -520,6 +523,8 @@ class _Task:
     atol: float
 
     def run(self, grid: SweepGrid, lo: int, hi: int, parallel: bool) -> BatchResult:
+        from ..simulation.compiled import simulate_batch
+
         sc = self.scenario
         return simulate_batch(
             sc.body, grid.stiffness[lo:hi], grid.viscosity[lo:hi], sc.disturbance,
@@ -546,6 +551,8 @@ def _rows(values: np.ndarray | None, lo: int, hi: int) -> np.ndarray | None:
 
 
 def _concatenate(parts: list[BatchResult]) -> BatchResult:
+    from ..simulation.compiled import BatchResult
+
     if len(parts) == 1:
         return parts[0]
     fields = ("fell", "fall_time", "peak_theta", "settling_time", "final_state", "status_code",
