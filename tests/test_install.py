@@ -9,6 +9,7 @@ Building and installing the wheel and the sdist in fresh environments is CI's sm
 
 from __future__ import annotations
 
+import re
 import shutil
 from pathlib import Path
 
@@ -76,3 +77,16 @@ def test_the_sdist_manifest_takes_every_c_source_and_header():
     manifest = (ROOT / "MANIFEST.in").read_text()
     csrc = CSRC.relative_to(ROOT).as_posix()
     assert f"recursive-include {csrc} *.c *.h" in manifest
+
+
+def test_ci_runs_the_readme_test_command_and_the_smoke_test_of_both_artefacts():
+    """The README's test command is one line, and .ci/run runs exactly it; .ci/run also
+    builds the wheel and the sdist and runs .ci/smoke.py on each."""
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    commands = [line for block in re.findall(r"```bash\n(.*?)```", readme, re.S)
+                for line in block.splitlines() if " pytest" in line]
+    assert len(commands) == 1
+    ci = (ROOT / ".ci" / "run").read_text(encoding="utf-8").splitlines()
+    assert commands[0] in ci
+    assert "python -m build" in "\n".join(ci) and any("smoke.py" in line for line in ci)
+    assert (ROOT / ".ci" / "smoke.py").is_file()
