@@ -5,7 +5,7 @@ agonist–antagonist muscle pairs acting as stiffness and viscosity. Starts
 from the ankle-strategy paper (three-link biped, Tables I–II, Figs. 3–10)
 and goes beyond it. Conventions: :mod:`posturelab.conventions`.
 
-The names below are the public API. They, the subpackages and their modules
+The names of :data:`PUBLIC_NAMES` are the public API. They, the subpackages and their modules
 (``pl.simulate``, ``pl.simulation.compiled``, ``pl.recovery``, ``pl.plots``, …) load
 on first attribute access, so that ``import posturelab`` (and so ``posturelab --help``)
 stays light: it loads nothing but the error classes, and neither numba, nor scipy,
