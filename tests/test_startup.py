@@ -10,6 +10,7 @@ import pytest
 
 import posturelab as pl
 from posturelab import _compat
+from posturelab.cli import SUBCOMMAND_HELP, SUBCOMMANDS
 
 HEAVY = ("numba", "scipy.integrate", "scipy.optimize", "scipy.stats", "matplotlib")
 
@@ -41,6 +42,73 @@ def test_start_up_loads_no_heavy_module(code):
     """import posturelab, import posturelab.cli and every --help load none of numba, scipy's
     integrators, optimisers or statistics, or matplotlib."""
     assert loaded_after(code) == []
+
+
+#: Modules that no --help may load: the compiled engine (its Python package too), numba and
+#: its compiler, matplotlib, and any part of scipy.
+NOT_AT_HELP = ("posturelab.simulation.compiled", "numba", "llvmlite", "matplotlib", "scipy")
+#: At most this many modules in all after `posturelab CMD --help` (a bare `import numpy` loads
+#: about 170, the interpreter about 30; every --help loaded 297 before start-up was made lazy,
+#: 244-253 for the heaviest commands when this was written) ...
+MAX_MODULES_AT_HELP = 280
+#: ... and at most this many of posturelab's own (55 before; 5-26 when this was written).
+MAX_POSTURELAB_MODULES_AT_HELP = 32
+
+HELP_PROBE = """
+import sys
+from posturelab.cli import main
+try:
+    main({argv!r})
+except SystemExit:
+    pass
+print("MODULES:" + " ".join(sorted(sys.modules)))
+"""
+
+
+def modules_after_help(argv: list[str]) -> list[str]:
+    """Every module loaded by ``posturelab ARGV`` in a fresh interpreter."""
+    out = subprocess.run([sys.executable, "-c", HELP_PROBE.format(argv=argv)],
+                         capture_output=True, text=True, check=True, timeout=120).stdout
+    line = [ln for ln in out.splitlines() if ln.startswith("MODULES:")][-1]
+    return line.removeprefix("MODULES:").split()
+
+
+@pytest.mark.parametrize("command", ["", *sorted(SUBCOMMANDS)])
+def test_help_loads_few_modules_and_no_engine(command):
+    """`posturelab --help` and `posturelab CMD --help` for every CMD load no compiled engine,
+    numba, matplotlib or scipy, and few modules (thresholds above)."""
+    modules = modules_after_help([command, "--help"] if command else ["--help"])
+    heavy = [m for m in modules if any(m == h or m.startswith(h + ".") for h in NOT_AT_HELP)]
+    assert heavy == []
+    assert len(modules) <= MAX_MODULES_AT_HELP
+    assert len([m for m in modules if m.split(".")[0] == "posturelab"]) \
+        <= MAX_POSTURELAB_MODULES_AT_HELP
+
+
+def test_posturelab_help_imports_no_subcommand():
+    """`posturelab --help` lists the subcommands from cli.SUBCOMMAND_HELP: it imports none of
+    their modules, nor numpy."""
+    modules = modules_after_help(["--help"])
+    assert [m for m in modules if m.startswith("posturelab.cli.")] == []
+    assert "numpy" not in modules
+
+
+def test_every_subcommand_has_one_help_line():
+    assert set(SUBCOMMAND_HELP) == set(SUBCOMMANDS)
+    assert all(line and "\n" not in line for line in SUBCOMMAND_HELP.values())
+
+
+def test_import_posturelab_loads_only_its_error_classes():
+    """The public API loads on first use: `import posturelab` runs nothing else of it."""
+    out = subprocess.run([sys.executable, "-c", "import sys, posturelab; print(sorted(m for m "
+                          "in sys.modules if m.startswith('posturelab')))"],
+                         capture_output=True, text=True, check=True, timeout=120).stdout
+    assert out.strip() == "['posturelab', 'posturelab._compat', 'posturelab.errors']"
+
+
+@pytest.mark.parametrize("name", sorted(pl.__all__))
+def test_public_names_load_on_first_access(name):
+    assert getattr(pl, name) is not None and name in dir(pl)
 
 
 @pytest.mark.parametrize("name", sorted(pl.LAZY_SUBMODULES))
@@ -75,3 +143,11 @@ def test_simulate_stays_the_function():
     from posturelab.simulate import FallCriteria, simulate
 
     assert simulate is pl.simulate and FallCriteria is pl.FallCriteria
+
+
+def test_simulate_stays_the_function_when_the_former_module_is_imported_first():
+    code = ("import posturelab.simulate\nimport posturelab as pl\n"
+            "print(pl.simulate.__module__, pl.simulate is pl.simulation.simulate)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True, timeout=120).stdout
+    assert out.split() == ["posturelab.simulation.engines", "True"]

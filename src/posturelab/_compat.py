@@ -11,7 +11,6 @@ follow it (``posturelab.fast._encode``). The layout itself is in ``docs/develop.
 from __future__ import annotations
 
 import importlib
-import importlib.abc
 import importlib.util
 import sys
 
@@ -50,8 +49,10 @@ def current_name(name: str) -> str | None:
     return None
 
 
-class _MovedModuleFinder(importlib.abc.MetaPathFinder, importlib.abc.Loader):
-    """Imports a former path as the module at its current path."""
+class _MovedModuleFinder:
+    """Imports a former path as the module at its current path (a meta path finder and its
+    loader; not derived from importlib.abc, whose import loads importlib.resources and
+    slows every start-up)."""
 
     def find_spec(self, fullname, path=None, target=None):  # noqa: D401 - importlib protocol
         if current_name(fullname) is None:

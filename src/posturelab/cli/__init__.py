@@ -13,8 +13,9 @@ from collections.abc import Sequence
 
 from ..errors import PostureLabError
 
-#: Subcommand name -> module in this package: each defines ``HELP`` (one line), ``DESCRIPTION``,
-#: ``add_arguments(parser)`` and ``run(args)`` (or ``add_parser(sub, name)`` and ``run``).
+#: Subcommand name -> module in this package: each defines ``DESCRIPTION``,
+#: ``add_arguments(parser)`` and ``run(args)`` (or ``add_parser(sub, name)`` and ``run``); its
+#: one line of help is in :data:`SUBCOMMAND_HELP`.
 SUBCOMMANDS: dict[str, str] = {
     "poles": "poles",
     "sensitivity": "sensitivity",
@@ -29,6 +30,28 @@ SUBCOMMANDS: dict[str, str] = {
     "fit-frf": "fit_frf",
     "compare": "compare",
     "explore": "explore",
+}
+
+#: Subcommand name -> its line in ``posturelab --help`` (here, so that ``posturelab --help``
+#: imports no subcommand's module).
+SUBCOMMAND_HELP: dict[str, str] = {
+    "poles": "poles and stability of the linearised model (Table II)",
+    "sensitivity": "disturbance severity J⁻¹H at a posture",
+    "simulate": "simulate a platform disturbance (nonlinear model)",
+    "reproduce": "regenerate the paper's tables and figures (HTML report)",
+    "stability-map": "stability map of the linearised model over two parameters",
+    "sweep": "simulate a grid of gains, delays, torque limits and perturbation sizes; outcomes "
+             "to CSV or Parquet",
+    "fit": "fit pair stiffness to measured angles (with confidence intervals)",
+    "delay-margin": "delay margin of the linearised model: the feedback delay at which it loses "
+                    "stability",
+    "frf": "frequency response function of a periodic-stimulus (PRTS) trial, from a CSV",
+    "frf-model": "frequency response of the linearised model to tilt or translation (exact "
+                 "delay)",
+    "fit-frf": "fit controller gains, delay and sensory weight to FRFs (one or several "
+               "conditions)",
+    "compare": "overlay saved runs (posturelab simulate --out) in one figure, and tabulate them",
+    "explore": "explore the model interactively in the web browser (a local page)",
 }
 
 
@@ -52,8 +75,13 @@ CONVENTIONS_EPILOG = (
 )
 
 
-def build_parser() -> OneLineParser:
-    """The top-level parser with every available subcommand."""
+def build_parser(command: str | None = None, *, summary: bool = False) -> OneLineParser:
+    """The top-level parser with every available subcommand, or with ``command`` alone.
+
+    ``command``: build that subcommand only, importing no other subcommand's module (what
+    ``posturelab COMMAND ...`` needs). ``summary``: every subcommand's name and help line
+    only, importing none of them (what ``posturelab --help`` shows; it runs nothing).
+    """
     from .. import __version__
 
     parser = OneLineParser(
@@ -66,6 +94,11 @@ def build_parser() -> OneLineParser:
     parser.add_argument("--version", action="version", version=f"posturelab {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=OneLineParser)
     for name, module_name in SUBCOMMANDS.items():
+        if command is not None and name != command:
+            continue
+        if summary:  # (names and help lines only: nothing to run)
+            sub.add_parser(name, help=SUBCOMMAND_HELP[name])
+            continue
         try:
             module = importlib.import_module(f"{__name__}.{module_name}")
         except ModuleNotFoundError as exc:  # a subcommand not built yet
@@ -73,7 +106,7 @@ def build_parser() -> OneLineParser:
                 continue
             raise
         if hasattr(module, "add_arguments"):
-            p = sub.add_parser(name, help=module.HELP, description=module.DESCRIPTION,
+            p = sub.add_parser(name, help=SUBCOMMAND_HELP[name], description=module.DESCRIPTION,
                                epilog=CONVENTIONS_EPILOG,
                                formatter_class=argparse.RawDescriptionHelpFormatter)
             module.add_arguments(p)
@@ -137,8 +170,11 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 def _main(argv: Sequence[str] | None) -> int:
     try:
-        parser = build_parser()
         argv = _join_negative_lists(list(sys.argv[1:] if argv is None else argv))
+        # only the named subcommand's module is imported; without one, only the help lines
+        command = next((arg for arg in argv if not arg.startswith("-")), None)
+        parser = (build_parser(command) if command in SUBCOMMANDS
+                  else build_parser(summary=True))
         args = parser.parse_args(argv)
         if getattr(args, "_run", None) is None:
             parser.print_help()

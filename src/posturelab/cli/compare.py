@@ -6,8 +6,6 @@ import argparse
 
 from ._common import FIGURE_SUFFIXES, check_writable, print_json
 
-HELP = "overlay saved runs (posturelab simulate --out) in one figure, and tabulate them"
-
 DESCRIPTION = """\
 Read runs written by posturelab simulate --out (columns t, theta1..N, omega1..N), print for
 each its samples, end time, largest |θ_i| [rad] and final state, and with --plot draw one

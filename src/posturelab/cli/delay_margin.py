@@ -7,8 +7,6 @@ import math
 
 from ._common import add_muscle_arguments, body_from_args, muscles_from_args, print_json
 
-HELP = "delay margin of the linearised model: the feedback delay at which it loses stability"
-
 DESCRIPTION = """\
 The delay margin of the chain linearised about upright: the smallest feedback delay τ at
 which a characteristic root of

@@ -4,8 +4,6 @@ from __future__ import annotations
 
 import argparse
 
-HELP = "explore the model interactively in the web browser (a local page)"
-
 DESCRIPTION = """\
 Serve a page on http://127.0.0.1:PORT/ (this machine only) and open it in the web
 browser: move the body, the five pair stiffnesses, the viscosity ratio, the active

@@ -6,14 +6,7 @@ import argparse
 
 from ..parameters import PAPER_PAIRS, resolve
 from ..parameters import unit as parameter_unit
-from ..simulation.results import atomic_write_text
-from ..studies.identification import (
-    ENGINES,
-    FIT_QUANTITIES,
-    RESIDUAL_MODELS,
-    fit_stiffness,
-    read_trajectory_csv,
-)
+from ..studies.identification import ENGINES, FIT_QUANTITIES, RESIDUAL_MODELS
 from . import UsageError
 from ._common import check_writable, print_json
 from .simulate import add_experiment_arguments, experiment_inputs, scenario_from_args
@@ -29,9 +22,6 @@ estimate with its standard error and 95 % confidence interval; by default these
 allow for residuals correlated from sample to sample (a first-order autoregression
 per link, estimated from the residuals), which measured sway always has.
 """
-
-
-HELP = "fit pair stiffness to measured angles (with confidence intervals)"
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -62,6 +52,8 @@ def run(args: argparse.Namespace) -> int:
     import json
 
     from .._files import refuse_input_as_output
+    from ..simulation.results import atomic_write_text
+    from ..studies.identification import fit_stiffness, read_trajectory_csv
 
     refuse_input_as_output({"--data": args.data, **experiment_inputs(args)},
                            {"--report": args.report})

@@ -14,8 +14,6 @@ from ._common import (
     print_json,
 )
 
-HELP = "fit controller gains, delay and sensory weight to FRFs (one or several conditions)"
-
 DESCRIPTION = f"""\
 Fit the linearised model's FRF to one or several measured FRFs. Each --data is a condition:
 a trial CSV (then --stimulus, --response, --cycle-length and --response-sign say how to

@@ -7,8 +7,6 @@ import math
 
 from ._common import FIGURE_SUFFIXES, check_writable, print_json
 
-HELP = "frequency response function of a periodic-stimulus (PRTS) trial, from a CSV"
-
 DESCRIPTION = """\
 Estimate the frequency response function (FRF) of one column to another in a CSV trial with a
 periodic stimulus (a PRTS), as Peterka (2002) did: the record is cut into cycles of

@@ -14,8 +14,6 @@ from ._common import (
     print_json,
 )
 
-HELP = "frequency response of the linearised model to tilt or translation (exact delay)"
-
 DESCRIPTION = """\
 The frequency response function of the model linearised about upright, with the delay as
 e^{−sτ} (no Padé approximation), for any body and controller (the options below, as in

@@ -4,8 +4,6 @@ from __future__ import annotations
 
 import argparse
 
-from ..linear.analysis import analyse_both_sides
-from ..paper.compare import erratum, table2_comparison
 from ._common import (
     add_muscle_arguments,
     body_from_args,
@@ -39,9 +37,6 @@ cannot settle), and 'stable' is false.
 """
 
 
-HELP = "poles and stability of the linearised model (Table II)"
-
-
 def add_arguments(p: argparse.ArgumentParser) -> None:
     """The options of ``posturelab poles``."""
     add_muscle_arguments(p)
@@ -68,6 +63,7 @@ def run(args: argparse.Namespace) -> int:
 
             raise UsageError("poles: --all takes no --case or --stiffness")
         return _run_all(args)
+    from ..linear.analysis import analyse_both_sides
     from ..linear.verdict import upright_verdict
 
     body = body_from_args(args)
@@ -143,6 +139,8 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _run_all(args: argparse.Namespace) -> int:
+    from ..paper.compare import erratum, table2_comparison
+
     rows = table2_comparison(viscosity_ratio=_ratio(args))
     if args.json:
         print_json({"table2": [

@@ -21,9 +21,6 @@ output.
 """
 
 
-HELP = "regenerate the paper's tables and figures (HTML report)"
-
-
 def add_arguments(p: argparse.ArgumentParser) -> None:
     """The options of ``posturelab reproduce``."""
     p.add_argument("--out", required=True, metavar="DIR",

@@ -4,8 +4,6 @@ from __future__ import annotations
 
 import argparse
 
-from ..linear.analysis import disturbance_sensitivity
-from ..model.body import paper_body
 from ._common import parse_float_list, print_json
 
 DESCRIPTION = """\
@@ -13,9 +11,6 @@ J(Θ)⁻¹H(Θ) [rad/m] for the paper's three-link body: the change of each link
 [rad/s] per unit change of platform velocity [m/s] (ΔΘ̇ = −J⁻¹H Δẋ_d), evaluated at
 posture Θ (default upright). The paper prints [2.5580, -0.0654, 0.0027] at upright.
 """
-
-
-HELP = "disturbance severity J⁻¹H at a posture"
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -27,6 +22,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from ..linear.analysis import disturbance_sensitivity
+    from ..model.body import paper_body
+
     body = paper_body()
     posture = parse_float_list(args.posture, "--posture [rad]", body.n_links)
     value = disturbance_sensitivity(body, posture)

@@ -58,7 +58,6 @@ run shorter than two cycles).
 """
 
 
-HELP = "simulate a platform disturbance (nonlinear model)"
 #: The wall-clock budget of one `simulate` run when neither --time-limit nor the scenario
 #: gives one: nothing legitimate takes this long on either engine. [s]
 DEFAULT_TIME_LIMIT = 600.0

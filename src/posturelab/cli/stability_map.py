@@ -15,7 +15,7 @@ from typing import IO
 
 from ..errors import ParameterError, UnknownNameError
 from ..parameters import PAPER_PAIRS, check_value, names_for, resolve
-from . import CONVENTIONS_EPILOG
+from . import CONVENTIONS_EPILOG, SUBCOMMAND_HELP
 from ._common import ExpectedTime, load_compiled
 
 #: Axis names, the parameter table's: the paper's five pair stiffnesses stiffness:PAIR
@@ -64,7 +64,7 @@ DELAYED_AXES = ("active_stiffness", "active_viscosity")
 
 def add_parser(sub, name: str) -> argparse.ArgumentParser:
     p = sub.add_parser(
-        name, help="stability map of the linearised model over two parameters",
+        name, help=SUBCOMMAND_HELP[name],
         description=DESCRIPTION, epilog=CONVENTIONS_EPILOG,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )

@@ -91,10 +91,6 @@ reference for undelayed runs); --rtol/--atol override them.
 """
 
 
-HELP = ("simulate a grid of gains, delays, torque limits and perturbation sizes; outcomes "
-        "to CSV or Parquet")
-
-
 #: Below this many runs a local sweep is faster than starting a Dask cluster. [-]
 SMALL_FOR_DASK = 20_000
 

@@ -85,9 +85,8 @@ from __future__ import annotations
 import math
 import tomllib
 from dataclasses import dataclass, replace
-from importlib import resources
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -118,9 +117,9 @@ from ..model.tilt import (
     read_tilt_csv,
 )
 from ..parameters import check_value
-from ..simulation.engines import engine_name, simulate
-from ..simulation.results import SimulationResult
-from ..simulation.setup import check_step_budget, check_time_limit
+
+if TYPE_CHECKING:  # (the simulation loads when a scenario is read or run: --help stays light)
+    from ..simulation.results import SimulationResult
 
 __all__ = [
     "Scenario",
@@ -221,6 +220,8 @@ class Scenario:
             ``solver.method`` names an integrator the engine does not have (the compiled
             engine has Radau, RK45 and RK23).
         """
+        from ..simulation.engines import engine_name, simulate
+
         name = engine_name(engine)
         sc = self.replace(**overrides) if overrides else self
         return simulate(
@@ -242,6 +243,8 @@ class Scenario:
         ParameterError
             The compiled engine and a method it does not have (it has Radau, RK45, RK23).
         """
+        from ..simulation.engines import engine_name
+
         if engine_name(engine) == "compiled" and self.method is not None:
             from ..simulation.compiled import METHODS
 
@@ -319,6 +322,8 @@ def _reject(d: dict, allowed, where: str, origin: str) -> None:
 
 
 def _parse(data: dict, base_dir: Path, origin: str) -> Scenario:
+    from ..simulation.setup import check_step_budget, check_time_limit
+
     _reject(data, TOP_KEYS, "the top level", origin)
     if "duration" not in data:
         raise ScenarioError(f"{origin}: missing required key 'duration' [s]")
@@ -620,12 +625,16 @@ def _need(d: dict, key: str, origin: str):
 
 def builtin_scenario_names() -> list[str]:
     """Names of the scenarios shipped with posturelab."""
+    from importlib import resources
+
     root = resources.files(__package__) / "builtin"
     return sorted(p.name[:-5] for p in root.iterdir() if p.name.endswith(".toml"))
 
 
 def builtin_scenario(name: str) -> Scenario:
     """A shipped scenario by name; an unknown name lists the known ones."""
+    from importlib import resources
+
     from ..errors import UnknownNameError
 
     names = builtin_scenario_names()

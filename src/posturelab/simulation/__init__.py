@@ -8,17 +8,30 @@ run and works out what both engines share; the reference engine
 whose derived series come from :mod:`.derived`.
 """
 
-from ..model.muscles import joint_crossing_matrix, moments_to_link_torques
-from ..model.options import (
-    FOOT_FROM_LITERATURE,
-    FOOT_LENGTH_FRACTION_OF_HEIGHT,
-    HEEL_FRACTION_OF_FOOT,
-    BaseOfSupport,
-    FallCriteria,
-    KneeMode,
-    KneeModel,
-    base_of_support_for_height,
-)
-from .engines import ENGINES, simulate
-from .results import DerivedSeries, SimulationResult
-from .setup import RunSetup, initial_state_for, prepare_run
+import importlib
+
+#: The names this package gives, loaded on first access (so that importing one of its
+#: modules, e.g. for a constant a --help needs, does not load the engines): module -> names.
+NAMES: dict[str, tuple[str, ...]] = {
+    "posturelab.model.muscles": ("joint_crossing_matrix", "moments_to_link_torques"),
+    "posturelab.model.options": ("FOOT_FROM_LITERATURE", "FOOT_LENGTH_FRACTION_OF_HEIGHT",
+                                 "HEEL_FRACTION_OF_FOOT", "BaseOfSupport", "FallCriteria",
+                                 "KneeMode", "KneeModel", "base_of_support_for_height"),
+    "posturelab.simulation.engines": ("ENGINES", "simulate"),
+    "posturelab.simulation.results": ("DerivedSeries", "SimulationResult"),
+    "posturelab.simulation.setup": ("RunSetup", "initial_state_for", "prepare_run"),
+}
+_MODULE_OF_NAME = {name: module for module, names in NAMES.items() for name in names}
+__all__ = sorted(_MODULE_OF_NAME)
+
+
+def __getattr__(name: str):
+    if name not in _MODULE_OF_NAME:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(importlib.import_module(_MODULE_OF_NAME[name]), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_MODULE_OF_NAME))

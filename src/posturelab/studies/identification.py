@@ -35,6 +35,7 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -44,7 +45,9 @@ from ..model.muscles import MuscleSet
 from ..parameters import FIT_MAX_GAIN, QUANTITIES, resolve
 from ..parameters import unit as parameter_unit
 from ..scenarios import Scenario
-from ..simulation.results import SimulationResult
+
+if TYPE_CHECKING:  # (loaded when a fit runs: posturelab fit --help stays light)
+    from ..simulation.results import SimulationResult
 
 __all__ = ["FitResult", "FitError", "fit_stiffness", "read_trajectory_csv"]
 
@@ -118,6 +121,7 @@ class FitResult:
 
     def to_dict(self) -> dict:
         """Plain-Python summary for JSON: units as in the attribute docs."""
+
         return {
             "parameters": {
                 name: {

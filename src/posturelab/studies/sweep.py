@@ -42,7 +42,7 @@ import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import IO, Any
+from typing import IO, TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -53,9 +53,12 @@ from ..parameters import PAPER_JOINTS, PAPER_PAIRS, check_value, names_for, pars
 from ..parameters import resolve as resolve_name
 from ..parameters import unit as parameter_unit
 from ..scenarios import Scenario
-from ..simulation.compiled import DEFAULT_ATOL, DEFAULT_RTOL, BatchResult, simulate_batch
 from ..simulation.outcome import UPRIGHT_BAND
 from ..simulation.results import atomic_write_bytes, atomic_write_text
+from ..simulation.tolerances import DEFAULT_ATOL, DEFAULT_RTOL
+
+if TYPE_CHECKING:  # (the engine loads when a sweep runs: posturelab --help stays light)
+    from ..simulation.compiled import BatchResult
 
 __all__ = [
     "SWEEP_PARAMETERS",
@@ -612,6 +615,8 @@ class _Task:
         return replace(result, steady_rms_theta=rms, steady_peak_theta=peak)
 
     def _batch(self, grid: SweepGrid, lo: int, hi: int, parallel: bool) -> BatchResult:
+        from ..simulation.compiled import simulate_batch
+
         sc = self.scenario
         return simulate_batch(
             sc.body, grid.stiffness[lo:hi], grid.viscosity[lo:hi], sc.disturbance,
@@ -638,6 +643,8 @@ def _rows(values: np.ndarray | None, lo: int, hi: int) -> np.ndarray | None:
 
 
 def _concatenate(parts: list[BatchResult]) -> BatchResult:
+    from ..simulation.compiled import BatchResult
+
     if len(parts) == 1:
         return parts[0]
     fields = ("fell", "fall_time", "peak_theta", "settling_time", "final_state", "status_code",

@@ -59,6 +59,7 @@ from ..setup import (
     start_moments,
     start_saturation,
 )
+from ..tolerances import DEFAULT_ATOL, DEFAULT_RTOL
 from . import _encode as enc
 from ._binding import Batch, Out, Run, library, pointer
 from ._layout import (
@@ -99,12 +100,6 @@ __all__ = [
     "warm_up",
 ]
 
-#: Default relative tolerance of the compiled engine. [-]
-DEFAULT_RTOL = 1e-6
-#: Default absolute tolerance [rad, rad/s]. With rtol = 1e-6 the angle error of the paper's
-#: scenarios and of random-gain sweeps stays below 1e-6 rad against a DOP853 rtol = 1e-10
-#: reference (measured by benchmarks/bench_simulate.py; tested in tests/test_fast.py).
-DEFAULT_ATOL = 1e-9
 #: The compiled integrators: Radau IIA of order 5, or an explicit pair given by its tableau.
 METHODS = {"Radau": None, "RK45": DORMAND_PRINCE_54, "RK23": BOGACKI_SHAMPINE_32}
 

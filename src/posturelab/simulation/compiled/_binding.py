@@ -1,8 +1,9 @@
 """The C engine (``_engine``, built by ``setup.py`` from ``csrc/``) seen from Python.
 
 The structs mirror ``csrc/pl.h`` field by field; :func:`library` loads the extension once
-and checks that it was built from the sources beside it. Calls go through ctypes, which
-releases the GIL for their duration, so batch chunks run in parallel on Python threads.
+and checks that it was built from the sources beside it, where they are all installed.
+Calls go through ctypes, which releases the GIL for their duration, so batch chunks run in
+parallel on Python threads.
 """
 
 from __future__ import annotations
@@ -12,7 +13,7 @@ import functools
 import importlib.util
 
 from ...errors import PostureLabError
-from ._sources import source_hash
+from ._sources import stale_digest
 
 _P = ctypes.POINTER
 _d = _P(ctypes.c_double)
@@ -62,6 +63,17 @@ def pointer(arr, kind=_d):
     return arr.ctypes.data_as(kind)
 
 
+def built_source_files(lib: ctypes.CDLL) -> list[str]:
+    """The names of the C sources the engine ``lib`` was built from ([] for a build that did
+    not record them)."""
+    try:
+        recorded = lib.pl_source_files
+    except AttributeError:
+        return []
+    recorded.restype = ctypes.c_char_p
+    return [name for name in recorded().decode().split(",") if name]
+
+
 @functools.cache
 def library() -> ctypes.CDLL:
     """The loaded engine, its functions typed."""
@@ -74,8 +86,8 @@ def library() -> ctypes.CDLL:
     lib = ctypes.CDLL(spec.origin)
     lib.pl_source_hash.restype = ctypes.c_char_p
     built = lib.pl_source_hash().decode()
-    here = source_hash()
-    if here and built != here:
+    here = stale_digest(built, built_source_files(lib))
+    if here:
         raise PostureLabError(
             f"posturelab's compiled engine was built from other C sources ({built}) than "
             f"those installed ({here}): rebuild it (pip install -e . in a source checkout)")

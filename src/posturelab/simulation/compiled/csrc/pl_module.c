@@ -4,7 +4,7 @@
  * batch keeping outcomes only, without the GIL (ctypes releases it), so Python threads run
  * chunks in parallel; pl_state_derivative evaluates the right-hand side (for the tests);
  * pl_rotate_value exposes the rotated sines (for the tests); pl_source_hash names the C
- * sources this build came from. */
+ * sources this build came from and pl_source_files lists them (names, comma-separated). */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
 #include <stdlib.h>
@@ -14,6 +14,9 @@
 #ifndef PL_SOURCE_HASH
 #define PL_SOURCE_HASH "unknown"
 #endif
+#ifndef PL_SOURCE_FILES
+#define PL_SOURCE_FILES ""
+#endif
 
 #ifdef _WIN32
 #define PL_EXPORT __declspec(dllexport)
@@ -22,6 +25,7 @@
 #endif
 
 PL_EXPORT const char *pl_source_hash(void) { return PL_SOURCE_HASH; }
+PL_EXPORT const char *pl_source_files(void) { return PL_SOURCE_FILES; }
 
 PL_EXPORT int64_t pl_run_one(const pl_run *run, pl_out *out) { return pl_integrate(run, out); }
 
