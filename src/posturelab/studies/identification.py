@@ -121,7 +121,6 @@ class FitResult:
 
     def to_dict(self) -> dict:
         """Plain-Python summary for JSON: units as in the attribute docs."""
-
         return {
             "parameters": {
                 name: {
