@@ -36,7 +36,8 @@ def compiled_evaluator(tmp_path_factory, capsys):
     the one-time compile notice cannot reach its stderr (under pytest-xdist this test may
     run before any other has compiled them)."""
     folder = tmp_path_factory.mktemp("warm")
-    assert main(["stability-map", "--x", "ankle:0:2000", "--y", "gastrocnemius:0:1000",
+    assert main(["stability-map", "--x", "stiffness:ankle:0:2000", "--y",
+                 "stiffness:gastrocnemius:0:1000",
                  "--resolution", "2", "--out", str(folder / "map.png")]) == 0
     capsys.readouterr()
 

@@ -17,7 +17,7 @@ from posturelab.linear.delay_batch import MAX_DELAY_MAP_RESOLUTION
 from posturelab.simulation.results import atomic_write_files
 
 DELAYED = ["stability-map", "--body", "paper-1link", "--stiffness", "28", "--viscosity", "11",
-           "--x", "active_stiffness:0:1700", "--y", "active_viscosity:0:680",
+           "--x", "active_stiffness:ankle:0:1700", "--y", "active_viscosity:ankle:0:680",
            "--feedback-delay", "0.15"]
 
 
@@ -51,8 +51,8 @@ def test_the_delayed_map_draws_progress(tmp_path):
 @pytest.mark.parametrize("delayed", [True, False])
 def test_an_unwritable_csv_is_found_before_any_work_and_nothing_is_written(tmp_path, delayed):
     (tmp_path / "m.csv").mkdir()
-    argv = (DELAYED if delayed else ["stability-map", "--x", "ankle:0:2000", "--y",
-                                     "hip:0:1000"])
+    argv = (DELAYED if delayed else ["stability-map", "--x", "stiffness:ankle:0:2000",
+                                     "--y", "stiffness:hip:0:1000"])
     one_line_exit_2(cli(*argv, "--resolution", "5", "--out", str(tmp_path / "m.png")),
                     "m.csv", "it is a directory")
     assert [f.name for f in tmp_path.iterdir()] == ["m.csv"]
@@ -88,7 +88,8 @@ def test_ctrl_c_stops_the_delayed_map_and_leaves_nothing(tmp_path):
     import signal
 
     proc = subprocess.Popen([sys.executable, "-m", "posturelab", "stability-map", "--x",
-                             "active_stiffness:0:1700", "--y", "active_viscosity:0:680",
+                             "active_stiffness:ankle:0:1700", "--y",
+                             "active_viscosity:ankle:0:680",
                              "--feedback-delay", "0.15", "--case", "1", "--resolution", "120",
                              "--progress", "--out", str(tmp_path / "m.png")],
                             stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)

@@ -164,7 +164,7 @@ def test_a_sweep_honours_or_refuses_the_scenarios_method():
 
     sc = builtin_scenario("paper-forward-case1").replace(duration=0.5, method="RK45")
     ankle = sc.muscles.stiffnesses[0]  # varied over its own value: the row is the scenario
-    vary = [parse_vary(f"ankle={ankle}:{ankle}:1")]
+    vary = [parse_vary(f"stiffness:ankle={ankle}:{ankle}:1")]
     result = run_sweep(sc, vary)
     options = {"initial_state": sc.initial_state, "rtol": 1e-6, "atol": 1e-9}  # a sweep's
     for method in ("RK45", "Radau"):

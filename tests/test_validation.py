@@ -163,7 +163,7 @@ def test_negative_or_non_finite_pair_fields():
 
 
 def test_bad_viscosity_ratio_and_list():
-    with raises_naming(ParameterError, "viscosity_ratio", ">= 0", "got -0.25"):
+    with raises_naming(ParameterError, "viscosity_ratio", "[0, 10]", "got -0.25"):
         paper_muscles("1", viscosity_ratio=-0.25)
     with raises_naming(ParameterError, "viscosity", "5 values", "got 2"):
         paper_muscles("1", viscosity=[1.0, 2.0])
