@@ -99,7 +99,7 @@ def main() -> None:
     preset = get_controller("icm-pmc5664365")
     true = preset.muscles(body)
     L, T = 1000, 20.0
-    x1 = PRTSTilt.peterka_2002(0.035).angle(np.arange(L) * T / L)
+    x1 = PRTSTilt.named("posturelab-80", 0.035).angle(np.arange(L) * T / L)
     X = np.fft.rfft(x1)
     fk = np.arange(X.size) / T
     Hk = np.zeros(X.size, complex)

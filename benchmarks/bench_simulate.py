@@ -314,7 +314,7 @@ def main() -> int:
     body1 = pl.get_body("paper-1link")
     preset = get_controller("icm-pmc5664365")
     m1 = preset.muscles(body1)
-    prts = PRTSTilt.peterka_2002(0.035)
+    prts = PRTSTilt.named("posturelab-80", 0.035)
     tilt_duration = 20.0 if QUICK else 40.0
 
     def tilted(engine, ka=None):

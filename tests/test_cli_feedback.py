@@ -81,7 +81,8 @@ def test_simulate_with_controller_and_tilt_is_the_api_run(capsys):
     obj = json.loads(out)
     preset = get_controller("peterka-2002")
     body = pl.get_body("paper-1link")
-    api = pl.simulate(body, preset.muscles(body), None, 3.0, tilt=PRTSTilt.peterka_2002(0.035),
+    api = pl.simulate(body, preset.muscles(body), None, 3.0,
+                      tilt=PRTSTilt.named("posturelab-80", 0.035),
                       engine="compiled", rtol=1e-8, atol=1e-10, **preset.run_options())
     assert obj["final_state"] == [float(v) for v in api.final_state]
 

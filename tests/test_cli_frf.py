@@ -44,7 +44,8 @@ def test_frf_json_is_the_estimate_of_the_simulated_trial(capsys, trial):
     assert set(obj) == KEYS and len(obj["frequency"]) == 11
     body = pl.get_body("paper-1link")
     preset = get_controller("peterka-2002")
-    r = pl.simulate(body, preset.muscles(body), None, 60.0, tilt=PRTSTilt.peterka_2002(0.035),
+    r = pl.simulate(body, preset.muscles(body), None, 60.0,
+                    tilt=PRTSTilt.named("posturelab-80", 0.035),
                     engine="compiled", sample_rate=50.0, rtol=1e-8, atol=1e-10,
                     **preset.run_options())
     est = estimate_frf(r.tilt[:-1], r.com_angle[:-1], 50.0, 20.0, discard_cycles=1,

@@ -26,7 +26,7 @@ L, T = 1000, 20.0
 def steady_cycle(muscles, delay, weight, amplitude=0.035, input="tilt"):
     """One cycle of Peterka's PRTS and the model's periodic steady response (the sway in the
     surface's sense), through the exact FRF at every harmonic."""
-    x = PRTSTilt.peterka_2002(amplitude).angle(np.arange(L) * T / L)
+    x = PRTSTilt.named("posturelab-80", amplitude).angle(np.arange(L) * T / L)
     X = np.fft.rfft(x)
     f = np.arange(X.size) / T
     H = np.zeros(X.size, complex)

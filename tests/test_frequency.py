@@ -116,7 +116,7 @@ def test_a_noise_free_simulated_prts_experiment_returns_the_model_frf():
     body = pl.get_body("paper-1link")
     preset = get_controller("icm-pmc5664365")
     muscles = preset.muscles(body)
-    tilt = PRTSTilt.peterka_2002(3.5e-5)
+    tilt = PRTSTilt.named("posturelab-80", 3.5e-5)
     fs = 5000.0
     r = pl.simulate(body, muscles, None, 100.0, tilt=tilt, sample_rate=fs, engine="compiled",
                     rtol=1e-11, atol=1e-16, **preset.run_options())

@@ -112,7 +112,7 @@ def test_a_prts_run_is_a_steady_sway_measured_after_its_first_cycle():
 
     body = pl.get_body("paper-1link")
     preset = get_controller("peterka-2002")
-    tilt = PRTSTilt.peterka_2002(0.035)
+    tilt = PRTSTilt.named("posturelab-80", 0.035)
     run = pl.simulate(body, preset.muscles(body), None, 41.0, tilt=tilt, engine="compiled",
                       **preset.run_options())
     out = run.outcome

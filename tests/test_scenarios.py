@@ -206,7 +206,7 @@ def test_scenario_with_active_gains_and_tilt_runs_as_the_api_does(tmp_path):
     np.testing.assert_array_equal(sc.run(engine="compiled").theta, api.theta)
     prts = load_scenario(write(tmp_path, MINIMAL + '[tilt]\ntype = "prts"\namplitude = 0.02\n',
                                "p.toml"))
-    assert prts.tilt == PRTSTilt.peterka_2002(0.02)
+    assert prts.tilt == PRTSTilt.named("posturelab-80", 0.02)
     csv = tmp_path / "tilt.csv"
     t = np.linspace(0, 2, 201)
     csv.write_text("time [s],tilt [rad]\n" + "".join(f"{a},{0.01 * np.sin(a)}\n" for a in t))

@@ -83,7 +83,7 @@ def test_a_1_khz_sampled_sine_reproduces_the_analytic_sine(engine):
 
 
 @pytest.mark.parametrize("tilt", [SineTilt(0.03, 0.4, 0.3), RaisedCosineTilt(-0.04, 0.6, 0.3),
-                                  PRTSTilt.peterka_2002(0.06)])
+                                  PRTSTilt.named("posturelab-80", 0.06)])
 def test_the_engines_agree_on_tilt_with_delay_and_sensory_weight(tilt):
     body, muscles = pl.paper_body(), split_case_1()
     kwargs = dict(tilt=tilt, proprioceptive_weight=0.7, feedback_delay=0.03, sample_rate=100,
@@ -116,7 +116,7 @@ def test_prts_has_the_properties_of_peterkas_sequence():
     v = prts_sequence(4, (1, 1, 0, 0), (1, 0, 0, 0))
     assert v.size == 80 and v.sum() == 0 and np.count_nonzero(v) == 54
     np.testing.assert_array_equal(v[40:], -v[:40])  # half-period antisymmetry: odd harmonics
-    tilt = PRTSTilt.peterka_2002(0.0349)
+    tilt = PRTSTilt.named("posturelab-80", 0.0349)
     assert tilt.cycle == 20.0
     t = np.linspace(0, 40, 40_001)
     a, rate = tilt.angle_and_rate(t)
@@ -206,7 +206,7 @@ def test_the_engines_agree_about_an_axis_below_the_ankle_with_a_starting_sine():
 def test_an_axis_depth_needs_a_smooth_tilt():
     body, muscles = pendulum()
     with pytest.raises(ParameterError, match="needs a tilt rate without jumps"):
-        pl.simulate(body, muscles, None, 1.0, tilt=PRTSTilt.peterka_2002(0.02),
+        pl.simulate(body, muscles, None, 1.0, tilt=PRTSTilt.named("posturelab-80", 0.02),
                     tilt_axis_depth=0.05)
     with pytest.raises(ParameterError, match=r"tilt_axis_depth \[m\] needs a tilt"):
         pl.simulate(body, muscles, None, 1.0, tilt_axis_depth=0.05)
@@ -279,7 +279,8 @@ def test_the_80_state_default_is_posturelabs_own_and_says_so():
     from posturelab.model.tilt import DEFAULT_PRTS, PRTS_SEQUENCES, PRTSTilt
 
     assert DEFAULT_PRTS == "posturelab-80"
-    assert PRTSTilt.peterka_2002(0.035) == PRTSTilt.named("posturelab-80", 0.035)
+    with pytest.raises(ParameterError, match="not Peterka 2002's"):
+        PRTSTilt.peterka_2002(0.035)  # the former name, which said otherwise
     assert "posturelab's own" in PRTS_SEQUENCES["posturelab-80"].citation
     assert "not Peterka 2002's" in PRTS_SEQUENCES["posturelab-80"].citation
     a, b = (PRTSTilt.named(n).velocity_sequence for n in ("posturelab-80", "comtest-80"))

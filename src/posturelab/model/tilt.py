@@ -488,10 +488,14 @@ class PRTSTilt(Tilt):
 
     @classmethod
     def peterka_2002(cls, amplitude: float) -> PRTSTilt:
-        """Former name of ``PRTSTilt.named("posturelab-80", amplitude)``, kept so that
-        existing code runs: posturelab's own 80-state, 20 s sequence, which is NOT Peterka
-        2002's (that is ``named("peterka-2002-242")``, 242 states, 60.5 s)."""
-        return cls.named("posturelab-80", amplitude)
+        """Refused: this former name gave posturelab's own 80-state, 20 s sequence, which is
+        not Peterka 2002's. Raises ParameterError naming ``named("posturelab-80", A)`` (the
+        sequence it gave) and ``named("peterka-2002-242", A)`` (Peterka 2002's)."""
+        raise ParameterError(
+            "PRTSTilt.peterka_2002 gave posturelab's own 80-state, 20 s sequence, which is not "
+            "Peterka 2002's: use PRTSTilt.named('posturelab-80', amplitude) for the same "
+            "sequence, or PRTSTilt.named('peterka-2002-242', amplitude) for Peterka 2002's "
+            "242-state, 60.5 s one")
 
     @property
     def sequence_name(self) -> str | None:
