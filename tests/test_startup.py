@@ -151,3 +151,28 @@ def test_simulate_stays_the_function_when_the_former_module_is_imported_first():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          check=True, timeout=120).stdout
     assert out.split() == ["posturelab.simulation.engines", "True"]
+
+
+def test_every_body_preset_and_dotted_path_works_in_a_fresh_process():
+    """In a fresh interpreter (nothing else imported first): every body preset is known
+    (the anthropometric ones register themselves when model.body loads) and the dotted paths
+    the README and docs use reach their modules without an import statement."""
+    import subprocess
+    import sys
+
+    code = """
+import posturelab as pl
+names = sorted(pl.BODY_PRESETS)
+assert names == ["paper", "paper-1link", "paper-2link", "winter-1.75m-75kg"], names
+assert all(pl.get_body(n).n_links >= 1 for n in names)
+assert pl.model.tilt.PRTSTilt.named("peterka-2002-242", 0.03).registers == 5
+assert callable(pl.linear.delay_batch.delay_stability_map)
+assert callable(pl.scenarios.schema.json_schema)
+assert "peterka-2002" in pl.model.controllers.CONTROLLERS
+assert callable(pl.frequency.model_frf_batch) and callable(pl.frequency.fit.fit_frf)
+assert pl.parameters.MAX_FEEDBACK_DELAY == 1.0
+print("ok")
+"""
+    p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                       timeout=120)
+    assert p.returncode == 0 and p.stdout.strip() == "ok", p.stderr[-2000:]

@@ -17,3 +17,7 @@ from .app import HOST, create_app, serve
 from .views import CONTROLS, compute_views, parse_parameters
 
 __all__ = ["HOST", "create_app", "serve", "CONTROLS", "compute_views", "parse_parameters"]
+
+from .._lazy import submodule_getattr  # noqa: E402
+
+__getattr__ = submodule_getattr(__name__, __path__)

@@ -8,8 +8,12 @@ gain and phase (published tables), :mod:`.fit` fits a controller to either.
 
 from .bands import PETERKA_BAND_HARMONICS, band_frequencies, harmonic_bands, peterka_bands
 from .estimate import FRFEstimate, estimate_frf
-from .model import model_frf
+from .model import model_frf, model_frf_batch
 from .table import FRFTable
 
 __all__ = ["PETERKA_BAND_HARMONICS", "band_frequencies", "harmonic_bands", "peterka_bands",
-           "FRFEstimate", "estimate_frf", "model_frf", "FRFTable"]
+           "FRFEstimate", "estimate_frf", "model_frf", "model_frf_batch", "FRFTable"]
+
+from .._lazy import submodule_getattr  # noqa: E402
+
+__getattr__ = submodule_getattr(__name__, __path__)

@@ -4,6 +4,7 @@
 millions of sets at once with compiled kernels (imported on first use).
 """
 
+from .._lazy import submodule_getattr  # noqa: E402
 from .analysis import (
     LinearAnalysis,
     OneSided,
@@ -14,3 +15,5 @@ from .analysis import (
     sorted_poles,
     state_matrix,
 )
+
+__getattr__ = submodule_getattr(__name__, __path__)

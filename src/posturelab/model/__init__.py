@@ -9,3 +9,7 @@ linear analysis and both simulators use this one statement of the physics; the
 event table of :mod:`.events` serves both simulators. The public names are exported
 by :mod:`posturelab` itself. Signs, frames and units: :mod:`posturelab.conventions`.
 """
+
+from .._lazy import submodule_getattr  # noqa: E402
+
+__getattr__ = submodule_getattr(__name__, __path__)

@@ -4,6 +4,7 @@ imported on first use: its runs (:mod:`.runs`), checks and findings as data
 (:mod:`.checks`, :mod:`.findings`), figures (:mod:`.figures`) and the page rendered from
 ``templates/report.html.j2`` (:mod:`.report`)."""
 
+from .._lazy import submodule_getattr  # noqa: E402
 from .printed import (
     BACKWARD_INITIAL_STATE,
     BACKWARD_INITIAL_STATE_SOURCE,
@@ -17,3 +18,5 @@ from .printed import (
     printed_decimals,
     printed_tolerance,
 )
+
+__getattr__ = submodule_getattr(__name__, __path__)

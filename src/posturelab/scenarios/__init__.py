@@ -643,3 +643,7 @@ def builtin_scenario(name: str) -> Scenario:
     res = resources.files(__package__) / "builtin" / f"{name}.toml"
     with resources.as_file(res) as path:
         return load_scenario(path)
+
+from .._lazy import submodule_getattr  # noqa: E402
+
+__getattr__ = submodule_getattr(__name__, __path__)

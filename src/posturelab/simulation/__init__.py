@@ -10,6 +10,8 @@ whose derived series come from :mod:`.derived`.
 
 import importlib
 
+from .._lazy import submodule_getattr
+
 #: The names this package gives, loaded on first access (so that importing one of its
 #: modules, e.g. for a constant a --help needs, does not load the engines): module -> names.
 NAMES: dict[str, tuple[str, ...]] = {
@@ -25,12 +27,15 @@ _MODULE_OF_NAME = {name: module for module, names in NAMES.items() for name in n
 __all__ = sorted(_MODULE_OF_NAME)
 
 
-def __getattr__(name: str):
+def _name(name: str):
     if name not in _MODULE_OF_NAME:
         raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
     value = getattr(importlib.import_module(_MODULE_OF_NAME[name]), name)
     globals()[name] = value
     return value
+
+
+__getattr__ = submodule_getattr(__name__, __path__, _name)
 
 
 def __dir__() -> list[str]:

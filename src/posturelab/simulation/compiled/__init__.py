@@ -807,3 +807,7 @@ def warm_up(methods: tuple[str, ...] = ("Radau",),
     for method in methods:
         _check_method(method)
     library()
+
+from ..._lazy import submodule_getattr  # noqa: E402
+
+__getattr__ = submodule_getattr(__name__, __path__)
