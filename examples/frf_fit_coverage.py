@@ -3,14 +3,14 @@
 
 Seeded in-silico PRTS experiments (:func:`posturelab.frequency.experiment.prts_experiment`):
 Peterka's controller (``peterka-2002``) on the one-link body, the 80-state PRTS tilt
-(``posturelab-80``: 0.035 rad peak to peak, 20 s cycles, the first of them discarded) on
-the compiled engine, white sensor noise on the recorded centre-of-mass angle and low-pass
-motor noise in the loop, each run with its own seeds. Each FRF is fitted
+(``posturelab-80``: 0.035 rad peak to peak, 20 s cycles, the first of them discarded) on the
+compiled engine, white sensor noise on the recorded centre-of-mass angle and low-pass motor
+noise in the loop, each run with its own seeds. Each FRF is fitted
 (:func:`posturelab.frequency.fit.fit_frf`: every band weighted by its own variance) for the
-active stiffness, the active viscosity and the delay, from 20–30 % off, and the script counts how often each 95 %
-interval holds the true value and the mean fit error (√(χ²/dof), about 1 when the model
-explains the data), for 2, 3 and 5 analysed cycles. ``tests/test_fit_frf.py`` checks the
-same at 40 runs per row (at least 90 % covered).
+active stiffness, the active viscosity and the delay, from 20–30 % off, and the script counts
+how often each 95 % interval holds the true value and the mean fit error (√(χ²/dof), about 1
+when the model explains the data), for 2, 3 and 5 analysed cycles. ``tests/test_fit_frf.py``
+checks the same at 40 runs per row (at least 90 % covered).
 
 Run it as (about 0.1–0.3 s per run; not run when the documentation is built)::
 
