@@ -368,13 +368,21 @@ def fit_stiffness(
     converged = bool(sol.status > 0)
     describes = _describes(sol.fun, sway, n)
     rms = float(np.sqrt(np.mean(sol.fun**2)))
+    # The Jacobian again, with steps of 1e-6 of each parameter's scale (its value, its start
+    # or 1e-3 of its box): the optimiser's steps are relative to the value, and at a value
+    # near 0 (an active gain at its bound) they are too small to move the simulation.
     scale = np.maximum.reduce([np.abs(sol.x), np.abs(x0), 1e-3 * (upper - lower)])
-    good, reasons = _determinacy(sol.jac, scale, names, sway, t.size)
+    jac = np.empty_like(sol.jac)
+    for k in range(len(names)):
+        step = np.zeros(len(names))
+        step[k] = 1e-6 * scale[k] * (1.0 if sol.x[k] + 1e-6 * scale[k] <= upper[k] else -1.0)
+        jac[:, k] = (residuals(sol.x + step) - sol.fun) / step[k]
+    good, reasons = _determinacy(jac, scale, names, sway, t.size)
     if residual_model == "ar1":
-        cov, se, rho, dof = _ar1_covariance(sol.jac, sol.x, sol.fun, n, good=good)
+        cov, se, rho, dof = _ar1_covariance(jac, sol.x, sol.fun, n, good=good)
     else:
         dof = max(sol.fun.size - len(names), 1)
-        cov, se = _covariance(sol.jac, sol.x, float(sol.fun @ sol.fun) / dof, good=good)
+        cov, se = _covariance(jac, sol.x, float(sol.fun @ sol.fun) / dof, good=good)
         rho = np.zeros(n)
     reasons = [why or ("" if math.isfinite(e) else "its standard error is not finite")
                for why, e in zip(reasons, se, strict=True)]
