@@ -152,3 +152,17 @@ def test_describes_tells_a_smooth_misfit_from_noise(rng):
     assert not _describes(smooth.ravel(), sway=0.1, n_links=3)
     assert _describes(0.3 * smooth.ravel(), sway=0.1, n_links=3)
     assert _describes(rng.normal(0.0, 0.08, (201, 3)).ravel(), sway=0.1, n_links=3)
+
+
+def test_a_fit_that_ran_out_of_simulations_is_no_success():
+    """Three simulations cannot converge: the fit says so, and shows no interval."""
+    sc = pl.builtin_scenario("paper-backward-case1").replace(duration=2.0, sample_rate=50)
+    truth = sc.run()
+    start = sc.replace(muscles=pl.paper_muscles(stiffness=[700, 300, 300, 300, 200]))
+    fit = fit_stiffness(start, truth.time, truth.theta,
+                        ["stiffness:ankle", "stiffness:gastrocnemius"], max_simulations=3)
+    assert not fit.converged and not fit.success
+    assert fit.warning.startswith("the optimiser did not converge")
+    d = fit.to_dict()
+    assert d["success"] is False and d["converged"] is False
+    assert all(p["ci95"] is None for p in d["parameters"].values())
