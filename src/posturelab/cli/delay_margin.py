@@ -23,6 +23,11 @@ rightmost roots at that delay. --json prints one object:
   {"delay_margin": seconds, or null if unstable without delay, or "infinite" if no crossing,
    "crossing_frequency": rad/s or null, "stable_without_delay": true/false,
    "units": {"delay_margin": "s", "crossing_frequency": "rad/s"}}
+With one-sided pairs the margin is of the side where they are engaged, and
+"unstable_sides" lists each other side on which upright is unstable already without delay
+({"engaged", "slack", "rightmost_root_without_delay": {"re", "im"} [1/s],
+"unstable_at_every_delay": true when the side's stiffness does not hold the gravitational
+load, det(K − g A) < 0, so a real positive root exists at every delay}).
 
 Example: posturelab delay-margin --case 1
          posturelab delay-margin --controller peterka-2002 --json
@@ -48,11 +53,20 @@ def run(args: argparse.Namespace) -> int:
     muscles = muscles_from_args(args, body)
     delay = feedback_options_from_args(args).get("feedback_delay")
     result = delay_margin(body, muscles)
+    unstable = _unstable_sides(body, muscles) if muscles.one_sided_mask.any() else []
     if args.json:
-        print_json({**result.to_dict(), "units": JSON_UNITS})
+        sides = {"unstable_sides": unstable} if muscles.one_sided_mask.any() else {}
+        print_json({**result.to_dict(), **sides, "units": JSON_UNITS})
         return 0
     kind = ("intrinsic gains at once, active gains delayed" if muscles.has_active_feedback
             else "every pair's whole feedback delayed")
+    for side in unstable:
+        root = side["rightmost_root_without_delay"]
+        when = ("whatever the delay (its stiffness does not hold the gravitational load, "
+                "det(K − g A) < 0)" if side["unstable_at_every_delay"]
+                else "already without delay")
+        print(f"upright is unstable while {' and '.join(side['slack'])} slack, {when}; "
+              f"rightmost root {root['re']:.4g}{root['im']:+.4g}j 1/s at τ = 0")
     print(f"delay margin ({kind}):")
     if not result.stable_without_delay:
         print("  unstable without delay: no delay margin")
@@ -63,8 +77,10 @@ def run(args: argparse.Namespace) -> int:
         print(f"  τ = {result.delay_margin:.6g} s ({result.delay_margin * 1000:.4g} ms), a root "
               f"crosses at ω = {w:.6g} rad/s ({w / (2 * math.pi):.4g} Hz)")
     if muscles.one_sided_mask.any():
-        print("  (of the side where the one-sided pairs are engaged; upright is their "
-              "switching point)")
+        engaged = ", ".join(p.name for p in muscles.pairs if p.one_sided)
+        print(f"  (only while {engaged} engaged; upright is the switching point"
+              + ("; on the slack side there is no margin: unstable at τ = 0)" if unstable
+                 else ")"))
     if delay is not None or muscles.one_sided_mask.any():
         # the one verdict about upright (posturelab poles and simulate give it too)
         verdict = upright_verdict(body, muscles, delay or 0.0)
@@ -72,3 +88,27 @@ def run(args: argparse.Namespace) -> int:
         print(f"at τ = {delay or 0.0:g} s: {verdict.describe()}; rightmost roots [1/s]: "
               + ", ".join(f"{z.real:.4g}{z.imag:+.4g}j" for z in roots))
     return 0
+
+
+def _unstable_sides(body, muscles) -> list[dict]:
+    """The sides of the one-sided pairs' switch, other than all engaged, on which upright is
+    unstable without delay; ``unstable_at_every_delay`` when det Δ(0) = det(K − g A) < 0
+    (Δ(0) does not depend on τ and det Δ(s) → +∞ along the positive real axis, so a real
+    positive root exists at every delay)."""
+    import numpy as np
+
+    from ..linear.delay import delayed_system
+    from ..linear.verdict import _side_muscles, upright_verdict
+
+    found = []
+    for side in upright_verdict(body, muscles, 0.0).sides[1:]:
+        if side.status != "unstable":
+            continue
+        system = delayed_system(body, _side_muscles(muscles, frozenset(side.engaged)))
+        static = float(np.linalg.det(system.stiffness + system.delayed_stiffness)) < 0
+        z = side.rightmost_root
+        found.append({"engaged": list(side.engaged), "slack": list(side.slack),
+                      "rightmost_root_without_delay": {"re": float(z.real),
+                                                       "im": float(z.imag)},
+                      "unstable_at_every_delay": static})
+    return found

@@ -82,10 +82,17 @@ def run(args: argparse.Namespace) -> int:
         rho = ", ".join(f"{v:.2f}" for v in fit.residual_autocorrelation)
         print(f"residuals: lag-1 correlation per link {rho} (allowed for in the intervals; "
               f"{fit.degrees_of_freedom:.0f} effective degrees of freedom)")
-    for name, e, se, (lo, hi) in zip(fit.parameter_names, fit.estimates, fit.standard_errors,
-                                     fit.confidence_intervals, strict=True):
+    for name, e, se, (lo, hi), why in zip(fit.parameter_names, fit.estimates,
+                                          fit.standard_errors, fit.confidence_intervals,
+                                          fit.undetermined_reasons, strict=True):
         unit = parameter_unit(name)
-        print(f"  {name:<22} {e:10.4g} ± {se:.3g} {unit}   (95 % CI {lo:.4g} … {hi:.4g})")
-    if not fit.success:
-        print(f"warning: the optimiser did not converge: {fit.message}")
+        if why:
+            print(f"  {name:<22} cannot be determined from these data: {why} "
+                  f"(stopped at {e:.4g} {unit})")
+        elif fit.success:
+            print(f"  {name:<22} {e:10.4g} ± {se:.3g} {unit}   (95 % CI {lo:.4g} … {hi:.4g})")
+        else:
+            print(f"  {name:<22} {e:10.4g} {unit}   (no interval: see the warning)")
+    if fit.warning:
+        print(f"warning: {fit.warning}")
     return 0

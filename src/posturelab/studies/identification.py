@@ -102,6 +102,23 @@ class FitResult:
         fits: not used). [-]
     degrees_of_freedom : float
         Of the t quantile of the intervals: effective samples minus parameters. [-]
+    determined : numpy.ndarray of bool, shape (P,)
+        Whether the data determine each parameter (else its standard error and interval
+        are NaN and ``undetermined_reasons`` says why).
+    undetermined_reasons : tuple of str
+        Why each parameter cannot be determined ("" where it can).
+    converged : bool
+        Whether the optimiser converged (its own criterion, within the simulation budget).
+    describes_data : bool
+        Whether the fitted model describes the data (module notes, "Does the fit describe
+        the data"); ``success`` is ``converged and describes_data``.
+    sway_rms : float
+        RMS of the measured angles about upright, the residual's yardstick. [rad]
+    n_starts : int
+        Starting points the optimiser ran from (1, or more after a fit that did not
+        describe the data). [-]
+    warning : str
+        One line on why the fit is not a success ("" when it is).
     """
 
     parameter_names: tuple[str, ...]
@@ -118,24 +135,45 @@ class FitResult:
     residual_model: str = "independent"
     residual_autocorrelation: np.ndarray | None = None
     degrees_of_freedom: float = math.nan
+    determined: np.ndarray | None = None
+    undetermined_reasons: tuple[str, ...] = ()
+    converged: bool = True
+    describes_data: bool = True
+    sway_rms: float = math.nan
+    n_starts: int = 1
+    warning: str = ""
 
     def to_dict(self) -> dict:
-        """Plain-Python summary for JSON: units as in the attribute docs."""
+        """Plain-Python summary for JSON: units as in the attribute docs. An undetermined
+        parameter has ``"determined": false``, a ``"reason"`` and null error and interval;
+        a fit that is not a success has null intervals (they would not be trustworthy)."""
+        determined = (np.ones(len(self.parameter_names), dtype=bool)
+                      if self.determined is None else self.determined)
+        reasons = self.undetermined_reasons or ("",) * len(self.parameter_names)
+        parameters = {}
+        for name, e, se, (lo, hi), ok, why in zip(
+                self.parameter_names, self.estimates, self.standard_errors,
+                self.confidence_intervals, determined, reasons, strict=True):
+            ok = bool(ok) and math.isfinite(se)
+            parameters[name] = {
+                "estimate": float(e),
+                "determined": ok,
+                "standard_error": float(se) if ok else None,
+                "ci95": [float(lo), float(hi)] if ok and self.success else None,
+                "unit": parameter_unit(name),
+            }
+            if not ok:
+                parameters[name]["reason"] = why or "its standard error is not finite"
         return {
-            "parameters": {
-                name: {
-                    "estimate": float(e),
-                    "standard_error": None if not math.isfinite(se) else float(se),
-                    "ci95": [float(lo), float(hi)] if math.isfinite(se) else None,
-                    "unit": parameter_unit(name),
-                }
-                for name, e, se, (lo, hi) in zip(self.parameter_names, self.estimates,
-                                                 self.standard_errors,
-                                                 self.confidence_intervals, strict=True)
-            },
+            "parameters": parameters,
             "residual_rms": float(self.residual_rms),
+            "sway_rms": float(self.sway_rms),
             "n_samples": int(self.n_samples),
             "success": bool(self.success),
+            "converged": bool(self.converged),
+            "describes_data": bool(self.describes_data),
+            "warning": self.warning or None,
+            "n_starts": int(self.n_starts),
             "message": self.message,
             "n_simulations": int(self.n_simulations),
             "residual_model": self.residual_model,
@@ -293,34 +331,162 @@ def fit_stiffness(
             raise FitError(f"a simulation inside the fit failed at {shown}: {result.message}")
         return result
 
-    def residuals(params: np.ndarray) -> np.ndarray:
+    def predicted(params: np.ndarray) -> np.ndarray:
         r = run(params)
         # a run that fell stops early: hold its last state (a large, smooth residual)
-        sim = np.column_stack([np.interp(t, r.time, r.theta[:, i]) for i in range(n)])
-        return (sim - th).ravel()
+        return np.column_stack([np.interp(t, r.time, r.theta[:, i]) for i in range(n)])
+
+    def residuals(params: np.ndarray) -> np.ndarray:
+        return (predicted(params) - th).ravel()
+
+    if np.max(np.abs(predicted(x0))) <= _NO_MOTION:
+        raise FitError("the model predicts no motion for this experiment (upright, no "
+                       "disturbance, no tilt): check --disturbance/--tilt")
+    sway = float(np.sqrt(np.mean(th**2)))
 
     # A relative step of 1e-6 keeps finite differences well above the integrator's error
     # (rtol 1e-8), so the Jacobian, and with it the standard errors, are not noise.
-    sol = least_squares(residuals, x0, bounds=(lower, upper), x_scale="jac",
-                        max_nfev=max_simulations, method="trf", diff_step=1e-6)
+    def solve(start: np.ndarray):
+        return least_squares(residuals, start, bounds=(lower, upper), x_scale="jac",
+                             max_nfev=max_simulations, method="trf", diff_step=1e-6)
+
+    sol = solve(x0)
+    starts = 1
+    if not _describes(sol.fun, sway, n):
+        # a local minimum (or a stall): seeded restarts, the best kept
+        rng = np.random.default_rng(_RESTART_SEED)
+        for _ in range(_RESTARTS):
+            starts += 1
+            try:
+                other = solve(_restart_point(rng, names, x0, lower, upper))
+            except FitError:  # a start whose simulations fail is skipped, not fatal
+                continue
+            if other.cost < sol.cost:
+                sol = other
+            if _describes(sol.fun, sway, n):
+                break
+    converged = bool(sol.status > 0)
+    describes = _describes(sol.fun, sway, n)
+    rms = float(np.sqrt(np.mean(sol.fun**2)))
+    # The Jacobian again, with steps of 1e-6 of each parameter's scale (its value, its start
+    # or 1e-3 of its box): the optimiser's steps are relative to the value, and at a value
+    # near 0 (an active gain at its bound) they are too small to move the simulation.
+    scale = np.maximum.reduce([np.abs(sol.x), np.abs(x0), 1e-3 * (upper - lower)])
+    jac = np.empty_like(sol.jac)
+    for k in range(len(names)):
+        step = np.zeros(len(names))
+        step[k] = 1e-6 * scale[k] * (1.0 if sol.x[k] + 1e-6 * scale[k] <= upper[k] else -1.0)
+        jac[:, k] = (residuals(sol.x + step) - sol.fun) / step[k]
+    good, reasons = _determinacy(jac, scale, names, sway, t.size)
     if residual_model == "ar1":
-        cov, se, rho, dof = _ar1_covariance(sol.jac, sol.x, sol.fun, n)
+        cov, se, rho, dof = _ar1_covariance(jac, sol.x, sol.fun, n, good=good)
     else:
         dof = max(sol.fun.size - len(names), 1)
-        cov, se = _covariance(sol.jac, sol.x, float(sol.fun @ sol.fun) / dof)
+        cov, se = _covariance(jac, sol.x, float(sol.fun @ sol.fun) / dof, good=good)
         rho = np.zeros(n)
+    reasons = [why or ("" if math.isfinite(e) else "its standard error is not finite")
+               for why, e in zip(reasons, se, strict=True)]
+    good = np.array([not why for why in reasons])
+    se = np.where(good, se, np.nan)
     with np.errstate(invalid="ignore", divide="ignore"):
         corr = cov / np.outer(se, se)
     tq = stats.t.ppf(0.975, dof)
     ci = np.column_stack([sol.x - tq * se, sol.x + tq * se])
+    warning = ""
+    if not describes:
+        warning = (f"the fit does not describe the data: residual RMS {rms:.3g} rad against "
+                   f"a sway of {sway:.3g} rad RMS (best of {starts} starts); the estimates "
+                   "and intervals are not trustworthy")
+    elif not converged:
+        warning = (f"the optimiser did not converge ({sol.message}); the intervals are not "
+                   "trustworthy")
     return FitResult(
         parameter_names=tuple(names), estimates=sol.x.copy(), standard_errors=se,
         confidence_intervals=ci, correlation=corr,
-        residual_rms=float(np.sqrt(np.mean(sol.fun**2))), n_samples=int(sol.fun.size),
-        success=bool(sol.success), message=str(sol.message), n_simulations=count[0] + 1,
+        residual_rms=rms, n_samples=int(sol.fun.size),
+        success=converged and describes, message=str(sol.message),
+        n_simulations=count[0] + 1,
         fitted=run(sol.x), residual_model=residual_model, residual_autocorrelation=rho,
-        degrees_of_freedom=float(dof),
+        degrees_of_freedom=float(dof), determined=good, undetermined_reasons=tuple(reasons),
+        converged=converged, describes_data=describes, sway_rms=sway, n_starts=starts,
+        warning=warning,
     )
+
+
+#: Largest |predicted angle| [rad] of a model that "predicts no motion" (an upright run
+#: without disturbance stays exactly at 0).
+_NO_MOTION = 1e-12
+#: A fit describes the data when its residual RMS is at most this fraction of the sway's
+#: RMS about upright (at 0.5 it explains three quarters of the sway's mean square; a wrong
+#: local minimum or a missing disturbance leaves residuals as large as the sway) ... [-]
+_DESCRIBES_FRACTION = 0.5
+#: ... or when the residuals look like noise: their RMS at most this multiple of the noise
+#: level estimated from successive differences (√(mean(Δr²)/2), the RMS of independent
+#: noise; a systematic misfit is smooth and its differences small). [-]
+_NOISE_MULTIPLE = 2.0
+#: Seeded restarts after a fit that does not describe the data, and their seed. [-]
+_RESTARTS = 8
+_RESTART_SEED = 20261202
+#: A parameter whose change by its scale moves the angles by less than this fraction of
+#: the sway (RMS) is one the data do not depend on. [-]
+_NO_EFFECT = 1e-6
+#: Singular values of the unit-norm Jacobian columns below this count as a dependence
+#: between parameters (exactly dependent columns give ~1e-8 from finite differences). [-]
+_DEPENDENT = 1e-4
+
+
+def _describes(residual: np.ndarray, sway: float, n_links: int) -> bool:
+    """Whether residuals (sample-major, ``n_links`` per sample) [rad] are small against the
+    sway's RMS [rad] or look like noise (the notes of the constants above)."""
+    r = residual.reshape(-1, n_links)
+    rms = float(np.sqrt(np.mean(r**2)))
+    if rms <= _DESCRIBES_FRACTION * sway:
+        return True
+    noise = float(np.sqrt(np.mean(np.diff(r, axis=0) ** 2) / 2)) if r.shape[0] > 1 else 0.0
+    return rms <= _NOISE_MULTIPLE * noise
+
+
+def _restart_point(rng: np.random.Generator, names: Sequence[str], x0: np.ndarray,
+                   lower: np.ndarray, upper: np.ndarray) -> np.ndarray:
+    """A seeded starting point: the delay and the weight uniform in their box, a gain the
+    start scaled by 10^U(−1, 1) (within the box). [units of each parameter]"""
+    point = np.empty(x0.size)
+    for k, name in enumerate(names):
+        if name in ("feedback_delay", "proprioceptive_weight") or x0[k] <= 0:
+            point[k] = rng.uniform(lower[k], upper[k])
+        else:
+            point[k] = x0[k] * 10.0 ** rng.uniform(-1.0, 1.0)
+    return np.clip(point, lower + 1e-9, upper)
+
+
+def _determinacy(jac: np.ndarray, scale: np.ndarray, names: Sequence[str], sway: float,
+                 samples: int) -> tuple[np.ndarray, list[str]]:
+    """Which parameters the data determine, and why not (the others).
+
+    A column of the Jacobian times the parameter's scale (its value, or its start, or
+    10⁻³ of its box: never 0, so a parameter at 0 is judged as any other) that moves the
+    angles by less than :data:`_NO_EFFECT` of the sway: "the data do not depend on it".
+    Columns scaled to unit norm whose singular values fall below :data:`_DEPENDENT`: the
+    parameters with a share above :data:`_NULL_SHARE` of such a direction are "not
+    separable from" the others in it.
+    """
+    p = jac.shape[1]
+    reasons = [""] * p
+    effect = np.linalg.norm(jac, axis=0) * scale / math.sqrt(max(samples, 1))
+    moving = effect > _NO_EFFECT * max(sway, 1e-12)
+    for k in np.flatnonzero(~moving):
+        reasons[k] = "the data do not depend on it"
+    idx = np.flatnonzero(moving)
+    if idx.size > 1:
+        cols = jac[:, idx] / np.linalg.norm(jac[:, idx], axis=0)
+        _, sv, vt = np.linalg.svd(cols, full_matrices=False)
+        for row in vt[sv < _DEPENDENT * sv.max()]:
+            involved = idx[np.abs(row) > _NULL_SHARE]
+            for k in involved:
+                others = [names[j] for j in involved if j != k]
+                if others and not reasons[k]:
+                    reasons[k] = f"not separable from {', '.join(others)}"
+    return np.array([not why for why in reasons]), reasons
 
 
 #: A parameter whose share of a near-null direction of the scaled Jacobian exceeds this
@@ -345,12 +511,13 @@ def _identifiable(jac: np.ndarray, x: np.ndarray) -> np.ndarray:
     return ~bad
 
 
-def _covariance(jac: np.ndarray, x: np.ndarray, s2: float) -> tuple[np.ndarray, np.ndarray]:
-    """Gauss–Newton covariance s²(JᵀJ)⁻¹ of independent residuals, with non-identifiable
-    parameters set to NaN."""
+def _covariance(jac: np.ndarray, x: np.ndarray, s2: float, good: np.ndarray | None = None
+                ) -> tuple[np.ndarray, np.ndarray]:
+    """Gauss–Newton covariance s²(JᵀJ)⁻¹ of independent residuals, with the parameters not
+    in ``good`` (default: :func:`_identifiable`) set to NaN."""
     p = x.size
     cov = np.full((p, p), np.nan)
-    good = _identifiable(jac, x)
+    good = _identifiable(jac, x) if good is None else good
     if good.any():
         jg = jac[:, good]
         cov[np.ix_(good, good)] = s2 * np.linalg.pinv(jg.T @ jg)
@@ -373,7 +540,8 @@ def ar1_filter_sum(values: np.ndarray, rho: float) -> np.ndarray:
     return forward + backward - values
 
 
-def _ar1_covariance(jac: np.ndarray, x: np.ndarray, residuals: np.ndarray, n_links: int
+def _ar1_covariance(jac: np.ndarray, x: np.ndarray, residuals: np.ndarray, n_links: int,
+                    good: np.ndarray | None = None
                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
     """The sandwich covariance of least squares when each link's residuals are a
     stationary AR(1) series (see the module's notes).
@@ -406,7 +574,7 @@ def _ar1_covariance(jac: np.ndarray, x: np.ndarray, residuals: np.ndarray, n_lin
     effective = float(np.sum(np.minimum(samples, samples * (1 - rho) / (1 + rho))))
     dof = max(effective - p, 1.0)
     cov = np.full((p, p), np.nan)
-    good = _identifiable(jac, x)
+    good = _identifiable(jac, x) if good is None else good
     if good.any():
         jg = jac[:, good]
         bread = np.linalg.pinv(jg.T @ jg)
