@@ -88,7 +88,8 @@ def add_muscle_arguments(p: argparse.ArgumentParser, *, require: bool = False,
                    + ", ".join(PAPER_PAIR_NAMES) + "), one per joint otherwise (one for a "
                    "one-link body). With active gains this is the intrinsic (undelayed) part.")
     g.add_argument("--controller", metavar="NAME",
-                   help="a published one-link controller (intrinsic and active gains as "
+                   help="a one-link controller preset after a published model (intrinsic "
+                   "and active gains as "
                    f"fractions of mgh, delay, weight): {', '.join(CONTROLLERS)}. Its body: "
                    "the paper's as one link (paper-1link) by default, --height/--mass "
                    "lumped to one link, or a one-link --body. Which of its numbers come from "

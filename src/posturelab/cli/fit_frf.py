@@ -46,7 +46,7 @@ a name given twice or a bound for a parameter not fitted is refused.
 
 Example: posturelab fit-frf --data trial.csv --stimulus tilt --response com_angle \\
              --cycle-length 20 --discard-cycles 1 --controller peterka-2002 \\
-             --free active_stiffness,active_viscosity,feedback_delay
+             --free active_stiffness:ankle,active_viscosity:ankle,feedback_delay
 """
 
 
@@ -57,17 +57,27 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--stimulus", metavar="COLUMN", help="stimulus column of a trial CSV.")
     p.add_argument("--response", metavar="COLUMN", help="response column of a trial CSV.")
     p.add_argument("--cycle-length", type=float, metavar="SECONDS", help="of a trial CSV [s].")
-    p.add_argument("--discard-cycles", type=int, default=0, metavar="N")
+    p.add_argument("--discard-cycles", type=int, default=0, metavar="N",
+                   help="leading cycles of a trial CSV to drop (the transient; default 0).")
     p.add_argument("--response-sign", choices=["-1", "+1", "1"], default="-1",
                    help="multiply a trial's response by this (default -1: posturelab's tilt "
                    "convention, as posturelab frf).")
-    p.add_argument("--input", choices=["tilt", "translation"], default="tilt")
+    p.add_argument("--input", choices=["tilt", "translation"], default="tilt",
+                   help="what the stimulus is: tilt [rad] (default) or platform "
+                   "translation [m].")
     p.add_argument("--output", default="com_angle", metavar="NAME",
                    help="the model output the response is (default com_angle).")
-    p.add_argument("--free", required=True, metavar="NAMES", help="shared parameters.")
+    p.add_argument("--free", required=True, metavar="NAMES",
+                   help="parameters shared by the conditions, comma separated, from "
+                   "stiffness:PAIR, viscosity:PAIR, active_stiffness:PAIR, "
+                   "active_viscosity:PAIR, feedback_delay, proprioceptive_weight (e.g. "
+                   "active_stiffness:ankle,feedback_delay).")
     p.add_argument("--per-condition", default="", metavar="NAMES",
-                   help="parameters with one value per condition.")
-    p.add_argument("--bounds", default="", metavar="NAME=LO:HI,...")
+                   help="parameters with one value per condition (names as --free).")
+    p.add_argument("--bounds", default="", metavar="NAME=LO:HI,...",
+                   help="bounds of fitted parameters, replacing the defaults (e.g. "
+                   "active_stiffness:ankle=0:2000,feedback_delay=0.05:0.3 [N·m/rad], [s]); "
+                   "within the table's ranges.")
     p.add_argument("--json", action="store_true", help="print one JSON object.")
     p.add_argument("--plot", metavar="BODE.png",
                    help="write a Bode plot of every condition with its fitted model (PNG/SVG/"

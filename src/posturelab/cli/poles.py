@@ -16,7 +16,8 @@ DESCRIPTION = """\
 Poles [1/s] of the paper's three-link biped (Appendix A; or any --body, --height/--mass)
 linearised about upright stance (Θ = 0, Θ̇ = 0), with the muscle pairs acting as
 stiffness K [N·m/rad] and viscosity L = R·K [N·m·s/rad]. The system is stable when every
-pole has a negative real part. --controller NAME: a published one-link controller on the
+pole has a negative real part. --controller NAME: a one-link controller preset after a
+published model (--help of simulate says which of its numbers come from the source) on the
 paper's body as one link, or on --height/--mass lumped to one link.
 
 With --feedback-delay (or a --controller's delay) the rightmost characteristic roots at

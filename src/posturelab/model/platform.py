@@ -423,12 +423,13 @@ class MeasuredProfile(Disturbance):
 
     Zero before the first and after the last sample: the platform keeps the velocity it has
     at the last sample (and stays where it is only if that velocity is zero). Every sample
-    within ±:data:`MAX_PLATFORM_ACCELERATION` [m/s²].
+    within ±:data:`MAX_PLATFORM_ACCELERATION` [m/s²]. A run starts at t = 0, so the first
+    sample is at t >= 0 (a run refuses a profile that starts after it ends).
 
     Parameters
     ----------
     time : array_like, shape (S,)
-        Sample times, strictly increasing. [s]
+        Sample times, strictly increasing, from t >= 0. [s]
     acceleration_x : array_like, shape (S,)
         ẍ_d. [m/s²]
     acceleration_y : array_like, shape (S,), optional
@@ -447,6 +448,9 @@ class MeasuredProfile(Disturbance):
         t = finite_array("time [s]", self.time, (None,))
         if t.size < 2:
             raise ParameterError(f"time [s] must have at least 2 samples, got {t.size}")
+        if t[0] < 0:
+            raise ParameterError(f"time [s] must start at t >= 0 (a run starts at 0), got "
+                                 f"{t[0]:g}")
         dt = np.diff(t)
         if np.any(dt <= 0):
             i = int(np.argmax(dt <= 0))
@@ -553,7 +557,8 @@ def read_profile_csv(path: str | Path) -> MeasuredProfile:
     (the aliases ``t``, ``ax``/``xdd`` and ``ay``/``ydd`` are accepted; a
     ``[unit]`` suffix such as ``time [s]`` is ignored). Time must be strictly
     increasing, no value may be NaN or missing, and every acceleration lies within
-    ±:data:`MAX_PLATFORM_ACCELERATION` (1000 m/s²). The acceleration is zero after the last
+    ±:data:`MAX_PLATFORM_ACCELERATION` (1000 m/s²). The first time is >= 0 (a run starts
+    at 0; a negative time is refused, not dropped). The acceleration is zero after the last
     sample (and before the first): the platform goes on at the velocity it has reached.
 
     Raises
@@ -609,6 +614,11 @@ def read_profile_csv(path: str | Path) -> MeasuredProfile:
                 )
             data[name].append(v)
     t = np.array(data["time"])
+    if t[0] < 0:
+        raise DataFileError(
+            f"platform profile {str(path)!r} line {lines[1]}: time {t[0]:g} s is before 0; "
+            "a profile starts at t >= 0 (the run starts at 0)"
+        )
     bad = np.nonzero(np.diff(t) <= 0)[0]
     if bad.size:
         i = int(bad[0])

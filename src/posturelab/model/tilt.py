@@ -543,7 +543,7 @@ class MeasuredTilt(Tilt):
     Parameters
     ----------
     time : array_like, shape (S,)
-        Strictly increasing, S >= 4. [s]
+        Strictly increasing, from t >= 0 (a run starts at 0), S >= 4. [s]
     angle : array_like, shape (S,)
         α at those times, |α| <= :data:`MAX_TILT`. [rad]
     source : str
@@ -563,6 +563,9 @@ class MeasuredTilt(Tilt):
             raise ParameterError(f"tilt time [s] must have at least 4 samples, got {t.size}")
         if np.any(np.diff(t) <= 0):
             raise ParameterError("tilt time [s] must be strictly increasing")
+        if t[0] < 0:
+            raise ParameterError(f"tilt time [s] must start at t >= 0 (a run starts at 0), "
+                                 f"got {t[0]:g}")
         a = finite_array("tilt [rad]", self.angle_samples, (t.size,))
         if np.abs(a).max() > MAX_TILT:
             raise ParameterError(f"tilt [rad] must be within ±{MAX_TILT:g} rad, got "
@@ -594,7 +597,8 @@ class MeasuredTilt(Tilt):
 def read_tilt_csv(path) -> MeasuredTilt:
     """A measured tilt from a CSV file with a header row and the columns ``time`` [s] and
     ``tilt`` [rad] (by name, a ``[unit]`` suffix ignored; other columns are ignored, so a
-    measured platform profile may carry its tilt).
+    measured platform profile may carry its tilt). The first time is >= 0 (a run starts at
+    0; a negative time is refused, not dropped).
 
     Raises
     ------
@@ -632,6 +636,10 @@ def read_tilt_csv(path) -> MeasuredTilt:
                 raise DataFileError(f"tilt profile {str(path)!r} line {lineno}: column "
                                     f"{name!r} is not finite")
             values[row_index, col] = v
+    if values[0, 0] < 0:
+        raise DataFileError(f"tilt profile {str(path)!r} line {numbered[1][0]}: time "
+                            f"{values[0, 0]:g} s is before 0; a profile starts at t >= 0 "
+                            "(the run starts at 0)")
     try:
         return MeasuredTilt(values[:, 0], values[:, 1], source=path.name)
     except ParameterError as exc:

@@ -3,16 +3,19 @@
 A run's perturbation is either *transient* (a velocity step, a pulse, a ramp-and-hold, a
 measured profile, a raised-cosine or measured tilt: it ends, at :attr:`StimulusTiming.end`)
 or *sustained* (a periodic tilt or platform motion, a PRTS, motor noise: it lasts the whole
-run). :func:`stimulus_timing` says which.
+run). :func:`stimulus_timing` says which; :func:`check_starts_within` refuses a transient
+one that starts only after the run ends.
 
 * ``recovered``: a transient run completed, and at its last sample every |θ_i| is within
   :data:`UPRIGHT_BAND` of upright and every |θ̇_i| within :data:`REST_RATE`; the settling
   time is counted from the end of the perturbation (the end of the platform's acceleration:
   a ramp-and-hold's stop, a pulse's end, a measured profile's last sample; the end of a
   tilt's ramp; 0 for a velocity step at t = 0) to the last sample after it at which some
-  |θ_i| was outside the band (0 if none was).
+  |θ_i| was outside the band (0 if none was). A run with no perturbation at all that starts
+  at rest upright and stays in the band says so ("no perturbation: …").
 * ``not recovered``: a transient run completed but ended outside that band of upright, or
-  still moving; the final lean max |θ_i| [rad] and rate max |θ̇_i| [rad/s] say how far.
+  still moving, or ended before its perturbation did (recovery is measured only within the
+  run); the final lean max |θ_i| [rad] and rate max |θ̇_i| [rad/s] say how far.
 * ``steady sway``: a sustained run completed. It has no settling time; its sway is the RMS
   (about upright, 0) and the peak |·| of each link angle θ_i [rad] and of the centre of
   pressure [m] over the steady part (:meth:`StimulusTiming.steady_start`: after the first
@@ -32,7 +35,8 @@ from dataclasses import dataclass
 import numpy as np
 
 __all__ = ["UPRIGHT_BAND", "REST_RATE", "OUTCOMES", "Outcome", "SteadySway", "StimulusTiming",
-           "stimulus_timing", "steady_sway", "classify", "classify_rows"]
+           "stimulus_timing", "check_starts_within", "steady_sway", "classify",
+           "classify_rows"]
 
 #: Half-width of the band about upright a recovered run ends in (and of the settling time). [rad]
 UPRIGHT_BAND = 0.01
@@ -58,12 +62,15 @@ class StimulusTiming:
         sines' longest period); None without one. [s]
     what : str
         The sustained stimulus in a few words ("" for a transient one).
+    perturbed : bool
+        The run has a perturbation at all (False: no platform motion, tilt or noise).
     """
 
     sustained: bool = False
     end: float = 0.0
     period: float | None = None
     what: str = ""
+    perturbed: bool = True
 
     def steady_start(self, duration: float) -> float:
         """Start of the steady part of a sustained run of ``duration`` [s]: one stimulus
@@ -86,10 +93,13 @@ def stimulus_timing(disturbance=None, tilt=None, motor_noise=None) -> StimulusTi
     from ..model import platform as pf
     from ..model import tilt as tl
 
-    ends, periods, what = [0.0], [], []
+    ends, periods, what, parts = [0.0], [], [], []
 
     def add(part) -> None:
-        if part is None or isinstance(part, pf.NoDisturbance | pf.VelocityStep):
+        if part is None or isinstance(part, pf.NoDisturbance):
+            return
+        parts.append(part)
+        if isinstance(part, pf.VelocityStep):
             return
         if isinstance(part, pf.CombinedDisturbance):
             for q in part.parts:
@@ -119,7 +129,48 @@ def stimulus_timing(disturbance=None, tilt=None, motor_noise=None) -> StimulusTi
     if what:
         return StimulusTiming(True, math.inf, max(periods) if periods else None,
                               ", ".join(what))
-    return StimulusTiming(False, max(ends))
+    return StimulusTiming(False, max(ends), perturbed=bool(parts) or motor_noise is not None)
+
+
+def _start(part) -> tuple[str, float] | None:
+    """A transient part's name and start [s]; None for a part that acts from t = 0."""
+    from ..model import platform as pf
+    from ..model import tilt as tl
+
+    source = f" ({part.source})" if getattr(part, "source", "") else ""
+    if isinstance(part, pf.MeasuredProfile):
+        return f"the platform profile{source}", float(part.time[0])
+    if isinstance(part, tl.MeasuredTilt):
+        return f"the tilt profile{source}", float(part.time[0])
+    if isinstance(part, tl.RaisedCosineTilt):
+        return "the raised-cosine tilt", float(part.start)
+    if isinstance(part, pf.HalfSinePulse):
+        return "the half-sine pulse", float(part.start)
+    if isinstance(part, pf.RampAndHold):
+        return "the ramp-and-hold", float(part.start)
+    return None
+
+
+def check_starts_within(disturbance, tilt, duration: float) -> None:
+    """Refuse a platform ``disturbance`` or ``tilt`` part that starts at or after the end of
+    a run of ``duration`` [s] (nothing of it would act), in one line naming its start.
+
+    Raises
+    ------
+    ParameterError
+    """
+    from ..errors import ParameterError
+    from ..model import platform as pf
+
+    parts = list(disturbance.parts) if isinstance(disturbance, pf.CombinedDisturbance) \
+        else [disturbance]
+    for part in [*parts, tilt]:
+        found = _start(part) if part is not None else None
+        if found is not None and found[1] >= duration:
+            name, start = found
+            when = "after" if start > duration else "just as"
+            raise ParameterError(f"{name} starts at {start:g} s, {when} the run ends at "
+                                 f"{duration:g} s (lengthen the run or start it earlier)")
 
 
 @dataclass(frozen=True)
@@ -256,20 +307,35 @@ def classify_rows(status: np.ndarray, settling_time: np.ndarray, final_state: np
 
 def classify(status: str, settling_time: float | None, final_state, *, fall_time=None,
              fall_reason=None, message: str = "", timing: StimulusTiming | None = None,
-             steady: SteadySway | None = None) -> Outcome:
+             steady: SteadySway | None = None, run_end: float | None = None,
+             started_at_rest: bool = False) -> Outcome:
     """The :class:`Outcome` of one run (arguments as for :func:`classify_rows`, one run;
     ``message``: the run's own words, kept for a failure; ``timing``: the stimulus's
     (a transient one ending at 0 if None); ``steady``: the sway over the steady part of a
-    sustained run)."""
+    sustained run; ``run_end``: the run's last time [s] (a run that ends before its
+    transient perturbation does is not recovered: recovery is measured within the run);
+    ``started_at_rest``: the run started upright at rest)."""
     timing = StimulusTiming() if timing is None else timing
     final_state = np.asarray(final_state, dtype=float)
     n = final_state.size // 2
     lean = float(np.abs(final_state[:n]).max())
     rate = float(np.abs(final_state[n:]).max())
+    cut_short = (run_end is not None and not timing.sustained
+                 and timing.end > float(run_end) + 1e-9)
+    if cut_short:
+        settling_time = None
     kind = str(classify_rows(np.array([status]), np.array(
         [np.nan if settling_time is None else settling_time]), final_state[None],
         timing.sustained)[0])
-    if kind == "recovered" and timing.end > 0:
+    if kind == "recovered" and not timing.perturbed and started_at_rest \
+            and settling_time == 0:
+        words = (f"recovered (no perturbation: started at rest upright and stayed within "
+                 f"±{UPRIGHT_BAND:g} rad)")
+    elif kind == "not recovered" and cut_short:
+        words = (f"not recovered: the run ended at {float(run_end):.4g} s, before the "
+                 f"perturbation did (at {timing.end:.4g} s): {lean:.4g} rad from upright, moving "
+                 f"at up to {rate:.4g} rad/s (run past {timing.end:.4g} s to measure recovery)")
+    elif kind == "recovered" and timing.end > 0:
         words = (f"recovered: within ±{UPRIGHT_BAND:g} rad of upright {settling_time:.3f} s "
                  f"after the perturbation ended at {timing.end:.4g} s")
     elif kind == "recovered":

@@ -229,13 +229,14 @@ class SimulationResult:
     def settling_time(self, tolerance: float = 0.01) -> float | None:
         """Time from the end of the perturbation (``stimulus.end``; 0 for a velocity step)
         to the last sample after it at which some |θ_i| exceeded ``tolerance`` [rad] (0 if
-        none did); None if the run fell, ended outside, or the stimulus is sustained. [s]"""
+        none did); None if the run fell, ended outside or before the perturbation ended, or
+        the stimulus is sustained. [s]"""
         timing = self.stimulus or StimulusTiming()
         if timing.sustained:
             return None
         outside = np.any(np.abs(self.theta) > tolerance, axis=1)
-        if self.fell or outside[-1]:
-            return None
+        if self.fell or outside[-1] or timing.end > float(self.time[-1]) + 1e-9:
+            return None  # (also when the run ended before its perturbation did)
         after = outside & (self.time >= timing.end)
         if not after.any():
             return 0.0
@@ -272,7 +273,9 @@ class SimulationResult:
         steady = self.steady_sway() if self.status == "completed" else None
         return classify(self.status, self.settling_time(UPRIGHT_BAND), self.final_state,
                         fall_time=self.fall_time, fall_reason=self.fall_reason,
-                        message=self.message, timing=timing, steady=steady)
+                        message=self.message, timing=timing, steady=steady,
+                        run_end=float(self.time[-1]),
+                        started_at_rest=not np.any(self.theta[0]) and not np.any(self.omega[0]))
 
     def summary(self) -> dict:
         """Plain-Python summary (the CLI's ``--json``): the outcome (``outcome``,

@@ -48,6 +48,7 @@ from ..model.tilt import (
     tilt_pair_gains,
 )
 from ..parameters import MAX_FEEDBACK_DELAY  # the parameter table's bound
+from .outcome import check_starts_within
 
 __all__ = [
     "RunSetup",
@@ -397,6 +398,7 @@ def _prepare(body: Body, muscles: MuscleSet, disturbance: Disturbance | None = N
         )
     duration = float_in_range("duration [s]", duration, 0.0, MAX_DURATION, include_low=False,
                               unit="s")
+    check_starts_within(disturbance, tilt, duration)
     noise = o["motor_noise"]
     motor_torque = None
     if noise is not None:

@@ -703,7 +703,9 @@ def simulate_batch(
     any_outside = results[:, R_ANY_OUTSIDE] > 0
     timing = stimulus_timing(base.disturbance, base.tilt, base.motor_noise)
     # counted from the end of the perturbation (the C engine gives the last time outside)
-    settling = np.where(fell | final_outside | timing.sustained, np.nan, np.where(
+    # (none when the run ends before its perturbation does: recovery is measured within it)
+    cut_short = not timing.sustained and timing.end > base.duration + 1e-9
+    settling = np.where(fell | final_outside | timing.sustained | cut_short, np.nan, np.where(
         any_outside, np.maximum(results[:, R_LAST_OUTSIDE] - timing.end, 0.0), 0.0))
     return BatchResult(
         fell=fell, fall_time=fall_time, peak_theta=peaks, settling_time=settling,
