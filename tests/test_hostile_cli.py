@@ -120,3 +120,113 @@ def test_a_closed_pipe_exits_141_without_a_word():
         os.close(write_end)
     assert p.returncode == 141
     assert p.stderr == ""
+
+
+def test_a_sweep_refuses_the_viscosity_ratio_and_a_pair_viscosity_together(tmp_path):
+    one_line_exit_2(cli("sweep", "--case", "1", "--disturbance", "backward", "--duration", "1",
+                        "--vary", "viscosity_ratio=0.1:0.3:2", "--vary",
+                        "viscosity:ankle=10:100:2", "--out", str(tmp_path / "v.csv")),
+                    "--vary viscosity_ratio or --vary viscosity:ankle, not both")
+    assert not (tmp_path / "v.csv").exists()
+
+
+@pytest.mark.parametrize("command", [
+    ["simulate", "--case", "1", "--duration", "0.5", "--platform-profile"],
+    ["fit", "--case", "1", "--free", "stiffness:ankle", "--data"],
+])
+def test_a_csv_row_with_more_fields_than_its_header_is_refused_by_line(tmp_path, command):
+    path = tmp_path / "p.csv"
+    if command[0] == "simulate":
+        path.write_text("time,x_acceleration\n0,0\n0.1,1,5\n0.2,0\n")
+    else:
+        path.write_text("t,theta1,theta2,theta3\n0,0,0,0\n0.1,0,0,0,7\n0.2,0,0,0\n")
+    one_line_exit_2(cli(*command, str(path)), "line 3 has", "fields; the header has")
+
+
+def test_empty_trailing_fields_are_not_extra_fields(tmp_path):
+    from posturelab._files import csv_rows
+
+    rows = list(csv_rows("time,x_acceleration\n0,0,\n0.1,1,,\n", "profile"))
+    assert [line for line, _ in rows] == [1, 2, 3]
+
+
+@pytest.mark.parametrize("posture,word", [("10,0,0", "θ1"), ("0,0,-1.6", "θ3")])
+def test_sensitivity_refuses_a_posture_beyond_horizontal(posture, word):
+    one_line_exit_2(cli("sensitivity", "--posture", posture), f"--posture {word}",
+                    "[-π/2, π/2] rad")
+
+
+def test_sensitivity_takes_a_posture_up_to_horizontal():
+    p = cli("sensitivity", "--posture", "1.5,0,-1.5")
+    assert p.returncode == 0, p.stderr
+
+
+@pytest.mark.parametrize("duration", ["inf", "nan", "-1", "100000"])
+def test_a_duration_out_of_range_names_the_range(duration):
+    one_line_exit_2(cli("simulate", "--case", "1", "--duration", duration),
+                    "--duration [s] must be in (0, 86400] s", f"got {duration}")
+
+
+PRTS = ["sweep", "--experiment", "prts", "--controller", "peterka-2002", "--tilt",
+        "prts:0.035", "--vary", "feedback_delay=0.12:0.18:2"]
+
+
+def test_too_many_prts_cycles_name_cycles_and_the_longest_run(tmp_path):
+    # the posturelab-80 sequence at its 0.25 s state: an 80 × 0.25 = 20 s cycle
+    one_line_exit_2(cli(*PRTS, "--cycles", "100000", "--out", str(tmp_path / "x.csv")),
+                    "--cycles 100000", "--discard-cycles 1", "the 20 s cycle = 2e+06 s",
+                    "exceeds the longest run, 86,400 s")
+
+
+def test_a_one_link_output_names_only_com_angle_and_theta1(tmp_path):
+    p = cli(*PRTS, "--output", "theta7", "--out", str(tmp_path / "x.csv"))
+    one_line_exit_2(p, "--output", "must be com_angle or theta1, got 'theta7'")
+    assert "…" not in p.stderr
+
+
+def test_output_choices_read_naturally_for_every_body():
+    from posturelab.frequency.experiment import output_choices
+
+    assert output_choices(1) == "com_angle or theta1"
+    assert output_choices(2) == "com_angle, theta1 or theta2"
+    assert output_choices(3) == "com_angle or theta1 … theta3"
+
+
+def test_the_stiffness_map_names_the_delayed_axes_with_their_pair(tmp_path):
+    one_line_exit_2(cli("stability-map", "--case", "1", "--x", "stiffness:ankle:0:2000",
+                        "--y", "stiffness:hip:0:1000", "--resolution", "301",
+                        "--feedback-delay", "0.01", "--out", str(tmp_path / "m.png")),
+                    "active_stiffness:PAIR:LO:HI", "active_viscosity:PAIR:LO:HI")
+
+
+@pytest.mark.parametrize("argv", [["--torque-limits", "-5,inf,inf"],
+                                  ["--torque-limits=-5,inf,inf"]])
+def test_a_negative_torque_limit_is_refused_with_the_range(argv):
+    one_line_exit_2(cli("simulate", "--case", "1", *argv),
+                    "--torque-limits [N·m] must each be in (0, inf]", "got '-5'")
+
+
+@pytest.mark.parametrize("engine,method,advice", [
+    ("compiled", "Radau", "Radau is already an implicit method"),
+    ("reference", "DOP853", "an implicit method such as Radau"),
+])
+def test_a_spent_step_budget_advises_for_the_method_that_ran(engine, method, advice):
+    p = cli("simulate", "--case", "1", "--disturbance", "backward", "--duration", "1",
+            "--max-steps", "10", "--engine", engine)
+    outcome = p.stdout.splitlines()[0]
+    assert f"the step budget of 10 {method} steps ran out" in outcome, p.stdout
+    assert advice in outcome
+
+
+@pytest.mark.parametrize("description", ["", 'description = "my run"\n'])
+def test_a_scenario_run_prints_its_outcome_first_and_no_empty_line(tmp_path, description):
+    path = tmp_path / "my-run.toml"
+    path.write_text(f'{description}duration = 1.0\n[body]\npreset = "paper"\n[muscles]\n'
+                    'case = "1"\n[disturbance]\ntype = "velocity-step"\n'
+                    'direction = "backward"\nspeed = 1.0\n')
+    p = cli("simulate", "--scenario", str(path))
+    assert p.returncode == 0, p.stderr
+    lines = p.stdout.splitlines()
+    assert lines[0].startswith("outcome: ")
+    assert all(line.strip() for line in lines)
+    assert ("my run" in lines[1]) == bool(description)

@@ -123,7 +123,7 @@ def build_parser(command: str | None = None, *, summary: bool = False) -> OneLin
 
 #: Options whose value is a comma-separated list that may start with a minus sign.
 LIST_OPTIONS = ("--posture", "--stiffness", "--initial-posture", "--initial-rates", "--foot",
-                "--viscosity")
+                "--viscosity", "--torque-limits")
 
 
 def _join_negative_lists(argv: list[str]) -> list[str]:

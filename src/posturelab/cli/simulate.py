@@ -261,8 +261,11 @@ def motor_noise_from_args(args: argparse.Namespace, n_joints: int):
 
 
 def _check_numbers(sc: Scenario) -> None:
-    if not (math.isfinite(sc.duration) and sc.duration > 0):
-        raise ParameterError(f"--duration [s] must be > 0, got {sc.duration:g}")
+    from ..simulation.setup import MAX_DURATION
+
+    if not 0 < sc.duration <= MAX_DURATION:
+        raise ParameterError(f"--duration [s] must be in (0, {MAX_DURATION:.0f}] s, got "
+                             f"{sc.duration:g}")
 
 
 def _foot(text: str) -> BaseOfSupport:
@@ -383,8 +386,9 @@ def run(args: argparse.Namespace) -> int:
                     "linear_stability": verdict.to_dict()})
     else:
         peaks = ", ".join(f"{x:.4f}" for x in result.max_abs_theta)
-        print(f"{sc.description}")
-        print(f"outcome: {outcome.message}")
+        print(f"outcome: {outcome.message}")  # first, as the help and README say
+        if sc.description.strip():
+            print(sc.description.strip())
         print(f"status: {result.status} ({result.message})")
         print(f"engine: {args.engine}")
         print(f"linear model: {verdict.describe()}")

@@ -47,7 +47,7 @@ parameter. Every other gain comes from the base experiment: --case/--stiffness/-
 with --disturbance or --tilt (as in posturelab simulate), --scenario FILE.toml or --builtin
 NAME. A pair's viscosity is the varied viscosity:PAIR, else the ratio times its stiffness:
 the varied viscosity_ratio, else --viscosity-ratio, else the base experiment's (0.25, the
-paper's, for --case).
+paper's, for --case); viscosity_ratio and viscosity:PAIR are not varied together.
 
 Columns: the varied parameters (stiffness:ankle, ...), then
 {", ".join(OUTCOME_COLUMNS)} (one peak_theta
@@ -270,6 +270,23 @@ def _with_progress(args: argparse.Namespace, total: int, work):
     return result, time.perf_counter() - t0
 
 
+def _check_experiment_length(args: argparse.Namespace, protocol, scenario) -> None:
+    """Refuse, naming --cycles and --discard-cycles, an experiment longer than the longest
+    run."""
+    from ..simulation.setup import MAX_DURATION
+
+    tilt = scenario.tilt
+    if tilt is None or not hasattr(tilt, "cycle"):
+        return  # (prts_sweep says the tilt must be a PRTS)
+    cycles = protocol.cycles + protocol.discard
+    total = tilt.cycle * cycles
+    if total > MAX_DURATION:
+        given = f"--cycles {protocol.cycles}" if protocol.discard == 0 else (
+            f"(--cycles {protocol.cycles} + --discard-cycles {protocol.discard})")
+        raise ParameterError(f"{given} × the {tilt.cycle:g} s cycle = {total:.3g} s exceeds "
+                             f"the longest run, {MAX_DURATION:,.0f} s")
+
+
 def _run_experiments(args: argparse.Namespace, scenario, varies, ratio) -> int:
     """``--experiment prts``: a PRTS identification experiment per parameter set."""
     from ..frequency.population import PRTSProtocol, prts_sweep
@@ -280,6 +297,7 @@ def _run_experiments(args: argparse.Namespace, scenario, varies, ratio) -> int:
         ("sample_rate", "record_rate"), ("output", "output")) if getattr(args, flag) is not None}
     with naming_given_options(args, PROTOCOL_FIELD_OPTIONS):
         protocol = PRTSProtocol(seed=args.seed or 0, fit=fit, **given)
+    _check_experiment_length(args, protocol, scenario)
     with naming_given_options(args, PROTOCOL_FIELD_OPTIONS):
         result, elapsed = _with_progress(args, _runs(varies), lambda progress: prts_sweep(
             scenario, varies, protocol, viscosity_ratio=ratio, workers=args.workers,

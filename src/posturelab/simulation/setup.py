@@ -699,8 +699,12 @@ def fall_at_start_by_posture(setup: RunSetup) -> str | None:
     return setup.fall_at_start
 
 
+#: The implicit integrators (of scipy's solve_ivp and the compiled engine's Radau IIA).
+IMPLICIT_METHODS = ("Radau", "BDF", "LSODA")
+
+
 def outcome_message(status: str, t: float, setup: RunSetup, *, fall_reason: str = "",
-                    detail: str = "") -> str:
+                    detail: str = "", method: str | None = None) -> str:
     """The words of a run's outcome.
 
     Parameters
@@ -711,6 +715,9 @@ def outcome_message(status: str, t: float, setup: RunSetup, *, fall_reason: str 
         its words from ``detail``).
     t : float
         When it happened (the fall, the failure). [s]
+    method : str, optional
+        The integrator that ran ("Radau", "RK45", "DOP853", …): a spent step budget suggests
+        an implicit method only to a run that had an explicit one.
     """
     if status == "completed":
         return f"ran to {setup.duration:g} s"
@@ -727,9 +734,14 @@ def outcome_message(status: str, t: float, setup: RunSetup, *, fall_reason: str 
     if status == "no-memory":
         return f"ran out of memory at t = {t:.6g} s"
     if status == "step-budget":
-        return (f"stopped at t = {t:.6g} s: the step budget of {setup.max_steps:,} integrator "
-                "steps ran out (raise max_steps; for very stiff or viscous gains an implicit "
-                "method such as Radau needs far fewer steps)")
+        if method in IMPLICIT_METHODS:
+            advice = f"raise max_steps; {method} is already an implicit method"
+        else:
+            advice = ("raise max_steps; for very stiff or viscous gains an implicit method "
+                      "such as Radau needs far fewer steps")
+        steps = f"{method} steps" if method else "integrator steps"
+        return (f"stopped at t = {t:.6g} s: the step budget of {setup.max_steps:,} {steps} "
+                f"ran out ({advice})")
     if status == "time-budget":
         return (f"stopped at t = {t:.6g} s: the time limit of {setup.time_limit:g} s "
                 "(wall clock) ran out (raise time_limit)")

@@ -345,6 +345,11 @@ def sweep_grid(scenario: Scenario, varies: Sequence[VaryRange],
     dup = sorted({n for n in names if names.count(n) > 1})
     if dup:
         raise ParameterError(f"--vary names a parameter more than once: {', '.join(dup)}")
+    pair_viscosities = [n for n in names if n.startswith("viscosity:")]
+    if "viscosity_ratio" in names and pair_viscosities:
+        given = ", --vary ".join(pair_viscosities)
+        raise ParameterError(f"--vary viscosity_ratio or --vary {given}, not both (a pair's "
+                             "viscosity is either varied or the ratio times its stiffness)")
     m = math.prod(v.count for v in varies)
     if m > MAX_RUNS:
         raise ParameterError(f"the grid has {m:,} runs ({' × '.join(str(v.count) for v in varies)})"
