@@ -230,3 +230,12 @@ def test_a_scenario_run_prints_its_outcome_first_and_no_empty_line(tmp_path, des
     assert lines[0].startswith("outcome: ")
     assert all(line.strip() for line in lines)
     assert ("my run" in lines[1]) == bool(description)
+
+
+def test_the_api_refuses_an_experiment_longer_than_the_longest_run_before_running():
+    from posturelab.errors import ParameterError
+    from posturelab.frequency.experiment import check_length
+
+    check_length(4319, 1, 20.0)  # 86,400 s exactly
+    with pytest.raises(ParameterError, match=r"cycles 4320 \(\+ discard 1\) × the 20 s cycle"):
+        check_length(4320, 1, 20.0)

@@ -151,7 +151,8 @@ def add_experiment_arguments(p: argparse.ArgumentParser) -> None:
                      help="seed of the motor noise (default 0); with sweep --experiment prts, "
                      "of the measurement noise too.")
     src.add_argument("--torque-limits", metavar="ANKLE,KNEE,HIP",
-                     help="largest net muscle moment at each joint [N·m] ('inf' for none).")
+                     help="largest net muscle moment at each joint [N·m], each > 0 ('inf' for "
+                     "none).")
     src.add_argument("--max-link-angle", type=float, default=None, metavar="RAD",
                      help="fall when any |θ_i| exceeds this [rad] (default π/3).")
     run = p.add_argument_group("integration")

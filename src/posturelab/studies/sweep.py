@@ -740,10 +740,12 @@ def run_sweep(
         Absolute tolerance. [rad, rad/s]
     workers : int, optional
         Run on a Dask LocalCluster of this many single-threaded worker
-        processes (unless ``scheduler`` or ``client`` is given). [-]
+        processes (unless ``scheduler`` or ``client`` is given), 1 …
+        :func:`max_workers` (4 × the CPUs). [-]
     scheduler : str, optional
-        Address of a running Dask scheduler (``tcp://host:8786``); its workers
-        need posturelab installed.
+        Address of a running Dask scheduler (``[tcp://]host:port``, checked before
+        connecting; one that does not answer within :data:`SCHEDULER_TIMEOUT` s is
+        refused); its workers need posturelab installed.
     client : distributed.Client, optional
         An existing Dask client to use.
     chunk_size : int, optional
