@@ -164,7 +164,7 @@ def test_sensitivity_takes_a_posture_up_to_horizontal():
 @pytest.mark.parametrize("duration", ["inf", "nan", "-1", "100000"])
 def test_a_duration_out_of_range_names_the_range(duration):
     one_line_exit_2(cli("simulate", "--case", "1", "--duration", duration),
-                    "--duration [s] must be in (0, 86400] s", f"got {duration}")
+                    "--duration: duration [s] must be in (0, 86400] s", f"got {duration}")
 
 
 PRTS = ["sweep", "--experiment", "prts", "--controller", "peterka-2002", "--tilt",
@@ -206,16 +206,16 @@ def test_a_negative_torque_limit_is_refused_with_the_range(argv):
                     "--torque-limits [N·m] must each be in (0, inf]", "got '-5'")
 
 
-@pytest.mark.parametrize("engine,method,advice", [
-    ("compiled", "Radau", "Radau is already an implicit method"),
-    ("reference", "DOP853", "an implicit method such as Radau"),
+@pytest.mark.parametrize("engine,advice,not_advice", [
+    ("compiled", "the Radau method that ran is already implicit", "such as Radau"),
+    ("reference", "an implicit method such as Radau", "already implicit"),
 ])
-def test_a_spent_step_budget_advises_for_the_method_that_ran(engine, method, advice):
+def test_a_spent_step_budget_advises_for_the_method_that_ran(engine, advice, not_advice):
     p = cli("simulate", "--case", "1", "--disturbance", "backward", "--duration", "1",
             "--max-steps", "10", "--engine", engine)
     outcome = p.stdout.splitlines()[0]
-    assert f"the step budget of 10 {method} steps ran out" in outcome, p.stdout
-    assert advice in outcome
+    assert "the step budget of 10 integrator steps ran out" in outcome, p.stdout
+    assert advice in outcome and not_advice not in outcome
 
 
 @pytest.mark.parametrize("description", ["", 'description = "my run"\n'])

@@ -265,8 +265,8 @@ def _check_numbers(sc: Scenario) -> None:
     from ..simulation.setup import MAX_DURATION
 
     if not 0 < sc.duration <= MAX_DURATION:
-        raise ParameterError(f"--duration [s] must be in (0, {MAX_DURATION:.0f}] s, got "
-                             f"{sc.duration:g}")
+        raise ParameterError(f"--duration: duration [s] must be in (0, {MAX_DURATION:.0f}] s, "
+                             f"got {sc.duration:g}")
 
 
 def _foot(text: str) -> BaseOfSupport:

@@ -735,13 +735,12 @@ def outcome_message(status: str, t: float, setup: RunSetup, *, fall_reason: str 
         return f"ran out of memory at t = {t:.6g} s"
     if status == "step-budget":
         if method in IMPLICIT_METHODS:
-            advice = f"raise max_steps; {method} is already an implicit method"
+            advice = f"raise max_steps; the {method} method that ran is already implicit"
         else:
             advice = ("raise max_steps; for very stiff or viscous gains an implicit method "
                       "such as Radau needs far fewer steps")
-        steps = f"{method} steps" if method else "integrator steps"
-        return (f"stopped at t = {t:.6g} s: the step budget of {setup.max_steps:,} {steps} "
-                f"ran out ({advice})")
+        return (f"stopped at t = {t:.6g} s: the step budget of {setup.max_steps:,} integrator "
+                f"steps ran out ({advice})")
     if status == "time-budget":
         return (f"stopped at t = {t:.6g} s: the time limit of {setup.time_limit:g} s "
                 "(wall clock) ran out (raise time_limit)")
