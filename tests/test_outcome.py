@@ -58,7 +58,7 @@ def test_a_body_left_leaning_is_not_recovered_and_warned_of():
     assert len(err) == 1 and err[0].startswith("posturelab: warning: these gains are unstable")
     text = posturelab_cli("simulate", "--stiffness", "0,300,300,300,818.18", "--disturbance",
                           "backward", "--engine", "compiled")
-    assert text.stdout.splitlines()[1].startswith("outcome: not recovered: ended 1.0")
+    assert text.stdout.splitlines()[0].startswith("outcome: not recovered: ended 1.0")
 
 
 def test_an_anthropometric_body_unstable_with_case_1_gains_is_not_called_recovered():

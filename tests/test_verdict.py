@@ -178,7 +178,7 @@ def test_simulate_and_poles_give_one_verdict(form):
     line = next(line for line in text_sim.splitlines() if line.startswith("linear model: "))
     assert line.removeprefix("linear model: ") == verdict.removeprefix("verdict: ")
     assert "stable: depends on the side" in text_poles
-    assert f"{form} gastrocnemius" in text_sim.splitlines()[0]
+    assert f"{form} gastrocnemius" in text_sim.splitlines()[1]
 
 
 def test_a_published_controller_on_a_body_from_height_and_mass_on_every_command(tmp_path):

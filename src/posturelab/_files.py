@@ -70,10 +70,12 @@ def read_text(path: str | Path, what: str, *, max_bytes: int = MAX_INPUT_BYTES,
 def csv_rows(text: str, what: str, *, max_rows: int = MAX_DATA_ROWS
              ) -> Iterator[tuple[int, list[str]]]:
     """(line number, cells) of each non-blank CSV row of ``text``, the header first; a
-    DataFileError in one line for a malformed row, a field over :data:`MAX_FIELD_CHARS`
-    characters or more than ``max_rows`` data rows."""
+    DataFileError in one line for a malformed row, a row with more fields than the header
+    (empty trailing fields aside), a field over :data:`MAX_FIELD_CHARS` characters or more
+    than ``max_rows`` data rows."""
     reader = csv.reader(io.StringIO(text, newline=""))
     count = 0
+    width = 0
     while True:
         try:
             row = next(reader)
@@ -88,6 +90,12 @@ def csv_rows(text: str, what: str, *, max_rows: int = MAX_DATA_ROWS
         if not row or not any(cell.strip() for cell in row):
             continue
         count += 1
+        if count == 1:
+            width = len(row)
+        elif len(row) > width and any(cell.strip() for cell in row[width:]):
+            fields = max(k for k, cell in enumerate(row) if cell.strip()) + 1
+            raise DataFileError(f"{what} line {reader.line_num} has {fields} fields; the "
+                                f"header has {width}")
         if count > max_rows + 1:
             raise DataFileError(f"{what} has more than {max_rows:,} data rows; at most "
                                 f"{max_rows:,} are read")

@@ -60,7 +60,12 @@ class UsageError(PostureLabError):
 
 
 class OneLineParser(argparse.ArgumentParser):
-    """An ArgumentParser whose errors are one line and exit code 2."""
+    """An ArgumentParser whose errors are one line and exit code 2, and which takes options
+    only as spelled in full (``--cas 1`` is refused, not read as ``--case 1``)."""
+
+    def __init__(self, *args, **kwargs) -> None:
+        kwargs.setdefault("allow_abbrev", False)
+        super().__init__(*args, **kwargs)
 
     def error(self, message: str) -> None:  # type: ignore[override]
         where = "" if self.prog == "posturelab" else f"{self.prog.removeprefix('posturelab ')}: "
@@ -118,7 +123,7 @@ def build_parser(command: str | None = None, *, summary: bool = False) -> OneLin
 
 #: Options whose value is a comma-separated list that may start with a minus sign.
 LIST_OPTIONS = ("--posture", "--stiffness", "--initial-posture", "--initial-rates", "--foot",
-                "--viscosity")
+                "--viscosity", "--torque-limits")
 
 
 def _join_negative_lists(argv: list[str]) -> list[str]:
@@ -179,7 +184,9 @@ def _main(argv: Sequence[str] | None) -> int:
         if getattr(args, "_run", None) is None:
             parser.print_help()
             return 2
-        return int(args._run(args) or 0)
+        code = int(args._run(args) or 0)
+        sys.stdout.flush()  # (a reader gone: BrokenPipeError here, not at exit)
+        return code
     except PostureLabError as exc:
         print(f"posturelab: error: {exc}", file=sys.stderr)
         return 2
@@ -189,7 +196,22 @@ def _main(argv: Sequence[str] | None) -> int:
         print("posturelab: interrupted", file=sys.stderr)
         return 130
     except BrokenPipeError:
-        return 1
+        return _quiet_broken_pipe()
+
+
+def _quiet_broken_pipe() -> int:
+    """The reader of standard output went away (``posturelab poles --all | head -1``): exit
+    141, the shell's code for SIGPIPE, without a word; standard output is pointed at the null
+    device so that flushing it at exit raises no second error."""
+    import os
+
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        os.close(devnull)
+    except (OSError, ValueError):  # (no real file descriptor behind sys.stdout)
+        pass
+    return 141
 
 
 if __name__ == "__main__":  # pragma: no cover

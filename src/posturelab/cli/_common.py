@@ -56,7 +56,8 @@ def parse_limit_list(text: str, field: str, n: int) -> list[float]:
         except ValueError:
             raise ParameterError(f"{field} must be numbers or 'inf', got {p!r}") from None
         if not (math.isfinite(v) and v > 0):
-            raise ParameterError(f"{field} must be > 0 (or 'inf'), got {p!r}")
+            raise ParameterError(f"{field} must each be in (0, inf] (a number > 0, or 'inf' "
+                                 f"for no limit), got {p!r}")
         out.append(v)
     return out
 

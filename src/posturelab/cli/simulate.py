@@ -151,7 +151,8 @@ def add_experiment_arguments(p: argparse.ArgumentParser) -> None:
                      help="seed of the motor noise (default 0); with sweep --experiment prts, "
                      "of the measurement noise too.")
     src.add_argument("--torque-limits", metavar="ANKLE,KNEE,HIP",
-                     help="largest net muscle moment at each joint [N·m] ('inf' for none).")
+                     help="largest net muscle moment at each joint [N·m], each > 0 ('inf' for "
+                     "none).")
     src.add_argument("--max-link-angle", type=float, default=None, metavar="RAD",
                      help="fall when any |θ_i| exceeds this [rad] (default π/3).")
     run = p.add_argument_group("integration")
@@ -261,8 +262,11 @@ def motor_noise_from_args(args: argparse.Namespace, n_joints: int):
 
 
 def _check_numbers(sc: Scenario) -> None:
-    if not (math.isfinite(sc.duration) and sc.duration > 0):
-        raise ParameterError(f"--duration [s] must be > 0, got {sc.duration:g}")
+    from ..simulation.setup import MAX_DURATION
+
+    if not 0 < sc.duration <= MAX_DURATION:
+        raise ParameterError(f"--duration: duration [s] must be in (0, {MAX_DURATION:.0f}] s, "
+                             f"got {sc.duration:g}")
 
 
 def _foot(text: str) -> BaseOfSupport:
@@ -383,8 +387,9 @@ def run(args: argparse.Namespace) -> int:
                     "linear_stability": verdict.to_dict()})
     else:
         peaks = ", ".join(f"{x:.4f}" for x in result.max_abs_theta)
-        print(f"{sc.description}")
-        print(f"outcome: {outcome.message}")
+        print(f"outcome: {outcome.message}")  # first, as the help and README say
+        if sc.description.strip():
+            print(sc.description.strip())
         print(f"status: {result.status} ({result.message})")
         print(f"engine: {args.engine}")
         print(f"linear model: {verdict.describe()}")

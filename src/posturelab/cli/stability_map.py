@@ -384,7 +384,8 @@ def run(args: argparse.Namespace) -> int:
     if model:
         raise ParameterError(
             f"--{model[0].replace('_', '-')} is for the delayed map (axes "
-            "active_stiffness:LO:HI and active_viscosity:LO:HI with --feedback-delay); the map "
+            "active_stiffness:PAIR:LO:HI and active_viscosity:PAIR:LO:HI with --feedback-delay); "
+            "the map "
             "over pair stiffnesses takes --body or --height/--mass, --case or --stiffness, and "
             "--viscosity-ratio")
     if args.gastrocnemius != "two-sided":

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import time
 
@@ -15,6 +16,8 @@ from ..studies.sweep import (
     SWEEP_PARAMETERS,
     ProgressBar,
     SweepInterrupted,
+    check_scheduler_address,
+    max_workers,
     parse_vary,
     run_sweep,
     table_format,
@@ -44,7 +47,7 @@ parameter. Every other gain comes from the base experiment: --case/--stiffness/-
 with --disturbance or --tilt (as in posturelab simulate), --scenario FILE.toml or --builtin
 NAME. A pair's viscosity is the varied viscosity:PAIR, else the ratio times its stiffness:
 the varied viscosity_ratio, else --viscosity-ratio, else the base experiment's (0.25, the
-paper's, for --case).
+paper's, for --case); viscosity_ratio and viscosity:PAIR are not varied together.
 
 Columns: the varied parameters (stiffness:ankle, ...), then
 {", ".join(OUTCOME_COLUMNS)} (one peak_theta
@@ -84,8 +87,9 @@ fit_NAME and se_NAME per fitted parameter (fit_active_stiffness:ankle, ...) and 
 
 Parallelism: the runs use every CPU
 available (one thread each). --workers N sends chunks of runs to a Dask LocalCluster of N
-single-threaded worker processes, --scheduler ADDRESS to a running Dask cluster (its
-workers need posturelab installed); the results are identical. Tolerances default to the
+single-threaded worker processes (N from 1 to 4 × the CPUs), --scheduler ADDRESS
+([tcp://]HOST:PORT) to a running Dask cluster (its workers need posturelab installed);
+the results are identical. Tolerances default to the
 compiled engine's (rtol 1e-6, atol 1e-9: angles within 1e-6 rad of a tight DOP853
 reference for undelayed runs); --rtol/--atol override them.
 """
@@ -104,9 +108,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     g.add_argument("--out", required=True, metavar="FILE.csv|FILE.parquet",
                    help="output table (.csv or .parquet).")
     g.add_argument("--workers", type=int, default=None, metavar="N",
-                   help="run on a Dask LocalCluster with N worker processes.")
+                   help="run on a Dask LocalCluster with N worker processes (1 … 4 × the "
+                   "CPUs).")
     g.add_argument("--scheduler", metavar="ADDRESS",
-                   help="run on the Dask cluster whose scheduler is at ADDRESS.")
+                   help="run on the Dask cluster whose scheduler is at ADDRESS "
+                   "([tcp://]HOST:PORT; refused if it does not answer within 10 s).")
     g.add_argument("--chunk-size", type=int, default=None, metavar="RUNS",
                    help="runs per chunk (progress step / Dask task).")
     g.add_argument("--progress", action="store_true",
@@ -148,8 +154,11 @@ def run(args: argparse.Namespace) -> int:
             or args.stiffness is not None or args.controller is not None):
         raise UsageError("sweep: give the base experiment: --case, --stiffness or --controller "
                          "(with --disturbance), or --scenario FILE.toml / --builtin NAME")
-    if args.workers is not None and args.workers < 1:
-        raise ParameterError(f"--workers must be >= 1, got {args.workers}")
+    if args.workers is not None and not 1 <= args.workers <= max_workers():
+        raise ParameterError(f"--workers must be in 1 … {max_workers()} (4 × the "
+                             f"{os.cpu_count() or 1} CPUs), got {args.workers}")
+    if args.scheduler is not None:
+        check_scheduler_address(args.scheduler)
     if args.chunk_size is not None and args.chunk_size < 1:
         raise ParameterError(f"--chunk-size must be >= 1, got {args.chunk_size}")
     ratio = args.viscosity_ratio
@@ -261,6 +270,23 @@ def _with_progress(args: argparse.Namespace, total: int, work):
     return result, time.perf_counter() - t0
 
 
+def _check_experiment_length(args: argparse.Namespace, protocol, scenario) -> None:
+    """Refuse, naming --cycles and --discard-cycles, an experiment longer than the longest
+    run."""
+    from ..simulation.setup import MAX_DURATION
+
+    tilt = scenario.tilt
+    if tilt is None or not hasattr(tilt, "cycle"):
+        return  # (prts_sweep says the tilt must be a PRTS)
+    cycles = protocol.cycles + protocol.discard
+    total = tilt.cycle * cycles
+    if total > MAX_DURATION:
+        given = f"--cycles {protocol.cycles}" if protocol.discard == 0 else (
+            f"(--cycles {protocol.cycles} + --discard-cycles {protocol.discard})")
+        raise ParameterError(f"{given} × the {tilt.cycle:g} s cycle = {total:.3g} s exceeds "
+                             f"the longest run, {MAX_DURATION:,.0f} s")
+
+
 def _run_experiments(args: argparse.Namespace, scenario, varies, ratio) -> int:
     """``--experiment prts``: a PRTS identification experiment per parameter set."""
     from ..frequency.population import PRTSProtocol, prts_sweep
@@ -271,6 +297,7 @@ def _run_experiments(args: argparse.Namespace, scenario, varies, ratio) -> int:
         ("sample_rate", "record_rate"), ("output", "output")) if getattr(args, flag) is not None}
     with naming_given_options(args, PROTOCOL_FIELD_OPTIONS):
         protocol = PRTSProtocol(seed=args.seed or 0, fit=fit, **given)
+    _check_experiment_length(args, protocol, scenario)
     with naming_given_options(args, PROTOCOL_FIELD_OPTIONS):
         result, elapsed = _with_progress(args, _runs(varies), lambda progress: prts_sweep(
             scenario, varies, protocol, viscosity_ratio=ratio, workers=args.workers,

@@ -45,6 +45,36 @@ class PRTSExperiment:
     fell: bool
 
 
+def output_choices(n_links: int) -> str:
+    """The angles an experiment can record, for a message: ``com_angle or theta1`` on one
+    link, ``com_angle, theta1 or theta2`` on two, ``com_angle or theta1 … thetaN`` on more."""
+    if n_links == 1:
+        return "com_angle or theta1"
+    if n_links == 2:
+        return "com_angle, theta1 or theta2"
+    return f"com_angle or theta1 … theta{n_links}"
+
+
+def check_output(output, n_links: int) -> None:
+    """Refuse an ``output`` that is not com_angle or theta1 … thetaN of an ``n_links`` body,
+    in one line naming the choices."""
+    if output == "com_angle" or (isinstance(output, str) and output.startswith("theta")
+                                 and output[5:].isdigit() and 1 <= int(output[5:]) <= n_links):
+        return
+    raise ParameterError(f"output must be {output_choices(n_links)}, got {output!r}")
+
+
+def check_length(cycles: int, discard: int, cycle: float) -> None:
+    """Refuse an experiment of ``discard + cycles`` cycles of ``cycle`` [s] longer than the
+    longest run (:data:`posturelab.simulation.setup.MAX_DURATION`, 86,400 s), naming both."""
+    from ..simulation.setup import MAX_DURATION
+
+    total = cycle * (cycles + discard)
+    if total > MAX_DURATION:
+        raise ParameterError(f"cycles {cycles} (+ discard {discard}) × the {cycle:g} s cycle = "
+                             f"{total:.3g} s exceeds the longest run, {MAX_DURATION:g} s")
+
+
 def prts_experiment(body, muscles, *, tilt=None, cycles: int = 5, discard: int = 1,
                     sensor_noise: float = 0.0, seed: int = 0, sample_rate: float = 100.0,
                     output: str = "com_angle", bands=None, **run_options
@@ -86,6 +116,8 @@ def prts_experiment(body, muscles, *, tilt=None, cycles: int = 5, discard: int =
     for name, value, least in (("cycles", cycles, 2), ("discard", discard, 0)):
         if isinstance(value, bool) or not isinstance(value, int) or value < least:
             raise ParameterError(f"{name} must be an integer >= {least}, got {value!r}")
+    check_length(cycles, discard, tilt.cycle)
+    check_output(output, body.n_links)
     from .._validation import float_in_range
     from .population import MAX_RECORD_RATE, MAX_SENSOR_NOISE
 
@@ -103,8 +135,7 @@ def prts_experiment(body, muscles, *, tilt=None, cycles: int = 5, discard: int =
             and 1 <= int(output[5:]) <= body.n_links:
         angle = r.theta[:, int(output[5:]) - 1]
     else:
-        raise ParameterError(f"output must be com_angle or theta1 … theta{body.n_links}, got "
-                             f"{output!r}")
+        check_output(output, body.n_links)
     rng = np.random.default_rng(seed)
     measured = angle[:t.size] + rng.normal(0.0, sensor_noise, t.size)
     stimulus = tilt.angle(t)

@@ -257,6 +257,7 @@ def prts_sweep(scenario: Scenario, varies: Sequence, protocol: PRTSProtocol | No
     from ..model.tilt import PRTSTilt
     from ..studies.sweep import SweepInterrupted, run_chunks, sweep_grid
     from .bands import band_frequencies, resolve_bands
+    from .experiment import check_length, check_output
     from .fit import _name
 
     protocol = PRTSProtocol() if protocol is None else protocol
@@ -273,6 +274,8 @@ def prts_sweep(scenario: Scenario, varies: Sequence, protocol: PRTSProtocol | No
         raise ParameterError(f"the grid has {grid.n_runs:,} runs; a PRTS experiment sweep takes "
                              f"at most {MAX_EXPERIMENTS:,}")
     cycle = scenario.tilt.cycle
+    check_length(protocol.cycles, protocol.discard, cycle)
+    check_output(protocol.output, scenario.body.n_links)
     samples = int(round(protocol.sample_rate * cycle))
     if samples < 8 or abs(samples - protocol.sample_rate * cycle) > 1e-6 * samples:
         raise ParameterError(f"the record rate {protocol.sample_rate:g} Hz must give a whole "

@@ -299,7 +299,7 @@ def integrate_reference(setup: RunSetup, method: str = "DOP853") -> SimulationRe
             if sol.status == -1:
                 status = "failed"
                 message = outcome_message(
-                    budget.spent or "failed", seg_end, setup,
+                    budget.spent or "failed", seg_end, setup, method=method,
                     detail=f"integrator failed at t = {seg_end:.6g} s: {sol.message}")
                 break
             x = sol.y[:, -1].copy()

@@ -701,8 +701,12 @@ def fall_at_start_by_posture(setup: RunSetup) -> str | None:
     return setup.fall_at_start
 
 
+#: The implicit integrators (of scipy's solve_ivp and the compiled engine's Radau IIA).
+IMPLICIT_METHODS = ("Radau", "BDF", "LSODA")
+
+
 def outcome_message(status: str, t: float, setup: RunSetup, *, fall_reason: str = "",
-                    detail: str = "") -> str:
+                    detail: str = "", method: str | None = None) -> str:
     """The words of a run's outcome.
 
     Parameters
@@ -713,6 +717,9 @@ def outcome_message(status: str, t: float, setup: RunSetup, *, fall_reason: str 
         its words from ``detail``).
     t : float
         When it happened (the fall, the failure). [s]
+    method : str, optional
+        The integrator that ran ("Radau", "RK45", "DOP853", …): a spent step budget suggests
+        an implicit method only to a run that had an explicit one.
     """
     if status == "completed":
         return f"ran to {setup.duration:g} s"
@@ -729,9 +736,13 @@ def outcome_message(status: str, t: float, setup: RunSetup, *, fall_reason: str 
     if status == "no-memory":
         return f"ran out of memory at t = {t:.6g} s"
     if status == "step-budget":
+        if method in IMPLICIT_METHODS:
+            advice = f"raise max_steps; the {method} method that ran is already implicit"
+        else:
+            advice = ("raise max_steps; for very stiff or viscous gains an implicit method "
+                      "such as Radau needs far fewer steps")
         return (f"stopped at t = {t:.6g} s: the step budget of {setup.max_steps:,} integrator "
-                "steps ran out (raise max_steps; for very stiff or viscous gains an implicit "
-                "method such as Radau needs far fewer steps)")
+                f"steps ran out ({advice})")
     if status == "time-budget":
         return (f"stopped at t = {t:.6g} s: the time limit of {setup.time_limit:g} s "
                 "(wall clock) ran out (raise time_limit)")

@@ -33,9 +33,11 @@ the single-process path (each run is the same deterministic computation).
 
 from __future__ import annotations
 
+import contextlib
 import io
 import itertools
 import math
+import os
 import re
 import sys
 import time
@@ -343,6 +345,11 @@ def sweep_grid(scenario: Scenario, varies: Sequence[VaryRange],
     dup = sorted({n for n in names if names.count(n) > 1})
     if dup:
         raise ParameterError(f"--vary names a parameter more than once: {', '.join(dup)}")
+    pair_viscosities = [n for n in names if n.startswith("viscosity:")]
+    if "viscosity_ratio" in names and pair_viscosities:
+        given = ", --vary ".join(pair_viscosities)
+        raise ParameterError(f"--vary viscosity_ratio or --vary {given}, not both (a pair's "
+                             "viscosity is either varied or the ratio times its stiffness)")
     m = math.prod(v.count for v in varies)
     if m > MAX_RUNS:
         raise ParameterError(f"the grid has {m:,} runs ({' × '.join(str(v.count) for v in varies)})"
@@ -733,10 +740,12 @@ def run_sweep(
         Absolute tolerance. [rad, rad/s]
     workers : int, optional
         Run on a Dask LocalCluster of this many single-threaded worker
-        processes (unless ``scheduler`` or ``client`` is given). [-]
+        processes (unless ``scheduler`` or ``client`` is given), 1 …
+        :func:`max_workers` (4 × the CPUs). [-]
     scheduler : str, optional
-        Address of a running Dask scheduler (``tcp://host:8786``); its workers
-        need posturelab installed.
+        Address of a running Dask scheduler (``[tcp://]host:port``, checked before
+        connecting; one that does not answer within :data:`SCHEDULER_TIMEOUT` s is
+        refused); its workers need posturelab installed.
     client : distributed.Client, optional
         An existing Dask client to use.
     chunk_size : int, optional
@@ -786,6 +795,39 @@ def _interrupted(exc: BaseException, parts: list, bounds: list, total: int
     return SweepInterrupted(done, rows, total, type(exc).__name__ == "Terminated")
 
 
+#: Dask worker processes a local sweep may start, per CPU. [-]
+WORKERS_PER_CPU = 4
+#: Seconds to wait for a Dask scheduler to answer before giving up. [s]
+SCHEDULER_TIMEOUT = 10
+
+
+def max_workers() -> int:
+    """The most Dask worker processes a local sweep starts: 4 per CPU. [-]"""
+    return WORKERS_PER_CPU * (os.cpu_count() or 1)
+
+
+#: Protocols a Dask scheduler address may name.
+SCHEDULER_PROTOCOLS = ("tcp", "tls", "ucx", "ws", "wss", "inproc")
+
+
+def check_scheduler_address(address: str) -> None:
+    """Refuse a Dask scheduler address that is not ``[PROTOCOL://]HOST:PORT`` (one line
+    naming it), before any connection is tried."""
+    form = "[tcp://]HOST:PORT, e.g. tcp://127.0.0.1:8786"
+    protocol, sep, rest = address.partition("://")
+    if not sep:
+        protocol, rest = "tcp", address
+    host, colon, port = rest.rpartition(":")
+    if protocol not in SCHEDULER_PROTOCOLS:
+        raise ParameterError(f"--scheduler {address!r}: unknown protocol {protocol!r} (one of "
+                             f"{', '.join(SCHEDULER_PROTOCOLS)}); the form is {form}")
+    if protocol == "inproc":
+        return
+    if not colon or not host or not port.isdigit() or not 1 <= int(port) <= 65535:
+        raise ParameterError(f"--scheduler {address!r} is not an address of the form {form} "
+                             "(PORT 1 … 65535)")
+
+
 def run_chunks(task, grid: SweepGrid, *, workers: int | None = None, scheduler: str | None = None,
                client: Any = None, chunk_size: int | None = None,
                progress: Callable[[int, int], None] | None = None, largest_chunk: int = 2048,
@@ -801,8 +843,11 @@ def run_chunks(task, grid: SweepGrid, *, workers: int | None = None, scheduler: 
     m = grid.n_runs
     distributed_run = client is not None or scheduler is not None or workers is not None
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int)
-                                or workers < 1):
-        raise ParameterError(f"--workers must be an integer >= 1, got {workers!r}")
+                                or not 1 <= workers <= max_workers()):
+        raise ParameterError(f"--workers must be an integer in 1 … {max_workers()} (4 × the "
+                             f"{os.cpu_count() or 1} CPUs), got {workers!r}")
+    if scheduler is not None:
+        check_scheduler_address(scheduler)
     if chunk_size is None:
         chunk_size = largest_chunk if not distributed_run else max(
             min(64, largest_chunk), min(largest_chunk, -(-m // (8 * (workers or 4)))))
@@ -854,6 +899,57 @@ def run_chunks(task, grid: SweepGrid, *, workers: int | None = None, scheduler: 
     return parts
 
 
+@contextlib.contextmanager
+def _quiet_dask():
+    """Every logger silent for the block (distributed's, tornado's and asyncio's report the
+    connections a shutdown after Ctrl-C cuts, as errors with tracebacks)."""
+    import logging
+
+    previous = logging.root.manager.disable
+    logging.disable(logging.CRITICAL)
+    try:
+        yield
+    finally:
+        logging.disable(previous)
+
+
+@contextlib.contextmanager
+def _sigint_held():
+    """Ctrl-C held back for the block and delivered after it (at once if it came meanwhile),
+    so that a cluster is not left half-started; the worker processes started in the block
+    ignore SIGINT (a terminal's Ctrl-C, or ``timeout -s INT``, reaches the whole process
+    group: only this process is to handle it, and then close the cluster)."""
+    import signal
+    import threading
+
+    hold = hasattr(signal, "pthread_sigmask") and \
+        threading.current_thread() is threading.main_thread()
+    if not hold:
+        yield
+        return
+    signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)  # (inherited by the workers; on
+    try:  # Linux a blocked signal stays pending though ignored)
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+
+
+def _close_dask(client, cluster, quiet: bool) -> None:
+    """Close the client, then the cluster (each at most a few seconds); after Ctrl-C with
+    every logger silent."""
+    with _quiet_dask() if quiet else contextlib.nullcontext():
+        for closing in (client, cluster):
+            if closing is None:
+                continue
+            try:
+                closing.close(timeout=5) if closing is client else closing.close()
+            except Exception:  # (a shutdown after Ctrl-C: the connections may be gone)
+                if not quiet:
+                    raise
+
+
 def _run_on_dask(task, grid, bounds, workers, scheduler, client, progress,
                  parts: list) -> list[BatchResult]:
     try:
@@ -862,37 +958,56 @@ def _run_on_dask(task, grid, bounds, workers, scheduler, client, progress,
         raise PostureLabError("--workers/--scheduler need Dask: pip install 'dask[distributed]' "
                               "(or 'posturelab[dask]')") from None
     own_client = own_cluster = None
+    interrupted = False
     try:
         if client is None:
             if scheduler is not None:
                 try:
-                    own_client = client = distributed.Client(scheduler, timeout=20)
-                except (OSError, TimeoutError) as exc:
-                    raise PostureLabError(f"cannot reach the Dask scheduler at {scheduler!r}: "
-                                          f"{exc}") from None
+                    with _quiet_dask():
+                        own_client = client = distributed.Client(
+                            scheduler, timeout=SCHEDULER_TIMEOUT)
+                except (OSError, TimeoutError, ValueError) as exc:
+                    reason = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+                    raise PostureLabError(
+                        f"cannot reach the Dask scheduler at {scheduler!r} within "
+                        f"{SCHEDULER_TIMEOUT} s: {reason}") from None
             else:
                 import logging
 
-                own_cluster = distributed.LocalCluster(
-                    n_workers=workers, threads_per_worker=1, processes=True,
-                    dashboard_address=None, silence_logs=logging.ERROR)
-                own_client = client = distributed.Client(own_cluster)
+                with _sigint_held():
+                    own_cluster = distributed.LocalCluster(
+                        n_workers=workers, threads_per_worker=1, processes=True,
+                        dashboard_address=None, silence_logs=logging.CRITICAL)
+                    own_client = client = distributed.Client(own_cluster)
         shared = client.scatter(task, broadcast=True)
         shared_grid = client.scatter(grid, broadcast=True)
         futures = [client.submit(_run_chunk, shared, shared_grid, lo, hi, pure=False)
                    for lo, hi in bounds]
         index = {f.key: k for k, f in enumerate(futures)}
         done = 0
-        for fut in distributed.as_completed(futures):
-            k = index[fut.key]
-            parts[k] = fut.result()
-            lo, hi = bounds[k]
-            done += hi - lo
-            if progress is not None:
-                progress(done, grid.n_runs)
+        try:
+            for fut in distributed.as_completed(futures):
+                k = index[fut.key]
+                parts[k] = fut.result()
+                lo, hi = bounds[k]
+                done += hi - lo
+                if progress is not None:
+                    progress(done, grid.n_runs)
+        except KeyboardInterrupt:
+            interrupted = True
+            with _quiet_dask():  # keep the chunks that finished, drop the rest
+                for k, fut in enumerate(futures):
+                    try:
+                        if parts[k] is None and fut.status == "finished":
+                            parts[k] = fut.result(timeout=5)
+                    except Exception:
+                        pass
+                with contextlib.suppress(Exception):
+                    client.cancel(futures)
+            raise
         return parts  # type: ignore[return-value]
+    except KeyboardInterrupt:
+        interrupted = True
+        raise
     finally:
-        if own_client is not None:
-            own_client.close()
-        if own_cluster is not None:
-            own_cluster.close()
+        _close_dask(own_client, own_cluster, quiet=interrupted)

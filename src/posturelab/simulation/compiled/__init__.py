@@ -273,7 +273,8 @@ def integrate_compiled(setup: RunSetup, method: str | None = None) -> Simulation
             message = outcome_message("fell", fall_time, setup, fall_reason=fall_reason)
         else:
             fall_time, fall_reason = None, None
-            message = outcome_message(STATUS_OUTCOMES[status], t_reached, setup)
+            message = outcome_message(STATUS_OUTCOMES[status], t_reached, setup,
+                                      method=method)
     # the engine keeps time last; the result holds time-first views of the same memory
     theta = samples[:n, :count].T
     omega = samples[n:, :count].T
