@@ -117,7 +117,7 @@ def test_a_run_ending_before_its_perturbation_is_not_recovered():
 def test_a_run_without_a_perturbation_says_so():
     p = posturelab_cli("simulate", "--case", "1", "--duration", "1")
     assert p.returncode == 0, p.stderr
-    assert p.stdout.splitlines()[1] == ("outcome: recovered (no perturbation: started at rest "
+    assert p.stdout.splitlines()[0] == ("outcome: recovered (no perturbation: started at rest "
                                         "upright and stayed within ±0.01 rad)")
     # an initial lean alone is a perturbation of the state: its settling time is given
     lean = pl.simulate(pl.paper_body(), pl.paper_muscles("1"), None, 5.0, engine="compiled",
