@@ -30,8 +30,9 @@ __all__ = ["batch_rightmost_root", "batch_delay_stable", "DelayStabilityMap",
            "delay_stability_map", "MAX_DELAY_MAP_RESOLUTION"]
 
 #: Largest grid side of :func:`delay_stability_map`: what finishes in reasonable time. The
-#: three-link body costs about 3.3 ms a set on a 2-core machine under load (measured:
-#: 30 × 30 sets in 3 s), so 300 × 300 takes about 5 min (1000 × 1000 would take an hour).
+#: three-link body costs about 1 ms a set on this project's 2-core machine when it is quiet
+#: and about 3 ms under load (300 × 300 took 1.2 min on 2026-12-02; 30 × 30 took 3 s under
+#: load), so 300 × 300 takes one to five minutes and 1000 × 1000 would take up to an hour.
 #: [-]
 MAX_DELAY_MAP_RESOLUTION = 300
 #: Sets per stacked eigenvalue call (bounds the memory of one call). [-]
