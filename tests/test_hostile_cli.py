@@ -13,19 +13,7 @@ import sys
 
 import pytest
 
-
-def cli(*args, cwd=None):
-    return subprocess.run([sys.executable, "-m", "posturelab", *args], capture_output=True,
-                          text=True, timeout=120, cwd=cwd)
-
-
-def one_line_exit_2(p, *words: str) -> None:
-    err = p.stderr.strip()
-    assert p.returncode == 2, p.stderr
-    assert len(err.splitlines()) == 1 and "Traceback" not in err, err
-    for w in words:
-        assert w in err, err
-
+from _cli import cli, one_line_exit_2
 
 SWEEP = ["sweep", "--case", "1", "--disturbance", "backward", "--duration", "1",
          "--vary", "stiffness:ankle=0:2000:3"]

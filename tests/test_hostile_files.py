@@ -10,25 +10,12 @@ the csv module's limit, TOML nested past the parser's recursion limit, a non-CSV
 from __future__ import annotations
 
 import os
-import subprocess
-import sys
 
 import pytest
 
+from _cli import cli, one_line_exit_2
 from posturelab._files import csv_rows
 from posturelab.errors import DataFileError
-
-
-def cli(*args, cwd=None):
-    return subprocess.run([sys.executable, "-m", "posturelab", *args], capture_output=True,
-                          text=True, timeout=120, cwd=cwd)
-
-
-def one_line_exit_2(p, words: str) -> None:
-    err = p.stderr.strip()
-    assert p.returncode == 2, p.stderr
-    assert len(err.splitlines()) == 1 and "Traceback" not in err, err
-    assert words in err, err
 
 
 def trajectory(tmp_path, name="run.csv", bom=False):

@@ -4,12 +4,12 @@ input, messages that name the option and the value as given."""
 from __future__ import annotations
 
 import shutil
-import subprocess
 import sys
 
 import numpy as np
 import pytest
 
+from _cli import cli, one_line_exit_2
 from posturelab.errors import ParameterError
 from posturelab.model.platform import (
     MAX_PLATFORM_ACCELERATION,
@@ -17,20 +17,6 @@ from posturelab.model.platform import (
     MeasuredProfile,
     SumOfSines,
 )
-
-
-def cli(*args, cwd=None):
-    return subprocess.run([sys.executable, "-m", "posturelab", *args], capture_output=True,
-                          text=True, timeout=120, cwd=cwd)
-
-
-def one_line_exit_2(p, *words: str) -> None:
-    err = p.stderr.strip()
-    assert p.returncode == 2, p.stderr
-    assert len(err.splitlines()) == 1 and "Traceback" not in err, err
-    for w in words:
-        assert w in err, err
-
 
 PROFILE = "time,x_acceleration\n0,0\n0.1,1\n0.2,0\n"
 

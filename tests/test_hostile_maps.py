@@ -11,6 +11,7 @@ import sys
 
 import pytest
 
+from _cli import cli, one_line_exit_2
 from posturelab.cli._common import ExpectedTime
 from posturelab.errors import PostureLabError
 from posturelab.linear.delay_batch import MAX_DELAY_MAP_RESOLUTION
@@ -20,18 +21,6 @@ DELAYED = ["stability-map", "--body", "paper-1link", "--stiffness", "28", "--vis
            "--x", "active_stiffness:ankle:0:1700", "--y", "active_viscosity:ankle:0:680",
            "--feedback-delay", "0.15"]
 
-
-def cli(*args):
-    return subprocess.run([sys.executable, "-m", "posturelab", *args], capture_output=True,
-                          text=True, timeout=300)
-
-
-def one_line_exit_2(p, *words: str) -> None:
-    err = p.stderr.strip()
-    assert p.returncode == 2, p.stderr
-    assert len(err.splitlines()) == 1 and "Traceback" not in err, err
-    for w in words:
-        assert w in err, err
 
 
 def test_the_delayed_map_resolution_is_bounded():

@@ -12,16 +12,7 @@ import time
 
 import pytest
 
-
-def cli(*args):
-    return subprocess.run([sys.executable, "-m", "posturelab", *args], capture_output=True,
-                          text=True, timeout=120)
-
-
-def one_line_exit_2(p, words: str) -> None:
-    err = p.stderr.strip()
-    assert p.returncode == 2, p.stderr
-    assert len(err.splitlines()) == 1 and "Traceback" not in err and words in err, err
+from _cli import cli, one_line_exit_2
 
 
 @pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="needs mkfifo")

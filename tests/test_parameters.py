@@ -9,14 +9,13 @@ import csv
 import json
 import math
 import re
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 import posturelab as pl
+from _cli import cli, one_line_exit_2
 from posturelab import parameters
 from posturelab.errors import ParameterError, UnknownNameError, UnknownParameterError
 from posturelab.parameters import (
@@ -32,17 +31,6 @@ ROOT = Path(__file__).resolve().parents[1]
 #: Just past the delay bound. [s]
 TOO_LONG = 1.0001
 
-
-def cli(*args, cwd=None):
-    return subprocess.run([sys.executable, "-m", "posturelab", *args], capture_output=True,
-                          text=True, timeout=300, cwd=cwd)
-
-
-def one_line_exit_2(p, words: str) -> None:
-    err = p.stderr.strip()
-    assert p.returncode == 2, p.stderr
-    assert len(err.splitlines()) == 1 and "Traceback" not in err, err
-    assert words in err, err
 
 
 # ---- the table -----------------------------------------------------------------------
