@@ -23,13 +23,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ParameterError
+from .model import MAX_FREQUENCY  # the highest frequency a model FRF is taken at [Hz]
 
 __all__ = ["FRFTable", "frf_table_from_json", "read_frf_json", "MAX_BANDS"]
 
 #: Most bands a table may have. [-]
 MAX_BANDS = 10_000
-#: Largest frequency a table may give. [Hz]
-MAX_FREQUENCY = 1e4
 #: Largest gain (or standard error) a table may give. [-]
 MAX_GAIN = 1e6
 
