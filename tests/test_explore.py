@@ -6,7 +6,6 @@ screenshot taken."""
 from __future__ import annotations
 
 import math
-import os
 import subprocess
 import sys
 
@@ -14,9 +13,9 @@ import numpy as np
 import pytest
 
 import posturelab as pl
+from _browser import explorer_page, needs_browser
 from posturelab.errors import ParameterError
 from posturelab.explore import CONTROLS, compute_views, create_app, parse_parameters
-from posturelab.explore.browser import chromium_path
 from posturelab.model.muscles import muscles_for
 
 flask = pytest.importorskip("flask")
@@ -127,12 +126,6 @@ def test_cli_explore_bad_port_and_help():
 
 # -- in a real browser ----------------------------------------------------------------------
 
-needs_browser = pytest.mark.skipif(
-    (chromium_path() is None or __import__("importlib").util.find_spec("playwright") is None)
-    and not os.environ.get("CI"),
-    reason="needs Debian's chromium and Playwright (CI installs both)")
-
-
 def _table(page, cls):
     cells = page.locator(f"#poles td.{cls}[data-re]")
     return np.array([float(c.get_attribute("data-re")) + 1j * float(c.get_attribute("data-im"))
@@ -141,17 +134,7 @@ def _table(page, cls):
 
 @needs_browser
 def test_the_page_in_chromium(tmp_path):
-    from playwright.sync_api import sync_playwright
-
-    from posturelab.explore.browser import launch_chromium, running_server
-
-    with running_server() as url, sync_playwright() as playwright:
-        browser = launch_chromium(playwright)
-        page = browser.new_page(viewport={"width": 1400, "height": 1000})
-        errors = []
-        page.on("pageerror", lambda exc: errors.append(str(exc)))
-        page.goto(url)
-        page.wait_for_function("Number(document.body.dataset.updates) >= 1", timeout=30_000)
+    with explorer_page() as (page, errors):
         np.testing.assert_allclose(_table(page, "pole"), _api_poles(CASE1).poles, rtol=1e-9)
         assert page.locator("#verdict").get_attribute("class") == "stable"
 
@@ -196,7 +179,6 @@ def test_the_page_in_chromium(tmp_path):
                                    rtol=1e-9)
         shot = tmp_path / "explore.png"
         page.screenshot(path=str(shot), full_page=True)
-        browser.close()
     assert shot.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and shot.stat().st_size > 50_000
     assert errors == []
 
@@ -261,19 +243,9 @@ def test_the_one_link_body_and_the_controller_presets_are_the_api_s():
 
 @needs_browser
 def test_the_page_offers_the_one_link_body_and_the_controller_presets():
-    from playwright.sync_api import sync_playwright
-
-    from posturelab.explore.browser import launch_chromium, running_server
     from posturelab.model.controllers import get_controller
 
-    with running_server() as url, sync_playwright() as playwright:
-        browser = launch_chromium(playwright)
-        page = browser.new_page(viewport={"width": 1400, "height": 1000})
-        errors = []
-        page.on("pageerror", lambda exc: errors.append(str(exc)))
-        page.goto(url)
-        page.wait_for_function("Number(document.body.dataset.updates) >= 1", timeout=30_000)
-
+    with explorer_page() as (page, errors):
         page.select_option("#body", "paper, one link")
         page.wait_for_function("Number(document.body.dataset.updates) >= 2", timeout=30_000)
         body = pl.get_body("paper-1link")
@@ -294,5 +266,4 @@ def test_the_page_offers_the_one_link_body_and_the_controller_presets():
         assert page.inner_text("#verdict") == verdict.describe()
         assert page.locator("#verdict").get_attribute("class") == (
             "stable" if verdict.stable else "unstable")
-        browser.close()
     assert errors == []

@@ -13,6 +13,7 @@ import pytest
 
 pytest.importorskip("flask")
 
+from _browser import explorer_page, needs_browser  # noqa: E402
 from posturelab.explore.app import MAX_JSON_DEPTH  # noqa: E402
 from posturelab.explore.browser import running_server  # noqa: E402
 
@@ -109,21 +110,9 @@ def test_an_unstable_loop_gets_a_notice_instead_of_an_frf():
     assert not delayed["stable"] and "unstable at this delay" in delayed["frf"]["note"]
 
 
+@needs_browser
 def test_the_page_shows_the_notice_and_gives_the_frf_room(tmp_path):
-    import os
-
-    from posturelab.explore.browser import chromium_path
-
-    if chromium_path() is None and not os.environ.get("CI"):
-        pytest.skip("needs Debian's chromium")
-    playwright = pytest.importorskip("playwright.sync_api")
-    from posturelab.explore.browser import launch_chromium
-
-    with running_server() as url, playwright.sync_playwright() as pw:
-        browser = launch_chromium(pw)
-        page = browser.new_page(viewport={"width": 1400, "height": 1000})
-        page.goto(url)
-        page.wait_for_function("Number(document.body.dataset.updates) >= 1", timeout=60_000)
+    with explorer_page() as (page, errors):
         assert page.is_hidden("#frf-note")
         gain = page.locator("#frf-gain").bounding_box()
         poles = page.locator("#poles-chart").bounding_box()
@@ -133,7 +122,7 @@ def test_the_page_shows_the_notice_and_gives_the_frf_room(tmp_path):
         assert page.is_visible("#frf-note")
         assert "an FRF cannot be measured" in page.inner_text("#frf-note")
         page.screenshot(path=str(tmp_path / "unstable.png"), full_page=True)
-        browser.close()
+    assert errors == []
 
 
 def test_a_body_not_declared_json_is_refused(port):
