@@ -252,7 +252,7 @@ def test_sweep_over_feedback_delay_equals_single_runs():
 
 
 def test_sweep_over_a_joint_torque_limit_equals_single_runs(tmp_path):
-    """--vary ankle_torque_limit keeps the base experiment's other limits (here the hip's)."""
+    """--vary torque_limit:ankle keeps the base experiment's other limits (here the hip's)."""
     sc = builtin_scenario("paper-backward-case1").replace(
         duration=1.0, torque_limits=(math.inf, math.inf, 40.0))
     result = run_sweep(sc, [parse_vary("torque_limit:ankle=30:120:4")])
