@@ -247,3 +247,29 @@ def test_a_scenario_names_its_prts_sequence(tmp_path):
     with pytest.raises(ScenarioError, match="takes sequence or a register"):
         load_scenario(write(tmp_path, MINIMAL + '[tilt]\ntype = "prts"\namplitude = 0.02\n'
                             'sequence = "comtest-80"\nregisters = 4\n', "n3.toml"))
+
+
+def test_a_one_link_scenario_takes_stiffness_per_pair_as_the_command_line_does(tmp_path):
+    """[muscles] stiffness / active gains, one value per pair of a body of other than three
+    links (the command line's --stiffness), equal the API's muscles_for; a wrong count or a
+    Table I case on such a body is one line naming the pairs."""
+    import subprocess
+    import sys
+
+    import posturelab as pl
+    from posturelab.model.muscles import muscles_for
+
+    text = ('duration = 1.0\n[body]\npreset = "paper-1link"\n[muscles]\nstiffness = [0.0]\n'
+            'active_stiffness = [761.4]\nactive_viscosity = [265.0]\nfeedback_delay = 0.15\n')
+    path = tmp_path / "one.toml"
+    path.write_text(text)
+    sc = pl.load_scenario(path)
+    want = muscles_for(1, [0.0], active_stiffness=[761.4], active_viscosity=[265.0])
+    assert sc.muscles == want and sc.feedback_delay == 0.15
+    for bad, words in (("stiffness = [0.0, 1.0]", "one value per pair of this 1-link body "
+                        "(ankle)"), ('case = "1"', "muscles.case is one of the paper's")):
+        path.write_text(text.replace("stiffness = [0.0]", bad))
+        p = subprocess.run([sys.executable, "-m", "posturelab", "simulate", "--scenario",
+                            str(path)], capture_output=True, text=True, timeout=120)
+        assert p.returncode == 2 and len(p.stderr.strip().splitlines()) == 1, p.stderr
+        assert words in p.stderr

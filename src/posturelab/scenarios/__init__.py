@@ -17,9 +17,12 @@ Schema (every table optional except where noted; units in brackets)::
     gravity = 9.81                       # [m/s²]
 
     [muscles]
-    case = "1"                           # Table I; or stiffness = [5 values] [N·m/rad];
-                                         # or pairs = [{name, lo, hi, stiffness,
-                                         #              viscosity, one_sided}]
+    case = "1"                           # Table I; or stiffness = [one value per pair]
+                                         # [N·m/rad] (the paper's five on 3 links, ankle on
+                                         # 1, ankle and hip on 2, as --stiffness); or
+                                         # pairs = [{name, lo, hi, stiffness, viscosity,
+                                         #   one_sided}] (lo, hi: the links the pair spans,
+                                         #   0 the foot: the ankle pair is lo = 0, hi = 1)
     viscosity_ratio = 0.25               # [s]
     gastrocnemius = "two-sided"          # or "one-sided" (θ2 ≥ 0), "pull-only"
     feedback_delay = 0.0                 # neural delay of the muscle feedback [s]
@@ -547,8 +550,27 @@ def _parse_muscles(mt: dict, body: Body, origin: str) -> tuple[MuscleSet, str | 
                                     bool(p.get("pull_only", False))))
         return MuscleSet(tuple(pairs), body.n_links), None
     if body.n_links != 3:
-        raise ScenarioError(f"{origin}: muscles.case / muscles.stiffness are the paper's five "
-                            f"pairs on 3 links; this body has {body.n_links}: use muscles.pairs")
+        if "case" in mt:
+            raise ScenarioError(f"{origin}: muscles.case is one of the paper's Table I sets of "
+                                f"five pairs on 3 links; this body has {body.n_links}: give "
+                                "muscles.stiffness (one value per pair, as on the command line) "
+                                "or muscles.pairs")
+        if mt.get("gastrocnemius", "two-sided") != "two-sided":
+            raise ScenarioError(f"{origin}: muscles.gastrocnemius is a pair of the paper's "
+                                f"three-link body; this body has {body.n_links} links")
+        from ..model.muscles import joint_pair_names, muscles_for
+
+        names = joint_pair_names(body.n_links)
+        stiffness = mt["stiffness"]
+        if not isinstance(stiffness, list) or len(stiffness) != len(names):
+            raise ScenarioError(f"{origin}: muscles.stiffness must have one value per pair of "
+                                f"this {body.n_links}-link body ({', '.join(names)}), got "
+                                f"{stiffness!r}")
+        return muscles_for(
+            body.n_links, stiffness, viscosity_ratio=mt.get("viscosity_ratio", 0.25),
+            active_stiffness=mt.get("active_stiffness"),
+            active_viscosity=mt.get("active_viscosity"),
+            active_viscosity_ratio=mt.get("active_viscosity_ratio")), None
     case = mt.get("case")
     return paper_muscles(
         None if case is None else str(case), stiffness=mt.get("stiffness"),
