@@ -273,3 +273,34 @@ def test_a_one_link_scenario_takes_stiffness_per_pair_as_the_command_line_does(t
                             str(path)], capture_output=True, text=True, timeout=120)
         assert p.returncode == 2 and len(p.stderr.strip().splitlines()) == 1, p.stderr
         assert words in p.stderr
+
+
+def test_a_scenario_names_a_controller_preset(tmp_path):
+    """[muscles] controller = NAME gives the preset's gains on the one-link body and its
+    delay and weight (unless the table gives them); gains beside it, a three-link body or an
+    unknown name are one line each."""
+    import posturelab as pl
+    from posturelab.errors import ScenarioError
+    from posturelab.model.controllers import CONTROLLERS, get_controller
+
+    text = ('duration = 1.0\n[body]\npreset = "paper-1link"\n[muscles]\n'
+            'controller = "peterka-2002"\n')
+    path = tmp_path / "c.toml"
+    path.write_text(text)
+    sc = pl.load_scenario(path)
+    preset = get_controller("peterka-2002")
+    body = pl.get_body("paper-1link")
+    assert sc.muscles == preset.muscles(body)
+    assert (sc.feedback_delay, sc.proprioceptive_weight) == (preset.feedback_delay,
+                                                             preset.proprioceptive_weight)
+    path.write_text(text + "feedback_delay = 0.1\n")
+    assert pl.load_scenario(path).feedback_delay == 0.1
+    for extra, words in (("stiffness = [500.0]\n", "cannot be given with muscles.controller"),
+                         ("", "is a one-link controller")):
+        body_text = text if extra else text.replace('"paper-1link"', '"paper"')
+        path.write_text(body_text + extra)
+        with pytest.raises(ScenarioError, match=words):
+            pl.load_scenario(path)
+    path.write_text(text.replace("peterka-2002", "peterka"))
+    with pytest.raises(ScenarioError, match=", ".join(CONTROLLERS)):
+        pl.load_scenario(path)

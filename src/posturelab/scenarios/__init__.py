@@ -17,6 +17,8 @@ Schema (every table optional except where noted; units in brackets)::
     gravity = 9.81                       # [m/s²]
 
     [muscles]
+    controller = "peterka-2002"          # a one-link controller preset (its gains, delay
+                                         # and weight) instead of the gains below; or
     case = "1"                           # Table I; or stiffness = [one value per pair]
                                          # [N·m/rad] (the paper's five on 3 links, ankle on
                                          # 1, ankle and hip on 2, as --stiffness); or
@@ -338,17 +340,20 @@ def _parse(data: dict, base_dir: Path, origin: str) -> Scenario:
     mt = _table(data, "muscles", ("case", "stiffness", "pairs", "viscosity_ratio",
                                   "gastrocnemius", "feedback_delay", "active_stiffness",
                                   "active_viscosity", "active_viscosity_ratio",
-                                  "proprioceptive_weight"), origin)
+                                  "proprioceptive_weight", "controller"), origin)
     mt = dict(mt)
-    delay = finite_float("muscles.feedback_delay [s]", mt.pop("feedback_delay", 0.0))
-    weight = finite_float("muscles.proprioceptive_weight [-]",
-                          mt.pop("proprioceptive_weight", 1.0))
+    preset = _controller(mt, body, origin)
+    delay = finite_float("muscles.feedback_delay [s]", mt.pop(
+        "feedback_delay", 0.0 if preset is None else preset.feedback_delay))
+    weight = finite_float("muscles.proprioceptive_weight [-]", mt.pop(
+        "proprioceptive_weight", 1.0 if preset is None else preset.proprioceptive_weight))
     for key, value in (("feedback_delay", delay), ("proprioceptive_weight", weight)):
         try:  # the parameter table's bounds
             check_value(key, value, f"muscles.{key}")
         except ParameterError as exc:
             raise ScenarioError(f"{origin}: {exc}") from None
-    muscles, case = _parse_muscles(mt, body, origin)
+    muscles, case = (_parse_muscles(mt, body, origin) if preset is None
+                     else (preset.muscles(body), None))
     tilt_table = _table(data, "tilt", TILT_KEYS, origin)
     tilt = _parse_tilt(tilt_table, base_dir, origin)
     depth = finite_float("tilt.axis_depth [m]", tilt_table.get("axis_depth", 0.0))
@@ -520,6 +525,31 @@ def _parse_body(bt: dict, origin: str) -> Body:
     if gravity is not None:
         body = body.with_gravity(gravity)
     return body
+
+
+def _controller(mt: dict, body: Body, origin: str):
+    """``[muscles] controller = NAME``: the preset (its gains on this one-link body, its delay
+    and weight unless the table gives them), or None."""
+    if "controller" not in mt:
+        return None
+    from ..model.controllers import get_controller
+
+    name = str(mt.pop("controller"))
+    try:
+        preset = get_controller(name)
+    except PostureLabError as exc:
+        raise ScenarioError(f"{origin}: muscles.controller: {exc}") from None
+    others = [k for k in ("case", "stiffness", "pairs", "viscosity_ratio", "gastrocnemius",
+                          "active_stiffness", "active_viscosity", "active_viscosity_ratio")
+              if k in mt]
+    if others:
+        raise ScenarioError(f"{origin}: muscles.{others[0]} cannot be given with "
+                            f"muscles.controller {name!r}, which sets every gain")
+    if body.n_links != 1:
+        raise ScenarioError(f"{origin}: muscles.controller {name!r} is a one-link controller; "
+                            f"this body has {body.n_links} links (preset = \"paper-1link\", or "
+                            "one segment)")
+    return preset
 
 
 def _parse_muscles(mt: dict, body: Body, origin: str) -> tuple[MuscleSet, str | None]:

@@ -73,6 +73,7 @@ class MusclesTable(_Table):
     active_viscosity: list[float] | None = None
     active_viscosity_ratio: float | None = None
     proprioceptive_weight: float | None = None
+    controller: str | None = None
 
 
 class TiltTable(_Table):
