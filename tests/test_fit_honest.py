@@ -170,3 +170,21 @@ def test_a_fit_that_ran_out_of_simulations_is_no_success():
     d = fit.to_dict()
     assert d["success"] is False and d["converged"] is False
     assert all(p["ci95"] is None for p in d["parameters"].values())
+
+
+def test_the_command_line_says_an_estimate_is_on_its_search_bound(measured):
+    """Case 1 has no active feedback: the active gain stops on its lower search bound, 0,
+    and `fit` says so in text and JSON instead of an interval reaching below 0."""
+    args = ["fit", "--data", str(measured), "--case", "1", "--disturbance", "backward",
+            "--free", "stiffness:ankle,active_stiffness:ankle"]
+    proc = run_cli(*args, "--json")
+    assert proc.returncode == 0, proc.stderr
+    p = json.loads(proc.stdout)["parameters"]
+    assert p["active_stiffness:ankle"]["at_bound"] == "low"
+    assert p["active_stiffness:ankle"]["determined"] is False
+    assert p["stiffness:ankle"]["at_bound"] is None and p["stiffness:ankle"]["determined"]
+    assert p["stiffness:ankle"]["ci95"][0] >= 0.0
+    text = run_cli(*args)
+    assert text.returncode == 0, text.stderr
+    assert ("active_stiffness:ankle cannot be determined from these data: at its search "
+            "bound LO = 0 N·m/rad") in text.stdout
