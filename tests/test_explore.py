@@ -267,3 +267,30 @@ def test_the_page_offers_the_one_link_body_and_the_controller_presets():
         assert page.locator("#verdict").get_attribute("class") == (
             "stable" if verdict.stable else "unstable")
     assert errors == []
+
+
+def test_a_controller_through_the_api_is_the_command_line_s():
+    """Without τ and W the API takes the controller's (as `simulate --controller`); a gain
+    sent with a controller is refused, naming the field; JSON's true is quoted as true."""
+    from posturelab.model.controllers import get_controller
+
+    preset = get_controller("peterka-2002")
+    client = create_app().test_client()
+    ok = client.post("/api/views", json={"body": "paper, one link",
+                                         "controller": "peterka-2002"})
+    assert ok.status_code == 200
+    body = pl.get_body("paper-1link")
+    want = pl.upright_verdict(body, preset.muscles(body), 0.15)
+    assert preset.feedback_delay == 0.15
+    assert ok.get_json()["linear_stability"] == want.to_dict()
+    p = parse_parameters({"controller": "peterka-2002", "proprioceptive_weight": 0.5})
+    assert (p["feedback_delay"], p["proprioceptive_weight"]) == (0.15, 0.5)
+    assert parse_parameters({})["feedback_delay"] == 0.0  # own gains: the control's default
+    bad = client.post("/api/views", json={"controller": "peterka-2002",
+                                          "active_stiffness:ankle": 3000})
+    assert bad.status_code == 422
+    assert bad.get_json()["field"] == "active_stiffness:ankle"
+    assert "set by the controller peterka-2002" in bad.get_json()["error"]
+    true = client.post("/api/views", json={"stiffness:ankle": True})
+    assert true.status_code == 422
+    assert true.get_json()["error"].endswith("must be a number, got true")

@@ -91,16 +91,20 @@ def test_parameters_that_are_not_separable_are_named(measured):
 
 def test_intrinsic_and_active_stiffness_separate_through_the_viscosity_model(rng):
     """Without the viscosity free, intrinsic stiffness brings its viscosity (ratio × K) and
-    the active gain does not: both are determined, and with seeded 2 mrad noise the
-    intervals hold the truth (500 and 0; it printed 5.05e-06 ± nan)."""
+    the active gain does not: the stiffness is determined (its interval holds 500 with
+    seeded 2 mrad noise), and the active gain, whose truth 0 is its search bound, stops on
+    that bound and is said to (it printed 5.05e-06 ± nan, then an interval below 0)."""
     sc = pl.builtin_scenario("paper-backward-case1").replace(duration=2.0, sample_rate=50)
     truth = sc.run()
     noisy = truth.theta + rng.normal(0.0, 0.002, truth.theta.shape)
     fit = fit_stiffness(sc, truth.time, noisy, ["stiffness:ankle", "active_stiffness:ankle"])
     assert fit.success and fit.describes_data and fit.n_starts == 1
-    assert fit.determined.all() and fit.undetermined_reasons == ("", "")
-    lo, hi = fit.confidence_intervals.T
-    assert lo[0] <= 500.0 <= hi[0] and lo[1] <= 0.0 <= hi[1]
+    assert fit.determined.tolist() == [True, False] and fit.at_bound == (None, "low")
+    assert fit.undetermined_reasons == ("", "at its search bound LO = 0 N·m/rad")
+    lo, hi = fit.confidence_intervals[0]
+    assert 0.0 <= lo <= 500.0 <= hi
+    active = fit.to_dict()["parameters"]["active_stiffness:ankle"]
+    assert active["at_bound"] == "low" and active["determined"] is False
 
 
 def test_a_well_posed_noisy_fit_is_determined_and_covers_the_truth(rng):
@@ -166,3 +170,21 @@ def test_a_fit_that_ran_out_of_simulations_is_no_success():
     d = fit.to_dict()
     assert d["success"] is False and d["converged"] is False
     assert all(p["ci95"] is None for p in d["parameters"].values())
+
+
+def test_the_command_line_says_an_estimate_is_on_its_search_bound(measured):
+    """Case 1 has no active feedback: the active gain stops on its lower search bound, 0,
+    and `fit` says so in text and JSON instead of an interval reaching below 0."""
+    args = ["fit", "--data", str(measured), "--case", "1", "--disturbance", "backward",
+            "--free", "stiffness:ankle,active_stiffness:ankle"]
+    proc = run_cli(*args, "--json")
+    assert proc.returncode == 0, proc.stderr
+    p = json.loads(proc.stdout)["parameters"]
+    assert p["active_stiffness:ankle"]["at_bound"] == "low"
+    assert p["active_stiffness:ankle"]["determined"] is False
+    assert p["stiffness:ankle"]["at_bound"] is None and p["stiffness:ankle"]["determined"]
+    assert p["stiffness:ankle"]["ci95"][0] >= 0.0
+    text = run_cli(*args)
+    assert text.returncode == 0, text.stderr
+    assert ("active_stiffness:ankle cannot be determined from these data: at its search "
+            "bound LO = 0 N·m/rad") in text.stdout

@@ -82,15 +82,18 @@ def run(args: argparse.Namespace) -> int:
         rho = ", ".join(f"{v:.2f}" for v in fit.residual_autocorrelation)
         print(f"residuals: lag-1 correlation per link {rho} (allowed for in the intervals; "
               f"{fit.degrees_of_freedom:.0f} effective degrees of freedom)")
-    for name, e, se, (lo, hi), why in zip(fit.parameter_names, fit.estimates,
-                                          fit.standard_errors, fit.confidence_intervals,
-                                          fit.undetermined_reasons, strict=True):
+    clipped = [False] * len(free) if fit.clipped is None else fit.clipped
+    for name, e, se, (lo, hi), why, cut in zip(fit.parameter_names, fit.estimates,
+                                               fit.standard_errors, fit.confidence_intervals,
+                                               fit.undetermined_reasons, clipped, strict=True):
         unit = parameter_unit(name)
         if why:
             print(f"  {name:<22} cannot be determined from these data: {why} "
                   f"(stopped at {e:.4g} {unit})")
         elif fit.success:
-            print(f"  {name:<22} {e:10.4g} ± {se:.3g} {unit}   (95 % CI {lo:.4g} … {hi:.4g})")
+            print(f"  {name:<22} {e:10.4g} ± {se:.3g} {unit}   (95 % CI {lo:.4g} … {hi:.4g})"
+                  + ("   (interval clipped to the accepted range and search bounds)" if cut
+                     else ""))
         else:
             print(f"  {name:<22} {e:10.4g} {unit}   (no interval: see the warning)")
     if fit.warning:

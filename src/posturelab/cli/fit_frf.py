@@ -39,8 +39,11 @@ estimate is (frf --json carries them, so its JSON fits as its trial does; a tabl
 them: the model at the band frequencies).
 Prints each parameter with its standard error and 95 % interval, the fit error (√(χ²/dof),
 about 1 when the model explains the data within their noise), and parameters the data
-cannot determine; when the fit error is too large for chance (p < 0.001) it says the
-model does not describe the data and widens the intervals by a model error it states;
+cannot determine (among them an estimate on its search bound, within 1e-6 of the bounds'
+range: "at its search bound LO/HI", "at_bound" in --json); every interval is clipped to the
+parameter's accepted range and its search bounds (said when it was); when the fit error
+is too large for chance (p < 0.001) it says the model does not describe the data and
+widens the intervals by a model error it states;
 warns when a band's coherence is below 0.5. Bounds must lie within each parameter's range;
 a name given twice or a bound for a parameter not fitted is refused.
 
@@ -200,10 +203,17 @@ def run(args: argparse.Namespace) -> int:
     print(f"weighting: {fit.weighting_text()}")
     if signs:
         print("response sign applied: " + ", ".join(f"{v:+d}" for v in signs))
-    for name, e, se, (lo, hi), ok in zip(fit.names, fit.estimates, fit.standard_errors,
-                                         fit.confidence_intervals, fit.determined,
-                                         strict=True):
-        note = "" if ok else "   (not determined by these data)"
+    from .._bounds import bound_note
+
+    for name, e, se, (lo, hi), ok, side, clipped, (blo, bhi) in zip(
+            fit.names, fit.estimates, fit.standard_errors, fit.confidence_intervals,
+            fit.determined, fit.at_bound, fit.clipped, fit.search_bounds, strict=True):
+        if side is not None:
+            note = f"   ({bound_note(name, side, blo, bhi)}: not determined by these data)"
+        else:
+            note = "" if ok else "   (not determined by these data)"
+        if clipped:
+            note += "   (interval clipped to the accepted range and search bounds)"
         if fit.mismatch:
             note += "   (model mismatch: the interval includes the systematic part)"
         print(f"  {name:<24} {e:10.4g} ± {se:.3g} {fit.unit(name)}   (95 % CI {lo:.4g} … "

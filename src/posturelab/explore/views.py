@@ -129,13 +129,29 @@ def _number(value: float) -> str:
 
 
 def _shown(raw) -> str:
-    """A request value as a message quotes it: its repr, cut at 40 characters."""
-    text = repr(raw if isinstance(raw, str) else str(raw))
+    """A request value as a message quotes it, cut at 40 characters: a string or a number
+    by its repr, JSON's true, false, null, lists and objects as JSON wrote them."""
+    if isinstance(raw, bool) or raw is None or isinstance(raw, list | dict):
+        import json
+
+        text = json.dumps(raw, ensure_ascii=False, default=str)
+    else:
+        text = repr(raw if isinstance(raw, str) else str(raw))
     return text if len(text) <= 40 else text[:39] + "…"
+
+
+#: The controls a controller sets (every pair gain, and the viscosity ratio): refused with
+#: one (:func:`parse_parameters`).
+_SET_BY_CONTROLLER = tuple(c.name for c in CONTROLS if c.group in ("pairs", "active"))
 
 
 def parse_parameters(fields: dict) -> dict:
     """Check a request's fields against :data:`CONTROLS`; missing ones take their default.
+
+    With a controller (not :data:`OWN_GAINS`) the feedback delay and the proprioceptive
+    weight not given are the controller's (as ``posturelab simulate --controller``; the
+    page sends its own), and a pair gain or the viscosity ratio given is refused: the
+    controller sets them.
 
     Returns
     -------
@@ -146,8 +162,9 @@ def parse_parameters(fields: dict) -> dict:
     ------
     ParameterError
         An unknown field, a value that is not a finite number, a number outside the
-        control's range or an unknown choice; the message names the control, the value
-        and the range, and ``error.field`` the control's name.
+        control's range, an unknown choice, or a gain given with a controller; the message
+        names the control, the value (as the JSON gave it) and the range, and
+        ``error.field`` the control's name.
     """
     if not isinstance(fields, dict):
         raise ParameterError("the request must be a JSON object of control values")
@@ -180,6 +197,16 @@ def parse_parameters(fields: dict) -> dict:
             raise _field_error(c.name, f"{c.label} [{c.unit}] must be in "
                                f"[{_number(c.low)}, {_number(c.high)}], got {_number(value)}")
         out[c.name] = value
+    if out["controller"] != OWN_GAINS:  # its gains, and its τ and W unless given
+        preset = CONTROLLERS[out["controller"]]
+        given = [name for name in _SET_BY_CONTROLLER if name in fields]
+        if given:
+            raise _field_error(given[0], f"{_BY_NAME[given[0]].label} ({given[0]}) is set "
+                               f"by the controller {out['controller']}: leave it out, or "
+                               f"choose {OWN_GAINS!r}")
+        for name in ("feedback_delay", "proprioceptive_weight"):
+            if name not in fields:
+                out[name] = float(getattr(preset, name))
     for name in PAIRS:  # a pair's viscosity is ratio × stiffness: its bound, on the stiffness
         viscosity = out["viscosity_ratio"] * out[f"stiffness:{name}"]
         if viscosity > MAX_PAIR_VISCOSITY:
@@ -226,8 +253,9 @@ def build_model(p: dict):
     """The body, muscle set, disturbance and tilt the checked parameters ``p`` describe.
 
     A controller gives every gain (scaled by the body's mgh); the feedback delay and the
-    proprioceptive weight are the page's (the page sets them to the controller's when it
-    is chosen). On a one-link body with own gains only the ankle pair acts.
+    proprioceptive weight are ``p``'s (:func:`parse_parameters` fills in the controller's
+    when a request leaves them out; the page sets them to the controller's when it is
+    chosen). On a one-link body with own gains only the ankle pair acts.
     """
     import posturelab as pl
 

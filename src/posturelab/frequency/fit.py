@@ -57,9 +57,11 @@ are estimate ± q standard errors (± β_k), q Student's t quantile with the res
 ``"relative"``, else with the fewest degrees of freedom of any band's variance (∞ for known
 standard errors: q = 1.96), a conservative stand-in for the Satterthwaite dof of each
 estimate's variance. A parameter the residuals do not depend on, whose relative standard
-error exceeds 1, or that the Jacobian cannot separate (condition number above 1e10), is
-reported as not determined. Bands with coherence below 0.5 raise a warning in
-``warnings``.
+error exceeds 1, that the Jacobian cannot separate (condition number above 1e10), or whose
+estimate stopped on its search bound (within 1e-6 of the bounds' range: ``at_bound``,
+:mod:`posturelab._bounds`) is reported as not determined; every interval is clipped to the
+parameter's accepted range (the parameter table) and its search bounds (``clipped``).
+Bands with coherence below 0.5 raise a warning in ``warnings``.
 """
 
 from __future__ import annotations
@@ -69,6 +71,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .._bounds import at_bound, clip_intervals
 from ..errors import ParameterError
 from ..model.body import Body
 from ..model.muscles import MuscleSet
@@ -133,6 +136,14 @@ class FRFFit:
     systematic : numpy.ndarray, shape (K,)
         β, the most a systematic model error of δ|Ĥ| per band moves each parameter; the
         intervals are widened by it (0 without a mismatch). [its unit]
+    at_bound : tuple of {"low", "high", None}
+        Per parameter, the search bound its estimate stopped on (within 1e-6 of the
+        bounds' range, :data:`posturelab._bounds.AT_BOUND_TOLERANCE`; then not determined).
+    search_bounds : numpy.ndarray, shape (K, 2)
+        Each parameter's search interval (LO, HI). [its unit]
+    clipped : numpy.ndarray of bool, shape (K,)
+        Whether the interval was clipped to the parameter's accepted range (the parameter
+        table) or its search interval.
     """
 
     names: tuple[str, ...]
@@ -149,6 +160,9 @@ class FRFFit:
     mismatch: bool = False
     model_error: float = 0.0
     systematic: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    at_bound: tuple = ()
+    search_bounds: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
+    clipped: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=bool))
 
     def unit(self, name: str) -> str:
         """Unit of a fitted parameter."""
@@ -163,12 +177,15 @@ class FRFFit:
         def num(v):
             return float(v) if math.isfinite(v) else None
 
+        sides = self.at_bound or (None,) * len(self.names)
+        clipped = self.clipped if self.clipped.size else np.zeros(len(self.names), bool)
         return {"parameters": [
             {"name": n, "unit": self.unit(n), "estimate": num(e), "standard_error": num(s),
-             "ci95": [num(lo), num(hi)], "determined": bool(d)}
-            for n, e, s, (lo, hi), d in zip(self.names, self.estimates, self.standard_errors,
-                                             self.confidence_intervals, self.determined,
-                                             strict=True)],
+             "ci95": [num(lo), num(hi)], "determined": bool(d), "at_bound": side,
+             "ci95_clipped": bool(c)}
+            for n, e, s, (lo, hi), d, side, c in zip(
+                self.names, self.estimates, self.standard_errors, self.confidence_intervals,
+                self.determined, sides, clipped, strict=True)],
             "fit_error": num(self.fit_error), "weighting": self.weighting,
             "weighting_description": self.weighting_text(), "mismatch": bool(self.mismatch),
             "model_error": num(self.model_error),
@@ -519,10 +536,14 @@ def fit_frf(body: Body, muscles: MuscleSet, data, free, *, input: str = "tilt",
     if mismatch and np.isfinite(cond) and seen_col.all():
         systematic = _systematic_bound(J, targets, delta, seen_col)
     ci = np.stack([p - q * se - systematic, p + q * se + systematic], axis=1)
-    determined = seen_col & np.isfinite(se) & (se <= np.abs(p)) & (cond < 1e10)
+    sides = at_bound(p, lo, hi)  # an estimate on its search bound is not determined
+    determined = (seen_col & np.isfinite(se) & (se <= np.abs(p)) & (cond < 1e10)
+                  & np.array([side is None for side in sides]))
+    ci, clipped = clip_intervals(labels, ci, lo, hi)
     return FRFFit(tuple(labels), p, se, ci, determined, float(fit_error), bool(sol.success),
                   str(sol.message), tuple(warnings), tuple(model(p, dense=True)), weighting,
-                  bool(mismatch), float(delta), systematic)
+                  bool(mismatch), float(delta), systematic, sides,
+                  np.stack([lo, hi], axis=1), clipped)
 
 
 def _systematic_bound(J: np.ndarray, targets: list, delta: float, seen: np.ndarray

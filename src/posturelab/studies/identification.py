@@ -39,6 +39,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .._bounds import at_bound, bound_note, clip_intervals
 from .._validation import finite_array
 from ..errors import DataFileError, ParameterError, PostureLabError, UnknownNameError
 from ..model.muscles import MuscleSet
@@ -119,6 +120,12 @@ class FitResult:
         describe the data). [-]
     warning : str
         One line on why the fit is not a success ("" when it is).
+    at_bound : tuple of {"low", "high", None}
+        Per parameter, the search bound its estimate stopped on (within 1e-6 of the box's
+        width, :mod:`posturelab._bounds`); such a parameter is not determined.
+    clipped : numpy.ndarray of bool, shape (P,), or None
+        Whether the interval was clipped to the parameter's accepted range (the parameter
+        table) or its search box.
     """
 
     parameter_names: tuple[str, ...]
@@ -142,6 +149,8 @@ class FitResult:
     sway_rms: float = math.nan
     n_starts: int = 1
     warning: str = ""
+    at_bound: tuple = ()
+    clipped: np.ndarray | None = None
 
     def to_dict(self) -> dict:
         """Plain-Python summary for JSON: units as in the attribute docs. An undetermined
@@ -150,10 +159,13 @@ class FitResult:
         determined = (np.ones(len(self.parameter_names), dtype=bool)
                       if self.determined is None else self.determined)
         reasons = self.undetermined_reasons or ("",) * len(self.parameter_names)
+        sides = self.at_bound or (None,) * len(self.parameter_names)
+        clipped = (np.zeros(len(self.parameter_names), dtype=bool) if self.clipped is None
+                   else self.clipped)
         parameters = {}
-        for name, e, se, (lo, hi), ok, why in zip(
+        for name, e, se, (lo, hi), ok, why, side, cut in zip(
                 self.parameter_names, self.estimates, self.standard_errors,
-                self.confidence_intervals, determined, reasons, strict=True):
+                self.confidence_intervals, determined, reasons, sides, clipped, strict=True):
             ok = bool(ok) and math.isfinite(se)
             parameters[name] = {
                 "estimate": float(e),
@@ -161,6 +173,8 @@ class FitResult:
                 "standard_error": float(se) if ok else None,
                 "ci95": [float(lo), float(hi)] if ok and self.success else None,
                 "unit": parameter_unit(name),
+                "at_bound": side,
+                "ci95_clipped": bool(cut) and ok,
             }
             if not ok:
                 parameters[name]["reason"] = why or "its standard error is not finite"
@@ -384,14 +398,18 @@ def fit_stiffness(
         dof = max(sol.fun.size - len(names), 1)
         cov, se = _covariance(jac, sol.x, float(sol.fun @ sol.fun) / dof, good=good)
         rho = np.zeros(n)
-    reasons = [why or ("" if math.isfinite(e) else "its standard error is not finite")
-               for why, e in zip(reasons, se, strict=True)]
+    sides = at_bound(sol.x, lower, upper)  # an estimate on its search box's edge
+    reasons = [why or ("" if side is None else bound_note(nm, side, a, b))
+               or ("" if math.isfinite(e) else "its standard error is not finite")
+               for why, e, side, nm, a, b in zip(reasons, se, sides, names, lower, upper,
+                                                 strict=True)]
     good = np.array([not why for why in reasons])
     se = np.where(good, se, np.nan)
     with np.errstate(invalid="ignore", divide="ignore"):
         corr = cov / np.outer(se, se)
     tq = stats.t.ppf(0.975, dof)
-    ci = np.column_stack([sol.x - tq * se, sol.x + tq * se])
+    ci, clipped = clip_intervals(names, np.column_stack([sol.x - tq * se, sol.x + tq * se]),
+                                 lower, upper)
     warning = ""
     if not describes:
         warning = (f"the fit does not describe the data: residual RMS {rms:.3g} rad against "
@@ -409,7 +427,7 @@ def fit_stiffness(
         fitted=run(sol.x), residual_model=residual_model, residual_autocorrelation=rho,
         degrees_of_freedom=float(dof), determined=good, undetermined_reasons=tuple(reasons),
         converged=converged, describes_data=describes, sway_rms=sway, n_starts=starts,
-        warning=warning,
+        warning=warning, at_bound=sides, clipped=clipped,
     )
 
 
