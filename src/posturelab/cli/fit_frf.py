@@ -21,8 +21,10 @@ estimate its FRF, as posturelab frf does), the JSON that posturelab frf --json w
 table as JSON: {{"frequency": [Hz], "gain": [...], "phase_deg": [...]}} with optional
 "gain_se" and "phase_se_deg" (standard errors of gain [-] and phase [deg], as published
 group means give them), or "frf_se" (standard error of the complex value), "dof" and
-"coherence". --free NAMES (comma separated) are shared by the conditions, --per-condition
-NAMES take one value per condition.
+"coherence". A trial's header may declare units, e.g. com [rad]; posturelab reads SI (time
+in s, a tilt in rad, a translation in m) and refuses a column in another unit. --free
+NAMES (comma separated) are shared by the conditions, --per-condition NAMES take one value
+per condition.
 Names (the parameter table's, as for sweep --vary and fit --free): stiffness:PAIR,
 viscosity:PAIR (intrinsic), active_stiffness:PAIR, active_viscosity:PAIR (:PAIR may be left
 out on a body with one pair), feedback_delay, proprioceptive_weight. The body and the
@@ -99,7 +101,8 @@ def _condition(path: str, args: argparse.Namespace):
         raise ParameterError("a trial CSV needs --stimulus, --response and --cycle-length")
     float_in_range("--cycle-length [s]", args.cycle_length, 1e-3, 1e5, unit="s")
     stim, resp = args.stimulus.strip().lower(), args.response.strip().lower()
-    fs, cols = read_series_csv(path, [stim, resp])
+    fs, cols = read_series_csv(path, [stim, resp],
+                               {stim: ("rad",) if args.input == "tilt" else ("m",)})
     x, y, _ = whole_cycles(cols[stim], cols[resp], fs, args.cycle_length)
     return estimate_frf(x, y, fs, args.cycle_length, discard_cycles=args.discard_cycles,
                         response_sign=response_sign(args.response_sign))

@@ -120,7 +120,7 @@ class FRFEstimate:
     response_sign : float
         The sign the response was multiplied by. [-]
     covariance : numpy.ndarray, shape (B, B)
-        E[(Ĥ_a − H_a)(Ĥ_b − H_b)*]: bands that share harmonics (Peterka's do) are
+        E[(Ĥ_a − H_a)(Ĥ_b − H_b)*]: bands that share harmonics (the 80-state ones do) are
         correlated (module notes). [(response unit / stimulus unit)²]
     """
 
@@ -259,9 +259,11 @@ def estimate_frf(stimulus, response, sample_rate: float, cycle_length: float, *,
         T; f_s·T must be a whole number of samples and divide each record. [s]
     discard_cycles : int
         Leading cycles of each trial to drop. [-]
-    bands : "peterka", "harmonics" or a list of lists of 1-based odd-harmonic numbers
-        Peterka's 11 bands (the rule in harmonic numbers, for any T), one band per odd
-        harmonic below the Nyquist frequency, or the bands given.
+    bands : "peterka", "harmonics", a sequence's name or a list of lists of harmonic numbers
+        The 11 bands of the 80-state protocol (COMTEST; "peterka" is their historical name,
+        "posturelab-80" and "comtest-80" the same; the rule in 1-based odd-harmonic numbers,
+        for any T), one band per odd harmonic below the Nyquist frequency, a named
+        sequence's bands (:data:`~.bands.SEQUENCE_BANDS`), or the bands given.
     response_sign : {1, -1}
         Multiplies the response (−1 for posturelab angles against a tilt). [-]
     ci : {"periodic", "otnes-enochson"}
@@ -282,9 +284,12 @@ def estimate_frf(stimulus, response, sample_rate: float, cycle_length: float, *,
     if len(xs) != len(ys):
         raise ParameterError(f"{len(xs)} stimulus trials but {len(ys)} response trials")
     L = fs * T
-    if abs(L - round(L)) > 1e-6 * max(1.0, L) or round(L) < 4:
-        raise ParameterError(f"the cycle length {T:g} s is not a whole number of samples at "
-                             f"{fs:g} Hz ({L:g} samples)")
+    if abs(L - round(L)) > 1e-6 * max(1.0, L):
+        raise ParameterError(f"the cycle length {T:g} s is {L:g} samples at {fs:g} Hz, not a "
+                             "whole number")
+    if round(L) < 4:
+        raise ParameterError(f"the cycle length {T:g} s is {round(L)} samples at {fs:g} Hz; "
+                             "a cycle needs at least 4")
     L = int(round(L))
     X, Y, cx, cy = [], [], [], []
     for i, (x, y) in enumerate(zip(xs, ys, strict=True)):
