@@ -96,3 +96,17 @@ def test_frf_and_frf_model_take_the_242_state_band_name(tmp_path):
     assert len(json.loads(p.stdout)["frequency"]) == 17
     for command in ("frf", "frf-model"):
         assert "historical name" in cli(command, "--help").stdout
+
+
+def test_the_estimate_itself_warns_of_a_sign_near_180_degrees():
+    """The API's default sign is +1 (the CLI's -1): a response recorded in posturelab's
+    convention (following the stimulus with the opposite sign) then reads 180 deg in the
+    lowest band, and the estimate says so; with -1 it does not."""
+    t = np.arange(int(3 * CYCLE * SAMPLE_RATE)) / SAMPLE_RATE
+    stim = sum(0.01 * np.sin(2 * np.pi * k / CYCLE * t + k) for k in range(1, 45, 2))
+    as_recorded = estimate_frf(stim, -GAIN * stim, SAMPLE_RATE, CYCLE)
+    assert as_recorded.response_sign == 1.0 and len(as_recorded.warnings) == 1
+    assert "check --response-sign" in as_recorded.warnings[0]
+    assert as_recorded.to_dict()["warnings"] == list(as_recorded.warnings)
+    flipped = estimate_frf(stim, -GAIN * stim, SAMPLE_RATE, CYCLE, response_sign=-1)
+    assert flipped.warnings == () and flipped.to_dict()["warnings"] == []

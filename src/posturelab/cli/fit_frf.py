@@ -184,10 +184,10 @@ def run(args: argparse.Namespace) -> int:
                     args.plot)
     signs = sorted({int(c.response_sign) for c in conditions
                     if getattr(c, "response_sign", None) is not None})
-    from ..frequency.estimate import FRFEstimate, sign_warning
+    from ..frequency.estimate import FRFEstimate
 
     sign_warnings = [f"--data {p!r}: {w}" for p, c in zip(args.data, conditions, strict=True)
-                     if isinstance(c, FRFEstimate) and (w := sign_warning(c))]
+                     if isinstance(c, FRFEstimate) for w in c.warnings]
     if sign_warnings:
         import sys
 

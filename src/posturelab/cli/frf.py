@@ -112,7 +112,7 @@ def run(args: argparse.Namespace) -> int:
     from .._files import refuse_input_as_output
     from .._validation import float_in_range
     from ..frequency.data import read_series_csv
-    from ..frequency.estimate import estimate_frf, sign_warning
+    from ..frequency.estimate import estimate_frf
 
     refuse_input_as_output({"--data": args.data},
                            {"--plot": args.plot, "--plot-cycles": args.plot_cycles})
@@ -125,7 +125,6 @@ def run(args: argparse.Namespace) -> int:
     est = estimate_frf(x, y, fs, args.cycle_length,
                        discard_cycles=args.discard_cycles, bands=args.bands,
                        response_sign=sign, ci=args.ci)
-    warning = sign_warning(est)
     label = f"{'−' if sign < 0 else ''}{resp} / {stim} (response × {sign:+d})"
     if args.plot:
         from ..viz.plots import plot_bode, save_figure
@@ -142,13 +141,13 @@ def run(args: argparse.Namespace) -> int:
                                      response_label=("−" if sign < 0 else "") + resp,
                                      stimulus_unit=unit(stim), response_unit=unit(resp)),
                     args.plot_cycles)
-    if warning:
+    if est.warnings:
         import sys
 
-        print(f"warning: {warning}", file=sys.stderr)
+        for warning in est.warnings:
+            print(f"warning: {warning}", file=sys.stderr)
     if args.json:
-        print_json({**est.to_dict(), "sign_convention": sign_convention(sign),
-                    "warnings": [warning] if warning else []})
+        print_json({**est.to_dict(), "sign_convention": sign_convention(sign)})
         return 0
     print(f"FRF of {resp} to {stim}, {sign_convention(sign)}: {est.n_cycles} cycles "
           f"of {est.cycle_length:g} s at {fs:g} Hz, {len(est.bands)} bands"
