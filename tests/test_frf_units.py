@@ -110,3 +110,30 @@ def test_the_estimate_itself_warns_of_a_sign_near_180_degrees():
     assert as_recorded.to_dict()["warnings"] == list(as_recorded.warnings)
     flipped = estimate_frf(stim, -GAIN * stim, SAMPLE_RATE, CYCLE, response_sign=-1)
     assert flipped.warnings == () and flipped.to_dict()["warnings"] == []
+
+
+def test_fit_frf_lists_its_conditions_in_the_order_of_data(tmp_path):
+    """NAME#k is condition k's value: the text and the JSON list each --data with its kind."""
+    import posturelab as pl
+    from posturelab.frequency import model_frf
+    from posturelab.model.controllers import get_controller
+
+    body, preset = pl.get_body("paper-1link"), get_controller("peterka-2002")
+    f = list(PETERKA_BAND_FREQUENCIES)
+    H = model_frf(body, preset.muscles(body), f, **preset.run_options())
+    table = tmp_path / "table.json"
+    table.write_text(json.dumps({"frequency": f, "gain": np.abs(H).tolist(),
+                                 "phase_deg": np.degrees(np.unwrap(np.angle(H))).tolist()}))
+    trial = write_trial(tmp_path / "trial.csv", "t [s],stim [rad],com [rad]")
+    argv = ["fit-frf", "--data", trial, "--data", str(table), "--stimulus", "stim",
+            "--response", "com", "--cycle-length", str(CYCLE), "--controller", "peterka-2002",
+            "--free", "feedback_delay", "--per-condition", "proprioceptive_weight"]
+    p = cli(*argv, "--json")
+    assert p.returncode == 0, p.stderr
+    obj = json.loads(p.stdout)
+    assert obj["conditions"] == [{"data": trial, "kind": "trial"},
+                                 {"data": str(table), "kind": "table"}]
+    text = cli(*argv)
+    assert text.returncode == 0, text.stderr
+    assert f"#1 {trial} (trial), #2 {table} (table)" in text.stdout
+    assert "proprioceptive_weight#2" in text.stdout

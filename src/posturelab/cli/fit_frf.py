@@ -24,7 +24,8 @@ group means give them), or "frf_se" (standard error of the complex value), "dof"
 "coherence". A trial's header may declare units, e.g. com [rad]; posturelab reads SI (time
 in s, a tilt in rad, a translation in m) and refuses a column in another unit. --free
 NAMES (comma separated) are shared by the conditions, --per-condition NAMES take one value
-per condition.
+per condition, NAME#1, NAME#2, … in the order of --data (the output lists the conditions:
+"conditions" in --json, each --data path and its kind, trial or table).
 Names (the parameter table's, as for sweep --vary and fit --free): stiffness:PAIR,
 viscosity:PAIR (intrinsic), active_stiffness:PAIR, active_viscosity:PAIR (:PAIR may be left
 out on a body with one pair), feedback_delay, proprioceptive_weight. The body and the
@@ -193,13 +194,17 @@ def run(args: argparse.Namespace) -> int:
 
         for w in sign_warnings:
             print(f"warning: {w}", file=sys.stderr)
+    kinds = [{"data": p, "kind": "trial" if isinstance(c, FRFEstimate) else "table"}
+             for p, c in zip(args.data, conditions, strict=True)]
     if args.json:
         out = fit.to_dict()
-        print_json({**out, "response_sign": signs,
+        print_json({**out, "conditions": kinds, "response_sign": signs,
                     "warnings": sign_warnings + out["warnings"]})
         return 0
     print(f"fitted {len(fit.names)} parameter(s) to {len(conditions)} condition(s); fit error "
           f"{fit.fit_error:.3g} (√(χ²/dof); about 1 when the model explains the data)")
+    print("conditions (NAME#k is condition k's value): " + ", ".join(
+        f"#{k + 1} {c['data']} ({c['kind']})" for k, c in enumerate(kinds)))
     print(f"weighting: {fit.weighting_text()}")
     if signs:
         print("response sign applied: " + ", ".join(f"{v:+d}" for v in signs))
