@@ -7,6 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._files import check_column_unit, column_unit
 from ..errors import DataFileError
 
 __all__ = ["read_series_csv", "column_unit", "check_column_unit", "SI_UNITS", "MAX_ROWS"]
@@ -23,32 +24,6 @@ SI_UNITS = ("rad", "m", "N", "N·m", "N m", "rad/s", "m/s")
 def _name(header: str) -> str:
     name = header.split("[")[0].strip().lower()
     return "time" if name == "t" else name
-
-
-def column_unit(header: str) -> str:
-    """The unit a header cell declares in brackets (``"stim [deg]"`` → ``"deg"``), or ``""``."""
-    if "[" not in header:
-        return ""
-    return header.split("[", 1)[1].split("]", 1)[0].strip()
-
-
-def check_column_unit(what: str, header: str, accepted: tuple[str, ...]) -> None:
-    """Refuse a column whose header declares a unit other than ``accepted`` (none declared is
-    read in posturelab's units).
-
-    Raises
-    ------
-    DataFileError
-        One line naming the file, the column, its unit and the units posturelab reads.
-    """
-    unit = column_unit(header)
-    if unit == "" or unit in accepted or unit.lower() in {a.lower() for a in accepted}:
-        return
-    reads = ("time in s" if accepted == ("s",)
-             else "angles in rad, translations in m and time in s")
-    raise DataFileError(f"{what}: column {header.strip()!r} is in {unit}; posturelab reads "
-                        f"{reads}: convert the column (expected "
-                        f"{' or '.join(f'[{a}]' for a in accepted)} or no unit)")
 
 
 def read_series_csv(path: str | Path, columns: list[str],

@@ -566,7 +566,7 @@ def read_profile_csv(path: str | Path) -> MeasuredProfile:
     DataFileError
         With the file name, row and column of the first problem.
     """
-    from .._files import csv_rows, header_words, read_text
+    from .._files import check_column_unit, csv_rows, header_words, read_text
 
     path = Path(path)
     what = f"platform profile {str(path)!r}"
@@ -592,6 +592,9 @@ def read_profile_csv(path: str | Path) -> MeasuredProfile:
         )
     idx = {name: header.index(name) for name in ("time", "x_acceleration", "y_acceleration")
            if name in header}
+    for name, j in idx.items():
+        accepted = ("s",) if name == "time" else ("m/s²", "m/s^2", "m/s2")
+        check_column_unit(what, rows[0][j], accepted, "accelerations in m/s² and time in s")
     data = {name: [] for name in idx}
     for lineno, r in zip(lines[1:], rows[1:], strict=True):
         for name, j in idx.items():
