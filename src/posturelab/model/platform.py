@@ -555,7 +555,7 @@ def read_profile_csv(path: str | Path) -> MeasuredProfile:
     The file has a header row. Columns, by header name: ``time`` [s],
     ``x_acceleration`` [m/s²] and optionally ``y_acceleration`` [m/s²]
     (the aliases ``t``, ``ax``/``xdd`` and ``ay``/``ydd`` are accepted; a
-    ``[unit]`` suffix such as ``time [s]`` is ignored). Time must be strictly
+    ``[unit]`` suffix must be that unit: ``time [ms]`` is refused). Time must be strictly
     increasing, no value may be NaN or missing, and every acceleration lies within
     ±:data:`MAX_PLATFORM_ACCELERATION` (1000 m/s²). The first time is >= 0 (a run starts
     at 0; a negative time is refused, not dropped). The acceleration is zero after the last

@@ -596,7 +596,7 @@ class MeasuredTilt(Tilt):
 
 def read_tilt_csv(path) -> MeasuredTilt:
     """A measured tilt from a CSV file with a header row and the columns ``time`` [s] and
-    ``tilt`` [rad] (by name, a ``[unit]`` suffix ignored; other columns are ignored, so a
+    ``tilt`` [rad] (by name, a ``[unit]`` suffix must be that one; other columns are ignored, so a
     measured platform profile may carry its tilt). The first time is >= 0 (a run starts at
     0; a negative time is refused, not dropped).
 
