@@ -154,3 +154,32 @@ def refuse_input_as_output(inputs: dict[str, str | Path | list | tuple | None],
             if same:
                 raise ParameterError(f"{out_option} {out_path!r} is the input {in_option} "
                                      f"{in_path!r}; an output never overwrites an input")
+
+
+def column_unit(header: str) -> str:
+    """The unit a header cell declares in brackets (``"stim [deg]"`` → ``"deg"``), or ``""``."""
+    if "[" not in header:
+        return ""
+    return header.split("[", 1)[1].split("]", 1)[0].strip()
+
+
+def check_column_unit(what: str, header: str, accepted: tuple[str, ...],
+                      reads: str | None = None) -> None:
+    """Refuse a column whose header declares a unit (``name [unit]``) other than ``accepted``
+    (none declared is read in posturelab's units): a unit is never ignored nor rescaled.
+    ``reads`` says what posturelab reads in which unit (default: angles, translations, time).
+
+    Raises
+    ------
+    DataFileError
+        One line naming the file, the column, its unit and the units posturelab reads.
+    """
+    unit = column_unit(header)
+    if unit == "" or unit in accepted or unit.lower() in {a.lower() for a in accepted}:
+        return
+    if reads is None:
+        reads = ("time in s" if accepted == ("s",)
+                 else "angles in rad, translations in m and time in s")
+    raise DataFileError(f"{what}: column {header.strip()!r} is in {unit}; posturelab reads "
+                        f"{reads}: convert the column (expected "
+                        f"{' or '.join(f'[{a}]' for a in accepted)} or no unit)")

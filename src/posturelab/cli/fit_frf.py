@@ -21,8 +21,11 @@ estimate its FRF, as posturelab frf does), the JSON that posturelab frf --json w
 table as JSON: {{"frequency": [Hz], "gain": [...], "phase_deg": [...]}} with optional
 "gain_se" and "phase_se_deg" (standard errors of gain [-] and phase [deg], as published
 group means give them), or "frf_se" (standard error of the complex value), "dof" and
-"coherence". --free NAMES (comma separated) are shared by the conditions, --per-condition
-NAMES take one value per condition.
+"coherence". A trial's header may declare units, e.g. com [rad]; posturelab reads SI (time
+in s, a tilt in rad, a translation in m) and refuses a column in another unit. --free
+NAMES (comma separated) are shared by the conditions, --per-condition NAMES take one value
+per condition, NAME#1, NAME#2, … in the order of --data (the output lists the conditions:
+"conditions" in --json, each --data path and its kind, trial or table).
 Names (the parameter table's, as for sweep --vary and fit --free): stiffness:PAIR,
 viscosity:PAIR (intrinsic), active_stiffness:PAIR, active_viscosity:PAIR (:PAIR may be left
 out on a body with one pair), feedback_delay, proprioceptive_weight. The body and the
@@ -102,7 +105,8 @@ def _condition(path: str, args: argparse.Namespace):
         raise ParameterError("a trial CSV needs --stimulus, --response and --cycle-length")
     float_in_range("--cycle-length [s]", args.cycle_length, 1e-3, 1e5, unit="s")
     stim, resp = args.stimulus.strip().lower(), args.response.strip().lower()
-    fs, cols = read_series_csv(path, [stim, resp])
+    fs, cols = read_series_csv(path, [stim, resp],
+                               {stim: ("rad",) if args.input == "tilt" else ("m",)})
     x, y, _ = whole_cycles(cols[stim], cols[resp], fs, args.cycle_length)
     return estimate_frf(x, y, fs, args.cycle_length, discard_cycles=args.discard_cycles,
                         response_sign=response_sign(args.response_sign))
@@ -184,22 +188,26 @@ def run(args: argparse.Namespace) -> int:
                     args.plot)
     signs = sorted({int(c.response_sign) for c in conditions
                     if getattr(c, "response_sign", None) is not None})
-    from ..frequency.estimate import FRFEstimate, sign_warning
+    from ..frequency.estimate import FRFEstimate
 
     sign_warnings = [f"--data {p!r}: {w}" for p, c in zip(args.data, conditions, strict=True)
-                     if isinstance(c, FRFEstimate) and (w := sign_warning(c))]
+                     if isinstance(c, FRFEstimate) for w in c.warnings]
     if sign_warnings:
         import sys
 
         for w in sign_warnings:
             print(f"warning: {w}", file=sys.stderr)
+    kinds = [{"data": p, "kind": "trial" if isinstance(c, FRFEstimate) else "table"}
+             for p, c in zip(args.data, conditions, strict=True)]
     if args.json:
         out = fit.to_dict()
-        print_json({**out, "response_sign": signs,
+        print_json({**out, "conditions": kinds, "response_sign": signs,
                     "warnings": sign_warnings + out["warnings"]})
         return 0
     print(f"fitted {len(fit.names)} parameter(s) to {len(conditions)} condition(s); fit error "
           f"{fit.fit_error:.3g} (√(χ²/dof); about 1 when the model explains the data)")
+    print("conditions (NAME#k is condition k's value): " + ", ".join(
+        f"#{k + 1} {c['data']} ({c['kind']})" for k, c in enumerate(kinds)))
     print(f"weighting: {fit.weighting_text()}")
     if signs:
         print("response sign applied: " + ", ".join(f"{v:+d}" for v in signs))

@@ -7,16 +7,24 @@ import math
 
 from ._common import FIGURE_SUFFIXES, check_writable, print_json
 
+#: Band names ``frf`` and ``frf-model`` both take (frequency.bands.SEQUENCE_BANDS; "peterka"
+#: is the historical name of the 80-state bands).
+BAND_CHOICES = ["peterka", "posturelab-80", "comtest-80", "peterka-2002-242"]
+
 DESCRIPTION = """\
 Estimate the frequency response function (FRF) of one column to another in a CSV trial with a
-periodic stimulus (a PRTS), as Peterka (2002) did: the record is cut into cycles of
+periodic stimulus (a PRTS), by Peterka's (2002) method: the record is cut into cycles of
 --cycle-length s (--discard-cycles leading ones dropped), the DFT cross- and auto-spectra are
 averaged over cycles at the stimulus's odd harmonics and then over frequency bands, and the
 FRF is G_xy/G_xx, with the coherence and 95 % bounds on gain and phase.
 
-The file has a header row and a uniform time column [s] (the sample rate comes from it).
---bands peterka (default) averages the 11 bands of an 80-state PRTS (20 s: 0.05 … 2.20 Hz; for
-another cycle length the same harmonic numbers); --bands harmonics gives every odd harmonic.
+The file has a header row and a uniform time column, t or time [s] (the sample rate comes
+from it). A header may declare units, e.g. com [rad]; posturelab reads SI (time in s,
+angles in rad, translations in m) and refuses a column in another unit (deg, ms, mm, ...).
+--bands peterka (default; the historical name, the same as posturelab-80 and comtest-80)
+averages the 11 bands of the 80-state protocol (COMTEST's analysis; 20 s: 0.05 … 2.20 Hz; for
+another cycle length the same harmonic numbers); --bands peterka-2002-242 the 17 bands
+posturelab uses for Peterka 2002's 242-state sequence; --bands harmonics every odd harmonic.
 
 Sign (declared, never guessed from column names): the response is multiplied by
 --response-sign before the ratio, and every output states the sign applied. A tilt FRF is
@@ -52,14 +60,14 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--stimulus", required=True, metavar="COLUMN", help="stimulus column.")
     p.add_argument("--response", required=True, metavar="COLUMN", help="response column.")
     p.add_argument("--cycle-length", required=True, type=float, metavar="SECONDS",
-                   help="stimulus cycle [s] (20 for Peterka's PRTS).")
+                   help="stimulus cycle [s] (20 for the 80-state PRTS).")
     p.add_argument("--discard-cycles", type=int, default=0, metavar="N",
                    help="leading cycles to drop (the transient; default 0).")
-    p.add_argument("--bands", choices=["peterka", "harmonics", "peterka-2002-242"],
-                   default="peterka",
-                   help="frequency bands (default peterka: the 11 of an 80-state PRTS; "
-                   "peterka-2002-242: 17 bands for Peterka 2002's 242-state sequence, "
-                   "posturelab's placement).")
+    p.add_argument("--bands", choices=BAND_CHOICES + ["harmonics"], default="peterka",
+                   help="frequency bands (default peterka, the historical name of the 11 "
+                   "bands of the 80-state protocol (COMTEST), the same as posturelab-80 and "
+                   "comtest-80; peterka-2002-242: 17 bands for Peterka 2002's 242-state "
+                   "sequence, posturelab's placement; harmonics: every odd harmonic).")
     p.add_argument("--response-sign", choices=["-1", "+1", "1"], default="-1",
                    help="multiply the response by this (default -1: posturelab's tilt "
                    "convention; see above).")
@@ -104,20 +112,19 @@ def run(args: argparse.Namespace) -> int:
     from .._files import refuse_input_as_output
     from .._validation import float_in_range
     from ..frequency.data import read_series_csv
-    from ..frequency.estimate import estimate_frf, sign_warning
+    from ..frequency.estimate import estimate_frf
 
     refuse_input_as_output({"--data": args.data},
                            {"--plot": args.plot, "--plot-cycles": args.plot_cycles})
     check_plot_path(args.plot, args.plot_cycles)
     float_in_range("--cycle-length [s]", args.cycle_length, 1e-3, 1e5, unit="s")
     stim, resp = args.stimulus.strip().lower(), args.response.strip().lower()
-    fs, cols = read_series_csv(args.data, [stim, resp])
+    fs, cols = read_series_csv(args.data, [stim, resp], {stim: ("rad", "m")})
     sign = response_sign(args.response_sign)
     x, y, trimmed = whole_cycles(cols[stim], cols[resp], fs, args.cycle_length)
     est = estimate_frf(x, y, fs, args.cycle_length,
                        discard_cycles=args.discard_cycles, bands=args.bands,
                        response_sign=sign, ci=args.ci)
-    warning = sign_warning(est)
     label = f"{'−' if sign < 0 else ''}{resp} / {stim} (response × {sign:+d})"
     if args.plot:
         from ..viz.plots import plot_bode, save_figure
@@ -134,13 +141,13 @@ def run(args: argparse.Namespace) -> int:
                                      response_label=("−" if sign < 0 else "") + resp,
                                      stimulus_unit=unit(stim), response_unit=unit(resp)),
                     args.plot_cycles)
-    if warning:
+    if est.warnings:
         import sys
 
-        print(f"warning: {warning}", file=sys.stderr)
+        for warning in est.warnings:
+            print(f"warning: {warning}", file=sys.stderr)
     if args.json:
-        print_json({**est.to_dict(), "sign_convention": sign_convention(sign),
-                    "warnings": [warning] if warning else []})
+        print_json({**est.to_dict(), "sign_convention": sign_convention(sign)})
         return 0
     print(f"FRF of {resp} to {stim}, {sign_convention(sign)}: {est.n_cycles} cycles "
           f"of {est.cycle_length:g} s at {fs:g} Hz, {len(est.bands)} bands"

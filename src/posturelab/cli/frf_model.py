@@ -13,6 +13,7 @@ from ._common import (
     parse_float_list,
     print_json,
 )
+from .frf import BAND_CHOICES
 
 DESCRIPTION = """\
 The frequency response function of the model linearised about upright, with the delay as
@@ -21,7 +22,8 @@ posturelab simulate). --input tilt (the surface angle, rad) or translation (the 
 displacement, m); --output com_angle (Σ a_i θ_i / Σ a_i), theta1 … or a joint angle
 (ankle_angle, knee_angle, hip_angle). Tilt FRFs use the literature's sign: a body that
 follows the surface has gain 1 and phase 0. At --frequencies LIST [Hz] or at the band
-frequencies of the 11 bands of an 80-state PRTS (--bands peterka, for --cycle-length s,
+frequencies of the 11 bands of the 80-state protocol (COMTEST; --bands peterka, the
+historical name, or posturelab-80 or comtest-80, for --cycle-length s,
 default 20) or of a named sequence's bands (--bands peterka-2002-242: 17 bands of the 242-state
 sequence, cycle 60.5 s by default; posturelab.frequency.bands.SEQUENCE_BANDS).
 
@@ -44,11 +46,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="com_angle (default), thetaN or a joint angle (ankle_angle, …).")
     g = p.add_mutually_exclusive_group()
     g.add_argument("--frequencies", metavar="LIST", help="frequencies [Hz], > 0.")
-    g.add_argument("--bands", choices=["peterka", "posturelab-80", "comtest-80",
-                                       "peterka-2002-242"],
-                   help="the band frequencies of an 80-state sequence (peterka, "
-                   "posturelab-80, comtest-80: the same 11 bands) or of Peterka 2002's "
-                   "242-state sequence (17 bands).")
+    g.add_argument("--bands", choices=BAND_CHOICES,
+                   help="the band frequencies of the 80-state protocol (COMTEST; peterka, "
+                   "its historical name, posturelab-80 and comtest-80: the same 11 bands) or "
+                   "of Peterka 2002's 242-state sequence (17 bands).")
     p.add_argument("--cycle-length", type=float, default=None, metavar="SECONDS",
                    help="stimulus cycle for --bands [s] (default 20; 60.5 for "
                    "peterka-2002-242).")

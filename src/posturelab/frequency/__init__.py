@@ -1,7 +1,8 @@
 """Frequency-domain identification: PRTS stimuli analysed as frequency response functions.
 
-:mod:`.bands` states the stimulus harmonics and Peterka's frequency bands, :mod:`.estimate`
-estimates an FRF with coherence and 95 % bounds from measured series, :mod:`.model` computes
+:mod:`.bands` states the stimulus harmonics and the frequency bands (the 80-state COMTEST
+protocol's and others), :mod:`.estimate` estimates an FRF with coherence and 95 % bounds
+from measured series, :mod:`.model` computes
 the linearised model's FRF exactly (the delay as e^{−sτ}), :mod:`.table` holds FRFs given as
 gain and phase (published tables), :mod:`.fit` fits a controller to either.
 """

@@ -7,12 +7,18 @@ from pathlib import Path
 
 import numpy as np
 
+from .._files import check_column_unit, column_unit
 from ..errors import DataFileError
 
-__all__ = ["read_series_csv", "MAX_ROWS"]
+__all__ = ["read_series_csv", "column_unit", "check_column_unit", "SI_UNITS", "MAX_ROWS"]
 
 #: Most data rows a series file may have. [-]
 MAX_ROWS = 2_000_000  # posturelab._files.MAX_DATA_ROWS
+
+
+#: Units a data column may declare in its header (``name [unit]``): those posturelab reads,
+#: SI. A column that declares another (deg, mm, ms, ...) is refused, never rescaled. [-]
+SI_UNITS = ("rad", "m", "N", "N·m", "N m", "rad/s", "m/s")
 
 
 def _name(header: str) -> str:
@@ -20,9 +26,15 @@ def _name(header: str) -> str:
     return "time" if name == "t" else name
 
 
-def read_series_csv(path: str | Path, columns: list[str]) -> tuple[float, dict[str, np.ndarray]]:
+def read_series_csv(path: str | Path, columns: list[str],
+                    units: dict[str, tuple[str, ...]] | None = None
+                    ) -> tuple[float, dict[str, np.ndarray]]:
     """The sample rate and the named columns of a CSV file with a header row and a uniform
-    ``time`` column [s] (a ``[unit]`` suffix in a header is ignored).
+    ``time`` (or ``t``) column [s].
+
+    A header may declare a column's unit in brackets (``com [rad]``); the time column must
+    then be in s and each named column in one of ``units[name]`` (default :data:`SI_UNITS`);
+    any other unit (deg, ms, mm, ...) is refused, never silently read as SI.
 
     Returns
     -------
@@ -32,8 +44,9 @@ def read_series_csv(path: str | Path, columns: list[str]) -> tuple[float, dict[s
     Raises
     ------
     DataFileError
-        Unreadable file, a missing or unknown column (the known ones are listed), a cell that
-        is not a finite number (line and column named), a non-uniform time column.
+        Unreadable file, a missing or unknown column (the known ones are listed), a column
+        in another unit, a cell that is not a finite number (line and column named), a
+        non-uniform time column.
     """
     from .._files import csv_rows, header_words, read_text
 
@@ -45,12 +58,16 @@ def read_series_csv(path: str | Path, columns: list[str]) -> tuple[float, dict[s
         raise DataFileError(f"{what} is empty")
     names = [_name(h) for h in first[1]]
     if "time" not in names:
-        raise DataFileError(f"{what} has no time column; {header_words(first[1])}")
+        raise DataFileError(f"{what} has no time column (named t or time, in s); "
+                            f"{header_words(first[1])}")
     for c in columns:
         if c not in names:
             raise DataFileError(f"{what} has no column {c!r}; {header_words(first[1])}")
     wanted = ["time", *columns]
     index = [names.index(c) for c in wanted]
+    for c, j in zip(wanted, index, strict=True):
+        accepted = ("s",) if c == "time" else (units or {}).get(c, SI_UNITS)
+        check_column_unit(what, first[1][j], accepted)
     rows = []
     for lineno, row in rows_in:
         values = []

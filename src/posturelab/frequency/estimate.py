@@ -61,7 +61,7 @@ tilt is taken with sign −1 (``posturelab frf`` does this for a ``tilt`` stimul
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -120,8 +120,12 @@ class FRFEstimate:
     response_sign : float
         The sign the response was multiplied by. [-]
     covariance : numpy.ndarray, shape (B, B)
-        E[(Ĥ_a − H_a)(Ĥ_b − H_b)*]: bands that share harmonics (Peterka's do) are
+        E[(Ĥ_a − H_a)(Ĥ_b − H_b)*]: bands that share harmonics (the 80-state ones do) are
         correlated (module notes). [(response unit / stimulus unit)²]
+    warnings : tuple of str
+        What the estimate itself warns of, one line each: the response sign probably the
+        opposite of the recording's convention (:func:`sign_warning`; ``posturelab frf``
+        prints these).
     """
 
     frequency: np.ndarray
@@ -143,6 +147,7 @@ class FRFEstimate:
     dof: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
     response_sign: float = 1.0
     covariance: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)), repr=False)
+    warnings: tuple = ()
 
     def band_average(self, frf_at) -> np.ndarray:
         """The band FRF a noise-free linear system with FRF ``frf_at(f)`` [f in Hz, vectorised]
@@ -187,6 +192,7 @@ class FRFEstimate:
             "phase_ci95_deg": [[num(lo), num(hi)] for lo, hi in self.phase_ci95_deg],
             **extra,
             "response_sign": int(self.response_sign),
+            "warnings": list(self.warnings),
         }
 
 
@@ -259,11 +265,16 @@ def estimate_frf(stimulus, response, sample_rate: float, cycle_length: float, *,
         T; f_s·T must be a whole number of samples and divide each record. [s]
     discard_cycles : int
         Leading cycles of each trial to drop. [-]
-    bands : "peterka", "harmonics" or a list of lists of 1-based odd-harmonic numbers
-        Peterka's 11 bands (the rule in harmonic numbers, for any T), one band per odd
-        harmonic below the Nyquist frequency, or the bands given.
+    bands : "peterka", "harmonics", a sequence's name or a list of lists of harmonic numbers
+        The 11 bands of the 80-state protocol (COMTEST; "peterka" is their historical name,
+        "posturelab-80" and "comtest-80" the same; the rule in 1-based odd-harmonic numbers,
+        for any T), one band per odd harmonic below the Nyquist frequency, a named
+        sequence's bands (:data:`~.bands.SEQUENCE_BANDS`), or the bands given.
     response_sign : {1, -1}
-        Multiplies the response (−1 for posturelab angles against a tilt). [-]
+        Multiplies the response. Default +1 here (the response as recorded), while
+        ``posturelab frf --response-sign`` defaults to −1 (posturelab's tilt convention):
+        give −1 for posturelab's angles against a tilt, +1 for a translation. A sign that
+        looks opposite to the recording's convention is in the result's ``warnings``. [-]
     ci : {"periodic", "otnes-enochson"}
         The form of the 95 % bounds (module notes).
 
@@ -282,9 +293,12 @@ def estimate_frf(stimulus, response, sample_rate: float, cycle_length: float, *,
     if len(xs) != len(ys):
         raise ParameterError(f"{len(xs)} stimulus trials but {len(ys)} response trials")
     L = fs * T
-    if abs(L - round(L)) > 1e-6 * max(1.0, L) or round(L) < 4:
-        raise ParameterError(f"the cycle length {T:g} s is not a whole number of samples at "
-                             f"{fs:g} Hz ({L:g} samples)")
+    if abs(L - round(L)) > 1e-6 * max(1.0, L):
+        raise ParameterError(f"the cycle length {T:g} s is {L:g} samples at {fs:g} Hz, not a "
+                             "whole number")
+    if round(L) < 4:
+        raise ParameterError(f"the cycle length {T:g} s is {round(L)} samples at {fs:g} Hz; "
+                             "a cycle needs at least 4")
     L = int(round(L))
     X, Y, cx, cy = [], [], [], []
     for i, (x, y) in enumerate(zip(xs, ys, strict=True)):
@@ -335,11 +349,13 @@ def estimate_frf(stimulus, response, sample_rate: float, cycle_length: float, *,
     gain_ci = np.stack([np.maximum(gain * (1 - r), 0.0), gain * (1 + r)], axis=1)
     half = np.where(r >= 1, 180.0, np.degrees(np.arcsin(np.minimum(r, 1.0))))
     phase_ci = np.stack([phase - half, phase + half], axis=1)
-    return FRFEstimate(band_frequencies(chosen, T), H, gain, phase, coh, gain_ci, phase_ci,
-                       averages, chosen, int(n_cycles), T,
-                       np.concatenate(cx).mean(axis=0), np.concatenate(cy).mean(axis=0),
-                       tuple(b / T for b in bins), tuple(Gxx_h[b] for b in bins),
-                       variance, dof, float(response_sign), covariance)
+    est = FRFEstimate(band_frequencies(chosen, T), H, gain, phase, coh, gain_ci, phase_ci,
+                      averages, chosen, int(n_cycles), T,
+                      np.concatenate(cx).mean(axis=0), np.concatenate(cy).mean(axis=0),
+                      tuple(b / T for b in bins), tuple(Gxx_h[b] for b in bins),
+                      variance, dof, float(response_sign), covariance)
+    warning = sign_warning(est)
+    return replace(est, warnings=(warning,)) if warning else est
 
 
 def band_variance(X: np.ndarray, Y: np.ndarray, bins) -> tuple[np.ndarray, ...]:
@@ -404,5 +420,5 @@ def sign_warning(est: FRFEstimate) -> str | None:
         return (f"the lowest band ({est.frequency[0]:.3g} Hz) has phase {phase:.0f} deg with "
                 f"coherence {est.coherence[0]:.2f}: the response sign "
                 f"({int(est.response_sign):+d}) is probably the opposite of this recording's "
-                "convention (check --response-sign)")
+                "convention (check --response-sign, or response_sign in the API)")
     return None

@@ -28,7 +28,7 @@ Weighting (``FRFFit.weighting`` says which was used), every band by its own prec
 * ``"variance"`` (an :class:`FRFEstimate`, or a table with ``frf_se``): the complex error
   e = H(f; p) − Ĥ over the bands, whitened by the estimate's band covariance V
   (:mod:`.estimate`: the noise about each harmonic from the scatter of the cycles, pooled
-  over neighbouring DFT bins to at least 20 degrees of freedom; Peterka's bands share
+  over neighbouring DFT bins to at least 20 degrees of freedom; COMTEST's bands share
   harmonics, so they are correlated): the real and imaginary parts each have covariance
   V/2, and the fit is generalised least squares (Aitken 1935, Proc R Soc Edinb 55:42–48),
   Σ = eᵀ(V/2)⁻¹e over both parts, with the covariance (JᵀJ)⁻¹ of the whitened Jacobian. A

@@ -555,7 +555,7 @@ def read_profile_csv(path: str | Path) -> MeasuredProfile:
     The file has a header row. Columns, by header name: ``time`` [s],
     ``x_acceleration`` [m/s²] and optionally ``y_acceleration`` [m/s²]
     (the aliases ``t``, ``ax``/``xdd`` and ``ay``/``ydd`` are accepted; a
-    ``[unit]`` suffix such as ``time [s]`` is ignored). Time must be strictly
+    ``[unit]`` suffix must be that unit: ``time [ms]`` is refused). Time must be strictly
     increasing, no value may be NaN or missing, and every acceleration lies within
     ±:data:`MAX_PLATFORM_ACCELERATION` (1000 m/s²). The first time is >= 0 (a run starts
     at 0; a negative time is refused, not dropped). The acceleration is zero after the last
@@ -566,7 +566,7 @@ def read_profile_csv(path: str | Path) -> MeasuredProfile:
     DataFileError
         With the file name, row and column of the first problem.
     """
-    from .._files import csv_rows, header_words, read_text
+    from .._files import check_column_unit, csv_rows, header_words, read_text
 
     path = Path(path)
     what = f"platform profile {str(path)!r}"
@@ -592,6 +592,9 @@ def read_profile_csv(path: str | Path) -> MeasuredProfile:
         )
     idx = {name: header.index(name) for name in ("time", "x_acceleration", "y_acceleration")
            if name in header}
+    for name, j in idx.items():
+        accepted = ("s",) if name == "time" else ("m/s²", "m/s^2", "m/s2")
+        check_column_unit(what, rows[0][j], accepted, "accelerations in m/s² and time in s")
     data = {name: [] for name in idx}
     for lineno, r in zip(lines[1:], rows[1:], strict=True):
         for name, j in idx.items():

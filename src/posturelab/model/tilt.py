@@ -596,7 +596,7 @@ class MeasuredTilt(Tilt):
 
 def read_tilt_csv(path) -> MeasuredTilt:
     """A measured tilt from a CSV file with a header row and the columns ``time`` [s] and
-    ``tilt`` [rad] (by name, a ``[unit]`` suffix ignored; other columns are ignored, so a
+    ``tilt`` [rad] (by name, a ``[unit]`` suffix must be that one; other columns are ignored, so a
     measured platform profile may carry its tilt). The first time is >= 0 (a run starts at
     0; a negative time is refused, not dropped).
 
@@ -607,7 +607,7 @@ def read_tilt_csv(path) -> MeasuredTilt:
     """
     from pathlib import Path
 
-    from .._files import csv_rows, read_text
+    from .._files import check_column_unit, csv_rows, read_text
     from ..errors import DataFileError
 
     path = Path(path)
@@ -624,6 +624,9 @@ def read_tilt_csv(path) -> MeasuredTilt:
             raise DataFileError(f"tilt profile {str(path)!r} lacks column {name!r}; needs "
                                 "time [s] and tilt [rad]")
     it, ia = header.index("time"), header.index("tilt")
+    for j, unit in ((it, "s"), (ia, "rad")):
+        check_column_unit(f"tilt profile {str(path)!r}", rows[0][j], (unit,),
+                          "a tilt in rad and time in s")
     values = np.empty((len(rows) - 1, 2))
     for row_index, (lineno, r) in enumerate(numbered[1:]):
         for col, j, name in ((0, it, "time"), (1, ia, "tilt")):

@@ -617,7 +617,7 @@ def read_trajectory_csv(path: str | Path, n_links: int) -> tuple[np.ndarray, np.
     theta : numpy.ndarray, shape (S, N)
         [rad]
     """
-    from .._files import csv_rows, read_text
+    from .._files import check_column_unit, csv_rows, read_text
 
     path = Path(path)
     rows = [r for _, r in csv_rows(read_text(path, "trajectory"), repr(str(path)))]
@@ -630,6 +630,9 @@ def read_trajectory_csv(path: str | Path, n_links: int) -> tuple[np.ndarray, np.
         raise DataFileError(f"{str(path)!r} lacks column {missing[0]!r}; needs "
                             f"{', '.join(need)}")
     idx = [header.index(c) for c in need]
+    for c, j in zip(need, idx, strict=True):
+        check_column_unit(repr(str(path)), rows[0][j], ("s",) if c == "t" else ("rad",),
+                          "angles in rad and time in s")
     try:
         data = np.array([[float(r[j]) for j in idx] for r in rows[1:]])
     except (ValueError, IndexError):
