@@ -1,6 +1,6 @@
 """Shared test helper: random but valid bodies (every caller passes a seeded generator)."""
 
-from posturelab.body import Body
+from posturelab.model.body import Body
 
 
 def random_body(rng, n, gravity=9.81):

@@ -1,6 +1,7 @@
 import numpy as np
 import pytest
-from posturelab.body import paper_body
+
+from posturelab.model.body import paper_body
 
 
 @pytest.fixture

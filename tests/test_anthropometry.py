@@ -2,11 +2,11 @@
 
 import numpy as np
 import pytest
-from posturelab.anthropometry import WINTER_TABLE, body_from_anthropometry, lump
-from posturelab.muscles import MusclePair, MuscleSet
-from posturelab.simulate import KneeModel, simulate
 
 import posturelab as pl
+from posturelab.model.anthropometry import WINTER_TABLE, body_from_anthropometry, lump
+from posturelab.model.muscles import MusclePair, MuscleSet
+from posturelab.simulation import KneeModel, simulate
 
 
 def test_winter_body_mass_and_lengths():

@@ -1,4 +1,4 @@
-"""Batched linear stability (posturelab.batch_linear) against the single-case path.
+"""Batched linear stability (posturelab.linear.batch) against the single-case path.
 
 Independent references: posturelab.linear.analyse (numpy eigvals of the 6×6
 state matrix), numpy.poly of that matrix, and the analytic roots of the
@@ -11,7 +11,10 @@ coefficient; stable flags identical.
 
 import numpy as np
 import pytest
-from posturelab.batch_linear import (
+
+from posturelab.errors import ParameterError, UnknownNameError
+from posturelab.linear import analyse, sorted_poles
+from posturelab.linear.batch import (
     GRID_PARAMETERS,
     STABILITY_MARGIN,
     BodyArrays,
@@ -22,17 +25,14 @@ from posturelab.batch_linear import (
     parameter_grid,
     stability_map,
 )
-from posturelab.body import Body
-from posturelab.muscles import (
+from posturelab.model.body import Body
+from posturelab.model.muscles import (
     PAPER_PAIR_NAMES,
     STIFFNESS_CASES,
     MusclePair,
     MuscleSet,
     paper_muscles,
 )
-
-from posturelab.errors import ParameterError, UnknownNameError
-from posturelab.linear import analyse, sorted_poles
 
 POLE_RTOL = 1e-8
 CASES = list(STIFFNESS_CASES)

@@ -8,11 +8,11 @@ import csv
 
 import numpy as np
 import pytest
-from posturelab.muscles import paper_muscles
 
 from posturelab.cli import main
 from posturelab.cli import stability_map as cli_map
 from posturelab.linear import analyse
+from posturelab.model.muscles import paper_muscles
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 

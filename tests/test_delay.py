@@ -4,10 +4,10 @@ import math
 
 import numpy as np
 import pytest
-from posturelab.muscles import MusclePair, MuscleSet
 from scipy.optimize import brentq
 
 import posturelab as pl
+from posturelab.model.muscles import MusclePair, MuscleSet
 
 
 def critical_delay(inertia, load, stiffness, viscosity):

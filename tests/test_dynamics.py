@@ -1,4 +1,4 @@
-"""Independent checks of posturelab.dynamics: structure, limit cases, energy, symmetry.
+"""Independent checks of posturelab.model.dynamics: structure, limit cases, energy, symmetry.
 
 Nothing here takes an expected value from the code under test: energies are
 rebuilt from the centre-of-mass positions and velocities by hand, the one-link
@@ -8,8 +8,11 @@ short, strong platform pulse, the gravity coefficients from Appendix A.
 
 import numpy as np
 import pytest
-from posturelab.body import Body, paper_body
-from posturelab.dynamics import (
+from scipy.integrate import solve_ivp
+
+from _bodies import random_body
+from posturelab.model.body import Body, paper_body
+from posturelab.model.dynamics import (
     angular_acceleration,
     gravity_vector,
     kinetic_energy,
@@ -20,9 +23,6 @@ from posturelab.dynamics import (
     velocity_step_response,
     velocity_terms,
 )
-from scipy.integrate import solve_ivp
-
-from _bodies import random_body
 
 SEED = 12345
 

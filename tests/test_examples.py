@@ -6,11 +6,12 @@ import importlib.util
 from pathlib import Path
 
 import numpy as np
-from posturelab.body import paper_body
-from posturelab.muscles import paper_muscles
-from posturelab.platform import VelocityStep
-from posturelab.recovery import largest_recoverable
-from posturelab.simulate import FOOT_FROM_LITERATURE, FallCriteria, simulate
+
+from posturelab.model.body import paper_body
+from posturelab.model.muscles import paper_muscles
+from posturelab.model.platform import VelocityStep
+from posturelab.simulation import FOOT_FROM_LITERATURE, FallCriteria, simulate
+from posturelab.studies.recovery import largest_recoverable
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 

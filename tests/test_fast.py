@@ -1,4 +1,5 @@
-"""The compiled simulator (posturelab.fast) against the reference simulate() (scipy DOP853).
+"""The compiled simulator (posturelab.simulation.compiled) against the reference simulate()
+(scipy DOP853).
 
 Nothing here is timed (see benchmarks/bench_simulate.py). Tolerances: the fast
 simulator runs at its defaults (rtol 1e-6, atol 1e-9), the reference at
@@ -14,10 +15,12 @@ import math
 
 import numpy as np
 import pytest
-from posturelab.body import Body, paper_body
-from posturelab.fast import BatchResult, simulate_batch, simulate_fast
-from posturelab.muscles import MusclePair, MuscleSet, paper_muscles
-from posturelab.platform import (
+
+import posturelab as pl
+from posturelab.errors import ParameterError
+from posturelab.model.body import Body, paper_body
+from posturelab.model.muscles import MusclePair, MuscleSet, paper_muscles
+from posturelab.model.platform import (
     Disturbance,
     HalfSinePulse,
     MeasuredProfile,
@@ -26,16 +29,14 @@ from posturelab.platform import (
     VelocityStep,
     combine,
 )
-from posturelab.simulate import (
+from posturelab.scenarios import builtin_scenario, builtin_scenario_names
+from posturelab.simulation import (
     FOOT_FROM_LITERATURE,
     FallCriteria,
     KneeModel,
     simulate,
 )
-
-import posturelab as pl
-from posturelab.errors import ParameterError
-from posturelab.scenarios import builtin_scenario, builtin_scenario_names
+from posturelab.simulation.compiled import BatchResult, simulate_batch, simulate_fast
 from posturelab.simulation.derived import derived_series
 from posturelab.simulation.setup import prepare_run
 
@@ -261,9 +262,8 @@ def test_derived_series_are_computed_on_first_access_and_kept():
 
 
 def test_a_result_without_its_derived_series_says_so():
-    from posturelab.results import SimulationResult
-
     from posturelab.errors import PostureLabError
+    from posturelab.simulation.results import SimulationResult
 
     bare = SimulationResult(time=np.zeros(1), theta=np.zeros((1, 3)), omega=np.zeros((1, 3)),
                             pair_names=("ankle",), status="completed", message="",
@@ -365,9 +365,9 @@ def test_batch_of_a_fall_at_the_start():
 @pytest.mark.parametrize("locked", [False, True])
 def test_compiled_right_hand_side_equals_the_numpy_dynamics(n_links, locked):
     """The compiled equations of motion (closed-form 3×3, or elimination for N = 4) equal
-    posturelab.dynamics at random states, pair activations and platform accelerations."""
-    from posturelab.dynamics import angular_acceleration, mass_matrix
-    from posturelab.fast import state_derivative
+    posturelab.model.dynamics at random states, pair activations and platform accelerations."""
+    from posturelab.model.dynamics import angular_acceleration, mass_matrix
+    from posturelab.simulation.compiled import state_derivative
 
     rng = np.random.default_rng(3 + n_links)
     lengths = rng.uniform(0.3, 0.6, n_links)
@@ -402,7 +402,7 @@ def test_compiled_right_hand_side_equals_the_numpy_dynamics(n_links, locked):
 def test_rotated_sines_and_cosines_are_exact_to_rounding():
     """Within a step the integrator rotates sin/cos from the step's start (angle-sum
     formulas and Taylor series for |δ| <= 0.1 rad); beyond that it calls libm."""
-    from posturelab.fast import rotated_sine_cosine
+    from posturelab.simulation.compiled import rotated_sine_cosine
 
     rng = np.random.default_rng(5)
     for _ in range(2000):

@@ -8,10 +8,9 @@ import sys
 
 import numpy as np
 import pytest
-from posturelab.identify import FitError, fit_stiffness
 
 import posturelab as pl
-from posturelab.studies.identification import _describes, _determinacy
+from posturelab.studies.identification import FitError, _describes, _determinacy, fit_stiffness
 
 
 def run_cli(*argv):

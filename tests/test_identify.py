@@ -4,10 +4,10 @@ import json
 
 import numpy as np
 import pytest
-from posturelab.identify import fit_stiffness, read_trajectory_csv
 
 import posturelab as pl
 from posturelab.cli import main
+from posturelab.studies.identification import fit_stiffness, read_trajectory_csv
 
 
 @pytest.fixture(scope="module")
@@ -229,7 +229,7 @@ def test_a_fit_never_uses_a_run_that_stopped_short(experiment, tmp_path):
     import subprocess
     import sys
 
-    from posturelab.identify import FitError
+    from posturelab.studies.identification import FitError
 
     sc, truth = experiment
     start = sc.replace(muscles=pl.paper_muscles(stiffness=[800, 300, 300, 300, 100]),

@@ -4,11 +4,11 @@ import math
 
 import numpy as np
 import pytest
-from posturelab.muscles import MusclePair, MuscleSet
-from posturelab.recovery import largest_recoverable
-from posturelab.simulate import moments_to_link_torques
 
 import posturelab as pl
+from posturelab.model.muscles import MusclePair, MuscleSet
+from posturelab.simulation import moments_to_link_torques
+from posturelab.studies.recovery import largest_recoverable
 
 FOOT = pl.FOOT_FROM_LITERATURE
 
@@ -44,7 +44,7 @@ def test_moments_to_link_torques_equals_minus_e_transpose_m():
     muscles = pl.paper_muscles("1")
     rng = np.random.default_rng(3)
     theta, omega = rng.normal(0, 0.1, 3), rng.normal(0, 0.5, 3)
-    from posturelab.simulate import joint_crossing_matrix
+    from posturelab.simulation import joint_crossing_matrix
 
     m = pl.pair_torques(muscles, theta, omega)
     np.testing.assert_allclose(moments_to_link_torques(m @ joint_crossing_matrix(muscles)),
@@ -159,8 +159,8 @@ def test_batch_bisection_equals_one_bisection_per_gain_set():
     """largest_recoverable_batch brackets each gain set exactly where largest_recoverable
     brackets it with simulate_fast and the scaled step (same engine, same midpoints); a set
     that falls at low or recovers at high is reported, not bisected."""
-    from posturelab.fast import simulate_fast
-    from posturelab.recovery import largest_recoverable_batch
+    from posturelab.simulation.compiled import simulate_fast
+    from posturelab.studies.recovery import largest_recoverable_batch
 
     body = pl.paper_body()
     fall = pl.FallCriteria(base_of_support=pl.FOOT_FROM_LITERATURE)

@@ -8,15 +8,6 @@ of Appendix C, and invariances that any correct linearisation must respect.
 
 import numpy as np
 import pytest
-from posturelab.body import Body, paper_body
-from posturelab.dynamics import state_derivative
-from posturelab.muscles import (
-    STIFFNESS_CASES,
-    MusclePair,
-    MuscleSet,
-    joint_torques,
-    paper_muscles,
-)
 
 from _bodies import random_body
 from posturelab.linear import (
@@ -24,6 +15,15 @@ from posturelab.linear import (
     analyse_both_sides,
     finite_difference_state_matrix,
     state_matrix,
+)
+from posturelab.model.body import Body, paper_body
+from posturelab.model.dynamics import state_derivative
+from posturelab.model.muscles import (
+    STIFFNESS_CASES,
+    MusclePair,
+    MuscleSet,
+    joint_torques,
+    paper_muscles,
 )
 
 SEED = 12345

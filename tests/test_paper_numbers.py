@@ -8,16 +8,16 @@ precision.
 
 import numpy as np
 import pytest
-from posturelab.compare import table2_comparison
-from posturelab.muscles import STIFFNESS_CASES, paper_muscles
 
 from posturelab.linear import analyse, disturbance_sensitivity
+from posturelab.model.muscles import STIFFNESS_CASES, paper_muscles
 from posturelab.paper import (
     SENSITIVITY_PRINTED,
     TABLE_II_PRINTED,
     match_printed_poles,
     printed_tolerance,
 )
+from posturelab.paper.compare import table2_comparison
 
 # (case, column) pairs the printed paper gets wrong, with the value the linearised
 # model gives (computed independently with numpy eigvals on the 6x6 matrix of

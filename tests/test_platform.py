@@ -2,7 +2,10 @@
 
 import numpy as np
 import pytest
-from posturelab.platform import (
+from scipy.integrate import cumulative_trapezoid
+
+from posturelab.errors import DataFileError, ParameterError
+from posturelab.model.platform import (
     HalfSinePulse,
     MeasuredProfile,
     NoDisturbance,
@@ -12,9 +15,6 @@ from posturelab.platform import (
     combine,
     read_profile_csv,
 )
-from scipy.integrate import cumulative_trapezoid
-
-from posturelab.errors import DataFileError, ParameterError
 
 
 def test_velocity_step_directions():
@@ -131,7 +131,7 @@ def test_scaled_rejects_a_non_finite_factor():
 
 
 def test_a_disturbance_that_does_not_define_scaling_is_refused():
-    from posturelab.platform import Disturbance
+    from posturelab.model.platform import Disturbance
 
     class Custom(Disturbance):
         pass

@@ -1,4 +1,4 @@
-"""Figures (posturelab.plots) and the stick-figure GIF (posturelab.animation).
+"""Figures (posturelab.viz.plots) and the stick-figure GIF (posturelab.viz.animation).
 
 The figures are checked as a reader would need them: every axis carries a
 label with a unit in brackets, a legend and a title; the functions draw on
@@ -14,7 +14,11 @@ import numpy as np
 import pytest
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
-from posturelab.plots import (
+
+from posturelab.errors import ParameterError, PostureLabError, UnknownNameError
+from posturelab.scenarios import builtin_scenario
+from posturelab.simulation import FOOT_FROM_LITERATURE
+from posturelab.viz.plots import (
     new_figure,
     plot_angle_angle,
     plot_cog_phase,
@@ -23,10 +27,6 @@ from posturelab.plots import (
     plot_time_histories,
     save_figure,
 )
-from posturelab.simulate import FOOT_FROM_LITERATURE
-
-from posturelab.errors import ParameterError, PostureLabError, UnknownNameError
-from posturelab.scenarios import builtin_scenario
 
 
 @pytest.fixture(scope="module")
@@ -53,7 +53,8 @@ def _assert_labelled(ax: Axes) -> None:
 
 def test_no_pyplot_import():
     """The plotting modules never load pyplot (no global state, safe on servers)."""
-    code = ("import sys, posturelab.plots, posturelab.animation, posturelab.report; "
+    code = ("import sys, posturelab.viz.plots, posturelab.viz.animation, "
+            "posturelab.paper.report; "
             "print('matplotlib.pyplot' in sys.modules)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          check=True)
@@ -163,7 +164,8 @@ def test_run_overview(backward, tmp_path):
 
 def test_animate_writes_gif(tmp_path):
     from PIL import Image
-    from posturelab.animation import animate
+
+    from posturelab.viz.animation import animate
 
     sc = builtin_scenario("paper-forward-case2")
     r = sc.run(duration=1.5, sample_rate=100.0)  # falls at ~1.19 s
@@ -176,8 +178,8 @@ def test_animate_writes_gif(tmp_path):
 
 
 def test_animate_bad_input(tmp_path, backward):
-    from posturelab.animation import animate
-    from posturelab.body import Body
+    from posturelab.model.body import Body
+    from posturelab.viz.animation import animate
 
     sc, r = backward
     with pytest.raises(ParameterError, match=".gif"):
@@ -194,7 +196,7 @@ def test_animate_bad_input(tmp_path, backward):
 
 def test_joint_positions_reach(body):
     """Upright, the top joint is at the summed link lengths; tilted, at l·sin θ."""
-    from posturelab.animation import joint_positions
+    from posturelab.viz.animation import joint_positions
 
     up = joint_positions(body, np.zeros(3))
     assert np.allclose(up[-1], [0.0, body.lengths.sum()])

@@ -14,12 +14,12 @@ import subprocess
 import sys
 
 import pytest
-from posturelab.report import reproduce_paper
 
 import posturelab
 from posturelab.cli import main
 from posturelab.errors import PostureLabError
 from posturelab.paper import TABLE_II_PRINTED
+from posturelab.paper.report import reproduce_paper
 
 FIGS = [f"fig{n:02d}" for n in range(3, 11)] + ["beyond1", "frf", "prts"]
 
@@ -114,9 +114,8 @@ def test_output_is_a_file(tmp_path):
 
 def test_failure_leaves_nothing(tmp_path, monkeypatch):
     """A failure half-way removes the temporary files and the directory it created."""
-    import posturelab.report as rep
-
     import posturelab.paper.checks as checks
+    import posturelab.paper.report as rep
 
     def boom(*args, **kwargs):
         raise PostureLabError("simulated failure")
@@ -130,9 +129,8 @@ def test_failure_leaves_nothing(tmp_path, monkeypatch):
 
 def test_interrupt_leaves_nothing(tmp_path, monkeypatch):
     """KeyboardInterrupt at the first step: the temporary files and new directories go."""
-    import posturelab.report as rep
-
     import posturelab.paper.checks as checks
+    import posturelab.paper.report as rep
 
     def interrupt(*args, **kwargs):
         raise KeyboardInterrupt
@@ -185,7 +183,7 @@ def test_cli_out_is_a_file(tmp_path):
 
 def test_cli_prints_path_and_summary(built, monkeypatch, capsys):
     """stdout: the path of index.html, then one paragraph; progress lines on stderr."""
-    import posturelab.report as rep
+    import posturelab.paper.report as rep
 
     out, report, _ = built
 
@@ -244,8 +242,7 @@ def test_searches_take_their_runner():
     """The two searches run on whatever runner they are given (the engine is one argument)."""
     from types import SimpleNamespace
 
-    from posturelab.body import paper_body
-
+    from posturelab.model.body import paper_body
     from posturelab.paper.checks import delay_finding, recovery_finding
     from posturelab.simulation import FOOT_FROM_LITERATURE
 

@@ -2,9 +2,9 @@
 
 import numpy as np
 import pytest
-from posturelab.platform import MeasuredProfile, VelocityStep
 
 from posturelab.errors import ScenarioError, UnknownNameError
+from posturelab.model.platform import MeasuredProfile, VelocityStep
 from posturelab.scenarios import builtin_scenario, builtin_scenario_names, load_scenario
 
 MINIMAL = """

@@ -4,9 +4,12 @@ import math
 
 import numpy as np
 import pytest
-from posturelab.muscles import MusclePair, MuscleSet
-from posturelab.platform import HalfSinePulse, MeasuredProfile, RampAndHold, VelocityStep
-from posturelab.simulate import (
+
+import posturelab as pl
+from posturelab.model.muscles import MusclePair, MuscleSet
+from posturelab.model.platform import HalfSinePulse, MeasuredProfile, RampAndHold, VelocityStep
+from posturelab.scenarios import builtin_scenario
+from posturelab.simulation import (
     FOOT_FROM_LITERATURE,
     BaseOfSupport,
     FallCriteria,
@@ -14,9 +17,6 @@ from posturelab.simulate import (
     initial_state_for,
     simulate,
 )
-
-import posturelab as pl
-from posturelab.scenarios import builtin_scenario
 
 PAPER_POSTURE = [0.1, -0.1, 0.1]
 
@@ -201,7 +201,7 @@ def test_ramp_and_hold_moves_platform_by_displacement():
 
 def test_vertical_acceleration_acts_like_gravity():
     """Erratum 3: a constant upward platform acceleration ÿ acts as gravity g + ÿ."""
-    from posturelab.platform import SumOfSines
+    from posturelab.model.platform import SumOfSines
 
     body, muscles = pl.paper_body(), pl.paper_muscles("1")
     x0 = [0.05, 0.0, -0.05, 0, 0, 0]

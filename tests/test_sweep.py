@@ -1,4 +1,4 @@
-"""Sweeps (posturelab.sweep) and ``posturelab sweep``: tables, formats, Dask, bad input."""
+"""Sweeps (posturelab.studies.sweep) and ``posturelab sweep``: tables, formats, Dask, bad input."""
 
 from __future__ import annotations
 
@@ -8,22 +8,22 @@ import sys
 
 import numpy as np
 import pytest
-from posturelab.body import paper_body
-from posturelab.fast import simulate_batch, simulate_fast
-from posturelab.muscles import paper_muscles
-from posturelab.platform import NoDisturbance, VelocityStep
-from posturelab.sweep import (
+
+from posturelab.cli import main
+from posturelab.errors import ParameterError
+from posturelab.model.body import paper_body
+from posturelab.model.muscles import paper_muscles
+from posturelab.model.platform import NoDisturbance, VelocityStep
+from posturelab.paper import BACKWARD_INITIAL_STATE
+from posturelab.scenarios import builtin_scenario
+from posturelab.simulation.compiled import simulate_batch, simulate_fast
+from posturelab.studies.sweep import (
     OUTCOME_COLUMNS,
     VaryRange,
     parse_vary,
     run_sweep,
     sweep_grid,
 )
-
-from posturelab.cli import main
-from posturelab.errors import ParameterError
-from posturelab.paper import BACKWARD_INITIAL_STATE
-from posturelab.scenarios import builtin_scenario
 
 POSTURE = list(BACKWARD_INITIAL_STATE[:3]) + [0.0, 0.0, 0.0]
 

@@ -24,14 +24,6 @@ sides are double-precision evaluations of closed forms).
 import numpy as np
 import pytest
 import sympy as sp
-from posturelab.body import Body, paper_body
-from posturelab.dynamics import (
-    angular_acceleration,
-    gravity_vector,
-    mass_matrix,
-    platform_vector,
-    velocity_terms,
-)
 from sympy.physics.mechanics import (
     LagrangesMethod,
     Lagrangian,
@@ -44,6 +36,14 @@ from sympy.physics.mechanics import (
 )
 
 from _bodies import random_body
+from posturelab.model.body import Body, paper_body
+from posturelab.model.dynamics import (
+    angular_acceleration,
+    gravity_vector,
+    mass_matrix,
+    platform_vector,
+    velocity_terms,
+)
 
 RTOL = 1e-10
 N_SAMPLES = 6

@@ -6,8 +6,11 @@ import re
 
 import numpy as np
 import pytest
-from posturelab.body import BODY_PRESETS, Body, Segment, get_body, paper_body
-from posturelab.muscles import (
+
+from posturelab.errors import ParameterError, PostureLabError, UnknownNameError
+from posturelab.linear import analyse, disturbance_sensitivity, state_matrix
+from posturelab.model.body import BODY_PRESETS, Body, Segment, get_body, paper_body
+from posturelab.model.muscles import (
     PAPER_PAIR_NAMES,
     STIFFNESS_CASES,
     MusclePair,
@@ -15,9 +18,6 @@ from posturelab.muscles import (
     get_stiffness_case,
     paper_muscles,
 )
-
-from posturelab.errors import ParameterError, PostureLabError, UnknownNameError
-from posturelab.linear import analyse, disturbance_sensitivity, state_matrix
 
 GOOD = {
     "masses": [5.0, 20.0, 40.0],
