@@ -30,11 +30,11 @@ def read_csv(path):
     return rows[0], rows[1:]
 
 
-@pytest.fixture
+@pytest.fixture(autouse=True)
 def compiled_evaluator(tmp_path_factory, capsys):
-    """The map's numba kernels compiled (or loaded from the cache) before the test, so that
-    the one-time compile notice cannot reach its stderr (under pytest-xdist this test may
-    run before any other has compiled them)."""
+    """The map's numba kernels compiled (or loaded from the cache) before every test here, so
+    that the one-time compile notice cannot reach a test's stderr (under pytest-xdist any of
+    them may run before another has compiled them)."""
     folder = tmp_path_factory.mktemp("warm")
     assert main(["stability-map", "--x", "stiffness:ankle:0:2000", "--y",
                  "stiffness:gastrocnemius:0:1000",

@@ -39,7 +39,7 @@ Writes the figure --out (colour = largest real part of the poles [1/s], stable r
 outlined, Table I cases that lie in the plane marked) and a CSV beside it with the same
 stem (columns: x name, y name, max_real_part [1/s], stable [1 or 0]). Stable means every
 pole has real part < -δ, δ = 1e-9 × the poles' magnitude scale [1/s] (a set with
-undamped poles on the imaginary axis is not stable; see posturelab.batch_linear).
+undamped poles on the imaginary axis is not stable; see posturelab.linear.batch).
 
 Example: posturelab stability-map --x stiffness:ankle:0:2000 \\
              --y stiffness:gastrocnemius:0:1000 --out map.png
@@ -98,7 +98,7 @@ def add_parser(sub, name: str) -> argparse.ArgumentParser:
 
 
 def parse_axis(text: str, flag: str, pairs: tuple[str, ...] = PAPER_PAIRS):
-    """Parse ``NAME:LO:HI`` into a :class:`posturelab.batch_linear.ParameterRange`; ``pairs``
+    """Parse ``NAME:LO:HI`` into a :class:`posturelab.linear.batch.ParameterRange`; ``pairs``
     are the body's pairs (NAME is ``stiffness:PAIR`` or ``viscosity_ratio``)."""
     from ..linear.batch import ParameterRange
 
@@ -241,7 +241,7 @@ class ProgressBar:
 
 
 def plot_stability_map(smap, figure_file, fmt: str) -> None:
-    """Draw ``smap`` (a :class:`posturelab.batch_linear.StabilityMap`) to ``figure_file``.
+    """Draw ``smap`` (a :class:`posturelab.linear.batch.StabilityMap`) to ``figure_file``.
 
     Colour is the largest real part of the poles [1/s] (diverging at 0: blue decays,
     red grows); the stable region is outlined in black; Table I cases lying in the

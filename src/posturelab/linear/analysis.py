@@ -87,7 +87,7 @@ def finite_difference_state_matrix(
     """State matrix from central differences of the *nonlinear* model at upright.
 
     An independent cross-check of :func:`state_matrix` (it uses only
-    :func:`posturelab.dynamics.state_derivative` and the pair torques).
+    :func:`posturelab.model.dynamics.state_derivative` and the pair torques).
 
     Parameters
     ----------

@@ -166,7 +166,7 @@ class BodyArrays:
 
     @classmethod
     def from_body(cls, body: Body) -> BodyArrays:
-        """The parameters of one :class:`~posturelab.body.Body`, shared by every set."""
+        """The parameters of one :class:`~posturelab.model.body.Body`, shared by every set."""
         return cls(body.masses, body.lengths, body.com_distances, body.inertias, body.gravity)
 
     @property

@@ -258,7 +258,8 @@ class RecoveryFinding:
     def text(self) -> str:
         """The finding in words, with its numbers."""
         return (
-            "Largest recoverable perturbation (posturelab.recovery.largest_recoverable): case "
+            "Largest recoverable perturbation "
+            "(posturelab.studies.recovery.largest_recoverable): case "
             f"1, the platform moved backward and held over {self.ramp_duration:g} s, the "
             f"typical foot above. The foot tips (centre of pressure past the toe) beyond a "
             f"{self.by_cop * 100:.1f} cm move; the centre of gravity leaves the foot only "

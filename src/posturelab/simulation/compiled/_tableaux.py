@@ -1,7 +1,7 @@
 """Explicit Runge–Kutta pairs as data: Butcher tableaux, error weights, dense output.
 
-One step routine (:func:`._explicit.rk_attempt`) runs any of them; a method is
-added by adding its tableau here and a line to :data:`._methods.METHODS`.
+One step routine (``csrc/pl_explicit.c``) runs any of them; a method is added by adding
+its tableau here and a line to :data:`posturelab.simulation.compiled.METHODS`.
 
 Each tableau is first-same-as-last (FSAL): its last row of ``A`` is its solution
 weights, so the last stage is f(t + h, y_new), the first stage of the next step.
