@@ -37,21 +37,32 @@ def timed(fn):
     return time.perf_counter() - t0, out
 
 
-def main() -> None:
-    print("posturelab frequency-domain benchmark")
-    print(f"machine: {platform.platform()}; {os.cpu_count()} CPUs; numpy {np.__version__}")
-    rng = np.random.default_rng(SEED)
+def one_link_sets(count: int, rng: np.random.Generator):
+    """``count`` random one-link controller sets (drawn from ``rng``) at the 11 bands of a
+    20 s cycle:
+    (body, layout, frequencies [Hz], intrinsic stiffness and viscosity, active stiffness and
+    viscosity [N·m/rad, N·m·s/rad], shape (count, 1) each, delays [s] and weights [-], shape
+    (count,)); bench_readme.py times ``model_frf_batch`` on the same sets."""
     f = band_frequencies(PETERKA_BAND_HARMONICS, 20.0)
     body = pl.get_body("paper-1link")
     layout = get_controller("peterka-2002").muscles(body)
     mgh = body.load_stiffness
+    k = rng.uniform(0, 0.2, (count, 1)) * mgh
+    v = rng.uniform(0, 0.1, (count, 1)) * mgh
+    ka = rng.uniform(0.8, 2.0, (count, 1)) * mgh
+    va = rng.uniform(0.2, 0.8, (count, 1)) * mgh
+    tau = rng.uniform(0.08, 0.2, count)
+    w = rng.uniform(0.3, 1.0, count)
+    return body, layout, f, k, v, ka, va, tau, w
+
+
+def main() -> None:
+    print("posturelab frequency-domain benchmark")
+    print(f"machine: {platform.platform()}; {os.cpu_count()} CPUs; numpy {np.__version__}")
+    rng = np.random.default_rng(SEED)
     M = 1_000_000
-    k = rng.uniform(0, 0.2, (M, 1)) * mgh
-    v = rng.uniform(0, 0.1, (M, 1)) * mgh
-    ka = rng.uniform(0.8, 2.0, (M, 1)) * mgh
-    va = rng.uniform(0.2, 0.8, (M, 1)) * mgh
-    tau = rng.uniform(0.08, 0.2, M)
-    w = rng.uniform(0.3, 1.0, M)
+    body, layout, f, k, v, ka, va, tau, w = one_link_sets(M, rng)
+    mgh = body.load_stiffness
     t_batch, H = timed(lambda: model_frf_batch(body, layout, f, k, v, ka, va, tau, w))
     J = body.inertia_diagonal[0]
     n_base = 20_000

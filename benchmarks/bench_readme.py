@@ -141,23 +141,11 @@ def bisection(repeats: int) -> tuple[float, list[float], int]:
 def frf_batch(repeats: int) -> tuple[float, list[float]]:
     """``model_frf_batch`` on 10⁶ random one-link sets at the 11 bands (bench_frequency's
     sets): median seconds and every call."""
-    import posturelab as pl
-    from posturelab.frequency.bands import PETERKA_BAND_HARMONICS, band_frequencies
-    from posturelab.frequency.model import model_frf_batch
-    from posturelab.model.controllers import get_controller
+    from bench_frequency import one_link_sets
 
-    rng = np.random.default_rng(SEED)
-    f = band_frequencies(PETERKA_BAND_HARMONICS, 20.0)
-    body = pl.get_body("paper-1link")
-    layout = get_controller("peterka-2002").muscles(body)
-    mgh = body.load_stiffness
-    m = 1_000_000
-    k = rng.uniform(0, 0.2, (m, 1)) * mgh
-    v = rng.uniform(0, 0.1, (m, 1)) * mgh
-    ka = rng.uniform(0.8, 2.0, (m, 1)) * mgh
-    va = rng.uniform(0.2, 0.8, (m, 1)) * mgh
-    tau = rng.uniform(0.08, 0.2, m)
-    w = rng.uniform(0.3, 1.0, m)
+    from posturelab.frequency.model import model_frf_batch
+
+    body, layout, f, k, v, ka, va, tau, w = one_link_sets(1_000_000, np.random.default_rng(SEED))
     med, times, _ = in_process_seconds(
         lambda: model_frf_batch(body, layout, f, k, v, ka, va, tau, w), repeats)
     return med, times
@@ -173,6 +161,15 @@ def d_subdivision(repeats: int) -> tuple[float, list[float]]:
         sys.path.pop(0)
     med, times, _ = in_process_seconds(lambda: example.compute(200), repeats)
     return med, times
+
+
+def timed_sweep(number: str, what: str, claim: str, argv: list[str], folder: str,
+                n: int) -> None:
+    """Time a ``posturelab sweep`` command in fresh processes and report the time it prints
+    and the whole command's [s] beside the README's claim."""
+    whole, times, out = fresh_seconds(posturelab_command(argv), folder, n)
+    report(number, what, claim, f"the command prints {printed_seconds(out)}; whole command "
+           f"{whole:.2f} s ({spread(times)})")
 
 
 def main() -> None:
@@ -196,11 +193,8 @@ def main() -> None:
         sweep = ["sweep", "--case", "1", "--disturbance", "backward", "--speed", "1",
                  "--foot", "literature", "--vary", "stiffness:ankle=300:2000:40",
                  "--vary", "disturbance_scale=0.05:1.5:30", "--out", "how-large.csv"]
-        whole, times, out = fresh_seconds(posturelab_command(sweep), tmp, n)
-        report("1.", "how-large sweep, 1,200 runs (sweep ... --out how-large.csv)",
-               "1,200 runs in 0.3 s",
-               f"the command prints {printed_seconds(out)}; whole command {whole:.2f} s "
-               f"({spread(times)})")
+        timed_sweep("1.", "how-large sweep, 1,200 runs (sweep ... --out how-large.csv)",
+                    "1,200 runs in 0.3 s", sweep, tmp, n)
 
         seconds, times, bracketed = bisection(n)
         report("2.", "largest_recoverable_batch, 10,000 sets to 0.01 m/s",
@@ -229,11 +223,8 @@ def main() -> None:
                 "--vary", "active_stiffness:ankle=650:850:5", "--sensor-noise", "0.001",
                 "--motor-noise", "2", "--motor-noise-cutoff", "1",
                 "--fit", "active_stiffness:ankle,feedback_delay", "--out", "pop.csv"]
-        whole, times, out = fresh_seconds(posturelab_command(prts), tmp, n)
-        report("6.", "PRTS population sweep, 20 fitted subjects (sweep --experiment prts ...)",
-               "the 20 fitted subjects in about 3 s",
-               f"the command prints {printed_seconds(out)}; whole command {whole:.2f} s "
-               f"({spread(times)})")
+        timed_sweep("6.", "PRTS population sweep, 20 fitted subjects (sweep --experiment "
+                    "prts ...)", "the 20 fitted subjects in about 3 s", prts, tmp, n)
 
         resolution = 60
         dmap = ["stability-map", "--case", "1", "--feedback-delay", "0.05",
