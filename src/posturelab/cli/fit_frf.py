@@ -98,8 +98,8 @@ def _condition(path: str, args: argparse.Namespace):
         return read_frf_json(path, "--data FRF JSON")
     from .._validation import float_in_range
     from ..frequency.data import read_series_csv
-    from ..frequency.estimate import estimate_frf
-    from .frf import response_sign, whole_cycles
+    from ..frequency.estimate import estimate_frf, whole_cycles
+    from .frf import response_sign
 
     if args.stimulus is None or args.response is None or args.cycle_length is None:
         raise ParameterError("a trial CSV needs --stimulus, --response and --cycle-length")
