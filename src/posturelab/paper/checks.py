@@ -15,7 +15,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, NamedTuple
+from typing import NamedTuple
 
 import numpy as np
 
@@ -51,9 +51,6 @@ from .findings import (
 )
 from .printed import BACKWARD_INITIAL_STATE, FIGURE_CAPTIONS
 from .runs import PaperRuns
-
-if TYPE_CHECKING:
-    pass
 
 __all__ = [
     "SETTLE_TOLERANCE", "PAPER_SETTLING_CLAIM", "ORDER_OF_MAGNITUDE", "IMPULSE_WINDOW",
