@@ -32,15 +32,12 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..scenarios import Scenario
+from .experiment import MAX_RECORD_RATE, MAX_SENSOR_NOISE  # (the one experiment's bounds)
 
 __all__ = ["PRTSProtocol", "PRTSSweepResult", "prts_sweep", "MAX_EXPERIMENTS"]
 
 #: Most experiments one sweep may run (each is a simulation of minutes of stance). [-]
 MAX_EXPERIMENTS = 100_000
-#: Largest sensor noise (standard deviation) on a recorded angle. [rad]
-MAX_SENSOR_NOISE = 1.0
-#: Highest record rate of a PRTS experiment. [Hz]
-MAX_RECORD_RATE = 1e5
 
 
 @dataclass(frozen=True)
