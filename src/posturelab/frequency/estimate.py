@@ -30,7 +30,7 @@ The gain bounds are |H|(1 ± r) (the lower clipped at 0), the phase bounds ±asi
 when r >= 1). Phase [deg] is unwrapped across the bands from the first, which lies in
 (−180°, 180°].
 
-Precision per band (what :func:`posturelab.frequency.fit_frf` weights by): the band's
+Precision per band (what :func:`posturelab.frequency.fit.fit_frf` weights by): the band's
 Ĥ = Σ_j G_j Ĥ_j / Σ_j G_j over its harmonics j (G_j = Σ_c |X_cj|² over the C cycles,
 Ĥ_j = Σ_c X̄_cj Y_cj / G_j) has, for noise of variance σ² in the response spectrum about the
 band, E|Ĥ − H|² = σ² / Σ_j G_j. σ² is estimated from the scatter of the cycles about the
