@@ -17,8 +17,9 @@ def plot_bode(estimates, labels=None, model=None) -> Figure:
 
     Parameters
     ----------
-    estimates : sequence of posturelab.frequency.FRFEstimate
-        One or several conditions.
+    estimates : sequence of posturelab.frequency.FRFEstimate or FRFTable
+        One or several conditions; a table's 95 % bounds come from its standard errors
+        (none without), its coherence is left out when not given.
     labels : sequence of str, optional
     model : sequence of (frequency [Hz], complex FRF, label), optional
         Curves to overlay.
@@ -29,7 +30,7 @@ def plot_bode(estimates, labels=None, model=None) -> Figure:
     """
     fig, (ax_g, ax_p, ax_c) = new_figure(3, 1, figsize=(6.5, 7.5), sharex=True)
     labels = list(labels or [f"condition {i + 1}" for i in range(len(estimates))])
-    for est, label in zip(estimates, labels, strict=True):
+    for est, label in zip(map(_with_bounds, estimates), labels, strict=True):
         line, = ax_g.loglog(est.frequency, est.gain, "o-", ms=4, label=label)
         ok = np.all(np.isfinite(est.gain_ci95), axis=1)
         if ok.any():
@@ -60,6 +61,27 @@ def plot_bode(estimates, labels=None, model=None) -> Figure:
     for ax in (ax_g, ax_p, ax_c):
         ax.grid(True, which="both", alpha=0.3)
     return fig
+
+
+def _with_bounds(frf):
+    """What :func:`plot_bode` draws of a condition: an estimate as it is; a table
+    (:class:`posturelab.frequency.table.FRFTable`) with 95 % bounds from its standard errors
+    (NaN without) and its coherence NaN when not given."""
+    if hasattr(frf, "gain_ci95"):
+        return frf
+    from types import SimpleNamespace
+
+    nan = np.full(frf.frequency.size, np.nan)
+    if frf.gain_se is not None:
+        gain_ci = np.stack([frf.gain - 1.96 * frf.gain_se, frf.gain + 1.96 * frf.gain_se],
+                           axis=1)
+        phase_ci = np.stack([frf.phase_deg - 1.96 * frf.phase_se_deg,
+                             frf.phase_deg + 1.96 * frf.phase_se_deg], axis=1)
+    else:
+        gain_ci = phase_ci = np.stack([nan, nan], axis=1)
+    return SimpleNamespace(frequency=frf.frequency, gain=frf.gain, phase_deg=frf.phase_deg,
+                           coherence=nan if frf.coherence is None else frf.coherence,
+                           gain_ci95=gain_ci, phase_ci95_deg=phase_ci)
 
 
 def plot_prts_cycles(estimate, *, stimulus_label: str = "tilt",
