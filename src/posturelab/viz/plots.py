@@ -16,7 +16,7 @@ function                      what                                         paper
 :func:`plot_run_overview`     a 2×2 summary of one run                     —
 ============================  ==========================================  ==========
 
-The functions live in :mod:`.runs` (runs), :mod:`.maps` (parameter planes),
+The functions live in :mod:`.run_figures` (runs), :mod:`.maps` (parameter planes),
 :mod:`.frequency` (frequency responses) and :mod:`.figure` (new figures, colours, saving);
 this module gathers them under one name.
 
@@ -39,7 +39,7 @@ from .figure import (
 )
 from .frequency import plot_bode, plot_prts_cycles
 from .maps import plot_delay_stability_map, plot_stability_map
-from .runs import (
+from .run_figures import (
     plot_angle_angle,
     plot_cog_phase,
     plot_compare,
