@@ -1,4 +1,4 @@
-"""Benchmark: batched linear stability (posturelab.batch_linear) against plain numpy.
+"""Benchmark: batched linear stability (posturelab.linear.batch) against plain numpy.
 
 Run:  python benchmarks/bench_linear.py [--sets 1000000] [--repeats 7]
 
@@ -36,16 +36,16 @@ import tempfile
 import time
 
 import numpy as np
-from posturelab.body import paper_body
-from posturelab.dynamics import mass_matrix
-from posturelab.muscles import paper_muscles
 
-from posturelab import batch_linear
+from posturelab.linear import batch as batch_linear
 from posturelab.linear import sorted_poles
+from posturelab.model.body import paper_body
+from posturelab.model.dynamics import mass_matrix
+from posturelab.model.muscles import paper_muscles
 
 FIRST_CALL = (
     "import time; t0 = time.perf_counter(); import numpy as np; "
-    "from posturelab.batch_linear import batch_analyse, batch_stable; t1 = time.perf_counter(); "
+    "from posturelab.linear.batch import batch_analyse, batch_stable; t1 = time.perf_counter(); "
     "k = np.array([[500.0, 300, 300, 300, 300]]); batch_stable(k); batch_analyse(k); "
     "t2 = time.perf_counter(); print(f'{t1 - t0:.3f} {t2 - t1:.3f}')"
 )

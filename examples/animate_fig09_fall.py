@@ -11,6 +11,7 @@ import sys
 from pathlib import Path
 
 from posturelab.animation import animate
+
 from posturelab.scenarios import builtin_scenario
 
 

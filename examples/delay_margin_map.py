@@ -22,7 +22,7 @@ import numpy as np
 
 import posturelab as pl
 from posturelab.model.controllers import get_controller
-from posturelab.plots import new_figure, save_figure
+from posturelab.viz.plots import new_figure, save_figure
 
 RESOLUTION = 41  # grid points per axis [-]
 

@@ -12,8 +12,8 @@ Usage: python examples/fig03_time_histories.py [OUTPUT_DIR]   (default: current 
 import sys
 from pathlib import Path
 
-from posturelab.plots import new_figure, plot_time_histories, save_figure
 from posturelab.scenarios import builtin_scenario
+from posturelab.viz.plots import new_figure, plot_time_histories, save_figure
 
 
 def make_figure():

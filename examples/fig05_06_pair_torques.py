@@ -14,8 +14,8 @@ from pathlib import Path
 
 import numpy as np
 
-from posturelab.plots import new_figure, plot_pair_torques, save_figure
 from posturelab.scenarios import builtin_scenario
+from posturelab.viz.plots import new_figure, plot_pair_torques, save_figure
 
 
 def make_figure():

@@ -14,9 +14,10 @@ Usage: python examples/fig07_10_cog_phase.py [OUTPUT_DIR]   (default: current di
 import sys
 from pathlib import Path
 
-from posturelab.plots import new_figure, plot_cog_phase, save_figure
-from posturelab.scenarios import builtin_scenario
 from posturelab.simulate import FOOT_FROM_LITERATURE
+
+from posturelab.scenarios import builtin_scenario
+from posturelab.viz.plots import new_figure, plot_cog_phase, save_figure
 
 PANELS = (
     ("paper-backward-case1", "Fig. 7 — backward, case 1"),

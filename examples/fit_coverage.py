@@ -20,9 +20,9 @@ from __future__ import annotations
 import argparse
 
 import numpy as np
+from posturelab.identify import fit_stiffness
 
 import posturelab as pl
-from posturelab.identify import fit_stiffness
 
 #: The fitted parameters and their true values. [N·m/rad], [N·m/rad], [s]
 FREE = ("stiffness:ankle", "stiffness:gastrocnemius", "viscosity_ratio")

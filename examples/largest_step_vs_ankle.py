@@ -23,13 +23,13 @@ import sys
 from pathlib import Path
 
 import numpy as np
-
-from posturelab.body import paper_body
-from posturelab.fast import simulate_batch
-from posturelab.muscles import paper_muscles
 from posturelab.platform import VelocityStep
-from posturelab.plots import new_figure, save_figure
 from posturelab.simulate import FOOT_FROM_LITERATURE, FallCriteria
+
+from posturelab.model.body import paper_body
+from posturelab.model.muscles import paper_muscles
+from posturelab.simulation.compiled import simulate_batch
+from posturelab.viz.plots import new_figure, save_figure
 
 ANKLE = np.linspace(300.0, 2000.0, 40)  # [N·m/rad]
 SPEED = np.linspace(0.05, 3.0, 60)  # [m/s]

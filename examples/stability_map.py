@@ -18,7 +18,7 @@ from pathlib import Path
 from matplotlib.colors import TwoSlopeNorm
 
 from posturelab.linear.batch import stability_map
-from posturelab.plots import new_figure, save_figure
+from posturelab.viz.plots import new_figure, save_figure
 
 RESOLUTION = 300  # grid points per axis [-]
 

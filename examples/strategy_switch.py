@@ -27,8 +27,8 @@ from pathlib import Path
 import numpy as np
 
 import posturelab as pl
-from posturelab.plots import new_figure, save_figure
 from posturelab.studies.strategy import hip_fraction_study
+from posturelab.viz.plots import new_figure, save_figure
 
 SIZES = np.linspace(0.02, 0.30, 29)  # backward displacements [m]
 LIMIT = 60.0  # ankle torque limit [N·m]

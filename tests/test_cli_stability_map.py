@@ -5,6 +5,7 @@ the CSV is checked against the same single-case path at a few points.
 """
 
 import csv
+import re
 
 import numpy as np
 import pytest
@@ -13,6 +14,7 @@ from posturelab.cli import main
 from posturelab.cli import stability_map as cli_map
 from posturelab.linear import analyse
 from posturelab.model.muscles import paper_muscles
+from posturelab.viz import maps as viz_maps
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 
@@ -72,7 +74,8 @@ def test_viscosity_axis_case_and_svg(tmp_path, capsys):
                           "--y", "stiffness:hip:0:1000", "--resolution", "3", "--case", "6a",
                           "--out", str(out), "--progress")
     assert code == 0, stderr
-    assert "100.0%" in stderr  # --progress draws the bar even off a terminal
+    # --progress draws the bar even off a terminal, to the last of the 3 × 3 sets
+    assert re.search(r"\] 100% 9/9 sets", stderr), stderr
     assert out.read_text(encoding="utf-8").lstrip().startswith("<?xml")
     header, rows = read_csv(tmp_path / "ratio.csv")
     assert header == ["viscosity_ratio", "stiffness:hip", "max_real_part", "stable"]
@@ -145,7 +148,7 @@ def test_write_failure_leaves_nothing_and_keeps_old_files(tmp_path, capsys, monk
     def disk_full(*args, **kwargs):
         raise OSError(28, "No space left on device")
 
-    monkeypatch.setattr(cli_map, "plot_stability_map", disk_full)
+    monkeypatch.setattr(viz_maps, "plot_stability_map", disk_full)
     code, _, stderr = run(capsys, "stability-map", "--x", "stiffness:ankle:0:1", "--y",
                           "stiffness:hip:0:1",
                           "--resolution", "2", "--out", str(tmp_path / "map.png"))
@@ -160,7 +163,7 @@ def test_interrupt_leaves_nothing(tmp_path, capsys, monkeypatch):
     def interrupted(*args, **kwargs):
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(cli_map, "plot_stability_map", interrupted)
+    monkeypatch.setattr(viz_maps, "plot_stability_map", interrupted)
     code, _, _ = run(capsys, "stability-map", "--x", "stiffness:ankle:0:1", "--y",
                      "stiffness:hip:0:1",
                      "--resolution", "2", "--out", str(tmp_path / "map.png"))
@@ -169,15 +172,22 @@ def test_interrupt_leaves_nothing(tmp_path, capsys, monkeypatch):
 
 
 def test_progress_bar_draws_in_place():
+    """The one bar every command draws (posturelab._progress): redrawn in place with carriage
+    returns, a repeated count not redrawn, the line ended when closed."""
     import io
 
+    from posturelab._progress import Progress
+
     stream = io.StringIO()
-    bar = cli_map.ProgressBar(stream, "map", "sets", width=10)
+    bar = Progress(label="map", unit="sets", stream=stream, width=10, every_step=True)
     for done in (0, 5, 5, 10):
         bar(done, 10)
+    assert "\n" not in stream.getvalue()
+    bar.close()
     text = stream.getvalue()
-    assert text.count("\r") == 3  # the repeated 5/10 is not redrawn
-    assert "[#####-----]  50.0%" in text and text.endswith("(10/10 sets)\n")
+    assert text.count("\r") == 4  # 0, 5, 10 and the closing line; the repeated 5 is not drawn
+    assert "map [#####.....]  50% 5/10 sets" in text
+    assert re.search(r"map \[#{10}\] 100% 10/10 sets \[[^]]*\]\n$", text), text
 
 
 def test_real_subprocess_bad_axis_is_one_line(tmp_path):

@@ -48,6 +48,38 @@ def test_ctrl_c_on_a_dask_sweep_is_one_line_and_keeps_the_finished_rows(tmp_path
     assert len(rows) - 1 == int(match.group(1).replace(",", "")) > 0
 
 
+def test_progress_counts_only_the_rows_an_interrupt_would_keep():
+    """Chunks finish out of order; an interrupt keeps the leading finished ones, so the bar
+    counts those (it once showed 4,096 finished runs and then wrote none: chunk 0 was still
+    running)."""
+    import threading
+
+    from posturelab.studies.sweep import run_chunks
+
+    release = threading.Event()
+
+    class Grid:
+        n_runs = 40
+
+    class Task:
+        def run(self, grid, lo, hi, parallel):
+            if lo == 0:  # the first chunk finishes last
+                assert release.wait(60)
+            return list(range(lo, hi))
+
+    seen: list[int] = []
+
+    def progress(done: int, total: int) -> None:
+        assert total == 40
+        seen.append(done)
+        if len(seen) == 3:  # chunks 1, 2 and 3 done: now let chunk 0 finish
+            release.set()
+
+    parts = run_chunks(Task(), Grid(), chunk_size=10, threads=2, progress=progress)
+    assert parts == [list(range(lo, lo + 10)) for lo in (0, 10, 20, 30)]
+    assert seen == [0, 0, 0, 40]
+
+
 @pytest.mark.parametrize("address,words", [
     ("nonsense", ["'nonsense'", "HOST:PORT"]),
     ("tcp://127.0.0.1", ["HOST:PORT"]),

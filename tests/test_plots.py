@@ -265,3 +265,23 @@ def test_cog_phase_several_runs_shade_foot_once(backward, falling):
     assert len(colours) == 3  # the repeated call carries on the colour cycle
     with pytest.raises(ParameterError, match="one colour per run"):
         plot_cog_phase([r, f], color="k")
+
+
+def test_bode_draws_a_table_with_and_without_standard_errors():
+    """A table of FRFs (fit-frf's JSON input) is drawn like an estimate: its 95 % band from
+    the standard errors (1.96 se each side), none without them."""
+    from posturelab.frequency.table import FRFTable
+    from posturelab.viz.plots import plot_bode
+
+    f = np.array([0.1, 0.5, 1.0])
+    h = np.array([1.0 + 0.1j, 0.8 - 0.3j, 0.3 - 0.5j])
+    gain_se = np.array([0.05, 0.04, 0.03])
+    with_se = FRFTable(f, h, gain_se=gain_se, phase_se_deg=np.array([2.0, 3.0, 4.0]))
+    bare = FRFTable(f, h)
+    fig = plot_bode([with_se, bare], ["with se", "bare"])
+    gain_axes = fig.axes[0]
+    bands = gain_axes.collections
+    assert len(bands) == 1  # the table without standard errors has no band
+    top = bands[0].get_paths()[0].vertices[:, 1].max()
+    assert top == pytest.approx(float(np.max(np.abs(h) + 1.96 * gain_se)))
+    assert [line.get_label() for line in gain_axes.get_lines()] == ["with se", "bare"]

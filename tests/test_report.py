@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import csv
 import dataclasses
+import re
 import subprocess
 import sys
 
@@ -198,7 +199,8 @@ def test_cli_prints_path_and_summary(built, monkeypatch, capsys):
     lines = captured.out.splitlines()
     assert lines[0] == str(out / "index.html")
     assert len(lines) == 2 and "51 of 54" in lines[1] and "Errata (7" in lines[1]
-    assert "[1/2] Fig. 3" in captured.err
+    # the bar: step 1 of 2 (none finished yet) is Fig. 3
+    assert re.search(r"\] +0% 0/2 steps \[[^]]*\], Fig\. 3", captured.err), captured.err
 
 
 def test_beyond_the_paper_findings(built):

@@ -3,10 +3,11 @@
 A least-squares fit inside a search box can stop on the box's edge: the estimate there is
 the bound, not a value the data determine, and estimate ± q·se there reaches outside what
 the parameter may be (a negative delay, a gain beyond the box). Both fits
-(:func:`posturelab.frequency.fit_frf`, :func:`posturelab.studies.fit_stiffness`) flag an
-estimate within :data:`AT_BOUND_TOLERANCE` of the box's width from either end as "at its
-search bound" (not determined), and clip every interval to the parameter's accepted range
-(the parameter table, :mod:`posturelab.parameters`) and to the search box.
+(:func:`posturelab.frequency.fit.fit_frf`,
+:func:`posturelab.studies.identification.fit_stiffness`) flag an estimate within
+:data:`AT_BOUND_TOLERANCE` of the box's width from either end as "at its search bound" (not
+determined), and clip every interval to the parameter's accepted range (the parameter
+table, :mod:`posturelab.parameters`) and to the search box.
 """
 
 from __future__ import annotations

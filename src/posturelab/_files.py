@@ -1,4 +1,5 @@
-"""Reading input files safely (private): one reader for every text and CSV input.
+"""Reading input files safely and writing outputs atomically (private): one reader for every
+text and CSV input, one writer for every output.
 
 Every input file is checked the same way before a byte is parsed:
 
@@ -11,21 +12,31 @@ Every input file is checked the same way before a byte is parsed:
   module's limit (:data:`MAX_FIELD_CHARS` characters); errors name the line.
 
 Messages never quote the file's content back.
+
+Every output goes through :func:`atomic_outputs` (or :func:`atomic_write_files`,
+:func:`atomic_write_bytes`, :func:`atomic_write_text` built on it): each file is written to a
+temporary file beside it, with the mode a new file gets, and renamed into place only when all
+are written; a failure or Ctrl-C leaves none of them. A device, FIFO or socket is never
+replaced.
 """
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import io
 import os
 import stat
-from collections.abc import Iterator
+import tempfile
+from collections.abc import Iterator, Mapping, Sequence
 from pathlib import Path
 
 from .errors import DataFileError, ParameterError, PostureLabError
 
 __all__ = ["MAX_INPUT_BYTES", "MAX_SCENARIO_BYTES", "MAX_DATA_ROWS", "MAX_FIELD_CHARS",
-           "read_text", "csv_rows", "refuse_non_regular", "refuse_input_as_output"]
+           "read_text", "csv_rows", "refuse_non_regular", "refuse_input_as_output",
+           "new_file_mode", "atomic_outputs", "atomic_write_files", "atomic_write_bytes",
+           "atomic_write_text"]
 
 #: Largest data file read. [bytes]
 MAX_INPUT_BYTES = 512 * 2**20
@@ -183,3 +194,107 @@ def check_column_unit(what: str, header: str, accepted: tuple[str, ...],
     raise DataFileError(f"{what}: column {header.strip()!r} is in {unit}; posturelab reads "
                         f"{reads}: convert the column (expected "
                         f"{' or '.join(f'[{a}]' for a in accepted)} or no unit)")
+
+
+# ---- writing ----------------------------------------------------------------
+
+
+def new_file_mode() -> int:
+    """Permission bits a newly created file gets under the current umask (0o644 for 022).
+
+    ``tempfile.mkstemp`` creates 0600 files; the atomic writers set this mode before renaming.
+    """
+    mask = os.umask(0)
+    os.umask(mask)
+    return 0o666 & ~mask
+
+
+def _unlink_quietly(path: str | Path) -> None:
+    try:
+        os.unlink(path)
+    except OSError:
+        pass
+
+
+@contextlib.contextmanager
+def atomic_outputs(paths: Sequence[str | Path], *, suffix: str = ".tmp", what: str = "",
+                   error: type[PostureLabError] = PostureLabError) -> Iterator[list[Path]]:
+    """Write several files all or none: a temporary file beside each of ``paths``.
+
+    The temporaries are created on entry, so that an unwritable place fails before any work,
+    with the mode a new file gets; the block writes them (by path); on a normal exit each is
+    renamed over its path in turn; on any exception (Ctrl-C too) all are removed.
+
+    Parameters
+    ----------
+    paths : sequence of path
+        The outputs.
+    suffix : str
+        The temporaries' suffix (a writer that looks at it, such as matplotlib's or Pillow's,
+        gets the right format).
+    what : str
+        Words before the path in a message (``"--out "``).
+    error : type
+        The PostureLabError raised, in one line naming the file.
+
+    Yields
+    ------
+    list of Path
+        The temporary files, in the order of ``paths``.
+    """
+    temporaries: list[tuple[Path, Path]] = []
+
+    def fail(path: Path, exc: OSError) -> PostureLabError:
+        return error(f"cannot write {what}{str(path)!r}: {exc.strerror or exc}")
+
+    try:
+        for path in map(Path, paths):
+            refuse_non_regular(path, error)
+            directory = path.parent if str(path.parent) else Path(".")
+            if not directory.is_dir():
+                raise error(f"cannot write {what}{str(path)!r}: directory {str(directory)!r} "
+                            "does not exist")
+            try:
+                fd, name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=suffix,
+                                            dir=directory)
+            except OSError as exc:
+                raise fail(path, exc) from None
+            temporaries.append((Path(name), path))
+            try:
+                os.fchmod(fd, new_file_mode())
+            finally:
+                os.close(fd)
+        yield [tmp for tmp, _ in temporaries]
+        while temporaries:
+            tmp, path = temporaries[0]
+            try:
+                os.replace(tmp, path)
+            except OSError as exc:
+                raise fail(path, exc) from None
+            temporaries.pop(0)
+    except OSError as exc:  # (raised by the block while writing a temporary)
+        where = next((path for tmp, path in temporaries if exc.filename in (str(tmp), tmp)),
+                     temporaries[0][1] if temporaries else Path(paths[0]))
+        raise fail(where, exc) from None
+    finally:
+        for tmp, _ in temporaries:
+            _unlink_quietly(tmp)
+
+
+def atomic_write_files(contents: Mapping[str | Path, bytes]) -> None:
+    """Write several files so that a failure leaves none of them written: each goes to a
+    temporary file beside it, and only when all are written are they renamed in turn."""
+    with atomic_outputs(list(contents)) as temporaries:
+        for tmp, data in zip(temporaries, contents.values(), strict=True):
+            with open(tmp, "wb") as fh:
+                fh.write(data)
+
+
+def atomic_write_bytes(path: str | Path, data: bytes) -> None:
+    """Write ``data`` to ``path`` through a temporary file and a rename."""
+    atomic_write_files({path: data})
+
+
+def atomic_write_text(path: str | Path, text: str) -> None:
+    """Write ``text`` (UTF-8) to ``path`` through a temporary file and a rename."""
+    atomic_write_files({path: text.encode("utf-8")})

@@ -14,8 +14,8 @@ from collections.abc import Sequence
 from ..errors import PostureLabError
 
 #: Subcommand name -> module in this package: each defines ``DESCRIPTION``,
-#: ``add_arguments(parser)`` and ``run(args)`` (or ``add_parser(sub, name)`` and ``run``); its
-#: one line of help is in :data:`SUBCOMMAND_HELP`.
+#: ``add_arguments(parser)`` and ``run(args)``; its one line of help is in
+#: :data:`SUBCOMMAND_HELP`.
 SUBCOMMANDS: dict[str, str] = {
     "poles": "poles",
     "sensitivity": "sensitivity",
@@ -110,13 +110,10 @@ def build_parser(command: str | None = None, *, summary: bool = False) -> OneLin
             if exc.name == f"{__name__}.{module_name}":
                 continue
             raise
-        if hasattr(module, "add_arguments"):
-            p = sub.add_parser(name, help=SUBCOMMAND_HELP[name], description=module.DESCRIPTION,
-                               epilog=CONVENTIONS_EPILOG,
-                               formatter_class=argparse.RawDescriptionHelpFormatter)
-            module.add_arguments(p)
-        else:
-            p = module.add_parser(sub, name)
+        p = sub.add_parser(name, help=SUBCOMMAND_HELP[name], description=module.DESCRIPTION,
+                           epilog=CONVENTIONS_EPILOG,
+                           formatter_class=argparse.RawDescriptionHelpFormatter)
+        module.add_arguments(p)
         p.set_defaults(_run=module.run)
     return parser
 

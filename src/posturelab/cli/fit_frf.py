@@ -98,8 +98,8 @@ def _condition(path: str, args: argparse.Namespace):
         return read_frf_json(path, "--data FRF JSON")
     from .._validation import float_in_range
     from ..frequency.data import read_series_csv
-    from ..frequency.estimate import estimate_frf
-    from .frf import response_sign, whole_cycles
+    from ..frequency.estimate import estimate_frf, whole_cycles
+    from .frf import response_sign
 
     if args.stimulus is None or args.response is None or args.cycle_length is None:
         raise ParameterError("a trial CSV needs --stimulus, --response and --cycle-length")
@@ -110,29 +110,6 @@ def _condition(path: str, args: argparse.Namespace):
     x, y, _ = whole_cycles(cols[stim], cols[resp], fs, args.cycle_length)
     return estimate_frf(x, y, fs, args.cycle_length, discard_cycles=args.discard_cycles,
                         response_sign=response_sign(args.response_sign))
-
-
-def _plottable(c):
-    """What plot_bode draws of a condition: a table's 95 % bounds from its standard errors
-    (none without), its coherence NaN when not given."""
-    from types import SimpleNamespace
-
-    import numpy as np
-
-    from ..frequency.table import FRFTable
-
-    if not isinstance(c, FRFTable):
-        return c
-    nan = np.full(c.frequency.size, np.nan)
-    if c.gain_se is not None:
-        gci = np.stack([c.gain - 1.96 * c.gain_se, c.gain + 1.96 * c.gain_se], axis=1)
-        pci = np.stack([c.phase_deg - 1.96 * c.phase_se_deg,
-                        c.phase_deg + 1.96 * c.phase_se_deg], axis=1)
-    else:
-        gci = pci = np.stack([nan, nan], axis=1)
-    return SimpleNamespace(frequency=c.frequency, gain=c.gain, phase_deg=c.phase_deg,
-                           coherence=nan if c.coherence is None else c.coherence,
-                           gain_ci95=gci, phase_ci95_deg=pci)
 
 
 def _names(text: str) -> list[str]:
@@ -184,7 +161,7 @@ def run(args: argparse.Namespace) -> int:
                   for p, c in zip(args.data, conditions, strict=True)]
         curves = [(f, h, f"fit: {label}") for (f, h), label in zip(fit.curves, labels,
                                                                      strict=True)]
-        save_figure(plot_bode([_plottable(c) for c in conditions], labels, model=curves),
+        save_figure(plot_bode(conditions, labels, model=curves),
                     args.plot)
     signs = sorted({int(c.response_sign) for c in conditions
                     if getattr(c, "response_sign", None) is not None})

@@ -91,28 +91,11 @@ def response_sign(choice: str) -> int:
     return -1 if str(choice).strip() == "-1" else 1
 
 
-def sign_convention(sign: int) -> str:
-    """One phrase stating the sign applied."""
-    return ("response × −1 (posturelab's tilt convention: sway forward positive, tilt "
-            "toes-up positive, following the surface reads gain 1, phase 0)" if sign < 0
-            else "response × +1 (as recorded)")
-
-
-def whole_cycles(x, y, sample_rate: float, cycle_length: float):
-    """``x, y`` without a last sample one past whole cycles (a record that includes its end
-    point, as posturelab simulate writes), and whether it was dropped."""
-    per_cycle = sample_rate * cycle_length
-    if per_cycle > 0 and abs(per_cycle - round(per_cycle)) < 1e-6 * per_cycle \
-            and x.size % round(per_cycle) == 1:
-        return x[:-1], y[:-1], True
-    return x, y, False
-
-
 def run(args: argparse.Namespace) -> int:
     from .._files import refuse_input_as_output
     from .._validation import float_in_range
     from ..frequency.data import read_series_csv
-    from ..frequency.estimate import estimate_frf
+    from ..frequency.estimate import estimate_frf, sign_convention, whole_cycles
 
     refuse_input_as_output({"--data": args.data},
                            {"--plot": args.plot, "--plot-cycles": args.plot_cycles})

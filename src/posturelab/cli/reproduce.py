@@ -28,14 +28,22 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--quiet", action="store_true", help="no progress lines on standard error.")
 
 
-def _progress(step: int, total: int, message: str) -> None:
-    print(f"[{step}/{total}] {message} …", file=sys.stderr, flush=True)
-
-
 def run(args: argparse.Namespace) -> int:
+    from .._progress import Progress
     from ..paper.report import reproduce_paper
 
-    report = reproduce_paper(args.out, progress=None if args.quiet else _progress)
+    bar = None if args.quiet else Progress(label="reproduce", unit="steps", every_step=True)
+
+    def progress(step: int, total: int, message: str) -> None:
+        bar(step - 1, total, message)  # (called before step ``step`` starts)
+
+    try:
+        report = reproduce_paper(args.out, progress=None if bar is None else progress)
+        if bar is not None:
+            bar(bar.total or 0, bar.total or 0, "done")
+    finally:
+        if bar is not None:
+            bar.close()
     if not args.quiet:
         print(f"done in {report.elapsed:.1f} s", file=sys.stderr)
     print(report.index_html)

@@ -1,21 +1,19 @@
-"""``posturelab stability-map``: stability of the linearised model over two parameters."""
+"""``posturelab stability-map``: stability of the linearised model over two parameters, the
+pair stiffnesses (:func:`posturelab.linear.batch.stability_map`) or, with a feedback delay, one
+pair's active gains (:func:`posturelab.linear.delay_batch.delay_stability_map`); the figures
+are drawn by :mod:`posturelab.viz.maps`."""
 
 from __future__ import annotations
 
 import argparse
 import io
 import math
-import os
 import re
-import sys
-import tempfile
 from concurrent.futures import ThreadPoolExecutor, wait
 from pathlib import Path
-from typing import IO
 
 from ..errors import ParameterError, UnknownNameError
 from ..parameters import PAPER_PAIRS, check_value, names_for, resolve
-from . import CONVENTIONS_EPILOG, SUBCOMMAND_HELP
 from ._common import ExpectedTime, load_compiled
 
 #: Axis names, the parameter table's: the paper's five pair stiffnesses stiffness:PAIR
@@ -62,12 +60,8 @@ MAX_RESOLUTION = 5000
 DELAYED_AXES = ("active_stiffness", "active_viscosity")
 
 
-def add_parser(sub, name: str) -> argparse.ArgumentParser:
-    p = sub.add_parser(
-        name, help=SUBCOMMAND_HELP[name],
-        description=DESCRIPTION, epilog=CONVENTIONS_EPILOG,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
-    )
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    """The options of ``posturelab stability-map``."""
     p.add_argument("--x", required=True, metavar="NAME:LO:HI",
                    help="horizontal axis: parameter name and range (e.g. stiffness:ankle:0:2000).")
     p.add_argument("--y", required=True, metavar="NAME:LO:HI",
@@ -91,7 +85,6 @@ def add_parser(sub, name: str) -> argparse.ArgumentParser:
     from ._common import add_muscle_arguments
 
     add_muscle_arguments(p, own_case=True)
-    return p
 
 
 # ---- argument parsing -------------------------------------------------------
@@ -198,118 +191,6 @@ def output_paths(out: str) -> tuple[Path, Path, str]:
     return figure, figure.with_suffix(".csv"), fmt
 
 
-# ---- progress bar -------------------------------------------------------------
-
-
-class ProgressBar:
-    """A one-line text progress bar, redrawn in place with carriage returns.
-
-    Parameters
-    ----------
-    stream : text stream
-        Where to draw (standard error).
-    label : str
-        Text before the bar.
-    unit : str
-        What is counted, e.g. "sets" or "rows".
-    width : int
-        Bar width in characters.
-    """
-
-    def __init__(self, stream: IO[str], label: str, unit: str = "sets", width: int = 30) -> None:
-        self.stream = stream
-        self.label = label
-        self.unit = unit
-        self.width = width
-        self._shown = -1
-
-    def __call__(self, done: int, total: int) -> None:
-        permille = 1000 if total <= 0 else int(1000 * done / total)
-        if permille == self._shown:
-            return
-        self._shown = permille
-        filled = self.width * permille // 1000
-        bar = "#" * filled + "-" * (self.width - filled)
-        self.stream.write(f"\r{self.label} [{bar}] {permille / 10:5.1f}% "
-                          f"({done:,}/{total:,} {self.unit})")
-        if done >= total:
-            self.stream.write("\n")
-        self.stream.flush()
-
-
-# ---- figure -------------------------------------------------------------------
-
-
-def plot_stability_map(smap, figure_file, fmt: str) -> None:
-    """Draw ``smap`` (a :class:`posturelab.linear.batch.StabilityMap`) to ``figure_file``.
-
-    Colour is the largest real part of the poles [1/s] (diverging at 0: blue decays,
-    red grows); the stable region is outlined in black; Table I cases lying in the
-    plane are marked.
-    """
-    from matplotlib.colors import TwoSlopeNorm
-    from matplotlib.figure import Figure
-    from matplotlib.lines import Line2D
-
-    grid = smap.grid
-    xs, ys = grid.x_values, grid.y_values
-    values = smap.max_real_part
-    low, high = float(values.min()), float(values.max())
-    if low < 0.0 < high:
-        norm = TwoSlopeNorm(vmin=low, vcenter=0.0, vmax=high)
-    else:
-        span = max(abs(low), abs(high), 1e-12)
-        norm = TwoSlopeNorm(vmin=-span, vcenter=0.0, vmax=span)
-    dx, dy = xs[1] - xs[0], ys[1] - ys[0]
-    extent = (xs[0] - dx / 2, xs[-1] + dx / 2, ys[0] - dy / 2, ys[-1] + dy / 2)
-
-    fig = Figure(figsize=(7.5, 5.8), layout="constrained")
-    ax = fig.add_subplot()
-    image = ax.imshow(values, origin="lower", extent=extent, aspect="auto",
-                      interpolation="nearest", cmap="RdBu_r", norm=norm)
-    fig.colorbar(image, ax=ax, label="largest real part of the poles [1/s]")
-    handles = []
-    if smap.stable.any() and not smap.stable.all():
-        ax.contour(xs, ys, smap.stable.astype(float), levels=[0.5], colors="k", linewidths=1.5)
-        handles.append(Line2D([], [], color="k", lw=1.5, label="stable region boundary"))
-    points = grid.table_i_points()
-    if points:
-        px = [p[1] for p in points]
-        py = [p[2] for p in points]
-        ax.plot(px, py, "o", ms=7, mfc="gold", mec="k", clip_on=False, zorder=5)
-        for case, x, y in points:
-            ax.annotate(f"case {case}", (x, y), xytext=(5, 5), textcoords="offset points",
-                        fontsize=9, annotation_clip=False,
-                        bbox=dict(boxstyle="round,pad=0.2", fc="w", alpha=0.7))
-        handles.append(Line2D([], [], ls="", marker="o", ms=7, mfc="gold", mec="k",
-                              label="Table I cases"))
-    ax.set_xlabel(grid.x.label)
-    ax.set_ylabel(grid.y.label)
-    fixed = []
-    if "viscosity_ratio" not in (grid.x.name, grid.y.name):
-        fixed.append(f"viscosity ratio {grid.base_viscosity_ratio:g} s")
-    others = [f"{n} {v:g}" for n, v in zip(grid.pair_names, grid.base_stiffness, strict=True)
-              if f"stiffness:{n}" not in (grid.x.name, grid.y.name)]
-    if others:
-        fixed.insert(0, f"{', '.join(others)} N·m/rad")
-    source = (f"others from Table I case {grid.base_case}" if grid.base_case is not None
-              else "others fixed" if fixed else "")
-    ax.set_title(
-        f"Linearised stability about upright of body {smap.body_name}"
-        f"{'; ' + source if source else ''}\n"
-        f"{'(' + '; '.join(fixed) + '); ' if fixed else ''}"
-        f"{100 * smap.stable_fraction:.1f}% stable",
-        fontsize=9,
-    )
-    if handles:
-        ax.legend(handles=handles, loc="upper right", fontsize=8, framealpha=0.8)
-    state = "all stable" if smap.stable.all() else "none stable" if not smap.stable.any() else ""
-    if state:
-        ax.text(0.02, 0.02, state, transform=ax.transAxes, fontsize=9,
-                bbox=dict(boxstyle="round", fc="w", alpha=0.8))
-    fig.savefig(figure_file, format=fmt, dpi=150)
-
-
 # ---- run ------------------------------------------------------------------------
 
 
@@ -333,50 +214,43 @@ def _base_muscles(args: argparse.Namespace, body):
     return muscles_for(body.n_links, stiffness)
 
 
-def _temporary_beside(path: Path) -> Path:
-    """Create an empty temporary file in ``path``'s directory (checks it is writable).
-
-    It gets the permissions a newly created file would (0666 minus the umask),
-    not mkstemp's private 0600, since it replaces the output.
-    """
-    try:
-        fd, name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    except OSError as exc:
-        raise ParameterError(
-            f"cannot write --out {str(path)!r}: {exc.strerror or exc}"
-        ) from None
-    try:
-        umask = os.umask(0)
-        os.umask(umask)
-        os.fchmod(fd, 0o666 & ~umask)
-    finally:
-        os.close(fd)
-    return Path(name)
-
-
 def _import_plotting() -> None:
-    """Import what :func:`plot_stability_map` uses (matplotlib's figure, Agg, fonts)."""
+    """Import what :func:`posturelab.viz.maps.plot_stability_map` uses (matplotlib's figure,
+    Agg, fonts)."""
     from matplotlib import font_manager
     from matplotlib.backends import backend_agg  # noqa: F401
-    from matplotlib.figure import Figure  # noqa: F401
+
+    from ..viz import maps  # noqa: F401
 
     font_manager.fontManager  # noqa: B018 (loads the font list)
 
 
 def _write_csv(smap, path: Path, show: bool) -> None:
     """Write ``smap``'s CSV to ``path`` (a progress bar on standard error if ``show``)."""
-    with open(path, "w", encoding="utf-8", newline="") as stream:
-        smap.write_csv(stream, progress=ProgressBar(sys.stderr, "writing CSV  ", "rows")
-                       if show else ExpectedTime("stability-map: writing the CSV", "rows",
-                                                 min_total=250_000))
+    from .._progress import Progress
+
+    bar = Progress(label="writing CSV", unit="rows") if show else None
+    try:
+        with open(path, "w", encoding="utf-8", newline="") as stream:
+            smap.write_csv(stream, progress=bar or ExpectedTime(
+                "stability-map: writing the CSV", "rows", min_total=250_000))
+    finally:
+        if bar is not None:
+            bar.close()
 
 
 def run(args: argparse.Namespace) -> int:
     names = {str(a).split(":")[0].strip().lower() for a in (args.x, args.y)}
     if names & set(DELAYED_AXES):
-        from ._delay_map import run_delay_map
+        return _run_delayed_map(args)
+    return _run_pair_map(args)
 
-        return run_delay_map(args)
+
+def _run_pair_map(args: argparse.Namespace) -> int:
+    """The map over pair stiffnesses (or the viscosity ratio), without a delay."""
+    from .._files import atomic_outputs
+    from .._progress import Progress, shown
+
     model = [f for f in ("controller", "viscosity", "active_stiffness", "active_viscosity",
                          "active_viscosity_ratio", "feedback_delay", "proprioceptive_weight",
                          "pair")
@@ -418,40 +292,33 @@ def run(args: argparse.Namespace) -> int:
     load_compiled(lambda: stability_map(x, y, 2, **where).write_csv(io.StringIO()),
                   "the stability evaluator")
 
-    temporaries: list[Path] = []
-    try:
-        # Created first: an unwritable directory fails before the computation.
-        tmp_figure = _temporary_beside(figure_path)
-        temporaries.append(tmp_figure)
-        tmp_csv = _temporary_beside(csv_path)
-        temporaries.append(tmp_csv)
+    show = shown(args.progress)
+    # Created first: an unwritable directory fails before the computation.
+    with atomic_outputs([figure_path, csv_path], what="--out ",
+                        error=ParameterError) as (tmp_figure, tmp_csv):
+        bar = Progress(label="stability-map", unit="sets") if show else None
+        try:
+            # The compiled map and CSV writer release the GIL: each runs on a worker thread
+            # while this one imports matplotlib and then draws the figure.
+            with ThreadPoolExecutor(max_workers=1) as worker:
+                computing = worker.submit(stability_map, x, y, resolution, progress=bar or
+                                          ExpectedTime("stability-map", "parameter sets",
+                                                       min_total=250_000), **where)
+                _import_plotting()
+                smap = computing.result()
+                if bar is not None:
+                    bar.close()
+                writing = worker.submit(_write_csv, smap, tmp_csv, show)
+                try:
+                    from ..viz.maps import plot_stability_map
 
-        show = args.progress or sys.stderr.isatty()
-        progress = ProgressBar(sys.stderr, "stability-map") if show else \
-            ExpectedTime("stability-map", "parameter sets", min_total=250_000)
-        # The compiled map and CSV writer release the GIL: each runs on a worker thread
-        # while this one imports matplotlib and then draws the figure.
-        with ThreadPoolExecutor(max_workers=1) as worker:
-            computing = worker.submit(stability_map, x, y, resolution, progress=progress,
-                                      **where)
-            _import_plotting()
-            smap = computing.result()
-            writing = worker.submit(_write_csv, smap, tmp_csv, show)
-            try:
-                with open(tmp_figure, "wb") as stream:
-                    plot_stability_map(smap, stream, fmt)
-            finally:
-                wait([writing])  # before the temporaries may be removed
-            writing.result()
-        os.replace(tmp_csv, csv_path)
-        temporaries.remove(tmp_csv)
-        os.replace(tmp_figure, figure_path)
-        temporaries.remove(tmp_figure)
-    except OSError as exc:
-        raise ParameterError(f"cannot write --out {args.out!r}: {exc.strerror or exc}") from None
-    finally:
-        for tmp in temporaries:
-            tmp.unlink(missing_ok=True)
+                    plot_stability_map(smap).savefig(tmp_figure, format=fmt, dpi=150)
+                finally:
+                    wait([writing])  # before the temporaries may be removed
+                writing.result()
+        finally:
+            if bar is not None:
+                bar.close()
     ny, nx = smap.grid.shape
     on = "" if body.name == "paper" else f" of body {body.name}"
     print(f"wrote {figure_path} and {csv_path}: {nx} × {ny} parameter sets{on}, "
@@ -459,3 +326,102 @@ def run(args: argparse.Namespace) -> int:
           f"(largest real part {smap.max_real_part.min():.3g} .. "
           f"{smap.max_real_part.max():.3g} 1/s)")
     return 0
+
+
+# ---- the delayed map -------------------------------------------------------------
+
+
+def _delayed_axis(text: str, flag: str, pairs) -> tuple[str, str, float, float]:
+    """``QUANTITY[:PAIR]:LO:HI`` -> (quantity, pair, LO, HI), the name the table's."""
+    parts = str(text).split(":")
+    if len(parts) not in (3, 4):
+        raise ParameterError(f"{flag} must be NAME:LO:HI (e.g. active_stiffness:ankle:0:1700), "
+                             f"got {text!r}")
+    given = ":".join(parts[:-2]).strip().lower()
+    if given.partition(":")[0] not in ("active_stiffness", "active_viscosity"):
+        raise ParameterError(f"{flag}: with a delayed map both axes are active_stiffness:PAIR "
+                             f"and active_viscosity:PAIR, got {given!r}")
+    name, _, pair = resolve(given, pairs, (), what=f"{flag} parameter").partition(":")
+    try:
+        low, high = float(parts[-2]), float(parts[-1])
+    except ValueError:
+        raise ParameterError(f"{flag} LO and HI must be numbers, got {text!r}") from None
+    if not (math.isfinite(low) and math.isfinite(high) and 0 <= low < high):
+        raise ParameterError(f"{flag} must have 0 <= LO < HI, got {low:g}:{high:g}")
+    check_value(name, high, f"{flag} HI")  # the parameter table's bound
+    return name, pair, low, high
+
+
+def _gain_pair_names(body) -> tuple[str, ...]:
+    """The pair names of the layout a body's gains have (the paper's five on three links)."""
+    from ..model.muscles import PAPER_PAIR_NAMES, joint_pair_names
+
+    return PAPER_PAIR_NAMES if body.n_links == 3 else joint_pair_names(body.n_links)
+
+
+def _run_delayed_map(args: argparse.Namespace) -> int:
+    """The D-subdivision map of one pair's active gains with a feedback delay."""
+    import numpy as np
+
+    from .._files import atomic_write_files
+    from .._progress import Progress, shown
+    from ..linear.delay_batch import MAX_DELAY_MAP_RESOLUTION, delay_stability_map
+    from ..viz.maps import plot_delay_stability_map
+    from ._common import body_from_args, feedback_options_from_args, muscles_from_args
+
+    if args.pair is not None:
+        raise ParameterError(f"--pair is now part of the axis names: --x active_stiffness:"
+                             f"{args.pair}:LO:HI --y active_viscosity:{args.pair}:LO:HI")
+    body = body_from_args(args)
+    pairs = _gain_pair_names(body)
+    parsed = [_delayed_axis(a, f, pairs) for a, f in ((args.x, "--x"), (args.y, "--y"))]
+    axes = {name: (low, high) for name, _, low, high in parsed}
+    if len(axes) != 2:
+        raise ParameterError("--x and --y must be active_stiffness:PAIR and "
+                             "active_viscosity:PAIR")
+    if parsed[0][1] != parsed[1][1]:
+        raise ParameterError(f"--x and --y must name the same pair, got {parsed[0][1]!r} and "
+                             f"{parsed[1][1]!r}")
+    pair = parsed[0][1]
+    resolution = parse_resolution(args.resolution, MAX_DELAY_MAP_RESOLUTION,
+                                  "with a feedback delay")
+    delay = feedback_options_from_args(args).get("feedback_delay")
+    if delay is None:
+        raise ParameterError("a map over active gains needs --feedback-delay S [s]")
+    figure_path, csv_path, fmt = output_paths(args.out)
+    if args.stiffness is None and args.controller is None:
+        if body.n_links != 3:
+            raise ParameterError("give --stiffness (the intrinsic gains) or --controller for "
+                                 "this body")
+    else:
+        args.case = None  # (--case has a default: the paper's Table I case 1)
+    args.viscosity_ratio = parse_viscosity_ratio(args.viscosity_ratio)
+    muscles = muscles_from_args(args, body)
+    bar = Progress(resolution**2, label="stability-map", unit="sets") \
+        if shown(args.progress) else None
+    try:
+        dmap = delay_stability_map(body, muscles, delay, axes["active_stiffness"],
+                                   axes["active_viscosity"], resolution, pair=pair,
+                                   progress=bar or ExpectedTime("stability-map", "sets",
+                                                                min_total=2500))
+    finally:
+        if bar is not None:
+            bar.close()
+    x_first = parsed[0][0] == "active_stiffness"
+    fig = plot_delay_stability_map(dmap)
+    kx, vy = np.meshgrid(dmap.active_stiffness, dmap.active_viscosity)
+    table = np.column_stack([kx.ravel(), vy.ravel(), dmap.max_real_part.ravel(),
+                             dmap.stable.ravel()])
+    buf = io.StringIO()
+    np.savetxt(buf, table, delimiter=",", fmt=["%.17g", "%.17g", "%.17g", "%d"],
+               header=f"active_stiffness:{pair},active_viscosity:{pair},max_real_part,stable",
+               comments="")
+    image = io.BytesIO()
+    fig.savefig(image, format=fmt, dpi=110)
+    atomic_write_files({csv_path: buf.getvalue().encode("utf-8"), figure_path: image.getvalue()})
+    print(f"wrote {figure_path} and {csv_path}: {resolution} × {resolution} sets of the "
+          f"{dmap.pair} pair's active gains at τ = {delay:g} s, "
+          f"{100 * float(np.mean(dmap.stable)):.1f}% stable"
+          + ("" if x_first else " (x is always the active stiffness)"))
+    return 0
+

@@ -14,7 +14,6 @@ from ..studies.sweep import (
     MAX_RUNS,
     OUTCOME_COLUMNS,
     SWEEP_PARAMETERS,
-    ProgressBar,
     SweepInterrupted,
     check_scheduler_address,
     max_workers,
@@ -260,10 +259,12 @@ def _runs(varies) -> int:
 def _with_progress(args: argparse.Namespace, total: int, work):
     """``work(progress)`` with a progress bar on standard error (a terminal, or
     --progress); returns its result and the seconds it took."""
-    bar = ProgressBar(total) if args.progress or sys.stderr.isatty() else None
+    from .._progress import Progress, shown
+
+    bar = Progress(total, label="sweep", unit="runs") if shown(args.progress) else None
     t0 = time.perf_counter()
     try:
-        result = work(None if bar is None else (lambda done, _: bar.update(done)))
+        result = work(bar)
     finally:
         if bar is not None:
             bar.close()

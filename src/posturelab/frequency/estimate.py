@@ -30,7 +30,7 @@ The gain bounds are |H|(1 ± r) (the lower clipped at 0), the phase bounds ±asi
 when r >= 1). Phase [deg] is unwrapped across the bands from the first, which lies in
 (−180°, 180°].
 
-Precision per band (what :func:`posturelab.frequency.fit_frf` weights by): the band's
+Precision per band (what :func:`posturelab.frequency.fit.fit_frf` weights by): the band's
 Ĥ = Σ_j G_j Ĥ_j / Σ_j G_j over its harmonics j (G_j = Σ_c |X_cj|² over the C cycles,
 Ĥ_j = Σ_c X̄_cj Y_cj / G_j) has, for noise of variance σ² in the response spectrum about the
 band, E|Ĥ − H|² = σ² / Σ_j G_j. σ² is estimated from the scatter of the cycles about the
@@ -69,7 +69,8 @@ from .._validation import finite_array, float_in_range
 from ..errors import ParameterError
 from .bands import band_frequencies, resolve_bands
 
-__all__ = ["FRFEstimate", "estimate_frf", "confidence_radius", "BOUNDS", "MAX_SAMPLES"]
+__all__ = ["FRFEstimate", "estimate_frf", "confidence_radius", "whole_cycles",
+           "sign_convention", "BOUNDS", "MAX_SAMPLES"]
 
 #: Degrees of freedom the noise estimate of a band pools at least (module notes). [-]
 POOLED_DOF = 20
@@ -422,3 +423,32 @@ def sign_warning(est: FRFEstimate) -> str | None:
                 f"({int(est.response_sign):+d}) is probably the opposite of this recording's "
                 "convention (check --response-sign, or response_sign in the API)")
     return None
+
+
+def whole_cycles(stimulus: np.ndarray, response: np.ndarray, sample_rate: float,
+                 cycle_length: float) -> tuple[np.ndarray, np.ndarray, bool]:
+    """The two series without a last sample one past whole cycles (a record that includes
+    its end point, as ``posturelab simulate`` writes), and whether it was dropped.
+
+    Parameters
+    ----------
+    stimulus, response : numpy.ndarray, shape (T,)
+        The series, sampled together. [rad or m]
+    sample_rate : float
+        Samples per second. [Hz]
+    cycle_length : float
+        The stimulus's cycle. [s]
+    """
+    per_cycle = sample_rate * cycle_length
+    if per_cycle > 0 and abs(per_cycle - round(per_cycle)) < 1e-6 * per_cycle \
+            and stimulus.size % round(per_cycle) == 1:
+        return stimulus[:-1], response[:-1], True
+    return stimulus, response, False
+
+
+def sign_convention(sign: int) -> str:
+    """One phrase stating the sign the response was taken with (−1: posturelab's tilt
+    convention; +1: as recorded)."""
+    return ("response × −1 (posturelab's tilt convention: sway forward positive, tilt "
+            "toes-up positive, following the surface reads gain 1, phase 0)" if sign < 0
+            else "response × +1 (as recorded)")

@@ -18,7 +18,12 @@ import numpy as np
 from ..errors import ParameterError
 from .estimate import FRFEstimate, estimate_frf
 
-__all__ = ["PRTSExperiment", "prts_experiment"]
+__all__ = ["PRTSExperiment", "prts_experiment", "MAX_SENSOR_NOISE", "MAX_RECORD_RATE"]
+
+#: Largest sensor noise (standard deviation) on a recorded angle. [rad]
+MAX_SENSOR_NOISE = 1.0
+#: Highest record rate of a PRTS experiment. [Hz]
+MAX_RECORD_RATE = 1e5
 
 
 @dataclass(frozen=True)
@@ -119,7 +124,6 @@ def prts_experiment(body, muscles, *, tilt=None, cycles: int = 5, discard: int =
     check_length(cycles, discard, tilt.cycle)
     check_output(output, body.n_links)
     from .._validation import float_in_range
-    from .population import MAX_RECORD_RATE, MAX_SENSOR_NOISE
 
     float_in_range("sensor_noise [rad]", sensor_noise, 0.0, MAX_SENSOR_NOISE, unit="rad")
     float_in_range("sample_rate [Hz]", sample_rate, 1.0, MAX_RECORD_RATE, unit="Hz")

@@ -7,7 +7,7 @@ each parameter set the in-silico identification experiment of
 :func:`posturelab.frequency.experiment.prts_experiment` (a :class:`PRTSProtocol`): the
 nonlinear model on the compiled engine for ``discard + cycles`` cycles, seeded measurement
 noise on the recorded angle, the scenario's motor noise, the FRF at the bands, and, if
-asked, :func:`posturelab.frequency.fit_frf` of the ``fit`` parameters, started from the base
+asked, :func:`posturelab.frequency.fit.fit_frf` of the ``fit`` parameters, started from the base
 experiment's values (what an experimenter would assume before seeing the subject).
 
 Seeds: run r's measurement noise uses the seed ``SeedSequence([seed, r])`` and its motor
@@ -32,15 +32,12 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..scenarios import Scenario
+from .experiment import MAX_RECORD_RATE, MAX_SENSOR_NOISE  # (the one experiment's bounds)
 
 __all__ = ["PRTSProtocol", "PRTSSweepResult", "prts_sweep", "MAX_EXPERIMENTS"]
 
 #: Most experiments one sweep may run (each is a simulation of minutes of stance). [-]
 MAX_EXPERIMENTS = 100_000
-#: Largest sensor noise (standard deviation) on a recorded angle. [rad]
-MAX_SENSOR_NOISE = 1.0
-#: Highest record rate of a PRTS experiment. [Hz]
-MAX_RECORD_RATE = 1e5
 
 
 @dataclass(frozen=True)
@@ -64,7 +61,7 @@ class PRTSProtocol:
         80-state sequence) becomes the sequence's own for another length
         (:func:`posturelab.frequency.bands.sequence_bands`).
     fit : tuple of str
-        Parameters for :func:`posturelab.frequency.fit_frf` to estimate per run (the
+        Parameters for :func:`posturelab.frequency.fit.fit_frf` to estimate per run (the
         parameter table's names: ``active_stiffness:ankle``, ``feedback_delay``, …); none:
         no fit.
     """

@@ -1,5 +1,5 @@
 """FRFs given as tables: gain and phase per band (published tables, group means), with
-optional standard errors, for :func:`posturelab.frequency.fit_frf`.
+optional standard errors, for :func:`posturelab.frequency.fit.fit_frf`.
 
 A table gives, per band, the frequency [Hz] and the FRF either as ``gain`` [-] and
 ``phase_deg`` [deg] or as ``frf`` ({re, im} pairs, what ``posturelab frf --json`` writes).

@@ -162,3 +162,47 @@ def centre_of_pressure(ankle_moment: np.ndarray, vertical_force: np.ndarray) -> 
     fy = np.asarray(vertical_force, dtype=float)
     with np.errstate(divide="ignore", invalid="ignore"):
         return np.where(fy > 0.0, tau / np.where(fy > 0.0, fy, 1.0), np.nan)
+
+
+# ---- strategies: the ankle (in-phase) and hip (anti-phase) modes -----------------------
+# (after Creath et al. 2005; definitions in posturelab.studies.strategy, which re-exports these)
+
+__all__ += ["strategy_modes", "hip_fraction"]
+
+
+def strategy_modes(theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The ankle (in-phase) and hip (anti-phase) modes of a trajectory.
+
+    With u(t) and w(t) the leg angle θ_1 and the trunk angle θ_N less their values at the
+    start, a = (u + w)/2 (leg and trunk lean together) and b = (u − w)/2 (they counter-rotate
+    about the hip); see :mod:`posturelab.studies.strategy`.
+
+    Parameters
+    ----------
+    theta : array_like, shape (T, N), N >= 2
+        Link angles. [rad]
+
+    Returns
+    -------
+    (numpy.ndarray, numpy.ndarray), each shape (T,)
+        a(t), b(t). [rad]
+    """
+    from ..errors import ParameterError
+
+    theta = np.asarray(theta, dtype=float)
+    if theta.ndim != 2 or theta.shape[1] < 2:
+        raise ParameterError(f"theta must have shape (T, N) with N >= 2 links, got "
+                             f"{theta.shape}")
+    u = theta[:, 0] - theta[0, 0]
+    w = theta[:, -1] - theta[0, -1]
+    return 0.5 * (u + w), 0.5 * (u - w)
+
+
+def hip_fraction(theta: np.ndarray) -> float:
+    """Σ b² / (Σ a² + Σ b²) of :func:`strategy_modes` [-]; 0 if nothing moves, NaN for N = 1."""
+    theta = np.asarray(theta, dtype=float)
+    if theta.ndim == 2 and theta.shape[1] == 1:
+        return float("nan")
+    a, b = strategy_modes(theta)
+    total = float(a @ a + b @ b)
+    return 0.0 if total == 0.0 else float(b @ b) / total

@@ -5,14 +5,18 @@ from __future__ import annotations
 import csv
 import functools
 import io
-import os
-import tempfile
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
+from .._files import (  # (re-exported: the writers keep this public path)
+    atomic_write_bytes,
+    atomic_write_files,
+    atomic_write_text,
+    new_file_mode,
+)
 from ..errors import PostureLabError
 from .outcome import StimulusTiming
 
@@ -220,9 +224,9 @@ class SimulationResult:
     @property
     def hip_fraction(self) -> float:
         """Share of the anti-phase (hip) mode of leg and trunk in the run's motion, in
-        [0, 1]; NaN for a one-link body (:func:`posturelab.studies.strategy.hip_fraction`:
+        [0, 1]; NaN for a one-link body (:func:`posturelab.model.kinematics.hip_fraction`:
         the definition, after Creath et al. 2005). [-]"""
-        from ..studies.strategy import hip_fraction
+        from ..model.kinematics import hip_fraction
 
         return hip_fraction(self.theta)
 
@@ -384,88 +388,3 @@ def read_run_csv(path: str | Path) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     if not np.all(np.isfinite(data)) or np.any(np.diff(data[:, 0]) < 0):
         raise DataFileError(f"{what}: values must be finite and t must not decrease")
     return data[:, 0], data[:, 1:1 + n], data[:, 1 + n:]
-
-
-def new_file_mode() -> int:
-    """Permission bits a newly created file gets under the current umask (0o644 for 022).
-
-    ``tempfile.mkstemp`` creates 0600 files; atomic writes set this mode before renaming.
-    """
-    mask = os.umask(0)
-    os.umask(mask)
-    return 0o666 & ~mask
-
-
-def _atomic_write(path: str | Path, data: bytes) -> None:
-    from .._files import refuse_non_regular
-
-    path = Path(path)
-    directory = path.parent if str(path.parent) else Path(".")
-    refuse_non_regular(path, PostureLabError)
-    if not directory.is_dir():
-        raise PostureLabError(
-            f"cannot write {str(path)!r}: directory {str(directory)!r} does not exist"
-        )
-    try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=directory)
-    except OSError as exc:
-        raise PostureLabError(f"cannot write {str(path)!r}: {exc.strerror}") from None
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-        os.chmod(tmp, new_file_mode())
-        os.replace(tmp, path)
-    except OSError as exc:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
-        raise PostureLabError(f"cannot write {str(path)!r}: {exc.strerror}") from None
-
-
-def atomic_write_files(contents: dict[str | Path, bytes]) -> None:
-    """Write several files so that a failure leaves none of them written: each goes to a
-    temporary file beside it, and only when all are written are they renamed in turn."""
-    from .._files import refuse_non_regular
-
-    temporaries: list[tuple[str, Path]] = []
-    try:
-        for path, data in contents.items():
-            path = Path(path)
-            refuse_non_regular(path, PostureLabError)
-            directory = path.parent if str(path.parent) else Path(".")
-            try:
-                fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp",
-                                           dir=directory)
-            except OSError as exc:
-                raise PostureLabError(f"cannot write {str(path)!r}: {exc.strerror}") from None
-            temporaries.append((tmp, path))
-            try:
-                with os.fdopen(fd, "wb") as fh:
-                    fh.write(data)
-                os.chmod(tmp, new_file_mode())
-            except OSError as exc:
-                raise PostureLabError(f"cannot write {str(path)!r}: {exc.strerror}") from None
-        while temporaries:
-            tmp, path = temporaries[0]
-            try:
-                os.replace(tmp, path)
-            except OSError as exc:
-                raise PostureLabError(f"cannot write {str(path)!r}: {exc.strerror}") from None
-            temporaries.pop(0)
-    finally:
-        for tmp, _ in temporaries:
-            try:
-                os.unlink(tmp)
-            except OSError:
-                pass
-
-
-def atomic_write_text(path: str | Path, text: str) -> None:
-    """Write ``text`` to ``path`` through a temporary file and a rename."""
-    _atomic_write(path, text.encode("utf-8"))
-
-
-def atomic_write_bytes(path: str | Path, data: bytes) -> None:
-    """Write ``data`` to ``path`` through a temporary file and a rename."""
-    _atomic_write(path, data)

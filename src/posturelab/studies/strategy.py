@@ -29,6 +29,7 @@ import numpy as np
 
 from .._validation import finite_array, float_in_range
 from ..errors import ParameterError
+from ..model.kinematics import hip_fraction, strategy_modes  # (defined with the kinematics)
 
 __all__ = ["strategy_modes", "hip_fraction", "HipFractionStudy", "hip_fraction_study",
            "CREATH_2005_CITATION", "RUNGE_1999_CITATION", "MAX_STUDY_RUNS"]
@@ -44,38 +45,6 @@ RUNGE_1999_CITATION = (
 )
 #: Most runs :func:`hip_fraction_study` accepts. [-]
 MAX_STUDY_RUNS = 10_000
-
-
-def strategy_modes(theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The ankle (in-phase) and hip (anti-phase) modes of a trajectory (module notes).
-
-    Parameters
-    ----------
-    theta : array_like, shape (T, N), N >= 2
-        Link angles. [rad]
-
-    Returns
-    -------
-    (numpy.ndarray, numpy.ndarray), each shape (T,)
-        a(t), b(t). [rad]
-    """
-    theta = np.asarray(theta, dtype=float)
-    if theta.ndim != 2 or theta.shape[1] < 2:
-        raise ParameterError(f"theta must have shape (T, N) with N >= 2 links, got "
-                             f"{theta.shape}")
-    u = theta[:, 0] - theta[0, 0]
-    w = theta[:, -1] - theta[0, -1]
-    return 0.5 * (u + w), 0.5 * (u - w)
-
-
-def hip_fraction(theta: np.ndarray) -> float:
-    """Σ b² / (Σ a² + Σ b²) of :func:`strategy_modes` [-]; 0 if nothing moves, NaN for N = 1."""
-    theta = np.asarray(theta, dtype=float)
-    if theta.ndim == 2 and theta.shape[1] == 1:
-        return float("nan")
-    a, b = strategy_modes(theta)
-    total = float(a @ a + b @ b)
-    return 0.0 if total == 0.0 else float(b @ b) / total
 
 
 @dataclass(frozen=True)

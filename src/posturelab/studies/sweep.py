@@ -39,8 +39,6 @@ import itertools
 import math
 import os
 import re
-import sys
-import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -664,51 +662,14 @@ def _concatenate(parts: list[BatchResult]) -> BatchResult:
                               np.concatenate([getattr(p, f) for p in parts])) for f in steady})
 
 
-class ProgressBar:
-    """A one-line progress bar on a text stream (standard error by default).
+def ProgressBar(total: int, stream: IO[str] | None = None, width: int = 30,
+                unit: str = "runs"):
+    """A one-line progress bar of ``total`` runs on ``stream`` (standard error by default):
+    :class:`posturelab._progress.Progress`, the bar every command draws; ``update(done)``
+    sets the finished count, ``close()`` ends the line."""
+    from .._progress import Progress
 
-    Parameters
-    ----------
-    total : int
-        Number of runs. [-]
-    stream : file-like, optional
-        Where to draw; ``sys.stderr`` by default.
-    width : int
-        Characters of the bar itself. [-]
-    unit : str
-        What is counted ("runs", "sets", ...).
-    """
-
-    def __init__(self, total: int, stream: IO[str] | None = None, width: int = 30,
-                 unit: str = "runs"):
-        self.total = max(int(total), 1)
-        self.stream = sys.stderr if stream is None else stream
-        self.width = width
-        self.unit = unit
-        self.start = time.perf_counter()
-        self.done = 0
-        self._draw()
-
-    def update(self, done: int) -> None:
-        """Set the number of finished runs and redraw."""
-        self.done = min(int(done), self.total)
-        self._draw()
-
-    def close(self) -> None:
-        """Finish the line."""
-        self._draw()
-        self.stream.write("\n")
-        self.stream.flush()
-
-    def _draw(self) -> None:
-        frac = self.done / self.total
-        filled = int(round(frac * self.width))
-        elapsed = time.perf_counter() - self.start
-        eta = elapsed * (1 - frac) / frac if frac > 0 else math.nan
-        eta_text = f", {eta:.1f} s left" if frac < 1 and math.isfinite(eta) else ""
-        self.stream.write(f"\r[{'#' * filled}{'.' * (self.width - filled)}] {frac:4.0%} "
-                          f"{self.done}/{self.total} {self.unit}, {elapsed:.1f} s{eta_text} ")
-        self.stream.flush()
+    return Progress(total, unit=unit, stream=stream, width=width)
 
 
 def run_sweep(
@@ -781,6 +742,20 @@ class SweepInterrupted(KeyboardInterrupt):
         super().__init__(f"interrupted after {rows} of {total} runs")
         self.parts, self.rows, self.total, self.terminated = parts, rows, total, terminated
         self.result: Any = None
+
+
+class _RowsKept:
+    """Rows of the leading finished chunks: what an interrupt keeps, and so what progress
+    counts (chunks finish out of order; one finished after a running one is not kept)."""
+
+    def __init__(self, parts: list, bounds: list) -> None:
+        self.parts, self.bounds, self.leading = parts, bounds, 0
+
+    def __call__(self) -> int:
+        """The rows kept now. [-]"""
+        while self.leading < len(self.parts) and self.parts[self.leading] is not None:
+            self.leading += 1
+        return self.bounds[self.leading - 1][1] if self.leading else 0
 
 
 def _interrupted(exc: BaseException, parts: list, bounds: list, total: int
@@ -878,15 +853,14 @@ def run_chunks(task, grid: SweepGrid, *, workers: int | None = None, scheduler: 
 
     pool = ThreadPoolExecutor(threads)
     futures: dict = {}
+    kept = _RowsKept(parts, bounds)
     try:
         futures = {pool.submit(task.run, grid, lo, hi, True): k
                    for k, (lo, hi) in enumerate(bounds)}
         for fut in as_completed(futures):
-            k = futures[fut]
-            parts[k] = fut.result()
-            done += bounds[k][1] - bounds[k][0]
+            parts[futures[fut]] = fut.result()
             if progress is not None:
-                progress(done, m)
+                progress(kept(), m)
     except KeyboardInterrupt as exc:
         pool.shutdown(wait=True, cancel_futures=True)  # the running chunks finish
         for fut, k in futures.items():
@@ -984,15 +958,12 @@ def _run_on_dask(task, grid, bounds, workers, scheduler, client, progress,
         futures = [client.submit(_run_chunk, shared, shared_grid, lo, hi, pure=False)
                    for lo, hi in bounds]
         index = {f.key: k for k, f in enumerate(futures)}
-        done = 0
+        kept = _RowsKept(parts, bounds)
         try:
             for fut in distributed.as_completed(futures):
-                k = index[fut.key]
-                parts[k] = fut.result()
-                lo, hi = bounds[k]
-                done += hi - lo
+                parts[index[fut.key]] = fut.result()
                 if progress is not None:
-                    progress(done, grid.n_runs)
+                    progress(kept(), grid.n_runs)
         except KeyboardInterrupt:
             interrupted = True
             with _quiet_dask():  # keep the chunks that finished, drop the rest

@@ -16,8 +16,6 @@ figure; the last frame is held for one second.
 from __future__ import annotations
 
 import math
-import os
-import tempfile
 import textwrap
 from pathlib import Path
 
@@ -27,11 +25,12 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from PIL import Image
 
+from .._files import atomic_outputs
 from .._validation import float_in_range, positive_float
 from ..errors import ParameterError, PostureLabError
 from ..model.body import Body
 from ..model.options import BaseOfSupport, base_of_support_for_height
-from ..simulation.results import SimulationResult, new_file_mode
+from ..simulation.results import SimulationResult
 
 _FALL_RED = "#c00000"
 _COG_YELLOW = "#f2a900"
@@ -271,24 +270,14 @@ def animate(
 
     hold = max(1, int(round(play_fps)))  # hold the last frame ~1 s
     moving = [links_line, cog_dot, cog_proj, cog_drop, floor_marks, stamp, fall_text]
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".gif", dir=directory)
-    os.close(fd)
-    try:
+    with atomic_outputs([path], suffix=".gif") as (tmp,):
         writer = _BlittingPillowWriter(moving, fps=play_fps)
-        with writer.saving(fig, tmp, dpi):
+        with writer.saving(fig, str(tmp), dpi):
             for k in range(len(idx)):
                 draw(k)
                 writer.grab_frame()
             for _ in range(hold):
                 writer.grab_frame()
-        os.chmod(tmp, new_file_mode())  # mkstemp makes 0600
-        os.replace(tmp, path)
-    except OSError as exc:
-        _unlink(tmp)
-        raise PostureLabError(f"cannot write {str(path)!r}: {exc.strerror or exc}") from None
-    except BaseException:
-        _unlink(tmp)
-        raise
     return path
 
 
@@ -345,10 +334,3 @@ class _BlittingPillowWriter(PillowWriter):
         self._images[0].save(self.outfile, format="GIF", save_all=True,
                              append_images=self._images[1:],
                              duration=int(round(1000 / self.fps)), loop=0, optimize=False)
-
-
-def _unlink(p: str) -> None:
-    try:
-        os.unlink(p)
-    except OSError:
-        pass
