@@ -177,6 +177,28 @@ def test_angular_acceleration_equals_symbolic(derivation):
         close(angular_acceleration(body, theta, omega, u, ax, ay), expected)
 
 
+def test_specification_of_the_compiled_engine_equals_symbolic(derivation):
+    """The equation of motion the compiled engine's C is generated from (the entry formulas
+    of posturelab.model.dynamics, assembled on sympy symbols by _codegen.spec) has the
+    Lagrangian's mass matrix and forcing: J = M and U − BΘ̇ + (g + ÿ_d)G − ẍ_d H = F."""
+    from posturelab.simulation.compiled._codegen.spec import equation_of_motion
+
+    n = derivation.n
+    J, B, G, H, sym = equation_of_motion(n)
+    pairs = sorted(sym["coupling"].items())
+    args = [sym["theta"], sym["omega"], sym["inertia"], sym["gravity_coefficient"],
+            [s for _, s in pairs]]
+    spec_J = sp.lambdify(args, J, "numpy")
+    spec_BGH = sp.lambdify(args, (B, G, H), "numpy")
+    for body, theta, omega, u, ax, ay, vx, vy in samples(n):
+        params = [theta, omega, body.inertia_diagonal, body.gravity_coefficients,
+                  [body.coupling[i, j] for (i, j), _ in pairs]]
+        close(np.array(spec_J(*params), dtype=float), derivation.mass(body, theta))
+        b, g, h = (np.array(v, dtype=float).reshape(n) for v in spec_BGH(*params))
+        close(u - b + (body.gravity + ay) * g - ax * h,
+              derivation.forcing(body, theta, omega, u, ax, ay, vx, vy))
+
+
 def test_joint_torque_enters_as_generalised_force(derivation):
     """With g = 0 and the body at rest, the forcing is exactly U (U is the generalised force)."""
     rng = np.random.default_rng(12345)

@@ -37,6 +37,26 @@ __all__ = [
 ]
 
 
+# The entries of the equation of motion, over a math namespace ``xp`` (numpy here; sympy when
+# the compiled engine's C is generated from them, posturelab.simulation.compiled._codegen).
+
+def coupling_formula(coupling, theta_i, theta_j, xp=np):
+    """J_ij = c_ij cos(θ_j − θ_i) (i ≠ j). [kg·m²]"""
+    return coupling * xp.cos(theta_j - theta_i)
+
+
+def centripetal_formula(coupling, theta_i, theta_j, omega_j, xp=np):
+    """Link j's part of (BΘ̇)_i: c_ij sin(θ_i − θ_j) θ̇_j². [N·m]"""
+    return coupling * xp.sin(theta_i - theta_j) * (omega_j * omega_j)
+
+
+def load_formula(gravity_coefficient, theta_i, gravity_and_lift, platform_x, xp=np):
+    """Gravity and platform acceleration on link i: a_i ((g + ÿ_d) sin θ_i − ẍ_d cos θ_i),
+    that is (g + ÿ_d) G_i − ẍ_d H_i. [N·m]"""
+    return gravity_coefficient * (gravity_and_lift * xp.sin(theta_i)
+                                  - platform_x * xp.cos(theta_i))
+
+
 def mass_matrix(body: Body, theta: np.ndarray) -> np.ndarray:
     """Inertia matrix J(Θ).
 
@@ -53,8 +73,7 @@ def mass_matrix(body: Body, theta: np.ndarray) -> np.ndarray:
         Symmetric positive-definite inertia matrix. [kg·m²]
     """
     theta = np.asarray(theta, dtype=float)
-    diff = theta[..., None, :] - theta[..., :, None]  # θ_j − θ_i
-    J = body.coupling * np.cos(diff)
+    J = coupling_formula(body.coupling, theta[..., :, None], theta[..., None, :])
     n = body.n_links
     J[..., np.arange(n), np.arange(n)] = body.inertia_diagonal
     return J
@@ -77,8 +96,8 @@ def velocity_terms(body: Body, theta: np.ndarray, omega: np.ndarray) -> np.ndarr
     """
     theta = np.asarray(theta, dtype=float)
     omega = np.asarray(omega, dtype=float)
-    diff = theta[..., :, None] - theta[..., None, :]  # θ_i − θ_j
-    return np.einsum("...ij,...j->...i", body.coupling * np.sin(diff), omega**2)
+    return np.sum(centripetal_formula(body.coupling, theta[..., :, None], theta[..., None, :],
+                                      omega[..., None, :]), axis=-1)
 
 
 def gravity_vector(body: Body, theta: np.ndarray) -> np.ndarray:
@@ -128,8 +147,7 @@ def angular_acceleration(
     rhs = (
         np.asarray(joint_torques, dtype=float)
         - velocity_terms(body, theta, omega)
-        + (body.gravity + ay) * gravity_vector(body, theta)
-        - ax * platform_vector(body, theta)
+        + load_formula(body.gravity_coefficients, theta, body.gravity + ay, ax)
     )
     J = mass_matrix(body, theta)
     return np.linalg.solve(J, rhs[..., None])[..., 0]

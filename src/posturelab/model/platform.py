@@ -117,6 +117,20 @@ class Primitive:
     samples: tuple | None = None
 
 
+def windowed_sine_formula(t, amplitude, duration, start, cycles, xp=np):
+    """A windowed sine's acceleration (:class:`Primitive` ``windowed-sine``): amplitude ·
+    sin(2π · cycles · s), s = (t − start) / duration in [0, 1], zero outside; over a math
+    namespace ``xp`` (numpy, or sympy when the C is generated). [m/s²]"""
+    s = (t - start) / duration
+    return xp.where((s >= 0) & (s <= 1), amplitude * xp.sin(2 * np.pi * cycles * s), 0.0)
+
+
+def sine_formula(t, amplitude, frequency, phase, xp=np):
+    """A sine's acceleration (:class:`Primitive` ``sine``): amplitude · sin(2π · frequency ·
+    t + phase). [m/s²]"""
+    return amplitude * xp.sin(2 * np.pi * frequency * t + phase)
+
+
 class Disturbance:
     """Base class: no velocity change, zero acceleration, no breakpoints."""
 
@@ -251,9 +265,8 @@ class _SinePulse(Disturbance):
 
     def acceleration(self, t):
         t = np.asarray(t, dtype=float)
-        s = (t - self.start) / self.duration
-        a = np.where((s >= 0) & (s <= 1),
-                     self.peak_acceleration_value * np.sin(2 * np.pi * self._cycles * s), 0.0)
+        a = windowed_sine_formula(t, self.peak_acceleration_value, self.duration, self.start,
+                                  self._cycles)
         out = np.zeros(t.shape + (2,))
         out[..., _axis(self.axis)] = a
         return out
@@ -407,7 +420,7 @@ class SumOfSines(Disturbance):
         t = np.asarray(t, dtype=float)
         a = np.zeros(t.shape)
         for amp, f, ph in zip(self.amplitudes, self.frequencies, self.phases, strict=True):
-            a = a + amp * np.sin(2 * np.pi * f * t + ph)
+            a = a + sine_formula(t, amp, f, ph)
         out = np.zeros(t.shape + (2,))
         out[..., _axis(self.axis)] = a
         return out

@@ -8,7 +8,7 @@ Two kinds of function live here.
   engine evaluates them on numpy arrays; the code generator of the compiled engine
   (``posturelab.simulation.compiled._codegen``, a development tool) evaluates the same
   functions on sympy symbols and prints them as C. ``xp`` needs ``sin``, ``cos``, ``abs``,
-  ``minimum`` and ``where(condition, a, b)``.
+  ``minimum``, ``maximum``, ``not_equal`` and ``where(condition, a, b)``.
 * **The model over arrays** (:func:`model_response`, :func:`raw_moments`,
   :func:`event_value`, …): the numpy right-hand side and event functions of one
   :class:`SwitchedModel`, built from the formulas and the equation of motion of
@@ -35,8 +35,8 @@ from .kinematics import centre_of_pressure, ground_reaction
 from .muscles import MuscleSet, feedback_pair_torques, moments_to_link_torques, muscle_set_gains
 from .noise import TorqueSeries, torque_at
 from .options import FallCriteria, KneeModel
-from .platform import Disturbance
-from .tilt import Tilt
+from .platform import Disturbance, sine_formula, windowed_sine_formula  # noqa: F401
+from .tilt import Tilt, axis_acceleration_formula
 
 __all__ = [
     "SwitchedModel",
@@ -87,7 +87,7 @@ def pull_value_formula(torque, stiffness, stretch, xp=np):
 def saturated_moment_formula(moment, saturation, limit, xp=np):
     """A joint's moment with its saturation applied: ±limit while saturated (saturation
     ±1), the moment itself while free (saturation 0). [N·m]"""
-    return xp.where(saturation != 0, saturation * limit, moment)
+    return xp.where(xp.not_equal(saturation, 0), saturation * limit, moment)
 
 
 def tilt_pair_torque_formula(gain_angle, gain_rate, gain_delayed_angle, gain_delayed_rate,
@@ -95,25 +95,6 @@ def tilt_pair_torque_formula(gain_angle, gain_rate, gain_delayed_angle, gain_del
     """A pair's torque from the tilt: g₀ α(t) + g₁ α̇(t) + g₂ α(t − τ) + g₃ α̇(t − τ). [N·m]"""
     return (gain_angle * angle + gain_rate * rate) + (gain_delayed_angle * delayed_angle
                                                       + gain_delayed_rate * delayed_rate)
-
-
-def axis_acceleration_formula(depth, angle, rate, accel, xp=np):
-    """The ankle's acceleration (ẍ, ÿ) when the surface turns about an axis ``depth`` below
-    it: ẍ = −h (α̈ cos α − α̇² sin α), ÿ = −h (α̈ sin α + α̇² cos α). [m/s²]"""
-    c, s = xp.cos(angle), xp.sin(angle)
-    return -depth * (accel * c - rate * rate * s), -depth * (accel * s + rate * rate * c)
-
-
-def windowed_sine_formula(t, amplitude, duration, start, cycles, xp=np):
-    """A windowed sine's acceleration: amplitude · sin(2π · cycles · s), s = (t − start) /
-    duration in [0, 1], zero outside. [m/s²]"""
-    s = (t - start) / duration
-    return xp.where((s >= 0) & (s <= 1), amplitude * xp.sin(2 * np.pi * cycles * s), 0.0)
-
-
-def sine_formula(t, amplitude, frequency, phase, xp=np):
-    """A sine's acceleration: amplitude · sin(2π · frequency · t + phase). [m/s²]"""
-    return amplitude * xp.sin(2 * np.pi * frequency * t + phase)
 
 
 def vertical_reaction_term_formula(gravity_coefficient, angle, rate, acceleration, xp=np):

@@ -68,6 +68,35 @@ PETERKA_2002_CITATION = (
 )
 
 
+def sine_tilt_formula(t, amplitude, frequency, phase, xp=np):
+    """(α, α̇, α̈) of a sine term: α = amplitude · sin(2π · frequency · t + phase) for t >= 0,
+    held at its t = 0 value before; over a math namespace ``xp`` (numpy, or sympy when the C
+    is generated). [rad], [rad/s], [rad/s²]"""
+    w = 2 * math.pi * frequency
+    arg = w * xp.maximum(t, 0.0) + phase
+    after = t >= 0
+    return (amplitude * xp.sin(arg), xp.where(after, amplitude * w * xp.cos(arg), 0.0),
+            xp.where(after, -amplitude * w * w * xp.sin(arg), 0.0))
+
+
+def raised_cosine_tilt_formula(t, amplitude, start, duration, xp=np):
+    """(α, α̇, α̈) of a raised-cosine ramp: α = amplitude · (1 − cos(π s))/2 for s = (t −
+    start)/duration in [0, 1], 0 before, amplitude after. [rad], [rad/s], [rad/s²]"""
+    s = xp.minimum(xp.maximum((t - start) / duration, 0.0), 1.0)
+    inside = (t > start) & (t < start + duration)
+    k = math.pi / duration
+    return (amplitude * 0.5 * (1.0 - xp.cos(math.pi * s)),
+            xp.where(inside, amplitude * 0.5 * k * xp.sin(math.pi * s), 0.0),
+            xp.where(inside, amplitude * 0.5 * k * k * xp.cos(math.pi * s), 0.0))
+
+
+def cubic_formula(c0, c1, c2, c3, u):
+    """c0 + c1 u + c2 u² + c3 u³ by Horner's rule, with its first and second derivatives in
+    u (a piecewise cubic's value on one interval, u = t − knot)."""
+    return (c0 + u * (c1 + u * (c2 + u * c3)), c1 + u * (2 * c2 + u * 3 * c3),
+            2 * c2 + 6 * u * c3)
+
+
 @dataclass(frozen=True)
 class TiltTerm:
     """One term of a tilt profile, in the form the engines evaluate.
@@ -115,20 +144,9 @@ class TiltTerm:
         """(α, α̇, α̈) at ``t`` (any shape). [rad], [rad/s], [rad/s²]"""
         t = np.asarray(t, dtype=float)
         if self.kind == "sine":
-            w = 2 * math.pi * self.frequency
-            tt = np.maximum(t, 0.0)
-            after = t >= 0.0
-            rate = np.where(after, self.amplitude * w * np.cos(w * tt + self.phase), 0.0)
-            accel = np.where(after, -self.amplitude * w * w * np.sin(w * tt + self.phase), 0.0)
-            return self.amplitude * np.sin(w * tt + self.phase), rate, accel
+            return sine_tilt_formula(t, self.amplitude, self.frequency, self.phase)
         if self.kind == "raised-cosine":
-            s = np.clip((t - self.start) / self.duration, 0.0, 1.0)
-            inside = (t > self.start) & (t < self.start + self.duration)
-            angle = self.amplitude * 0.5 * (1.0 - np.cos(math.pi * s))
-            k = math.pi / self.duration
-            rate = np.where(inside, self.amplitude * 0.5 * k * np.sin(math.pi * s), 0.0)
-            accel = np.where(inside, self.amplitude * 0.5 * k * k * np.cos(math.pi * s), 0.0)
-            return angle, rate, accel
+            return raised_cosine_tilt_formula(t, self.amplitude, self.start, self.duration)
         # piecewise cubic
         x, c = self.knots, self.coefficients
         tt = t
@@ -139,9 +157,7 @@ class TiltTerm:
         k = np.clip(np.searchsorted(x, tc, side="right") - 1, 0, len(c) - 1)
         u = tc - x[k]
         ck = c[k]
-        angle = ck[..., 0] + u * (ck[..., 1] + u * (ck[..., 2] + u * ck[..., 3]))
-        rate = ck[..., 1] + u * (2 * ck[..., 2] + u * 3 * ck[..., 3])
-        accel = 2 * ck[..., 2] + 6 * u * ck[..., 3]
+        angle, rate, accel = cubic_formula(ck[..., 0], ck[..., 1], ck[..., 2], ck[..., 3], u)
         return angle, np.where(inside, rate, 0.0), np.where(inside, accel, 0.0)
 
 
@@ -686,6 +702,13 @@ def tilt_pair_gains(split_gains: np.ndarray, spans_foot: np.ndarray, delay,
     ], axis=-2)
 
 
+def axis_acceleration_formula(depth, angle, rate, accel, xp=np):
+    """The ankle's acceleration (ẍ, ÿ) when the surface turns about an axis ``depth`` [m]
+    below it: ẍ = −h (α̈ cos α − α̇² sin α), ÿ = −h (α̈ sin α + α̇² cos α). [m/s²]"""
+    c, s = xp.cos(angle), xp.sin(angle)
+    return -depth * (accel * c - rate * rate * s), -depth * (accel * s + rate * rate * c)
+
+
 def axis_translation(tilt: Tilt, depth: float, t) -> tuple[np.ndarray, np.ndarray]:
     """The ankle's acceleration and velocity when the surface turns about an axis ``depth``
     [m] below the ankle: the ankle sits at (−h sin α, h (cos α − 1)) from its level place, so
@@ -699,9 +722,8 @@ def axis_translation(tilt: Tilt, depth: float, t) -> tuple[np.ndarray, np.ndarra
         Acceleration [m/s²] and velocity [m/s], (x, y).
     """
     a, ad, add = tilt.kinematics(t)
-    c, s = np.cos(a), np.sin(a)
-    acc = np.stack([-depth * (add * c - ad * ad * s), -depth * (add * s + ad * ad * c)], axis=-1)
-    vel = np.stack([-depth * ad * c, -depth * ad * s], axis=-1)
+    acc = np.stack(axis_acceleration_formula(depth, a, ad, add), axis=-1)
+    vel = np.stack([-depth * ad * np.cos(a), -depth * ad * np.sin(a)], axis=-1)
     return acc, vel
 
 

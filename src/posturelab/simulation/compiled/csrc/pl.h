@@ -13,44 +13,11 @@
 #include <math.h>
 #include <stdint.h>
 
-/* Outcome codes (R_STATUS of the result vector); _layout.py holds the same numbers. */
-enum { PL_COMPLETED = 0, PL_FELL = 1, PL_STEP_TOO_SMALL = 2, PL_NONFINITE = 3,
-       PL_CHATTERING = 4, PL_NO_MEMORY = 5, PL_STEP_BUDGET = 6, PL_TIME_BUDGET = 7 };
-
-/* Result vector indices */
-enum { R_STATUS = 0, R_N_SAMPLES, R_FALL_KIND, R_FALL_INDEX, R_FALL_TIME, R_N_SWITCHES,
-       R_T_REACHED, R_N_STEPS, R_N_REJECTED, R_N_EVALS, R_LAST_OUTSIDE, R_ANY_OUTSIDE,
-       R_FINAL_OUTSIDE, R_FALL_SAMPLE, N_RESULT };
-
-/* fpar / ipar indices */
-enum { F_MAX_ANGLE = 0, F_HEEL, F_TOE, F_STOP_ANGLE, F_RTOL, F_ATOL, F_MAX_STEP, F_DURATION,
-       F_SETTLE_TOL, F_TIME_LIMIT, N_FPAR };
-enum { I_USE_BOS = 0, I_USE_COP, I_KNEE_MODE, I_MAX_SWITCHES, I_LOCKED0, I_MAX_STEPS, N_IPAR };
-enum { KNEE_FREE = 0, KNEE_LOCKED = 1, KNEE_STOP = 2 };
-
-/* Packed disturbance: dp[0] = number of terms, then rows of DIST_ROW numbers
- * (kind, axis, p0, p1, p2, p3), then sampled profiles (posturelab.model.platform.Primitive). */
-enum { DIST_ROW = 6, DIST_WINDOWED_SINE = 1, DIST_SINE = 2, DIST_SAMPLES = 3 };
-
-/* Packed tilt: tp[0] = number of terms, then rows of TILT_ROW numbers
- * (kind, p0 … p5), then piecewise-cubic data (posturelab.model.tilt.TiltTerm):
- * sine (A, f, φ), raised cosine (A, start, duration), ppoly (offset, K, period): at
- * tp[offset] K + 1 knots, then K rows of 4 coefficients in ascending powers of t − knot. */
-enum { TILT_ROW = 7, TILT_SINE = 1, TILT_RAISED_COSINE = 2, TILT_PPOLY = 3 };
+#include "pl_codes.h"  /* the codes and layouts (generated; _layout.py states the same) */
 
 /* Packed motor noise (posturelab.model.noise.TorqueSeries): mp[0] = K intervals (0: none),
  * then K + 1 knots, then K·4·n coefficients, interval-major, ascending powers of t − knot,
  * joint fastest. */
-
-/* Event kinds (posturelab.model.events) and the conditions of the segment's event slots */
-enum { EV_LINK_ANGLE = 0, EV_COG_TOE, EV_COG_HEEL, EV_COP_TOE, EV_COP_HEEL, EV_SATURATES,
-       EV_LETS_GO, EV_PAIR_SLACKENS, EV_PAIR_ENGAGES, EV_KNEE_HITS_STOP, EV_KNEE_LEAVES_STOP,
-       EV_PAIR_PUSHES, EV_PAIR_PULLS };
-enum { COND_ALWAYS = 0, COND_JOINT_FREE, COND_JOINT_SATURATED, COND_PAIR_ACTIVE,
-       COND_PAIR_SLACK, COND_KNEE_FREE, COND_KNEE_LOCKED };
-
-/* Methods */
-enum { METHOD_RADAU = 0, METHOD_EXPLICIT = 1 };
 
 /* One run: everything the integration needs (read only). */
 typedef struct {
@@ -124,7 +91,7 @@ static inline void pl_rotate(double theta, double theta_b, double s_b, double c_
     *c = c_b + (c_b * cdm1 - s_b * sd);
 }
 
-/* right-hand side (pl_rhs.c, pl_rhs_small.c) */
+/* right-hand side (generated: pl_model.c, pl_rhs_small.c) */
 void pl_rhs(const pl_model *md, const double *x, double *out, const double *inp, int locked);
 void pl_rhs_general(const pl_model *md, const double *x, double *out, const double *inp,
                     int locked);
@@ -143,7 +110,7 @@ void pl_lu_solve(const double *A, const int64_t *piv, double *b, int64_t n);
 void pl_inverse3(const double *a, double *out);
 void pl_inverse3_complex(const double *ar, const double *ai, double *outr, double *outi);
 
-/* platform (pl_platform.c) */
+/* inputs (generated: pl_model.c) */
 void pl_platform_acceleration(double t, const double *dp, double *ax, double *ay);
 void pl_tilt(double t, const double *tp, double *angle, double *rate, double *accel);
 void pl_motor_noise_add(double t, const double *mp, int64_t n, double *tau);

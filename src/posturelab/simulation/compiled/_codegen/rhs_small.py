@@ -19,7 +19,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-TARGET = Path(__file__).with_name("csrc") / "pl_rhs_small.c"
+TARGET = Path(__file__).resolve().parent.parent / "csrc" / "pl_rhs_small.c"
 SIZES = (1, 2, 3)
 
 HEADER = """/* Right-hand sides for N = 1, 2, 3 links: GENERATED, do not edit.
