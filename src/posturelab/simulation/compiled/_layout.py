@@ -117,6 +117,18 @@ STATUS_FAILURES = ("", "", "step size underflow", "non-finite state",
 #: The outcome of each code in the words of posturelab.simulation.setup.outcome_message.
 STATUS_OUTCOMES = ("completed", "fell", "step-too-small", "non-finite", "chattering",
                    "no-memory", "step-budget", "time-budget")
+#: The fields of ``pl_run`` (csrc/pl_model.h) and their types: i64, f64, *… arrays.
+RUN_FIELDS = ("n:i64", "p:i64", "n_grid:i64", "n_bps:i64", "n_slots:i64", "n_stages:i64",
+              "method:i64", "x0:*f64", "before:*f64", "grid:*f64", "bp:*f64", "E:*f64",
+              "C:*f64", "one_sided:*i64", "gains:*f64", "lim:*f64", "delay:f64", "dp:*f64",
+              "bps:*f64", "fpar:*f64", "ipar:*i64", "active0:*f64", "sat0:*f64",
+              "slot_kind:*i64", "slot_index:*i64", "slot_cond:*i64", "slot_side:*f64",
+              "ev_offset:*f64", "ev_direction:*i64", "ev_ends:*i64", "tab_A:*f64", "tab_c:*f64",
+              "tab_e:*f64", "tab_P:*f64", "tab_error_order:i64", "delay_multiples:i64",
+              "tp:*f64", "tilt_gain:*f64", "tilt_depth:f64", "mp:*f64")
+#: The fields of ``pl_out`` (csrc/pl_model.h) and their types: i64, f64, *… arrays.
+OUT_FIELDS = ("samples:*f64", "fb:*f64", "locked:*u8", "switches:*f64", "switch_cap:i64",
+              "peak:*f64", "final:*f64", "res:*f64")
 
 
 def body_size(n: int) -> int:

@@ -187,6 +187,13 @@ def layout() -> str:
     out.append("#: The outcome of each code in the words of "
                "posturelab.simulation.setup.outcome_message.")
     out += _tuple("STATUS_OUTCOMES", [o for _, _, o in STATUS_TEXT])
+    from .headers import OUT_FIELDS, RUN_FIELDS
+
+    for name, fields, struct in (("RUN_FIELDS", RUN_FIELDS, "pl_run"),
+                                 ("OUT_FIELDS", OUT_FIELDS, "pl_out")):
+        out.append(f"#: The fields of ``{struct}`` (csrc/pl_model.h) and their types: i64, f64, "
+                   "*… arrays.")
+        out += _tuple(name, [f"{field}:{kind.lstrip('w')}" for field, kind, _ in fields])
     out += ["", "",
             "def body_size(n: int) -> int:",
             '    """Length of the packed body ``bp``: a (N), J_ii (N), c_ij (N², row-major), g, '
