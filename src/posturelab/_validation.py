@@ -100,17 +100,3 @@ def expect_type(name: str, value: Any, kind: type | tuple[type, ...]) -> None:
         want = kind.__name__ if isinstance(kind, type) else " or ".join(k.__name__ for k in kind)
         raise ParameterError(f"{name} must be a {want}, got {type(value).__name__} "
                              f"{value!r:.60}")
-
-
-def check_model(body: Any, muscles: Any = None) -> None:
-    """The public API's first check: ``body`` is a Body, ``muscles`` (if given) a MuscleSet
-    for as many links."""
-    from .model.body import Body
-    from .model.muscles import MuscleSet
-
-    expect_type("body", body, Body)
-    if muscles is not None:
-        expect_type("muscles", muscles, MuscleSet)
-        if muscles.n_links != body.n_links:
-            raise ParameterError(f"muscle set is for {muscles.n_links} links but the body "
-                                 f"has {body.n_links}")

@@ -118,9 +118,11 @@ def angular_acceleration(
     body: Body,
     theta: np.ndarray,
     omega: np.ndarray,
-    joint_torques: np.ndarray | float = 0.0,
+    link_torques: np.ndarray | float = 0.0,
     platform_acceleration_x: np.ndarray | float = 0.0,
     platform_acceleration_y: np.ndarray | float = 0.0,
+    *,
+    joint_torques: np.ndarray | float | None = None,
 ) -> np.ndarray:
     """Θ̈ from eq. 1: J⁻¹ [U − BΘ̇ + (g + ÿ_d) G − ẍ_d H].
 
@@ -128,8 +130,9 @@ def angular_acceleration(
     ----------
     theta, omega : array_like, shape (..., N)
         Link angles [rad] and rates [rad/s].
-    joint_torques : array_like, shape (..., N) or scalar
-        Generalised torques U on the link-angle coordinates. [N·m]
+    link_torques : array_like, shape (..., N) or scalar
+        Generalised torques U on the link-angle coordinates (U_i = τ_{i+1} − τ_i from the
+        joint moments τ: :func:`posturelab.model.feedback.moments_to_link_torques`). [N·m]
     platform_acceleration_x : array_like, shape (...) or scalar
         Horizontal platform acceleration ẍ_d, forward positive. [m/s²]
     platform_acceleration_y : array_like, shape (...) or scalar
@@ -140,12 +143,14 @@ def angular_acceleration(
     numpy.ndarray, shape (..., N)
         Link angular accelerations. [rad/s²]
     """
+    if joint_torques is not None:  # the former name of link_torques
+        link_torques = joint_torques
     theta = np.asarray(theta, dtype=float)
     omega = np.asarray(omega, dtype=float)
     ax = np.asarray(platform_acceleration_x, dtype=float)[..., None]
     ay = np.asarray(platform_acceleration_y, dtype=float)[..., None]
     rhs = (
-        np.asarray(joint_torques, dtype=float)
+        np.asarray(link_torques, dtype=float)
         - velocity_terms(body, theta, omega)
         + load_formula(body.gravity_coefficients, theta, body.gravity + ay, ax)
     )
@@ -156,9 +161,11 @@ def angular_acceleration(
 def state_derivative(
     body: Body,
     state: np.ndarray,
-    joint_torques: np.ndarray | float = 0.0,
+    link_torques: np.ndarray | float = 0.0,
     platform_acceleration_x: np.ndarray | float = 0.0,
     platform_acceleration_y: np.ndarray | float = 0.0,
+    *,
+    joint_torques: np.ndarray | float | None = None,
 ) -> np.ndarray:
     """Time derivative of the state ``[Θ, Θ̇]``.
 
@@ -166,8 +173,9 @@ def state_derivative(
     ----------
     state : array_like, shape (..., 2N)
         ``[θ1 … θN, θ̇1 … θ̇N]`` in [rad] and [rad/s].
-    joint_torques, platform_acceleration_x, platform_acceleration_y
-        As in :func:`angular_acceleration`. [N·m], [m/s²], [m/s²]
+    link_torques, platform_acceleration_x, platform_acceleration_y
+        As in :func:`angular_acceleration` (``joint_torques``: the former name of
+        ``link_torques``). [N·m], [m/s²], [m/s²]
 
     Returns
     -------
@@ -178,7 +186,8 @@ def state_derivative(
     n = body.n_links
     theta, omega = state[..., :n], state[..., n:]
     acc = angular_acceleration(
-        body, theta, omega, joint_torques, platform_acceleration_x, platform_acceleration_y
+        body, theta, omega, link_torques if joint_torques is None else joint_torques,
+        platform_acceleration_x, platform_acceleration_y
     )
     return np.concatenate([omega, acc], axis=-1)
 

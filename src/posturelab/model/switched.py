@@ -30,12 +30,13 @@ import numpy as np
 from . import events as ev
 from .body import Body
 from .dynamics import angular_acceleration, constrained_acceleration, constrained_velocity
+from .feedback import feedback_pair_torques, moments_to_link_torques, muscle_set_gains
 from .gains import DELAYED_STIFFNESS, DELAYED_VISCOSITY, IMMEDIATE_STIFFNESS, IMMEDIATE_VISCOSITY
 from .kinematics import centre_of_pressure, ground_reaction
-from .muscles import MuscleSet, feedback_pair_torques, moments_to_link_torques, muscle_set_gains
+from .muscles import MuscleSet
 from .noise import TorqueSeries, torque_at
 from .options import FallCriteria, KneeModel
-from .platform import Disturbance, sine_formula, windowed_sine_formula  # noqa: F401
+from .platform import Disturbance
 from .tilt import Tilt, axis_acceleration_formula
 
 __all__ = [
@@ -46,9 +47,6 @@ __all__ = [
     "pull_value_formula",
     "saturated_moment_formula",
     "tilt_pair_torque_formula",
-    "axis_acceleration_formula",
-    "windowed_sine_formula",
-    "sine_formula",
     "vertical_reaction_term_formula",
     "model_response",
     "raw_moments",
@@ -58,6 +56,7 @@ __all__ = [
     "ankle_moment_and_load",
     "centre_of_pressure_at",
     "event_value",
+    "pair_gains",
     "pair_activity_after",
     "saturation_after",
     "knee_impact",
@@ -244,12 +243,13 @@ def tilt_pair_torques(tilt: Tilt, tilt_gains: np.ndarray, delay: float, t) -> np
     t = np.asarray(t, dtype=float)
     a, ad = tilt.angle_and_rate(t)
     a, ad = a[..., None], ad[..., None]
-    g = tilt_gains
+    k, v = tilt_gains[..., IMMEDIATE_STIFFNESS, :], tilt_gains[..., IMMEDIATE_VISCOSITY, :]
     if delay > 0:
         a_d, ad_d = tilt.angle_and_rate(t - delay)
-        return tilt_pair_torque_formula(g[..., 0, :], g[..., 1, :], g[..., 2, :], g[..., 3, :],
-                                        a, ad, a_d[..., None], ad_d[..., None])
-    return g[..., 0, :] * a + g[..., 1, :] * ad
+        return tilt_pair_torque_formula(k, v, tilt_gains[..., DELAYED_STIFFNESS, :],
+                                        tilt_gains[..., DELAYED_VISCOSITY, :], a, ad,
+                                        a_d[..., None], ad_d[..., None])
+    return k * a + v * ad
 
 
 def raw_moments(model: SwitchedModel, t: float, x: np.ndarray, feedback: np.ndarray,

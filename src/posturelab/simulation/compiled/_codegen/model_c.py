@@ -15,6 +15,7 @@ import sympy as sp
 
 from ....model import dynamics, platform, switched, tilt
 from ....model import events as ev
+from ....model.gains import GAIN_ROWS
 from .spec import SYMPY, c, symbols
 
 HEADER = """/* The switched model for any N links: GENERATED, do not edit.
@@ -188,7 +189,7 @@ void pl_motor_noise_add(double t, const double *mp, int64_t n, double *tau)
 def _inputs() -> str:
     h, a, ad, add = symbols("cx->tilt_depth", "a", "ad", "add")
     axis_x, axis_y = tilt.axis_acceleration_formula(h, a, ad, add, SYMPY)
-    g = symbols("g[j]", "g[n + j]", "g[2 * n + j]", "g[3 * n + j]")
+    g = symbols(*(f"g[GAIN_{row.upper()} * n + j]" for row in GAIN_ROWS))
     tilt_moment = switched.tilt_pair_torque_formula(*g, a, ad, *symbols("a_d", "ad_d"))
     return f"""
 /* The inputs at t: inp = (ẍ_d, ÿ_d, the moments that do not depend on the state now: the

@@ -166,7 +166,7 @@ void pl_inputs_at(const pl_ctx *cx, double t, double *out)
         if (cx->delay > 0.0)
             pl_tilt(t - cx->delay, cx->tp, &a_d, &ad_d, &add_d);
         for (int64_t j = 0; j < n; j++)
-            out[2 + j] += a*g[j] + a_d*g[2 * n + j] + ad*g[n + j] + ad_d*g[3 * n + j];
+            out[2 + j] += a*g[GAIN_IMMEDIATE_STIFFNESS * n + j] + a_d*g[GAIN_DELAYED_STIFFNESS * n + j] + ad*g[GAIN_IMMEDIATE_VISCOSITY * n + j] + ad_d*g[GAIN_DELAYED_VISCOSITY * n + j];
     }
     if (cx->mp[0] > 0.0)  /* the motor noise, on the motor command */
         pl_motor_noise_add(t, cx->mp, n, out + 2);
