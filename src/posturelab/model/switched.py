@@ -47,7 +47,6 @@ __all__ = [
     "pull_value_formula",
     "saturated_moment_formula",
     "tilt_pair_torque_formula",
-    "vertical_reaction_term_formula",
     "model_response",
     "raw_moments",
     "saturated_moments",
@@ -94,12 +93,6 @@ def tilt_pair_torque_formula(gain_angle, gain_rate, gain_delayed_angle, gain_del
     """A pair's torque from the tilt: g₀ α(t) + g₁ α̇(t) + g₂ α(t − τ) + g₃ α̇(t − τ). [N·m]"""
     return (gain_angle * angle + gain_rate * rate) + (gain_delayed_angle * delayed_angle
                                                       + gain_delayed_rate * delayed_rate)
-
-
-def vertical_reaction_term_formula(gravity_coefficient, angle, rate, acceleration, xp=np):
-    """Link i's part of F_y / (Σm) − (g + ÿ_d) times Σm: −a_i (θ̈_i sin θ_i + θ̇_i² cos θ_i);
-    F_y = Σm (g + ÿ_d) + Σ_i of these. [N]"""
-    return -gravity_coefficient * (acceleration * xp.sin(angle) + rate * rate * xp.cos(angle))
 
 
 # The event values (the physical part g of each event function; the offset of

@@ -13,7 +13,7 @@ import inspect
 
 import sympy as sp
 
-from ....model import dynamics, platform, switched, tilt
+from ....model import dynamics, kinematics, platform, switched, tilt
 from ....model import events as ev
 from ....model.gains import GAIN_ROWS
 from .spec import SYMPY, c, symbols
@@ -399,8 +399,8 @@ def _cog_step() -> str:
 
 
 def _reaction_step() -> str:
-    term = switched.vertical_reaction_term_formula(
-        *symbols("bp[i]", "y[i]", "y[n + i]", "cx->sc_out[n + i]"), SYMPY)
+    term = kinematics.cog_acceleration_terms_formula(
+        *symbols("bp[i]", "y[i]", "y[n + i]", "cx->sc_out[n + i]"), SYMPY)[1]
     return f"""double fy = bp[2 * n + n * n + 1] * (bp[2 * n + n * n] + cx->sc_inp[1]);
         for (int64_t i = 0; i < n; i++)
             fy += {c(term)};"""
