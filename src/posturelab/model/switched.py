@@ -59,6 +59,7 @@ __all__ = [
     "pair_activity_after",
     "saturation_after",
     "knee_impact",
+    "apply_switch",
     "start_activity",
     "start_moments",
     "start_saturation",
@@ -418,6 +419,28 @@ def knee_impact(body: Body, x: np.ndarray, stop_angle: float, knee_row: np.ndarr
     x[1] = x[0] + stop_angle
     x[n:] = constrained_velocity(body, x[:n], x[n:], knee_row)
     return x
+
+
+def apply_switch(model: SwitchedModel, kind: int, j: int, side: float, x: np.ndarray,
+                 feedback: np.ndarray, active: np.ndarray, saturation: np.ndarray,
+                 locked: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray, bool]:
+    """What switch ``kind`` (index ``j``, side ``side``) does at state ``x`` (2N,), the muscles
+    responding to ``feedback`` (2N,): the new (state, active, saturation, locked), new arrays
+    where they change. A stretch event sets pair j's activity (:func:`pair_activity_after`),
+    the knee stop locks the knee after a plastic impact (:func:`knee_impact`) or lets it go, a
+    joint saturates or lets go (:func:`saturation_after`). [rad, rad/s], [-], [-]"""
+    if kind in (ev.PAIR_SLACKENS, ev.PAIR_ENGAGES, ev.PAIR_PUSHES, ev.PAIR_PULLS):
+        n = model.n_links
+        active = active.copy()
+        active[j] = pair_activity_after(kind, model.muscles.selection_matrix[j] @ feedback[n:])
+    elif kind == ev.KNEE_HITS_STOP:
+        x, locked = knee_impact(model.body, x, model.knee.stop_angle, model.knee_row), True
+    elif kind == ev.KNEE_LEAVES_STOP:
+        locked = False
+    elif kind in (ev.SATURATES, ev.LETS_GO):
+        saturation = saturation.copy()
+        saturation[j] = saturation_after(kind, side)
+    return x, active, saturation, locked
 
 
 # ---------------------------------------------------------------------------

@@ -130,7 +130,7 @@ def integrate_reference(setup: RunSetup, method: str = "DOP853") -> SimulationRe
         raise ParameterError(f"method must be one of {', '.join(REFERENCE_METHODS)} for the "
                              f"reference engine, got {method!r}")
     n = setup.n_links
-    body, muscles, fall, knee = setup.body, setup.muscles, setup.fall, setup.knee
+    muscles, fall, knee = setup.muscles, setup.fall, setup.knee
     delay = setup.feedback_delay
     history = _History(setup.before) if delay > 0 else None
     budget = _Budget(setup.max_steps, setup.time_limit)
@@ -147,7 +147,6 @@ def integrate_reference(setup: RunSetup, method: str = "DOP853") -> SimulationRe
     active = setup.active0.copy()
     saturation = setup.saturation0.copy()
     bos = fall.base_of_support
-    E = muscles.selection_matrix
     slots = ev.event_slots(n, bos is not None, fall.centre_of_pressure, limited,
                            muscles.one_sided_mask, knee.mode == "stop", muscles.pull_only_mask)
 
@@ -306,21 +305,12 @@ def integrate_reference(setup: RunSetup, method: str = "DOP853") -> SimulationRe
             status = "failed"
             message = outcome_message("chattering", seg_end, setup)
             break
-        if kind in (ev.PAIR_SLACKENS, ev.PAIR_ENGAGES, ev.PAIR_PUSHES, ev.PAIR_PULLS):
-            active = active.copy()
-            active[j] = sw.pair_activity_after(kind, E[j] @ feedback(seg_end, x)[n:])
-        elif kind == ev.KNEE_HITS_STOP:
-            x = sw.knee_impact(body, x, knee.stop_angle, setup.knee_row)
-            locked = True
-            if delay > 0:  # the muscles feel the impact τ later, its derivatives 2τ, … later
-                rate_jumps.append(seg_end)
-                feedback_jumps.extend(seg_end + k * delay
-                                      for k in range(1, DELAY_BREAKPOINT_MULTIPLES + 1))
-        elif kind == ev.KNEE_LEAVES_STOP:
-            locked = False
-        else:  # SATURATES / LETS_GO
-            saturation = saturation.copy()
-            saturation[j] = sw.saturation_after(kind, sd)
+        x, active, saturation, locked = sw.apply_switch(
+            model, kind, j, sd, x, feedback(seg_end, x), active, saturation, locked)
+        if kind == ev.KNEE_HITS_STOP and delay > 0:  # the muscles feel the impact τ later,
+            rate_jumps.append(seg_end)  # its derivatives 2τ, … later
+            feedback_jumps.extend(seg_end + k * delay
+                                  for k in range(1, DELAY_BREAKPOINT_MULTIPLES + 1))
 
     if not times:  # the run ended before its first sample: the series is its initial state
         times.append(np.array([0.0]))
