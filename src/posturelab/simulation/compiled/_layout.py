@@ -117,6 +117,16 @@ STATUS_FAILURES = ("", "", "step size underflow", "non-finite state",
 #: The outcome of each code in the words of posturelab.simulation.setup.outcome_message.
 STATUS_OUTCOMES = ("completed", "fell", "step-too-small", "non-finite", "chattering",
                    "no-memory", "step-budget", "time-budget")
+#: The parameters of each analytic term, packed in this order after (kind, axis).
+DIST_TERM_FIELDS = {
+    "windowed-sine": ("amplitude", "duration", "start", "cycles"),
+    "sine": ("amplitude", "frequency", "phase"),
+}
+#: The parameters of each analytic term, packed in this order after its kind.
+TILT_TERM_FIELDS = {
+    "sine": ("amplitude", "frequency", "phase"),
+    "raised-cosine": ("amplitude", "start", "duration"),
+}
 #: The fields of ``pl_run`` (csrc/pl_model.h) and their types: i64, f64, *… arrays.
 RUN_FIELDS = ("n:i64", "p:i64", "n_grid:i64", "n_bps:i64", "n_slots:i64", "n_stages:i64",
               "method:i64", "x0:*f64", "before:*f64", "grid:*f64", "bp:*f64", "E:*f64",

@@ -92,6 +92,14 @@ GROUPS: list[tuple[str, list[tuple[str, str | None, int, str]]]] = [
     ]),
 ]
 
+#: The parameters of each analytic disturbance term (model.platform.Primitive), packed in
+#: this order after (kind, axis); the names are those of its formula's arguments.
+DIST_TERM_FIELDS = {"windowed-sine": ("amplitude", "duration", "start", "cycles"),
+                    "sine": ("amplitude", "frequency", "phase")}
+#: The parameters of each analytic tilt term (model.tilt.TiltTerm), packed after its kind.
+TILT_TERM_FIELDS = {"sine": ("amplitude", "frequency", "phase"),
+                    "raised-cosine": ("amplitude", "start", "duration")}
+
 #: SimulationResult.status, a failure's words and outcome_message's word, by status code.
 STATUS_TEXT = [
     ("completed", "", "completed"),
@@ -188,6 +196,13 @@ def layout() -> str:
                "posturelab.simulation.setup.outcome_message.")
     out += _tuple("STATUS_OUTCOMES", [o for _, _, o in STATUS_TEXT])
     from .headers import OUT_FIELDS, RUN_FIELDS
+
+    for name, table, where in (("DIST_TERM_FIELDS", DIST_TERM_FIELDS, "after (kind, axis)"),
+                               ("TILT_TERM_FIELDS", TILT_TERM_FIELDS, "after its kind")):
+        out.append(f"#: The parameters of each analytic term, packed in this order {where}.")
+        out.append(f"{name} = {{")
+        out += [f"    {kind!r}: {fields!r},".replace("'", '"') for kind, fields in table.items()]
+        out.append("}")
 
     for name, fields, struct in (("RUN_FIELDS", RUN_FIELDS, "pl_run"),
                                  ("OUT_FIELDS", OUT_FIELDS, "pl_out")):

@@ -16,6 +16,7 @@ import sympy as sp
 from ....model import dynamics, kinematics, platform, switched, tilt
 from ....model import events as ev
 from ....model.gains import GAIN_ROWS
+from .codes import DIST_TERM_FIELDS, TILT_TERM_FIELDS
 from .spec import SYMPY, c, symbols
 
 HEADER = """/* The switched model for any N links: GENERATED, do not edit.
@@ -51,10 +52,16 @@ def _trig_symbols(expr, angles: dict):
 # ---------------------------------------------------------------------------
 
 
+def _row(kind: str, table: dict, first: int) -> dict:
+    """A packed term's parameters as symbols r[first], r[first + 1], … by name."""
+    return {name: symbols(f"r[{first + k}]") for k, name in enumerate(table[kind])}
+
+
 def _platform() -> str:
-    t, r2, r3, r4, r5 = symbols("t", "r[2]", "r[3]", "r[4]", "r[5]")
-    windowed = platform.windowed_sine_formula(t, r2, r3, r4, r5, SYMPY)
-    sine = platform.sine_formula(t, r2, r3, r4, SYMPY)
+    t = symbols("t")
+    windowed = platform.windowed_sine_formula(t, **_row("windowed-sine", DIST_TERM_FIELDS, 2),
+                                              xp=SYMPY)
+    sine = platform.sine_formula(t, **_row("sine", DIST_TERM_FIELDS, 2), xp=SYMPY)
     return f"""
 /* the largest k in [lo, hi) with x[k] <= t, by bisection (x increasing; lo if none) */
 static int64_t interval_of(const double *x, int64_t lo, int64_t hi, double t)
@@ -115,9 +122,10 @@ void pl_platform_acceleration(double t, const double *dp, double *ax, double *ay
 
 
 def _tilt() -> str:
-    t, r1, r2, r3 = symbols("t", "r[1]", "r[2]", "r[3]")
-    sine = tilt.sine_tilt_formula(t, r1, r2, r3, SYMPY)
-    ramp = tilt.raised_cosine_tilt_formula(t, r1, r2, r3, SYMPY)
+    t = symbols("t")
+    sine = tilt.sine_tilt_formula(t, **_row("sine", TILT_TERM_FIELDS, 1), xp=SYMPY)
+    ramp = tilt.raised_cosine_tilt_formula(t, **_row("raised-cosine", TILT_TERM_FIELDS, 1),
+                                           xp=SYMPY)
     q0, q1, q2, q3, u = symbols("q[0]", "q[1]", "q[2]", "q[3]", "u")
     cubic = tilt.cubic_formula(q0, q1, q2, q3, u)
     qj = symbols("q[j]", "q[n + j]", "q[2 * n + j]", "q[3 * n + j]")
