@@ -37,17 +37,6 @@ import numpy as np
 from .._validation import finite_array, float_in_range
 from ..errors import ParameterError, UnknownNameError
 from ..parameters import MAX_PAIR_STIFFNESS, MAX_PAIR_VISCOSITY, check_value
-from .feedback import (  # the torques and gains of a muscle set (stated in .feedback)
-    feedback_gains,
-    feedback_pair_torques,
-    joint_crossing_matrix,
-    joint_moments,
-    joint_torques,
-    link_torques,
-    moments_to_link_torques,
-    muscle_set_gains,
-    pair_torques,
-)
 
 __all__ = [
     "MusclePair",
@@ -60,15 +49,6 @@ __all__ = [
     "DEFAULT_VISCOSITY_RATIO",
     "paper_muscles",
     "get_stiffness_case",
-    "pair_torques",
-    "link_torques",
-    "joint_torques",
-    "joint_crossing_matrix",
-    "joint_moments",
-    "moments_to_link_torques",
-    "feedback_gains",
-    "muscle_set_gains",
-    "feedback_pair_torques",
     "joint_pair_names",
     "muscles_for",
 ]
@@ -585,3 +565,18 @@ def _five(name: str, values) -> np.ndarray:
     if np.any(arr < 0):
         raise ParameterError(f"{name} must be >= 0, got {arr[arr < 0][0]:g}")
     return arr
+
+
+#: The torques and gains of a muscle set, stated in :mod:`.feedback` and found here too
+#: (loaded on first use, so that what only needs the pairs does not load them).
+_FEEDBACK_NAMES = ("pair_torques", "link_torques", "joint_torques", "joint_crossing_matrix",
+                   "joint_moments", "moments_to_link_torques", "feedback_gains",
+                   "muscle_set_gains", "feedback_pair_torques")
+
+
+def __getattr__(name: str):
+    if name in _FEEDBACK_NAMES:
+        from . import feedback
+
+        return getattr(feedback, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

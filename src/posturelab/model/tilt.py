@@ -37,7 +37,6 @@ import numpy as np
 from .._validation import finite_array, finite_float, float_in_range
 from ..errors import ParameterError
 from ..parameters import MAX_TILT
-from .gains import DELAYED_STIFFNESS, DELAYED_VISCOSITY, IMMEDIATE_STIFFNESS, IMMEDIATE_VISCOSITY
 from .prts import (  # the sequences (stated in .prts)
     DEFAULT_PRTS,
     PETERKA_2002_CITATION,
@@ -545,6 +544,13 @@ def tilt_pair_gains(split_gains: np.ndarray, spans_foot: np.ndarray, delay,
     numpy.ndarray, shape (..., 4, P)
         [N·m/rad], [N·m·s/rad], [N·m/rad], [N·m·s/rad]
     """
+    from .gains import (  # (loaded here: a tilt's profile alone does not need them)
+        DELAYED_STIFFNESS,
+        DELAYED_VISCOSITY,
+        IMMEDIATE_STIFFNESS,
+        IMMEDIATE_VISCOSITY,
+    )
+
     g = np.asarray(split_gains, dtype=float) * np.asarray(spans_foot, dtype=float)
     w = np.asarray(proprioceptive_weight, dtype=float)[..., None]
     delayed = (np.asarray(delay, dtype=float) > 0)[..., None]
