@@ -9,14 +9,27 @@ torque on link angle θ_i (U_i = τ_{i+1} − τ_i).
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import Protocol
 
 import numpy as np
 
 from .gains import DELAYED_STIFFNESS, DELAYED_VISCOSITY, IMMEDIATE_STIFFNESS, IMMEDIATE_VISCOSITY
 
-if TYPE_CHECKING:
-    from .muscles import MuscleSet
+
+class MuscleSet(Protocol):
+    """What these functions read of a :class:`posturelab.model.muscles.MuscleSet` (stated
+    here as a protocol, so that this module does not import the one that re-exports it)."""
+
+    n_links: int
+    pairs: tuple
+    selection_matrix: np.ndarray
+    crossing_matrix: np.ndarray
+    stiffnesses: np.ndarray
+    viscosities: np.ndarray
+    active_stiffnesses: np.ndarray
+    active_viscosities: np.ndarray
+    one_sided_mask: np.ndarray
+    has_active_feedback: bool
 
 __all__ = [
     "pair_torques",
