@@ -269,8 +269,9 @@ def test_the_engine_was_built_from_the_sources_beside_it():
 
 
 def _c_enums() -> dict[str, int]:
-    """Every NAME = value (or implicit value) of the enums in csrc/pl.h."""
-    text = (Path(compiled.__file__).parent / "csrc" / "pl.h").read_text()
+    """Every NAME = value (or implicit value) of the enums in csrc/pl.h and pl_codes.h."""
+    text = "".join((Path(compiled.__file__).parent / "csrc" / name).read_text()
+                   for name in ("pl.h", "pl_codes.h"))
     values: dict[str, int] = {}
     for body in re.findall(r"enum\s*\{([^}]*)\}", text):
         nxt = 0

@@ -45,7 +45,7 @@ def test_unchanged_sources_are_not_stale(sources):
 
 def test_a_changed_source_is_stale(sources):
     built = source_hash(sources)
-    (sources / "pl_rhs.c").write_bytes((sources / "pl_rhs.c").read_bytes() + b"\n")
+    (sources / "pl_model.c").write_bytes((sources / "pl_model.c").read_bytes() + b"\n")
     assert stale_digest(built, source_files(CSRC), sources) == source_hash(sources) != built
 
 

@@ -177,6 +177,54 @@ def test_angular_acceleration_equals_symbolic(derivation):
         close(angular_acceleration(body, theta, omega, u, ax, ay), expected)
 
 
+def test_specification_of_the_compiled_engine_equals_symbolic(derivation):
+    """The equation of motion the compiled engine's C is generated from (the entry formulas
+    of posturelab.model.dynamics, assembled on sympy symbols by _codegen.spec) has the
+    Lagrangian's mass matrix and forcing: J = M and U − BΘ̇ + (g + ÿ_d)G − ẍ_d H = F."""
+    from posturelab.simulation.compiled._codegen.spec import equation_of_motion
+
+    n = derivation.n
+    J, B, G, H, sym = equation_of_motion(n)
+    pairs = sorted(sym["coupling"].items())
+    args = [sym["theta"], sym["omega"], sym["inertia"], sym["gravity_coefficient"],
+            [s for _, s in pairs]]
+    spec_J = sp.lambdify(args, J, "numpy")
+    spec_BGH = sp.lambdify(args, (B, G, H), "numpy")
+    for body, theta, omega, u, ax, ay, vx, vy in samples(n):
+        params = [theta, omega, body.inertia_diagonal, body.gravity_coefficients,
+                  [body.coupling[i, j] for (i, j), _ in pairs]]
+        close(np.array(spec_J(*params), dtype=float), derivation.mass(body, theta))
+        b, g, h = (np.array(v, dtype=float).reshape(n) for v in spec_BGH(*params))
+        close(u - b + (body.gravity + ay) * g - ax * h,
+              derivation.forcing(body, theta, omega, u, ax, ay, vx, vy))
+
+
+@pytest.mark.parametrize("general", [False, True], ids=["small", "general"])
+def test_generated_c_right_hand_side_equals_symbolic(derivation, general):
+    """The compiled engine's right-hand side (C generated from the model's formulas: the
+    straight-line code for N <= 3 and the general-N elimination) gives the derivation's
+    M⁻¹F, with joint moments τ entering as U_i = τ_{i+1} − τ_i and both platform
+    accelerations."""
+    from posturelab.model.feedback import moments_to_link_torques
+    from posturelab.model.muscles import MusclePair, MuscleSet
+    from posturelab.simulation import compiled
+
+    n = derivation.n
+    muscles = MuscleSet((MusclePair("p", 0, 1, 100.0, 10.0),), n)
+    rng = np.random.default_rng(2024 + n)
+    for body, theta, omega, _, ax, ay, vx, vy in samples(n):
+        moments = rng.normal(0.0, 100.0, n)
+        expected = np.linalg.solve(
+            derivation.mass(body, theta),
+            derivation.forcing(body, theta, omega, moments_to_link_torques(moments), ax, ay,
+                               vx, vy))
+        out = compiled.state_derivative(body, muscles, np.concatenate([theta, omega]),
+                                        active=np.zeros(1), platform_acceleration=(ax, ay),
+                                        delayed_moments=moments, general=general)
+        close(out[:n], omega)
+        close(out[n:], expected)
+
+
 def test_joint_torque_enters_as_generalised_force(derivation):
     """With g = 0 and the body at rest, the forcing is exactly U (U is the generalised force)."""
     rng = np.random.default_rng(12345)

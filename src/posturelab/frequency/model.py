@@ -99,7 +99,7 @@ def model_frf_batch(body: Body, muscles: MuscleSet, frequencies, stiffness, visc
     numpy.ndarray of complex, shape (M, F)
         [-] for tilt, [rad/m] for translation.
     """
-    from ..model._checks import check_model
+    from ..model.checks import check_model
 
     check_model(body, muscles)
     if input not in INPUTS:

@@ -265,7 +265,7 @@ def disturbance_sensitivity(body: Body, posture: np.ndarray | None = None) -> np
     ...                                                         [0.1, -0.1, 0.1])]
     [2.268, 0.291, -0.071]
     """
-    from ..model._checks import check_model
+    from ..model.checks import check_model
 
     check_model(body)
     if posture is None:
@@ -275,6 +275,6 @@ def disturbance_sensitivity(body: Body, posture: np.ndarray | None = None) -> np
 
 
 def _check_match(body: Body, muscles: MuscleSet) -> None:
-    from ..model._checks import check_model
+    from ..model.checks import check_model
 
     check_model(body, muscles)

@@ -6,8 +6,12 @@ Everything here is validated immutable parameters (:class:`~.body.Body`,
 :mod:`.options`) and pure functions over arrays (the equation of motion in
 :mod:`.dynamics`, the centre of gravity and pressure in :mod:`.kinematics`). The
 linear analysis and both simulators use this one statement of the physics; the
-event table of :mod:`.events` serves both simulators. The public names are exported
-by :mod:`posturelab` itself. Signs, frames and units: :mod:`posturelab.conventions`.
+event table of :mod:`.events` serves both simulators, and :mod:`.switched` states the
+switched model of a run once (its inputs, right-hand side, event values, what a switch
+does, the start): the reference engine evaluates it with numpy, and the compiled engine's
+C is generated from the same formulas (``posturelab.simulation.compiled._codegen``). The
+public names are exported by :mod:`posturelab` itself. Signs, frames and units:
+:mod:`posturelab.conventions`.
 """
 
 from .._lazy import submodule_getattr  # noqa: E402

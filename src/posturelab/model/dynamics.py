@@ -37,6 +37,26 @@ __all__ = [
 ]
 
 
+# The entries of the equation of motion, over a math namespace ``xp`` (numpy here; sympy when
+# the compiled engine's C is generated from them, posturelab.simulation.compiled._codegen).
+
+def coupling_formula(coupling, theta_i, theta_j, xp=np):
+    """J_ij = c_ij cos(θ_j − θ_i) (i ≠ j). [kg·m²]"""
+    return coupling * xp.cos(theta_j - theta_i)
+
+
+def centripetal_formula(coupling, theta_i, theta_j, omega_j, xp=np):
+    """Link j's part of (BΘ̇)_i: c_ij sin(θ_i − θ_j) θ̇_j². [N·m]"""
+    return coupling * xp.sin(theta_i - theta_j) * (omega_j * omega_j)
+
+
+def load_formula(gravity_coefficient, theta_i, gravity_and_lift, platform_x, xp=np):
+    """Gravity and platform acceleration on link i: a_i ((g + ÿ_d) sin θ_i − ẍ_d cos θ_i),
+    that is (g + ÿ_d) G_i − ẍ_d H_i. [N·m]"""
+    return gravity_coefficient * (gravity_and_lift * xp.sin(theta_i)
+                                  - platform_x * xp.cos(theta_i))
+
+
 def mass_matrix(body: Body, theta: np.ndarray) -> np.ndarray:
     """Inertia matrix J(Θ).
 
@@ -53,8 +73,7 @@ def mass_matrix(body: Body, theta: np.ndarray) -> np.ndarray:
         Symmetric positive-definite inertia matrix. [kg·m²]
     """
     theta = np.asarray(theta, dtype=float)
-    diff = theta[..., None, :] - theta[..., :, None]  # θ_j − θ_i
-    J = body.coupling * np.cos(diff)
+    J = coupling_formula(body.coupling, theta[..., :, None], theta[..., None, :])
     n = body.n_links
     J[..., np.arange(n), np.arange(n)] = body.inertia_diagonal
     return J
@@ -77,8 +96,8 @@ def velocity_terms(body: Body, theta: np.ndarray, omega: np.ndarray) -> np.ndarr
     """
     theta = np.asarray(theta, dtype=float)
     omega = np.asarray(omega, dtype=float)
-    diff = theta[..., :, None] - theta[..., None, :]  # θ_i − θ_j
-    return np.einsum("...ij,...j->...i", body.coupling * np.sin(diff), omega**2)
+    return np.sum(centripetal_formula(body.coupling, theta[..., :, None], theta[..., None, :],
+                                      omega[..., None, :]), axis=-1)
 
 
 def gravity_vector(body: Body, theta: np.ndarray) -> np.ndarray:
@@ -99,9 +118,11 @@ def angular_acceleration(
     body: Body,
     theta: np.ndarray,
     omega: np.ndarray,
-    joint_torques: np.ndarray | float = 0.0,
+    link_torques: np.ndarray | float = 0.0,
     platform_acceleration_x: np.ndarray | float = 0.0,
     platform_acceleration_y: np.ndarray | float = 0.0,
+    *,
+    joint_torques: np.ndarray | float | None = None,
 ) -> np.ndarray:
     """Θ̈ from eq. 1: J⁻¹ [U − BΘ̇ + (g + ÿ_d) G − ẍ_d H].
 
@@ -109,8 +130,9 @@ def angular_acceleration(
     ----------
     theta, omega : array_like, shape (..., N)
         Link angles [rad] and rates [rad/s].
-    joint_torques : array_like, shape (..., N) or scalar
-        Generalised torques U on the link-angle coordinates. [N·m]
+    link_torques : array_like, shape (..., N) or scalar
+        Generalised torques U on the link-angle coordinates (U_i = τ_{i+1} − τ_i from the
+        joint moments τ: :func:`posturelab.model.feedback.moments_to_link_torques`). [N·m]
     platform_acceleration_x : array_like, shape (...) or scalar
         Horizontal platform acceleration ẍ_d, forward positive. [m/s²]
     platform_acceleration_y : array_like, shape (...) or scalar
@@ -121,15 +143,16 @@ def angular_acceleration(
     numpy.ndarray, shape (..., N)
         Link angular accelerations. [rad/s²]
     """
+    if joint_torques is not None:  # the former name of link_torques
+        link_torques = joint_torques
     theta = np.asarray(theta, dtype=float)
     omega = np.asarray(omega, dtype=float)
     ax = np.asarray(platform_acceleration_x, dtype=float)[..., None]
     ay = np.asarray(platform_acceleration_y, dtype=float)[..., None]
     rhs = (
-        np.asarray(joint_torques, dtype=float)
+        np.asarray(link_torques, dtype=float)
         - velocity_terms(body, theta, omega)
-        + (body.gravity + ay) * gravity_vector(body, theta)
-        - ax * platform_vector(body, theta)
+        + load_formula(body.gravity_coefficients, theta, body.gravity + ay, ax)
     )
     J = mass_matrix(body, theta)
     return np.linalg.solve(J, rhs[..., None])[..., 0]
@@ -138,9 +161,11 @@ def angular_acceleration(
 def state_derivative(
     body: Body,
     state: np.ndarray,
-    joint_torques: np.ndarray | float = 0.0,
+    link_torques: np.ndarray | float = 0.0,
     platform_acceleration_x: np.ndarray | float = 0.0,
     platform_acceleration_y: np.ndarray | float = 0.0,
+    *,
+    joint_torques: np.ndarray | float | None = None,
 ) -> np.ndarray:
     """Time derivative of the state ``[Θ, Θ̇]``.
 
@@ -148,8 +173,9 @@ def state_derivative(
     ----------
     state : array_like, shape (..., 2N)
         ``[θ1 … θN, θ̇1 … θ̇N]`` in [rad] and [rad/s].
-    joint_torques, platform_acceleration_x, platform_acceleration_y
-        As in :func:`angular_acceleration`. [N·m], [m/s²], [m/s²]
+    link_torques, platform_acceleration_x, platform_acceleration_y
+        As in :func:`angular_acceleration` (``joint_torques``: the former name of
+        ``link_torques``). [N·m], [m/s²], [m/s²]
 
     Returns
     -------
@@ -160,7 +186,8 @@ def state_derivative(
     n = body.n_links
     theta, omega = state[..., :n], state[..., n:]
     acc = angular_acceleration(
-        body, theta, omega, joint_torques, platform_acceleration_x, platform_acceleration_y
+        body, theta, omega, link_torques if joint_torques is None else joint_torques,
+        platform_acceleration_x, platform_acceleration_y
     )
     return np.concatenate([omega, acc], axis=-1)
 

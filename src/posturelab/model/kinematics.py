@@ -19,6 +19,7 @@ __all__ = [
     "centre_of_gravity_velocity",
     "physiological_state",
     "centre_of_gravity_acceleration",
+    "cog_acceleration_terms_formula",
     "ground_reaction",
     "centre_of_pressure",
 ]
@@ -94,6 +95,15 @@ def physiological_state(body: Body, state: np.ndarray) -> np.ndarray:
     )
 
 
+def cog_acceleration_terms_formula(gravity_coefficient, angle, rate, acceleration, xp=np):
+    """Link i's part of Σm times the centre of gravity's acceleration (ẍ_c, ÿ_c):
+    a_i (θ̈_i cos θ_i − θ̇_i² sin θ_i) and −a_i (θ̈_i sin θ_i + θ̇_i² cos θ_i); over a math
+    namespace ``xp`` (numpy, or sympy when the compiled engine is generated). [N]"""
+    s, c = xp.sin(angle), xp.cos(angle)
+    return (gravity_coefficient * (acceleration * c - rate * rate * s),
+            -gravity_coefficient * (acceleration * s + rate * rate * c))
+
+
 def centre_of_gravity_acceleration(body: Body, theta: np.ndarray, omega: np.ndarray,
                                    alpha: np.ndarray) -> np.ndarray:
     """Acceleration of the centre of gravity relative to the ankle.
@@ -114,11 +124,8 @@ def centre_of_gravity_acceleration(body: Body, theta: np.ndarray, omega: np.ndar
     theta = np.asarray(theta, dtype=float)
     omega = np.asarray(omega, dtype=float)
     alpha = np.asarray(alpha, dtype=float)
-    a = body.gravity_coefficients
-    s, c = np.sin(theta), np.cos(theta)
-    ax = np.sum(a * (alpha * c - omega**2 * s), axis=-1) / body.total_mass
-    ay = -np.sum(a * (alpha * s + omega**2 * c), axis=-1) / body.total_mass
-    return np.stack([ax, ay], axis=-1)
+    tx, ty = cog_acceleration_terms_formula(body.gravity_coefficients, theta, omega, alpha)
+    return np.stack([np.sum(tx, axis=-1), np.sum(ty, axis=-1)], axis=-1) / body.total_mass
 
 
 def ground_reaction(body: Body, theta: np.ndarray, omega: np.ndarray, alpha: np.ndarray,

@@ -37,6 +37,19 @@ import numpy as np
 from .._validation import finite_array, finite_float, float_in_range
 from ..errors import ParameterError
 from ..parameters import MAX_TILT
+from .prts import (  # the sequences (stated in .prts)
+    DEFAULT_PRTS,
+    PETERKA_2002_CITATION,
+    PETERKA_SEED,
+    PETERKA_TAPS,
+    POSTURELAB_80_SEED,
+    POSTURELAB_80_TAPS,
+    PRTS_SEQUENCES,
+    PRTSSequence,
+    get_prts_sequence,
+    peterka_register,
+    prts_sequence,
+)
 
 __all__ = [
     "Tilt",
@@ -56,16 +69,44 @@ __all__ = [
     "PRTS_SEQUENCES",
     "DEFAULT_PRTS",
     "get_prts_sequence",
+    "PETERKA_TAPS",
+    "PETERKA_SEED",
+    "peterka_register",
 ]
 
 # MAX_TILT [rad], the largest |α| a profile may reach: the parameter table's
 #: Largest distance of the tilt axis below the ankle. [m]
 MAX_AXIS_DEPTH = 1.0
 
-PETERKA_2002_CITATION = (
-    "Peterka RJ (2002) Sensorimotor integration in human postural control. "
-    "J Neurophysiol 88:1097–1118 (242-state PRTS, 0.25 s per state, 60.5 s cycle)"
-)
+
+
+def sine_tilt_formula(t, amplitude, frequency, phase, xp=np):
+    """(α, α̇, α̈) of a sine term: α = amplitude · sin(2π · frequency · t + phase) for t >= 0,
+    held at its t = 0 value before; over a math namespace ``xp`` (numpy, or sympy when the C
+    is generated). [rad], [rad/s], [rad/s²]"""
+    w = 2 * math.pi * frequency
+    arg = w * xp.maximum(t, 0.0) + phase
+    after = t >= 0
+    return (amplitude * xp.sin(arg), xp.where(after, amplitude * w * xp.cos(arg), 0.0),
+            xp.where(after, -amplitude * w * w * xp.sin(arg), 0.0))
+
+
+def raised_cosine_tilt_formula(t, amplitude, start, duration, xp=np):
+    """(α, α̇, α̈) of a raised-cosine ramp: α = amplitude · (1 − cos(π s))/2 for s = (t −
+    start)/duration in [0, 1], 0 before, amplitude after. [rad], [rad/s], [rad/s²]"""
+    s = xp.minimum(xp.maximum((t - start) / duration, 0.0), 1.0)
+    inside = (t > start) & (t < start + duration)
+    k = math.pi / duration
+    return (amplitude * 0.5 * (1.0 - xp.cos(math.pi * s)),
+            xp.where(inside, amplitude * 0.5 * k * xp.sin(math.pi * s), 0.0),
+            xp.where(inside, amplitude * 0.5 * k * k * xp.cos(math.pi * s), 0.0))
+
+
+def cubic_formula(c0, c1, c2, c3, u):
+    """c0 + c1 u + c2 u² + c3 u³ by Horner's rule, with its first and second derivatives in
+    u (a piecewise cubic's value on one interval, u = t − knot)."""
+    return (c0 + u * (c1 + u * (c2 + u * c3)), c1 + u * (2 * c2 + u * 3 * c3),
+            2 * c2 + 6 * u * c3)
 
 
 @dataclass(frozen=True)
@@ -115,20 +156,9 @@ class TiltTerm:
         """(α, α̇, α̈) at ``t`` (any shape). [rad], [rad/s], [rad/s²]"""
         t = np.asarray(t, dtype=float)
         if self.kind == "sine":
-            w = 2 * math.pi * self.frequency
-            tt = np.maximum(t, 0.0)
-            after = t >= 0.0
-            rate = np.where(after, self.amplitude * w * np.cos(w * tt + self.phase), 0.0)
-            accel = np.where(after, -self.amplitude * w * w * np.sin(w * tt + self.phase), 0.0)
-            return self.amplitude * np.sin(w * tt + self.phase), rate, accel
+            return sine_tilt_formula(t, self.amplitude, self.frequency, self.phase)
         if self.kind == "raised-cosine":
-            s = np.clip((t - self.start) / self.duration, 0.0, 1.0)
-            inside = (t > self.start) & (t < self.start + self.duration)
-            angle = self.amplitude * 0.5 * (1.0 - np.cos(math.pi * s))
-            k = math.pi / self.duration
-            rate = np.where(inside, self.amplitude * 0.5 * k * np.sin(math.pi * s), 0.0)
-            accel = np.where(inside, self.amplitude * 0.5 * k * k * np.cos(math.pi * s), 0.0)
-            return angle, rate, accel
+            return raised_cosine_tilt_formula(t, self.amplitude, self.start, self.duration)
         # piecewise cubic
         x, c = self.knots, self.coefficients
         tt = t
@@ -139,9 +169,7 @@ class TiltTerm:
         k = np.clip(np.searchsorted(x, tc, side="right") - 1, 0, len(c) - 1)
         u = tc - x[k]
         ck = c[k]
-        angle = ck[..., 0] + u * (ck[..., 1] + u * (ck[..., 2] + u * ck[..., 3]))
-        rate = ck[..., 1] + u * (2 * ck[..., 2] + u * 3 * ck[..., 3])
-        accel = 2 * ck[..., 2] + 6 * u * ck[..., 3]
+        angle, rate, accel = cubic_formula(ck[..., 0], ck[..., 1], ck[..., 2], ck[..., 3], u)
         return angle, np.where(inside, rate, 0.0), np.where(inside, accel, 0.0)
 
 
@@ -273,162 +301,6 @@ class RaisedCosineTilt(Tilt):
     def describe(self) -> str:
         return (f"raised-cosine tilt to {self.amplitude:g} rad over {self.duration:g} s"
                 + (f" from {self.start:g} s" if self.start else ""))
-
-
-def prts_sequence(registers: int, taps: tuple[int, ...], seed: tuple[int, ...]) -> np.ndarray:
-    """One period of a pseudorandom ternary sequence from a shift register over GF(3).
-
-    The register holds ``registers`` digits in {0, 1, 2}; each step the new digit is
-    Σ taps[i] · register[i] (mod 3), the register shifts by one, and the digit that leaves
-    it is the output. Digits map to the values 0 → 0, 1 → +1, 2 → −1. With a primitive
-    feedback polynomial the period is 3^registers − 1 and the sequence sums to zero.
-
-    Parameters
-    ----------
-    registers : int
-        1 … 8. [-]
-    taps : tuple of int
-        One coefficient in {0, 1, 2} per register (the oldest digit first). [-]
-    seed : tuple of int
-        The register's start, digits in {0, 1, 2}, not all zero. [-]
-
-    Returns
-    -------
-    numpy.ndarray, shape (period,)
-        Values in {−1, 0, 1}. [-]
-    """
-    if isinstance(registers, bool) or not isinstance(registers, int) or not 1 <= registers <= 8:
-        raise ParameterError(f"PRTS registers must be an integer in [1, 8], got {registers!r}")
-    for name, digits in (("taps", taps), ("seed", seed)):
-        if len(digits) != registers or any(d not in (0, 1, 2) for d in digits):
-            raise ParameterError(f"PRTS {name} must be {registers} digits in {{0, 1, 2}}, "
-                                 f"got {tuple(digits)!r}")
-    if not any(seed):
-        raise ParameterError("PRTS seed must not be all zeros")
-    state = list(seed)
-    out = []
-    start = tuple(state)
-    for _ in range(3**registers):
-        new = sum(t * s for t, s in zip(taps, state, strict=True)) % 3
-        out.append(state[0])
-        state = state[1:] + [new]
-        if tuple(state) == start:
-            break
-    values = np.array([0.0, 1.0, -1.0])[np.array(out)]
-    return values
-
-
-#: posturelab's own 80-state register: new = x_{k−4} + x_{k−3} (mod 3), from the primitive
-#: polynomial x⁴ + 2x + 2 over GF(3) (a test checks that its period is 80), started at
-#: (1, 0, 0, 0). Not a published sequence (see :data:`PRTS_SEQUENCES`).
-POSTURELAB_80_TAPS = (1, 1, 0, 0)
-POSTURELAB_80_SEED = (1, 0, 0, 0)
-#: Former names of the two above (they are posturelab's, not Peterka's). [-]
-PETERKA_TAPS, PETERKA_SEED = POSTURELAB_80_TAPS, POSTURELAB_80_SEED
-
-
-def peterka_register(feedback: tuple[int, ...], seed: tuple[int, ...]) -> tuple[tuple, tuple]:
-    """The ``taps`` and ``seed`` of :func:`prts_sequence` for a register written as in
-    Peterka's Matlab generator ``pseudogen3(n, feedback, seed, …)``: the register newest
-    digit first, each step's new digit Σ feedback_i · register_i (mod 3) shifted in at the
-    front and output (as a Matlab script that follows Peterka 2002 writes it out:
-    ``Output = mod(Reg(3)−Reg(4)−Reg(5), 3); Reg(2:5) = Reg(1:4); Reg(1) = Output``).
-    The output starts with the first new digit. [-]"""
-    taps = tuple(int(f) % 3 for f in reversed(feedback))
-    reg, first = list(seed), []
-    for _ in range(len(seed)):  # the first n new digits are the register that outputs them
-        new = sum(f * r for f, r in zip(feedback, reg, strict=True)) % 3
-        reg = [new] + reg[:-1]
-        first.append(new)
-    return taps, tuple(first)
-
-
-@dataclass(frozen=True)
-class PRTSSequence:
-    """A named PRTS: its shift register, its state duration and where it comes from.
-
-    Attributes
-    ----------
-    name : str
-    registers : int
-        Register length n; the sequence has 3ⁿ − 1 states. [-]
-    taps, seed : tuple of int
-        As for :func:`prts_sequence`. [-]
-    state_duration : float
-        Time per state. [s]
-    citation : str
-        The source, and what of it is posturelab's own.
-    """
-
-    name: str
-    registers: int
-    taps: tuple[int, ...]
-    seed: tuple[int, ...]
-    state_duration: float
-    citation: str
-
-    @property
-    def states(self) -> int:
-        """3ⁿ − 1. [-]"""
-        return 3 ** self.registers - 1
-
-    @property
-    def cycle(self) -> float:
-        """states × state_duration. [s]"""
-        return self.states * self.state_duration
-
-
-_COMTEST_TAPS, _COMTEST_SEED = peterka_register((0, 0, -1, 1), (0, 0, 0, 1))
-_PETERKA_242_TAPS, _PETERKA_242_SEED = peterka_register((0, 0, 1, -1, -1), (2, 0, 2, 0, 2))
-
-#: The named sequences. Sources (found with posturelab's search tool; see each citation):
-#: the COMTEST analysis code github.com/VittorioFreiburg/COMTEST, ANALYSIS/MATLAB/PRTS2012.m
-#: and PRTS2020.m ("Calc of the theoretical stimulus": pseudogen3(4, [0 0 −1 1], [0 0 0 1],
-#: 25) at 100 samples/s, 80 × 25 samples per cycle); for the 242-state register, Matlab
-#: code of Peterka's group and of others that follow Peterka 2002 (pseudogen3(5,
-#: [0 0 1 −1 −1], [2 0 2 0 2], …) "% 242 state sequence"; a script that cites the paper
-#: gives [2 0 2 0 2] as "the given initial sequence from the paper").
-PRTS_SEQUENCES: dict[str, PRTSSequence] = {
-    "posturelab-80": PRTSSequence(
-        "posturelab-80", 4, POSTURELAB_80_TAPS, POSTURELAB_80_SEED, 0.25,
-        "posturelab's own 80-state sequence (register x⁴ + 2x + 2 over GF(3), seed 1000), "
-        "0.25 s per state, 20 s cycle: the length, state time and 11-band analysis of the "
-        "80-state PRTS of the Eurobench COMTEST protocol (Lippi, Mergner et al.; "
-        "github.com/VittorioFreiburg/COMTEST, ANALYSIS/MATLAB/PRTS2020.m), not its register "
-        "(that is 'comtest-80'); not Peterka 2002's (that is 'peterka-2002-242')"),
-    "comtest-80": PRTSSequence(
-        "comtest-80", 4, _COMTEST_TAPS, _COMTEST_SEED, 0.25,
-        "The 80-state PRTS of the Eurobench COMTEST protocol's analysis code (Lippi, Mergner "
-        "et al.; github.com/VittorioFreiburg/COMTEST, ANALYSIS/MATLAB/PRTS2012.m, "
-        "PRTS2020.m: pseudogen3(4, [0 0 −1 1], [0 0 0 1], 25) at 100 samples/s, i.e. 0.25 s "
-        "per state, 20 s cycle); the register as posturelab reads pseudogen3's arguments "
-        "(peterka_register), and the cycle's start where the register's does (COMTEST "
-        "shifts its copy by 912 samples)"),
-    "peterka-2002-242": PRTSSequence(
-        "peterka-2002-242", 5, _PETERKA_242_TAPS, _PETERKA_242_SEED, 0.25,
-        PETERKA_2002_CITATION + "; the register pseudogen3(5, [0 0 1 −1 −1], [2 0 2 0 2]) "
-        "as Matlab code of Peterka's group and of others following the paper writes it "
-        "(peterka_register), not checked here against the paper's own appendix"),
-}
-#: The sequence of ``--tilt prts:A`` and of :meth:`PRTSTilt.named` without a name.
-DEFAULT_PRTS = "posturelab-80"
-
-
-def get_prts_sequence(name: str) -> PRTSSequence:
-    """The named sequence :data:`PRTS_SEQUENCES` [name].
-
-    Raises
-    ------
-    UnknownNameError
-        Naming the known sequences.
-    """
-    from ..errors import UnknownNameError
-
-    key = str(name).strip().lower()
-    if key not in PRTS_SEQUENCES:
-        raise UnknownNameError(f"unknown PRTS sequence {name!r}; known sequences: "
-                               f"{', '.join(PRTS_SEQUENCES)}")
-    return PRTS_SEQUENCES[key]
 
 
 @dataclass(frozen=True)
@@ -672,11 +544,18 @@ def tilt_pair_gains(split_gains: np.ndarray, spans_foot: np.ndarray, delay,
     numpy.ndarray, shape (..., 4, P)
         [N·m/rad], [N·m·s/rad], [N·m/rad], [N·m·s/rad]
     """
+    from .gains import (  # (loaded here: a tilt's profile alone does not need them)
+        DELAYED_STIFFNESS,
+        DELAYED_VISCOSITY,
+        IMMEDIATE_STIFFNESS,
+        IMMEDIATE_VISCOSITY,
+    )
+
     g = np.asarray(split_gains, dtype=float) * np.asarray(spans_foot, dtype=float)
     w = np.asarray(proprioceptive_weight, dtype=float)[..., None]
     delayed = (np.asarray(delay, dtype=float) > 0)[..., None]
-    intrinsic_k, intrinsic_l = g[..., 0, :], g[..., 1, :]
-    active_k, active_l = w * g[..., 2, :], w * g[..., 3, :]
+    intrinsic_k, intrinsic_l = g[..., IMMEDIATE_STIFFNESS, :], g[..., IMMEDIATE_VISCOSITY, :]
+    active_k, active_l = w * g[..., DELAYED_STIFFNESS, :], w * g[..., DELAYED_VISCOSITY, :]
     zero = np.zeros_like(intrinsic_k)
     return np.stack([
         intrinsic_k + np.where(delayed, zero, active_k),
@@ -684,6 +563,13 @@ def tilt_pair_gains(split_gains: np.ndarray, spans_foot: np.ndarray, delay,
         np.where(delayed, active_k, zero),
         np.where(delayed, active_l, zero),
     ], axis=-2)
+
+
+def axis_acceleration_formula(depth, angle, rate, accel, xp=np):
+    """The ankle's acceleration (ẍ, ÿ) when the surface turns about an axis ``depth`` [m]
+    below it: ẍ = −h (α̈ cos α − α̇² sin α), ÿ = −h (α̈ sin α + α̇² cos α). [m/s²]"""
+    c, s = xp.cos(angle), xp.sin(angle)
+    return -depth * (accel * c - rate * rate * s), -depth * (accel * s + rate * rate * c)
 
 
 def axis_translation(tilt: Tilt, depth: float, t) -> tuple[np.ndarray, np.ndarray]:
@@ -699,9 +585,8 @@ def axis_translation(tilt: Tilt, depth: float, t) -> tuple[np.ndarray, np.ndarra
         Acceleration [m/s²] and velocity [m/s], (x, y).
     """
     a, ad, add = tilt.kinematics(t)
-    c, s = np.cos(a), np.sin(a)
-    acc = np.stack([-depth * (add * c - ad * ad * s), -depth * (add * s + ad * ad * c)], axis=-1)
-    vel = np.stack([-depth * ad * c, -depth * ad * s], axis=-1)
+    acc = np.stack(axis_acceleration_formula(depth, a, ad, add), axis=-1)
+    vel = np.stack([-depth * ad * np.cos(a), -depth * ad * np.sin(a)], axis=-1)
     return acc, vel
 
 

@@ -1,10 +1,11 @@
 """The reference engine: the model's numpy functions integrated by scipy's ``solve_ivp``.
 
-Slow and obvious on purpose: its right-hand side is
-:func:`posturelab.simulation.setup.model_response` (the numpy equation of motion of
-:mod:`posturelab.model.dynamics` with the run's switches applied), its events are
-Python closures over the same model functions, and scipy integrates. It is the
-check on the compiled engine, which shares only the run set-up and the event table.
+Slow and obvious on purpose: the switched model of :mod:`posturelab.model.switched` (its
+right-hand side :func:`~posturelab.model.switched.model_response`, its event values
+:func:`~posturelab.model.switched.event_value` and what each switch does) evaluated with
+numpy, and scipy integrates. This module keeps only the segments, the delay history and
+the calls to ``solve_ivp``. It is the check on the compiled engine, whose C is generated
+from the same formulas.
 
 Switches are located as events, never as an ``if`` inside the right-hand
 side that the integrator could step over: the integration runs in segments
@@ -32,18 +33,15 @@ import time
 import numpy as np
 
 from ..model import events as ev
+from ..model import switched as sw
 from .derived import derived_series
 from .outcome import stimulus_timing
 from .results import SimulationResult
 from .setup import (
     DELAY_BREAKPOINT_MULTIPLES,
     RunSetup,
-    ankle_moment_and_load,
-    model_response,
     outcome_message,
-    pair_pulls_value,
-    pair_torque_if_acting,
-    raw_moments,
+    switched_model,
 )
 
 __all__ = ["integrate_reference", "REFERENCE_METHODS"]
@@ -132,7 +130,7 @@ def integrate_reference(setup: RunSetup, method: str = "DOP853") -> SimulationRe
         raise ParameterError(f"method must be one of {', '.join(REFERENCE_METHODS)} for the "
                              f"reference engine, got {method!r}")
     n = setup.n_links
-    body, muscles, fall, knee = setup.body, setup.muscles, setup.fall, setup.knee
+    muscles, fall, knee = setup.muscles, setup.fall, setup.knee
     delay = setup.feedback_delay
     history = _History(setup.before) if delay > 0 else None
     budget = _Budget(setup.max_steps, setup.time_limit)
@@ -141,6 +139,7 @@ def integrate_reference(setup: RunSetup, method: str = "DOP853") -> SimulationRe
     def feedback(t: float, x: np.ndarray) -> np.ndarray:
         return x if history is None else history(t - delay)
 
+    model = switched_model(setup)
     limits = setup.torque_limits
     limited = np.isfinite(limits).astype(np.int64) if limits is not None else np.zeros(n, int)
     x = setup.x0.copy()
@@ -148,46 +147,15 @@ def integrate_reference(setup: RunSetup, method: str = "DOP853") -> SimulationRe
     active = setup.active0.copy()
     saturation = setup.saturation0.copy()
     bos = fall.base_of_support
-    a_coef = body.gravity_coefficients
-    mtot = body.total_mass
-    E = muscles.selection_matrix
     slots = ev.event_slots(n, bos is not None, fall.centre_of_pressure, limited,
                            muscles.one_sided_mask, knee.mode == "stop", muscles.pull_only_mask)
 
     def event_function(k: int, j: int, sd: float, _active, _locked, _sat, feedback=feedback):
-        """The event function g(t, x) of event kind k (index j, side sd) in this segment;
-        ``feedback(t, x)`` is the state the muscles respond to (by default the run's)."""
-        offset = ev.EVENT_OFFSET[k]
-        if k == ev.LINK_ANGLE:
-            return lambda t, y: fall.max_link_angle - abs(y[j])
-        if k == ev.COG_TOE:
-            return lambda t, y: bos.toe - (a_coef @ np.sin(y[:n])) / mtot
-        if k == ev.COG_HEEL:
-            return lambda t, y: (a_coef @ np.sin(y[:n])) / mtot - bos.heel
-        if k in (ev.COP_TOE, ev.COP_HEEL):  # in moment form: toe F_y − τ, τ − heel F_y
-            edge, sign = (bos.toe, -1.0) if k == ev.COP_TOE else (bos.heel, 1.0)
-
-            def cop_event(t, y):
-                tau, fy = ankle_moment_and_load(setup, t, y, feedback(t, y), _active, _locked,
-                                                _sat)
-                return sign * (tau - edge * fy)
-            return cop_event
-        if k in (ev.SATURATES, ev.LETS_GO):
-            return lambda t, y: sd * raw_moments(setup, t, y, feedback(t, y), _active)[j] \
-                - limits[j] + offset
-        if k in (ev.PAIR_SLACKENS, ev.PAIR_ENGAGES):
-            return lambda t, y: E[j] @ feedback(t, y)[:n] + offset
-        if k == ev.PAIR_PUSHES:
-            return lambda t, y: pair_torque_if_acting(setup, j, feedback(t, y)) + offset
-        if k == ev.PAIR_PULLS:
-            return lambda t, y: pair_pulls_value(setup, j, feedback(t, y)) + offset
-        if k == ev.KNEE_HITS_STOP:
-            return lambda t, y: (y[1] - y[0]) - knee.stop_angle + offset
-        # KNEE_LEAVES_STOP: the free knee acceleration
-        def release(t, y):
-            acc = model_response(setup, t, y, feedback(t, y), _active, False, _sat)[1]
-            return acc[1] - acc[0] + offset
-        return release
+        """The event function g(t, x) of event kind k (index j, side sd) in this segment
+        (:func:`posturelab.model.switched.event_value`); ``feedback(t, x)`` is the state the
+        muscles respond to (by default the run's)."""
+        return lambda t, y: sw.event_value(model, k, j, sd, t, y, feedback(t, y), _active,
+                                           _locked, _sat)
 
     if locked and knee.mode == "stop" and event_function(
             ev.KNEE_LEAVES_STOP, 1, 0.0, active, False, saturation)(0.0, x) < 0.0:
@@ -264,7 +232,8 @@ def integrate_reference(setup: RunSetup, method: str = "DOP853") -> SimulationRe
             sat = saturation.copy() if limits is not None else None
 
             def rhs(tt, xx, _active=active, _locked=locked, _sat=sat):
-                acc = model_response(setup, tt, xx, feedback(tt, xx), _active, _locked, _sat)[1]
+                acc = sw.model_response(model, tt, xx, feedback(tt, xx), _active, _locked,
+                                        _sat)[1]
                 return np.concatenate([xx[n:], acc])
 
             events = []
@@ -336,32 +305,12 @@ def integrate_reference(setup: RunSetup, method: str = "DOP853") -> SimulationRe
             status = "failed"
             message = outcome_message("chattering", seg_end, setup)
             break
-        if kind in (ev.PAIR_SLACKENS, ev.PAIR_ENGAGES, ev.PAIR_PUSHES, ev.PAIR_PULLS):
-            # stretch events: the pair acts if its stretch is now growing; a pull-only pair
-            # goes slack when it would push, and acts again when it pulls while stretched
-            fb = feedback(seg_end, x)
-            active = active.copy()
-            if kind == ev.PAIR_PUSHES:
-                active[j] = 0.0
-            elif kind == ev.PAIR_PULLS:
-                active[j] = 1.0
-            else:
-                active[j] = 1.0 if E[j] @ fb[n:] >= 0 else 0.0
-        elif kind == ev.KNEE_HITS_STOP:
-            from ..model.dynamics import constrained_velocity
-
-            x[1] = x[0] + knee.stop_angle
-            x[n:] = constrained_velocity(body, x[:n], x[n:], setup.knee_row)
-            locked = True
-            if delay > 0:  # the muscles feel the impact τ later, its derivatives 2τ, … later
-                rate_jumps.append(seg_end)
-                feedback_jumps.extend(seg_end + k * delay
-                                      for k in range(1, DELAY_BREAKPOINT_MULTIPLES + 1))
-        elif kind == ev.KNEE_LEAVES_STOP:
-            locked = False
-        else:  # SATURATES / LETS_GO
-            saturation = saturation.copy()
-            saturation[j] = sd if kind == ev.SATURATES else 0.0
+        x, active, saturation, locked = sw.apply_switch(
+            model, kind, j, sd, x, feedback(seg_end, x), active, saturation, locked)
+        if kind == ev.KNEE_HITS_STOP and delay > 0:  # the muscles feel the impact τ later,
+            rate_jumps.append(seg_end)  # its derivatives 2τ, … later
+            feedback_jumps.extend(seg_end + k * delay
+                                  for k in range(1, DELAY_BREAKPOINT_MULTIPLES + 1))
 
     if not times:  # the run ended before its first sample: the series is its initial state
         times.append(np.array([0.0]))

@@ -20,23 +20,16 @@ import numpy as np
 
 from .._validation import finite_array, float_in_range
 from ..errors import ParameterError
+from ..model import switched
 from ..model.body import Body
 from ..model.dynamics import (
-    angular_acceleration,
-    constrained_acceleration,
     constrained_velocity,
     gravity_vector,
     knee_constraint_row,
     mass_matrix,
     platform_vector,
 )
-from ..model.kinematics import centre_of_pressure, ground_reaction
-from ..model.muscles import (
-    MuscleSet,
-    feedback_pair_torques,
-    moments_to_link_torques,
-    muscle_set_gains,
-)
+from ..model.muscles import MuscleSet, muscle_set_gains
 from ..model.noise import MotorNoise, TorqueSeries, motor_noise_series, torque_at
 from ..model.options import FallCriteria, KneeModel, torque_limit_array
 from ..model.platform import Disturbance, NoDisturbance
@@ -485,183 +478,92 @@ def _prepare(body: Body, muscles: MuscleSet, disturbance: Disturbance | None = N
     return setup
 
 
-def start_activity(muscles: MuscleSet, state: np.ndarray, gains: np.ndarray | None = None
-                   ) -> np.ndarray:
-    """Which pairs act at the start: one-sided pairs if stretched, or at zero stretch and
-    stretching, in the state the muscles respond to, ``state`` (..., 2N); a pull-only pair
-    also only if its torque k s + l ṡ is >= 0, with the run's ``gains`` (..., 4, P) (the
-    muscles' own by default; :func:`posturelab.model.muscles.feedback_gains`). Returns
-    (..., P)."""
-    n = muscles.n_links
-    E = muscles.selection_matrix
-    state = np.asarray(state, dtype=float)
-    s, sd = state[..., :n] @ E.T, state[..., n:] @ E.T
-    act = np.where(muscles.one_sided_mask, (s > 0) | ((s == 0) & (sd >= 0)), True)
-    pull = muscles.pull_only_mask
-    if pull.any():
-        g = muscle_set_gains(muscles, 0.0) if gains is None else np.asarray(gains, float)
-        torque = (g[..., 0, :] + g[..., 2, :]) * s + (g[..., 1, :] + g[..., 3, :]) * sd
-        act = act & np.where(pull, torque >= 0, True)
-    return act.astype(float)
+# The switched model lives in posturelab.model.switched; these are its run-level forms.
+start_activity = switched.start_activity
+start_moments = switched.start_moments
+start_saturation = switched.start_saturation
+tilt_torques = switched.tilt_pair_torques
+
+
+def switched_model(setup: RunSetup) -> switched.SwitchedModel:
+    """The switched model of a run (:class:`posturelab.model.switched.SwitchedModel`), built
+    once per set-up."""
+    model = setup.__dict__.get("_switched_model")
+    if model is None:
+        model = switched.SwitchedModel(
+            body=setup.body, muscles=setup.muscles, gains=setup.gains,
+            disturbance=setup.disturbance, torque_limits=setup.torque_limits,
+            feedback_delay=setup.feedback_delay, tilt=setup.tilt, tilt_gains=setup.tilt_gains,
+            tilt_axis_depth=setup.tilt_axis_depth, motor_torque=setup.motor_torque,
+            knee_row=setup.knee_row, knee=setup.knee, fall=setup.fall)
+        object.__setattr__(setup, "_switched_model", model)
+    return model
 
 
 def pair_torque_if_acting(setup: RunSetup, j: int, feedback: np.ndarray) -> float:
-    """M_j = k s + l ṡ of pair j on the state the muscles respond to, ``feedback`` (2N,)
-    (what a pull-only pair's switch looks at; one-sided pairs are wholly immediate or
-    wholly delayed). [N·m]"""
+    """M_j = k s + l ṡ of pair j on the state the muscles respond to, ``feedback`` (2N,).
+    [N·m]"""
     n = setup.n_links
-    E, g = setup.muscles.selection_matrix, setup.gains
-    return float((g[0, j] + g[2, j]) * (E[j] @ feedback[:n])
-                 + (g[1, j] + g[3, j]) * (E[j] @ feedback[n:]))
+    e = setup.muscles.selection_matrix[j]
+    return float(switched.pair_torque_formula(*switched.pair_gains(switched_model(setup), j),
+                                              e @ feedback[:n], e @ feedback[n:]))
 
 
 def pair_pulls_value(setup: RunSetup, j: int, feedback: np.ndarray) -> float:
     """min(M_j, k_j s_j) of a slack pull-only pair: positive once it is stretched and its
     torque pulls (k_j its stiffness, 1 N·m/rad if it has none). [N·m]"""
     n = setup.n_links
-    k = setup.gains[0, j] + setup.gains[2, j]
-    stretch = float(setup.muscles.selection_matrix[j] @ feedback[:n])
-    return min(pair_torque_if_acting(setup, j, feedback), (k if k > 0 else 1.0) * stretch)
-
-
-def start_moments(muscles: MuscleSet, state: np.ndarray, before: np.ndarray,
-                  active: np.ndarray, gains: np.ndarray) -> np.ndarray:
-    """Unsaturated joint moments at t = 0, τ = Cᵀ M, for gains that may differ per run:
-    the immediate part on ``state`` (..., 2N), the delayed part on ``before`` (..., 2N),
-    ``active`` (..., P), ``gains`` (..., 4, P) (:func:`feedback_pair_torques`).
-    Returns (..., N). [N·m]"""
-    return feedback_pair_torques(muscles, gains, state, before, active) @ muscles.crossing_matrix
-
-
-def start_saturation(moments: np.ndarray, limits: np.ndarray | None) -> np.ndarray:
-    """±1 for each joint whose moment starts beyond its limit, else 0 (shape of moments)."""
-    moments = np.asarray(moments, dtype=float)
-    sat = np.zeros(moments.shape)
-    if limits is not None:
-        limits = np.broadcast_to(np.asarray(limits, dtype=float), moments.shape)
-        over = np.isfinite(limits) & (np.abs(moments) > limits)
-        sat[over] = np.sign(moments[over])
-    return sat
+    stiffness = switched.pair_gains(switched_model(setup), j)[0]
+    stretch = setup.muscles.selection_matrix[j] @ feedback[:n]
+    return float(switched.pull_value_formula(pair_torque_if_acting(setup, j, feedback),
+                                             stiffness, stretch))
 
 
 def start_centre_of_pressure(setup: RunSetup, moments: np.ndarray, limits, saturation
                              ) -> np.ndarray:
     """Centre of pressure at t = 0 for runs that differ in their moments (..., N) [N·m],
-    limits (..., N) [N·m] and saturation (..., N): x_p (...). [m]"""
-    n = setup.n_links
-    x = setup.x0
-    tau = np.asarray(moments, dtype=float)
-    if limits is not None:
-        bound = np.where(np.isfinite(limits), limits, 0.0)
-        tau = np.where(saturation != 0, saturation * bound, tau)
-    a = platform_acceleration(setup, 0.0)
-    theta = np.broadcast_to(x[:n], tau.shape)
-    omega = np.broadcast_to(x[n:], tau.shape)
-    acc = angular_acceleration(setup.body, theta, omega, moments_to_link_torques(tau), a[0],
-                               a[1])
-    if setup.locked0:
-        acc = np.apply_along_axis(
-            lambda row: constrained_acceleration(setup.body, x[:n], row, setup.knee_row),
-            -1, acc)
-    fy = ground_reaction(setup.body, theta, omega, acc, np.broadcast_to(a, tau.shape[:-1] + (2,))
-                         )[..., 1]
-    return centre_of_pressure(tau[..., 0], fy)
+    limits (..., N) [N·m] and saturation (..., N): x_p (...)
+    (:func:`posturelab.model.switched.start_centre_of_pressure`). [m]"""
+    return switched.start_centre_of_pressure(switched_model(setup), setup.x0, setup.locked0,
+                                             moments, limits, saturation)
 
 
 def model_response(setup: RunSetup, t: float, x: np.ndarray, feedback: np.ndarray,
                    active: np.ndarray, locked: bool, saturation: np.ndarray | None
                    ) -> tuple[np.ndarray, np.ndarray]:
-    """The model at one state with the run's switches applied (numpy).
-
-    Parameters
-    ----------
-    t : float
-        Time. [s]
-    x : numpy.ndarray, shape (2N,)
-        The state. [rad], [rad/s]
-    feedback : numpy.ndarray, shape (2N,)
-        The state the delayed part of the feedback responds to, x(t − τ) (x itself
-        without a delay). [rad], [rad/s]
-    active : numpy.ndarray, shape (P,)
-        Which pairs act. [-]
-    locked : bool
-        The knee constraint holds.
-    saturation : numpy.ndarray, shape (N,), or None
-        ±1 for a saturated joint (its moment is ±limit), 0 for a free one. [-]
-
-    Returns
-    -------
-    moments : numpy.ndarray, shape (N,)
-        Net muscle moment per joint, after saturation. [N·m]
-    acceleration : numpy.ndarray, shape (N,)
-        Θ̈ (on the knee constraint if locked). [rad/s²]
-    """
-    n = setup.n_links
-    tau = raw_moments(setup, t, x, feedback, active)
-    if saturation is not None and setup.torque_limits is not None:
-        bound = np.where(np.isfinite(setup.torque_limits), setup.torque_limits, 0.0)
-        tau = np.where(saturation != 0, saturation * bound, tau)
-    a = platform_acceleration(setup, t)
-    acc = angular_acceleration(setup.body, x[:n], x[n:], moments_to_link_torques(tau),
-                               a[0], a[1])
-    if locked:
-        acc = constrained_acceleration(setup.body, x[:n], acc, setup.knee_row)
-    return tau, acc
+    """The model at one state with the run's switches applied: (moments [N·m], Θ̈ [rad/s²])
+    (:func:`posturelab.model.switched.model_response`)."""
+    return switched.model_response(switched_model(setup), t, x, feedback, active, locked,
+                                   saturation)
 
 
 def raw_moments(setup: RunSetup, t: float, x: np.ndarray, feedback: np.ndarray,
                 active: np.ndarray) -> np.ndarray:
-    """Unsaturated net muscle moment per joint at time ``t`` [s]: the immediate part on the
-    state ``x``, the delayed part on ``feedback`` (x(t − τ)), the tilt's part and the motor
-    noise. [N·m]"""
-    M = feedback_pair_torques(setup.muscles, setup.gains, x, feedback, active)
-    if setup.tilt is not None:
-        M = M + tilt_torques(setup.tilt, setup.tilt_gains, setup.feedback_delay, t)
-    tau = M @ setup.muscles.crossing_matrix
-    if setup.motor_torque is not None:
-        tau = tau + torque_at(setup.motor_torque, t)
-    return tau
+    """Unsaturated net muscle moment per joint (:func:`posturelab.model.switched.raw_moments`).
+    [N·m]"""
+    return switched.raw_moments(switched_model(setup), t, x, feedback, active)
 
 
 def platform_acceleration(setup: RunSetup, t) -> np.ndarray:
-    """The ankle's acceleration (ẍ_d, ÿ_d) at ``t``, shape t.shape + (2,): the disturbance's,
-    plus that of a tilt about an axis below the ankle
-    (:func:`posturelab.model.tilt.axis_translation`). [m/s²]"""
-    a = setup.disturbance.acceleration(t)
-    if setup.tilt is not None and setup.tilt_axis_depth > 0:
-        a = a + axis_translation(setup.tilt, setup.tilt_axis_depth, t)[0]
-    return a
-
-
-def tilt_torques(tilt: Tilt, tilt_gains: np.ndarray, delay: float, t) -> np.ndarray:
-    """Pair torques from the tilt at times ``t`` (any shape), shape t.shape + (P,):
-    g₀ α(t) + g₁ α̇(t) + g₂ α(t − τ) + g₃ α̇(t − τ) for ``tilt_gains`` g (..., 4, P). [N·m]"""
-    t = np.asarray(t, dtype=float)
-    a, ad = tilt.angle_and_rate(t)
-    out = tilt_gains[..., 0, :] * a[..., None] + tilt_gains[..., 1, :] * ad[..., None]
-    if delay > 0:
-        a, ad = tilt.angle_and_rate(t - delay)
-        out = out + tilt_gains[..., 2, :] * a[..., None] + tilt_gains[..., 3, :] * ad[..., None]
-    return out
+    """The ankle's acceleration (ẍ_d, ÿ_d) at ``t``, shape t.shape + (2,)
+    (:func:`posturelab.model.switched.platform_acceleration`). [m/s²]"""
+    return switched.platform_acceleration(switched_model(setup), t)
 
 
 def cop_at(setup: RunSetup, t: float, x: np.ndarray, feedback: np.ndarray, active, locked,
            saturation) -> float:
-    """Centre of pressure x_p at one state, relative to the ankle (NaN when the foot is not
-    pressed on the platform, F_y <= 0). [m]"""
-    return float(centre_of_pressure(*ankle_moment_and_load(setup, t, x, feedback, active,
-                                                           locked, saturation)))
+    """Centre of pressure x_p at one state
+    (:func:`posturelab.model.switched.centre_of_pressure_at`). [m]"""
+    return switched.centre_of_pressure_at(switched_model(setup), t, x, feedback, active, locked,
+                                          saturation)
 
 
 def ankle_moment_and_load(setup: RunSetup, t: float, x: np.ndarray, feedback: np.ndarray,
                           active, locked, saturation) -> tuple[float, float]:
-    """The net muscle moment at the ankle τ_ankle [N·m] and the vertical ground reaction F_y
-    [N] at one state: x_p = τ_ankle / F_y. The centre-of-pressure events use them in moment
-    form (:mod:`posturelab.model.events`), continuous where F_y passes 0."""
-    n = setup.n_links
-    tau, acc = model_response(setup, t, x, feedback, active, locked, saturation)
-    fy = ground_reaction(setup.body, x[:n], x[n:], acc, platform_acceleration(setup, t))[1]
-    return float(tau[0]), float(fy)
+    """τ_ankle [N·m] and F_y [N] at one state
+    (:func:`posturelab.model.switched.ankle_moment_and_load`)."""
+    return switched.ankle_moment_and_load(switched_model(setup), t, x, feedback, active, locked,
+                                          saturation)
 
 
 def _fall_at_start(setup: RunSetup) -> str | None:

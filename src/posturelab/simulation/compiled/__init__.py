@@ -543,7 +543,7 @@ def simulate_batch(
     -------
     BatchResult
     """
-    from ...model._checks import check_model
+    from ...model.checks import check_model
 
     check_model(body, muscles)
     if method is not None:

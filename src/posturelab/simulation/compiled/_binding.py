@@ -1,6 +1,7 @@
 """The C engine (``_engine``, built by ``setup.py`` from ``csrc/``) seen from Python.
 
-The structs mirror ``csrc/pl.h`` field by field; :func:`library` loads the extension once
+The structs take their fields from ``_layout.py``, generated with ``csrc/pl_model.h`` from
+one table; :func:`library` loads the extension once
 and checks that it was built from the sources beside it, where they are all installed.
 Calls go through ctypes, which releases the GIL for their duration, so batch chunks run in
 parallel on Python threads.
@@ -13,6 +14,7 @@ import functools
 import importlib.util
 
 from ...errors import PostureLabError
+from ._layout import OUT_FIELDS, RUN_FIELDS
 from ._sources import stale_digest
 
 _P = ctypes.POINTER
@@ -20,28 +22,25 @@ _d = _P(ctypes.c_double)
 _i = _P(ctypes.c_int64)
 
 
+_TYPES = {"i64": ctypes.c_int64, "f64": ctypes.c_double, "*f64": _d, "*i64": _i,
+          "*u8": _P(ctypes.c_uint8)}
+
+
+def _fields(spec: tuple[str, ...]) -> list:
+    """ctypes fields from the ``name:type`` list of a struct in ``_layout.py``."""
+    return [(name, _TYPES[kind]) for name, kind in (item.split(":") for item in spec)]
+
+
 class Run(ctypes.Structure):
     """``pl_run``: one run's inputs."""
 
-    _fields_ = [(name, ctypes.c_int64) for name in
-                ("n", "p", "n_grid", "n_bps", "n_slots", "n_stages", "method")] + [
-        ("x0", _d), ("before", _d), ("grid", _d), ("bp", _d), ("E", _d), ("C", _d),
-        ("one_sided", _i), ("gains", _d), ("lim", _d), ("delay", ctypes.c_double),
-        ("dp", _d), ("bps", _d), ("fpar", _d), ("ipar", _i), ("active0", _d), ("sat0", _d),
-        ("slot_kind", _i), ("slot_index", _i), ("slot_cond", _i), ("slot_side", _d),
-        ("ev_offset", _d), ("ev_direction", _i), ("ev_ends", _i),
-        ("tab_A", _d), ("tab_c", _d), ("tab_e", _d), ("tab_P", _d),
-        ("tab_error_order", ctypes.c_int64), ("delay_multiples", ctypes.c_int64),
-        ("tp", _d), ("tilt_gain", _d), ("tilt_depth", ctypes.c_double), ("mp", _d),
-    ]
+    _fields_ = _fields(RUN_FIELDS)
 
 
 class Out(ctypes.Structure):
     """``pl_out``: where one run's outputs go."""
 
-    _fields_ = [("samples", _d), ("fb", _d), ("locked", _P(ctypes.c_uint8)),
-                ("switches", _d), ("switch_cap", ctypes.c_int64), ("peak", _d),
-                ("final", _d), ("res", _d)]
+    _fields_ = _fields(OUT_FIELDS)
 
 
 class Batch(ctypes.Structure):

@@ -15,6 +15,7 @@ from ._layout import (
     DIST_ROW,
     DIST_SAMPLES,
     DIST_SINE,
+    DIST_TERM_FIELDS,
     DIST_WINDOWED_SINE,
     F_ATOL,
     F_DURATION,
@@ -41,6 +42,7 @@ from ._layout import (
     TILT_RAISED_COSINE,
     TILT_ROW,
     TILT_SINE,
+    TILT_TERM_FIELDS,
     body_size,
 )
 
@@ -73,11 +75,10 @@ def encode_disturbance(disturbance: Disturbance | None) -> np.ndarray:
             time, ax, ay = (np.asarray(a, dtype=float) for a in q.samples)
             rows.append([DIST_SAMPLES, 0, -1.0, float(time.size), 0.0, 0.0])
             profiles.append((len(rows) - 1, np.concatenate([time, ax, ay])))
-        elif q.kind == "windowed-sine":
-            rows.append([DIST_WINDOWED_SINE, q.axis, q.amplitude, q.duration, q.start,
-                         q.cycles])
-        elif q.kind == "sine":
-            rows.append([DIST_SINE, q.axis, q.amplitude, q.frequency, q.phase, 0.0])
+        elif q.kind in DIST_TERM_FIELDS:
+            code = DIST_WINDOWED_SINE if q.kind == "windowed-sine" else DIST_SINE
+            row = [code, q.axis, *(getattr(q, f) for f in DIST_TERM_FIELDS[q.kind])]
+            rows.append(row + [0.0] * (DIST_ROW - len(row)))
         else:
             raise ParameterError(f"unknown kind of platform motion term {q.kind!r}")
     offset = 1 + DIST_ROW * len(rows)
@@ -96,10 +97,10 @@ def encode_tilt(tilt) -> np.ndarray:
     rows: list[list[float]] = []
     data: list[tuple[int, np.ndarray]] = []
     for q in tilt.terms():
-        if q.kind == "sine":
-            rows.append([TILT_SINE, q.amplitude, q.frequency, q.phase, 0.0, 0.0, 0.0])
-        elif q.kind == "raised-cosine":
-            rows.append([TILT_RAISED_COSINE, q.amplitude, q.start, q.duration, 0.0, 0.0, 0.0])
+        if q.kind in TILT_TERM_FIELDS:
+            code = TILT_SINE if q.kind == "sine" else TILT_RAISED_COSINE
+            row = [code, *(getattr(q, f) for f in TILT_TERM_FIELDS[q.kind])]
+            rows.append(row + [0.0] * (TILT_ROW - len(row)))
         elif q.kind == "ppoly":
             knots = np.asarray(q.knots, dtype=float)
             coefficients = np.asarray(q.coefficients, dtype=float)

@@ -4,8 +4,7 @@
 #define _POSIX_C_SOURCE 200809L /* clock_gettime, for a run's time limit (as Python.h sets it) */
 #endif
 #include "pl_linalg.c"
-#include "pl_platform.c"
-#include "pl_rhs.c"
+#include "pl_model.c"
 #include "pl_rhs_small.c"
 #include "pl_history.c"
 #include "pl_explicit.c"

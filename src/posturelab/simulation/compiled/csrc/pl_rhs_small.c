@@ -1,7 +1,7 @@
 /* Right-hand sides for N = 1, 2, 3 links: GENERATED, do not edit.
  *
- * python -m posturelab.simulation.compiled._codegen writes this file from the formulas
- * stated in _codegen.py (those of pl_rhs_general in pl_rhs.c, unrolled); a test regenerates
+ * python -m posturelab.simulation.compiled._codegen writes this file from the formulas of
+ * posturelab.model (those of pl_rhs_general in pl_model.c, unrolled); a test regenerates
  * it and compares. */
 #include "pl.h"
 
@@ -17,10 +17,9 @@ void pl_rhs1(const pl_model *md, const double *x, double *out, const double *inp
     const double ax = inp[0];
     const double ga = bp[3] + inp[1];
     double t0 = inp[2] + (tk[0] * th0) + (tl[0] * w0);
-    if (md->sat[0] != 0.0)
-        t0 = md->sat[0] * md->lim[0];
+    t0 = ((md->sat[0] != 0.0) ? (md->lim[0]*md->sat[0]) : (t0));
     const double u0 = -t0;
-    const double r0 = u0 + bp[0] * (ga * s0 - ax * c0);
+    const double r0 = u0 + bp[0]*(-ax*c0 + ga*s0);
     const double j00 = bp[1];
     const double m00 = 1.0;
     const double inv_det = 1.0 / (j00 * m00);
@@ -44,18 +43,15 @@ void pl_rhs2(const pl_model *md, const double *x, double *out, const double *inp
     const double ax = inp[0];
     const double ga = bp[8] + inp[1];
     double t0 = inp[2] + (tk[0] * th0 + tk[1] * th1) + (tl[0] * w0 + tl[1] * w1);
-    if (md->sat[0] != 0.0)
-        t0 = md->sat[0] * md->lim[0];
+    t0 = ((md->sat[0] != 0.0) ? (md->lim[0]*md->sat[0]) : (t0));
     double t1 = inp[3] + (tk[2] * th0 + tk[3] * th1) + (tl[2] * w0 + tl[3] * w1);
-    if (md->sat[1] != 0.0)
-        t1 = md->sat[1] * md->lim[1];
+    t1 = ((md->sat[1] != 0.0) ? (md->lim[1]*md->sat[1]) : (t1));
     const double u0 = t1 - t0;
     const double u1 = -t1;
-    const double n01 = bp[5] * (s0 * c1 - c0 * s1);
-    const double r0 = u0 - (n01 * (w1 * w1)) + bp[0] * (ga * s0 - ax * c0);
-    const double r1 = u1 - (-n01 * (w0 * w0)) + bp[1] * (ga * s1 - ax * c1);
+    const double r0 = u0 - (bp[5]*(w1 * w1)*(-c0*s1 + c1*s0)) + bp[0]*(-ax*c0 + ga*s0);
+    const double r1 = u1 - (-bp[5]*(w0 * w0)*(-c0*s1 + c1*s0)) + bp[1]*(-ax*c1 + ga*s1);
     const double j00 = bp[2];
-    const double j01 = bp[5] * (c0 * c1 + s0 * s1);
+    const double j01 = bp[5]*(c0*c1 + s0*s1);
     const double j11 = bp[3];
     const double q0 = -j01;
     const double m00 = j11;
@@ -97,28 +93,22 @@ void pl_rhs3(const pl_model *md, const double *x, double *out, const double *inp
     const double ax = inp[0];
     const double ga = bp[15] + inp[1];
     double t0 = inp[2] + (tk[0] * th0 + tk[1] * th1 + tk[2] * th2) + (tl[0] * w0 + tl[1] * w1 + tl[2] * w2);
-    if (md->sat[0] != 0.0)
-        t0 = md->sat[0] * md->lim[0];
+    t0 = ((md->sat[0] != 0.0) ? (md->lim[0]*md->sat[0]) : (t0));
     double t1 = inp[3] + (tk[3] * th0 + tk[4] * th1 + tk[5] * th2) + (tl[3] * w0 + tl[4] * w1 + tl[5] * w2);
-    if (md->sat[1] != 0.0)
-        t1 = md->sat[1] * md->lim[1];
+    t1 = ((md->sat[1] != 0.0) ? (md->lim[1]*md->sat[1]) : (t1));
     double t2 = inp[4] + (tk[6] * th0 + tk[7] * th1 + tk[8] * th2) + (tl[6] * w0 + tl[7] * w1 + tl[8] * w2);
-    if (md->sat[2] != 0.0)
-        t2 = md->sat[2] * md->lim[2];
+    t2 = ((md->sat[2] != 0.0) ? (md->lim[2]*md->sat[2]) : (t2));
     const double u0 = t1 - t0;
     const double u1 = t2 - t1;
     const double u2 = -t2;
-    const double n01 = bp[7] * (s0 * c1 - c0 * s1);
-    const double n02 = bp[8] * (s0 * c2 - c0 * s2);
-    const double n12 = bp[11] * (s1 * c2 - c1 * s2);
-    const double r0 = u0 - (n01 * (w1 * w1) + n02 * (w2 * w2)) + bp[0] * (ga * s0 - ax * c0);
-    const double r1 = u1 - (-n01 * (w0 * w0) + n12 * (w2 * w2)) + bp[1] * (ga * s1 - ax * c1);
-    const double r2 = u2 - (-n02 * (w0 * w0) + -n12 * (w1 * w1)) + bp[2] * (ga * s2 - ax * c2);
+    const double r0 = u0 - (bp[7]*(w1 * w1)*(-c0*s1 + c1*s0) + bp[8]*(w2 * w2)*(-c0*s2 + c2*s0)) + bp[0]*(-ax*c0 + ga*s0);
+    const double r1 = u1 - (-bp[7]*(w0 * w0)*(-c0*s1 + c1*s0) + bp[11]*(w2 * w2)*(-c1*s2 + c2*s1)) + bp[1]*(-ax*c1 + ga*s1);
+    const double r2 = u2 - (-bp[8]*(w0 * w0)*(-c0*s2 + c2*s0) + -bp[11]*(w1 * w1)*(-c1*s2 + c2*s1)) + bp[2]*(-ax*c2 + ga*s2);
     const double j00 = bp[3];
-    const double j01 = bp[7] * (c0 * c1 + s0 * s1);
-    const double j02 = bp[8] * (c0 * c2 + s0 * s2);
+    const double j01 = bp[7]*(c0*c1 + s0*s1);
+    const double j02 = bp[8]*(c0*c2 + s0*s2);
     const double j11 = bp[4];
-    const double j12 = bp[11] * (c1 * c2 + s1 * s2);
+    const double j12 = bp[11]*(c1*c2 + s1*s2);
     const double j22 = bp[5];
     const double q0 = -j01*j22 + j02*j12;
     const double q1 = j01*j12 - j02*j11;

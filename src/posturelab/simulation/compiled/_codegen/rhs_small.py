@@ -2,8 +2,10 @@
 straight-line C.
 
 Run ``python -m posturelab.simulation.compiled._codegen`` to rewrite the file; a test
-regenerates it and compares. The formulas are those of the general-N right-hand side
-(``pl_rhs_general`` in ``csrc/pl_rhs.c``), unrolled: for link i,
+regenerates it and compares. The entries (J_ij, the centripetal terms, gravity and platform
+load, saturation) are the formulas of :mod:`posturelab.model.dynamics` and
+:mod:`posturelab.model.switched` printed through :mod:`.spec`, as in the general-N code of
+``csrc/pl_model.c``, unrolled: for link i,
 
 * τ_j = (T_K Θ + T_L Θ̇ + τ_delayed)_j, or ±limit_j while joint j saturates; U_i = τ_{i+1} − τ_i
 * r_i = U_i − Σ_{j≠i} c_ij sin(θ_i − θ_j) θ̇_j² + a_i ((g + ÿ_d) sin θ_i − ẍ_d cos θ_i)
@@ -19,13 +21,13 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-TARGET = Path(__file__).with_name("csrc") / "pl_rhs_small.c"
+TARGET = Path(__file__).resolve().parent.parent / "csrc" / "pl_rhs_small.c"
 SIZES = (1, 2, 3)
 
 HEADER = """/* Right-hand sides for N = 1, 2, 3 links: GENERATED, do not edit.
  *
- * python -m posturelab.simulation.compiled._codegen writes this file from the formulas
- * stated in _codegen.py (those of pl_rhs_general in pl_rhs.c, unrolled); a test regenerates
+ * python -m posturelab.simulation.compiled._codegen writes this file from the formulas of
+ * posturelab.model (those of pl_rhs_general in pl_model.c, unrolled); a test regenerates
  * it and compares. */
 #include "pl.h"
 """
@@ -65,6 +67,47 @@ def _adjugate_lines(n: int, printer) -> tuple[list[str], list[list[str]]]:
     return lines, names
 
 
+def _entry(expr, *links: int) -> str:
+    """An entry formula on θ_i symbols printed with s_i, c_i for sin θ_i, cos θ_i."""
+    from .model_c import _trig_symbols
+    from .spec import c, symbols
+
+    return c(_trig_symbols(expr, {symbols(f"th{i}"): (f"s{i}", f"c{i}") for i in links}))
+
+
+def _coupling(n: int, i: int, j: int) -> str:
+    from ....model.dynamics import coupling_formula
+    from .spec import SYMPY, symbols
+
+    return _entry(coupling_formula(symbols(f"bp[{2 * n + i * n + j}]"), symbols(f"th{i}"),
+                                   symbols(f"th{j}"), SYMPY), i, j)
+
+
+def _centripetal(n: int, i: int, j: int) -> str:
+    from ....model.dynamics import centripetal_formula
+    from .spec import SYMPY, symbols
+
+    return _entry(centripetal_formula(symbols(f"bp[{2 * n + min(i, j) * n + max(i, j)}]"),
+                                      symbols(f"th{i}"), symbols(f"th{j}"), symbols(f"w{j}"),
+                                      SYMPY), i, j)
+
+
+def _load(i: int) -> str:
+    from ....model.dynamics import load_formula
+    from .spec import SYMPY, symbols
+
+    return _entry(load_formula(symbols(f"bp[{i}]"), symbols(f"th{i}"), *symbols("ga", "ax"),
+                               SYMPY), i)
+
+
+def _saturated(j: int) -> str:
+    from ....model.switched import saturated_moment_formula
+    from .spec import SYMPY, c, symbols
+
+    return c(saturated_moment_formula(*symbols(f"t{j}", f"md->sat[{j}]", f"md->lim[{j}]"),
+                                      SYMPY))
+
+
 def _rhs_function(n: int, printer) -> str:
     L = [f"void pl_rhs{n}(const pl_model *md, const double *x, double *out, const double *inp,",
          "             int locked)", "{",
@@ -84,28 +127,18 @@ def _rhs_function(n: int, printer) -> str:
         k_terms = " + ".join(f"tk[{j * n + k}] * th{k}" for k in range(n))
         l_terms = " + ".join(f"tl[{j * n + k}] * w{k}" for k in range(n))
         L.append(f"    double t{j} = inp[{2 + j}] + ({k_terms}) + ({l_terms});")
-        L.append(f"    if (md->sat[{j}] != 0.0)")
-        L.append(f"        t{j} = md->sat[{j}] * md->lim[{j}];")
+        L.append(f"    t{j} = {_saturated(j)};")
     for i in range(n):
         rhs = f"t{i + 1} - t{i}" if i + 1 < n else f"-t{i}"
         L.append(f"    const double u{i} = {rhs};")
     for i in range(n):
-        for j in range(i + 1, n):
-            L.append(f"    const double n{i}{j} = bp[{2 * n + i * n + j}] "
-                     f"* (s{i} * c{j} - c{i} * s{j});")
-    for i in range(n):
-        terms = []
-        for j in range(n):
-            if j != i:
-                coef = f"n{i}{j}" if i < j else f"-n{j}{i}"
-                terms.append(f"{coef} * (w{j} * w{j})")
+        terms = [_centripetal(n, i, j) for j in range(n) if j != i]
         bterm = f" - ({' + '.join(terms)})" if terms else ""
-        L.append(f"    const double r{i} = u{i}{bterm} + bp[{i}] * (ga * s{i} - ax * c{i});")
+        L.append(f"    const double r{i} = u{i}{bterm} + {_load(i)};")
     for i in range(n):
         L.append(f"    const double j{i}{i} = bp[{n + i}];")
         for j in range(i + 1, n):
-            L.append(f"    const double j{i}{j} = bp[{2 * n + i * n + j}] "
-                     f"* (c{i} * c{j} + s{i} * s{j});")
+            L.append(f"    const double j{i}{j} = {_coupling(n, i, j)};")
     lines, names = _adjugate_lines(n, printer)
     L += [f"    {line}" for line in lines]
     det = " + ".join(f"j{min(0, k)}{max(0, k)} * {names[k][0]}" for k in range(n))

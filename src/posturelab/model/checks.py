@@ -1,4 +1,5 @@
-"""The public API's first check of a model (private): a Body and a MuscleSet that fit it."""
+"""Checks of a model's parts at the public API's edge (the generic checks of fields and values
+are in :mod:`posturelab._validation`, which knows nothing of the model)."""
 
 from __future__ import annotations
 
@@ -14,7 +15,7 @@ __all__ = ["check_model"]
 
 def check_model(body: Any, muscles: Any = None) -> None:
     """The public API's first check: ``body`` is a Body, ``muscles`` (if given) a MuscleSet
-    for as many links; a ParameterError in one line otherwise."""
+    for as many links."""
     expect_type("body", body, Body)
     if muscles is not None:
         expect_type("muscles", muscles, MuscleSet)

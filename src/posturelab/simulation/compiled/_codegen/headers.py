@@ -1,0 +1,169 @@
+"""Writes ``csrc/pl_model.h``: the interface of the generated model — the structs a run and its
+outputs are packed into (their fields stated once in :data:`RUN_FIELDS` and
+:data:`OUT_FIELDS`, which ``_layout.py`` also carries for the ctypes mirror in
+``_binding.py``), what the right-hand side and the event values need (``pl_model``,
+``pl_ctx``), the angle-sum rotation whose series sympy derives, and the generated functions'
+prototypes.
+"""
+
+from __future__ import annotations
+
+#: C type of each field code: i64/f64 scalars, *… read-only arrays, w… arrays written to.
+C_TYPES = {"i64": "int64_t ", "f64": "double ", "*f64": "const double *",
+           "*i64": "const int64_t *", "w*f64": "double *", "w*u8": "uint8_t *"}
+
+#: ``pl_run``: one run, everything the integration needs (read only): (field, type, comment).
+RUN_FIELDS = [
+    ("n", "i64", ""), ("p", "i64", ""), ("n_grid", "i64", ""), ("n_bps", "i64", ""),
+    ("n_slots", "i64", ""), ("n_stages", "i64", ""), ("method", "i64", ""),
+    ("x0", "*f64", "(2n)"), ("before", "*f64", "(2n)"), ("grid", "*f64", "(n_grid)"),
+    ("bp", "*f64", "a (n), J_ii (n), c_ij (n*n), g, total mass"),
+    ("E", "*f64", "(p, n) stretch rows"), ("C", "*f64", "(p, n) joint-crossing rows"),
+    ("one_sided", "*i64", "(p)"),
+    ("gains", "*f64", "(4, p) rows GAIN_*: immediate k, l, delayed k, l"),
+    ("lim", "*f64", "(n) torque limits, inf for none [N·m]"),
+    ("delay", "f64", "feedback delay [s]"),
+    ("dp", "*f64", "packed disturbance"), ("bps", "*f64", "breakpoints in (0, duration)"),
+    ("fpar", "*f64", "F_*"), ("ipar", "*i64", "I_*"),
+    ("active0", "*f64", "(p) at the start"), ("sat0", "*f64", "(n) at the start"),
+    ("slot_kind", "*i64", "(n_slots) event slots, in order"), ("slot_index", "*i64", ""),
+    ("slot_cond", "*i64", ""), ("slot_side", "*f64", ""),
+    ("ev_offset", "*f64", "by kind: the event function's constant part"),
+    ("ev_direction", "*i64", ""), ("ev_ends", "*i64", ""),
+    ("tab_A", "*f64", "explicit tableau (n_stages ...)"), ("tab_c", "*f64", ""),
+    ("tab_e", "*f64", ""), ("tab_P", "*f64", ""), ("tab_error_order", "i64", ""),
+    ("delay_multiples", "i64", "land on k·delay for k = 1 … this"),
+    ("tp", "*f64", "packed tilt (tp[0] = 0: none)"),
+    ("tilt_gain", "*f64", "(4, n) joint moments per α(t), α̇(t), α(t−τ), α̇(t−τ)"),
+    ("tilt_depth", "f64", "tilt axis below the ankle [m] (0: the ankle's)"),
+    ("mp", "*f64", "packed motor noise (mp[0] = 0: none)"),
+]
+#: ``pl_out``: where one run's outputs go (any pointer may be NULL where noted).
+OUT_FIELDS = [
+    ("samples", "w*f64", "(2n, n_grid + 1) or NULL"),
+    ("fb", "w*f64", "(2n, n_grid + 1) states the muscles responded to, or NULL"),
+    ("locked", "w*u8", "(n_grid + 1) or NULL"),
+    ("switches", "w*f64", "(switch_cap) or NULL"), ("switch_cap", "i64", ""),
+    ("peak", "w*f64", "(n)"), ("final", "w*f64", "(2n)"), ("res", "w*f64", "(N_RESULT)"),
+]
+
+
+def _struct(name: str, fields) -> list[str]:
+    out = ["typedef struct {"]
+    for field, kind, comment in fields:
+        line = f"    {C_TYPES[kind]}{field};"
+        out.append(f"{line:<40}/* {comment} */" if comment else line)
+    return out + [f"}} {name};", ""]
+
+
+def _rotation() -> str:
+    """pl_rotate, with the series of sin δ and cos δ − 1 from sympy in Horner form in z = δ²."""
+    import sympy as sp
+
+    from .spec import c
+
+    d, z = sp.symbols("d z")
+    sin_poly = sp.Poly(sp.series(sp.sin(d), d, 0, 11).removeO(), d)
+    cos_poly = sp.Poly(sp.series(sp.cos(d) - 1, d, 0, 10).removeO(), d)
+
+    def horner(coefficients):  # Σ c_k z^k, k >= 1, as z·(c_1 + z·(c_2 + …))
+        expr = sp.S.Zero
+        for coefficient in reversed(coefficients):
+            expr = sp.Mul(sp.Add(sp.Rational(coefficient), expr, evaluate=False), z,
+                          evaluate=False) if expr != 0 else sp.Mul(sp.Rational(coefficient), z,
+                                                                    evaluate=False)
+        return expr
+
+    sin_terms = [sin_poly.coeff_monomial(d ** (2 * k + 1)) for k in range(1, 5)]
+    cos_terms = [cos_poly.coeff_monomial(d ** (2 * k)) for k in range(1, 5)]
+    return f"""\
+/* sin θ and cos θ from those of a nearby θ_b by the angle-sum formulas: within a step the
+ * angles move by hundredths of a radian, and the series of sin δ (to δ⁹) and cos δ − 1 (to δ⁸)
+ * are exact to rounding for |δ| <= 0.1 and much shorter than libm's sin and cos; farther
+ * away, libm. pl_set_base stores (θ_b, sin θ_b, cos θ_b) at each step's start. */
+static inline void pl_rotate(double theta, double theta_b, double s_b, double c_b, double *s,
+                             double *c)
+{{
+    const double d = theta - theta_b;
+    if (d > 0.1 || d < -0.1) {{
+        *s = sin(theta);
+        *c = cos(theta);
+        return;
+    }}
+    const double z = d * d;
+    const double sd = d + d * ({c(horner(sin_terms))});
+    const double cdm1 = {c(horner(cos_terms))};
+    *s = s_b + (s_b * cdm1 + c_b * sd);
+    *c = c_b + (c_b * cdm1 - s_b * sd);
+}}
+"""
+
+
+def header() -> str:
+    """The text of ``csrc/pl_model.h``."""
+    out = ["/* The interface of the generated model: GENERATED, do not edit.",
+           " *",
+           " * python -m posturelab.simulation.compiled._codegen writes this file from",
+           " * _codegen/headers.py (the structs' fields, which _layout.py carries for _binding.py)",
+           " * and sympy (the rotation's series); pl.h includes it. */",
+           "#ifndef PL_MODEL_H", "#define PL_MODEL_H", "",
+           "/* One run: everything the integration needs (read only). */"]
+    out += _struct("pl_run", RUN_FIELDS)
+    out.append("/* Outputs of one run (any pointer may be NULL where noted). */")
+    out += _struct("pl_out", OUT_FIELDS)
+    out.append(MODEL_STRUCTS)
+    out.append(_rotation())
+    out.append(PROTOTYPES)
+    out.append("#endif")
+    return "\n".join(out) + "\n"
+
+
+MODEL_STRUCTS = """/* What the right-hand side needs besides the state. */
+typedef struct {
+    int64_t n;
+    const double *bp;
+    double *tm;          /* (4, n, n): T_K, T_L, delayed T_K, delayed T_L */
+    const double *lim;   /* (n) */
+    double *sat;         /* (n) saturation signs */
+    double *base;        /* (3n) θ, sin θ, cos θ at the step's start */
+    double *work;        /* (n, n + 4) */
+    double *tau;         /* (n) receives the joint moments */
+} pl_model;
+
+struct pl_history;
+
+/* What the inputs and an event function need besides (t, y). */
+typedef struct {
+    const pl_model *md;
+    const double *E, *dp, *fpar, *before, *ev_offset;
+    const struct pl_history *hist;
+    double delay;
+    const double *tp, *tilt_gain;          /* packed tilt, (4, n) joint gains on it */
+    double tilt_depth;                     /* tilt axis below the ankle [m] */
+    const double *mp;                      /* packed motor noise */
+    const double *gains;                   /* (4, p) the run's pair gains */
+    int64_t p;
+    double *sc_out, *sc_inp, *sc_x, *ys;   /* scratch (2n), (2 + n), (2n), (2n) */
+} pl_ctx;
+"""
+
+PROTOTYPES = """/* the right-hand side (pl_model.c, pl_rhs_small.c) */
+void pl_rhs(const pl_model *md, const double *x, double *out, const double *inp, int locked);
+void pl_rhs_general(const pl_model *md, const double *x, double *out, const double *inp,
+                    int locked);
+void pl_rhs1(const pl_model *md, const double *x, double *out, const double *inp, int locked);
+void pl_rhs2(const pl_model *md, const double *x, double *out, const double *inp, int locked);
+void pl_rhs3(const pl_model *md, const double *x, double *out, const double *inp, int locked);
+void pl_set_base(const double *x, double *base, int64_t n);
+void pl_moment_gains(const double *E, const double *C, const double *kd, const double *ld,
+                     const double *active, int64_t p, int64_t n, double *tk, double *tl);
+void pl_project_velocity(double *x, const double *bp, double *work, int64_t n);
+
+/* the inputs and the event values (pl_model.c) */
+void pl_platform_acceleration(double t, const double *dp, double *ax, double *ay);
+void pl_tilt(double t, const double *tp, double *angle, double *rate, double *accel);
+void pl_motor_noise_add(double t, const double *mp, int64_t n, double *tau);
+void pl_inputs_at(const pl_ctx *cx, double t, double *out);
+double pl_event_value(const pl_ctx *cx, int64_t kind, int64_t idx, double side, double t,
+                      const double *y, int locked);
+"""

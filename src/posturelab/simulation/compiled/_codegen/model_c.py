@@ -1,0 +1,482 @@
+"""Writes ``csrc/pl_model.c``: the switched model in C for any N — the inputs (platform
+acceleration, tilt, axis translation, delayed moments, motor noise), the right-hand side
+(``pl_rhs_general``, the knee impact ``pl_project_velocity``, the dispatch to the small-N code)
+and each event's value (``pl_event_value``).
+
+The loops and the packing are written here; every formula is evaluated from its one statement
+in :mod:`posturelab.model` on sympy symbols named as C expressions (:mod:`.spec`) and printed.
+"""
+
+from __future__ import annotations
+
+import inspect
+
+import sympy as sp
+
+from ....model import dynamics, kinematics, platform, switched, tilt
+from ....model import events as ev
+from ....model.gains import GAIN_ROWS
+from .codes import DIST_TERM_FIELDS, TILT_TERM_FIELDS
+from .spec import SYMPY, c, symbols
+
+HEADER = """/* The switched model for any N links: GENERATED, do not edit.
+ *
+ * python -m posturelab.simulation.compiled._codegen writes this file from the formulas of
+ * posturelab.model (dynamics, platform, tilt, switched), printed by sympy into the loops of
+ * _codegen/model_c.py; a test regenerates it and compares. Layouts: pl.h, pl_codes.h.
+ *
+ *   J(Θ)Θ̈ + B(Θ,Θ̇)Θ̇ − (g + ÿ_d)G(Θ) + ẍ_d H(Θ) = U,   U_i = τ_{i+1} − τ_i,
+ *
+ * τ the net muscle moments at the joints: τ = T_K Θ + T_L Θ̇ + inp[2 + j] (T_K = Cᵀ
+ * diag(k·active) E, pl_moment_gains), or ±limit_j while joint j saturates;
+ * inp = (ẍ_d, ÿ_d, delayed, tilt and noise moments), from pl_inputs_at. */
+#include <math.h>
+#include "pl.h"
+#include "pl_events.h"
+"""
+
+
+def _trig_symbols(expr, angles: dict):
+    """``expr`` with sin and cos of differences expanded and sin θ, cos θ of each angle in
+    ``angles`` (symbol -> (sin name, cos name)) replaced by those names."""
+    expr = sp.expand_trig(expr)
+    subs = {}
+    for angle, (s, co) in angles.items():
+        subs[sp.sin(angle)] = symbols(s)
+        subs[sp.cos(angle)] = symbols(co)
+    return expr.xreplace(subs)
+
+
+# ---------------------------------------------------------------------------
+# Inputs: platform, tilt, motor noise
+# ---------------------------------------------------------------------------
+
+
+def _row(kind: str, table: dict, first: int) -> dict:
+    """A packed term's parameters as symbols r[first], r[first + 1], … by name."""
+    return {name: symbols(f"r[{first + k}]") for k, name in enumerate(table[kind])}
+
+
+def _platform() -> str:
+    t = symbols("t")
+    windowed = platform.windowed_sine_formula(t, **_row("windowed-sine", DIST_TERM_FIELDS, 2),
+                                              xp=SYMPY)
+    sine = platform.sine_formula(t, **_row("sine", DIST_TERM_FIELDS, 2), xp=SYMPY)
+    return f"""
+/* the largest k in [lo, hi) with x[k] <= t, by bisection (x increasing; lo if none) */
+static int64_t interval_of(const double *x, int64_t lo, int64_t hi, double t)
+{{
+    while (hi - lo > 1) {{
+        const int64_t mid = (lo + hi) >> 1;
+        if (x[mid] <= t)
+            lo = mid;
+        else
+            hi = mid;
+    }}
+    return lo;
+}}
+
+/* numpy.interp(t, xp, fp, left=0, right=0), xp = dp[first .. first+count), fp its col-th
+ * block of count values after it */
+static double interp0(double t, const double *dp, int64_t first, int64_t count, int64_t col)
+{{
+    const int64_t hi = first + count - 1;
+    if (!(t >= dp[first] && t <= dp[hi]))
+        return 0.0;
+    const int64_t off = col * count;
+    if (t == dp[hi])
+        return dp[hi + off];
+    const int64_t lo = interval_of(dp, first, hi, t);
+    const double slope = (dp[lo + 1 + off] - dp[lo + off]) / (dp[lo + 1] - dp[lo]);
+    return slope * (t - dp[lo]) + dp[lo + off];
+}}
+
+/* the platform acceleration: the sum of the disturbance's terms (model.platform.Primitive) */
+void pl_platform_acceleration(double t, const double *dp, double *ax, double *ay)
+{{
+    double sx = 0.0, sy = 0.0;
+    const int64_t nq = (int64_t)dp[0];
+    for (int64_t q = 0; q < nq; q++) {{
+        const double *r = dp + 1 + DIST_ROW * q;
+        const int kind = (int)r[0];
+        double v = 0.0;
+        if (kind == DIST_WINDOWED_SINE) {{
+            v = {c(windowed)};
+        }} else if (kind == DIST_SINE) {{
+            v = {c(sine)};
+        }} else if (kind == DIST_SAMPLES) {{
+            const int64_t first = (int64_t)r[2], count = (int64_t)r[3];
+            sx += interp0(t, dp, first, count, 1);
+            sy += interp0(t, dp, first, count, 2);
+            continue;
+        }}
+        if (r[1] == 0.0)
+            sx += v;
+        else
+            sy += v;
+    }}
+    *ax = sx;
+    *ay = sy;
+}}
+"""
+
+
+def _tilt() -> str:
+    t = symbols("t")
+    sine = tilt.sine_tilt_formula(t, **_row("sine", TILT_TERM_FIELDS, 1), xp=SYMPY)
+    ramp = tilt.raised_cosine_tilt_formula(t, **_row("raised-cosine", TILT_TERM_FIELDS, 1),
+                                           xp=SYMPY)
+    q0, q1, q2, q3, u = symbols("q[0]", "q[1]", "q[2]", "q[3]", "u")
+    cubic = tilt.cubic_formula(q0, q1, q2, q3, u)
+    qj = symbols("q[j]", "q[n + j]", "q[2 * n + j]", "q[3 * n + j]")
+    noise = tilt.cubic_formula(*qj, u)[0]
+
+    def add(parts):
+        return "\n".join(f"            {v} += {c(e)};" for v, e in zip(("a", "ad", "add"), parts,
+                                                                         strict=True))
+
+    return f"""
+/* α, α̇, α̈ of one piecewise cubic: knots x[0..K], coefficients c[4k .. 4k+3] */
+static void ppoly(double t, const double *x, const double *c, int64_t K, double period,
+                  double *angle, double *rate, double *accel)
+{{
+    if (period > 0.0 && t >= x[0])
+        t = x[0] + fmod(t - x[0], period);
+    const int inside = t >= x[0] && t <= x[K];
+    if (t < x[0])
+        t = x[0];
+    if (t > x[K])
+        t = x[K];
+    const int64_t lo = interval_of(x, 0, K, t);
+    const double u = t - x[lo], *q = c + 4 * lo;
+    *angle = {c(cubic[0])};
+    *rate = inside ? {c(cubic[1])} : 0.0;
+    *accel = inside ? {c(cubic[2])} : 0.0;
+}}
+
+/* the tilt: the sum of its terms (model.tilt.TiltTerm) */
+void pl_tilt(double t, const double *tp, double *angle, double *rate, double *accel)
+{{
+    double a = 0.0, ad = 0.0, add = 0.0;
+    const int64_t nq = (int64_t)tp[0];
+    for (int64_t q = 0; q < nq; q++) {{
+        const double *r = tp + 1 + TILT_ROW * q;
+        const int kind = (int)r[0];
+        if (kind == TILT_SINE) {{
+{add(sine)}
+        }} else if (kind == TILT_RAISED_COSINE) {{
+{add(ramp)}
+        }} else if (kind == TILT_PPOLY) {{
+            const int64_t off = (int64_t)r[1], K = (int64_t)r[2];
+            double pa, pr, pq;
+            ppoly(t, tp + off, tp + off + K + 1, K, r[3], &pa, &pr, &pq);
+            a += pa;
+            ad += pr;
+            add += pq;
+        }}
+    }}
+    *angle = a;
+    *rate = ad;
+    *accel = add;
+}}
+
+/* tau[j] += the motor noise at joint j (model.noise.torque_at: the interval whose knot is the
+ * last at or before t, the end intervals carried on outside the knots) */
+void pl_motor_noise_add(double t, const double *mp, int64_t n, double *tau)
+{{
+    const int64_t K = (int64_t)mp[0];
+    const double *x = mp + 1, *c = mp + 2 + K;
+    const int64_t lo = interval_of(x, 0, K, t);  /* in [0, K - 1] */
+    const double u = t - x[lo], *q = c + lo * 4 * n;
+    for (int64_t j = 0; j < n; j++)
+        tau[j] += {c(noise)};
+}}
+"""
+
+
+def _inputs() -> str:
+    h, a, ad, add = symbols("cx->tilt_depth", "a", "ad", "add")
+    axis_x, axis_y = tilt.axis_acceleration_formula(h, a, ad, add, SYMPY)
+    g = symbols(*(f"g[GAIN_{row.upper()} * n + j]" for row in GAIN_ROWS))
+    tilt_moment = switched.tilt_pair_torque_formula(*g, a, ad, *symbols("a_d", "ad_d"))
+    return f"""
+/* The inputs at t: inp = (ẍ_d, ÿ_d, the moments that do not depend on the state now: the
+ * delayed part of the feedback on x(t − τ), the tilt's part, the motor noise). */
+void pl_inputs_at(const pl_ctx *cx, double t, double *out)
+{{
+    const int64_t n = cx->md->n;
+    const double *tm = cx->md->tm;
+    double ax = 0.0, ay = 0.0;
+    if (cx->dp[0] > 0.0)
+        pl_platform_acceleration(t, cx->dp, &ax, &ay);
+    double a = 0.0, ad = 0.0, add = 0.0;
+    if (cx->tp[0] > 0.0)
+        pl_tilt(t, cx->tp, &a, &ad, &add);
+    if (cx->tilt_depth > 0.0) {{  /* the ankle moves on a circle about the tilt axis */
+        ax += {c(axis_x)};
+        ay += {c(axis_y)};
+    }}
+    out[0] = ax;
+    out[1] = ay;
+    if (cx->delay > 0.0) {{
+        pl_history_at(cx->hist, cx->before, t - cx->delay, cx->sc_x);
+        for (int64_t j = 0; j < n; j++) {{
+            double s = 0.0;
+            for (int64_t k = 0; k < n; k++)
+                s += tm[2 * n * n + j * n + k] * cx->sc_x[k]
+                     + tm[3 * n * n + j * n + k] * cx->sc_x[n + k];
+            out[2 + j] = s;
+        }}
+    }} else {{
+        for (int64_t j = 0; j < n; j++)
+            out[2 + j] = 0.0;
+    }}
+    if (cx->tp[0] > 0.0) {{  /* the tilt's moments: now, and as the delayed part felt it */
+        const double *g = cx->tilt_gain;
+        double a_d = 0.0, ad_d = 0.0, add_d = 0.0;
+        if (cx->delay > 0.0)
+            pl_tilt(t - cx->delay, cx->tp, &a_d, &ad_d, &add_d);
+        for (int64_t j = 0; j < n; j++)
+            out[2 + j] += {c(tilt_moment)};
+    }}
+    if (cx->mp[0] > 0.0)  /* the motor noise, on the motor command */
+        pl_motor_noise_add(t, cx->mp, n, out + 2);
+}}
+"""
+
+
+# ---------------------------------------------------------------------------
+# The right-hand side for any N
+# ---------------------------------------------------------------------------
+
+
+def _rhs() -> str:
+    thi, thj, wj = symbols("thi", "thj", "x[n + j]")
+    trig = {thi: ("si", "ci"), thj: ("sj", "cj")}
+    cij, a_i = symbols("cij", "bp[i]")
+    coupling = _trig_symbols(dynamics.coupling_formula(cij, thi, thj, SYMPY), trig)
+    centripetal = _trig_symbols(dynamics.centripetal_formula(cij, thi, thj, wj, SYMPY), trig)
+    load = _trig_symbols(dynamics.load_formula(a_i, thi, *symbols("ga", "ax"), SYMPY), trig)
+    saturated = switched.saturated_moment_formula(*symbols("t", "md->sat[j]", "md->lim[j]"),
+                                                  SYMPY)
+    xi, xj = symbols("x[i]", "x[j]")
+    impact = dynamics.coupling_formula(symbols("bp[2 * n + i * n + j]"), xi, xj, SYMPY)
+    return f"""
+void pl_set_base(const double *x, double *base, int64_t n)
+{{
+    for (int64_t i = 0; i < n; i++) {{
+        base[i] = x[i];
+        base[n + i] = sin(x[i]);
+        base[2 * n + i] = cos(x[i]);
+    }}
+}}
+
+void pl_rhs_general(const pl_model *md, const double *x, double *out, const double *inp,
+                    int locked)
+{{
+    const int64_t n = md->n, oc = 2 * n, w = n + 4;
+    const double *bp = md->bp, *tk = md->tm, *tl = md->tm + n * n;
+    double *work = md->work, *tau = md->tau;
+    const double ax = inp[0], ga = bp[oc + n * n] + inp[1];
+    for (int64_t i = 0; i < n; i++)
+        pl_rotate(x[i], md->base[i], md->base[n + i], md->base[2 * n + i],
+                  &work[i * w + n + 2], &work[i * w + n + 3]);
+    for (int64_t j = 0; j < n; j++) {{
+        double t = inp[2 + j];
+        for (int64_t k = 0; k < n; k++)
+            t += tk[j * n + k] * x[k] + tl[j * n + k] * x[n + k];
+        tau[j] = {c(saturated)};
+    }}
+    for (int64_t i = 0; i < n; i++) {{
+        const double si = work[i * w + n + 2], ci = work[i * w + n + 3];
+        double r = (i + 1 < n ? tau[i + 1] : 0.0) - tau[i] + {c(load)};
+        for (int64_t j = 0; j < n; j++) {{
+            if (j == i) {{
+                work[i * w + j] = bp[n + i];
+                continue;
+            }}
+            const double sj = work[j * w + n + 2], cj = work[j * w + n + 3];
+            const double cij = bp[oc + i * n + j];
+            r -= {c(centripetal)};
+            work[i * w + j] = {c(coupling)};
+        }}
+        work[i * w + n] = r;
+        work[i * w + n + 1] = 0.0;
+    }}
+    int64_t ncol = 1;
+    if (locked) {{
+        work[n + 1] = -1.0;
+        work[w + n + 1] = 1.0;
+        ncol = 2;
+    }}
+    pl_solve_into(work, n, ncol, w);
+    if (locked) {{
+        const double lam = (work[w + n] - work[n]) / (work[w + n + 1] - work[n + 1]);
+        for (int64_t i = 0; i < n; i++)
+            work[i * w + n] -= work[i * w + n + 1] * lam;
+    }}
+    for (int64_t i = 0; i < n; i++) {{
+        out[i] = x[n + i];
+        out[n + i] = work[i * w + n];
+    }}
+}}
+
+void pl_rhs(const pl_model *md, const double *x, double *out, const double *inp, int locked)
+{{
+    switch (md->n) {{
+    case 3: pl_rhs3(md, x, out, inp, locked); break;
+    case 2: pl_rhs2(md, x, out, inp, locked); break;
+    case 1: pl_rhs1(md, x, out, inp, locked); break;
+    default: pl_rhs_general(md, x, out, inp, locked);
+    }}
+}}
+
+void pl_moment_gains(const double *E, const double *C, const double *kd, const double *ld,
+                     const double *active, int64_t p, int64_t n, double *tk, double *tl)
+{{
+    for (int64_t j = 0; j < n; j++)
+        for (int64_t k = 0; k < n; k++) {{
+            double sk = 0.0, sl = 0.0;
+            for (int64_t q = 0; q < p; q++) {{
+                const double wgt = C[q * n + j] * E[q * n + k] * active[q];
+                sk += wgt * kd[q];
+                sl += wgt * ld[q];
+            }}
+            tk[j * n + k] = sk;
+            tl[j * n + k] = sl;
+        }}
+}}
+
+/* Plastic impact onto the knee constraint, in place on x's rates:
+ * Θ̇ − J⁻¹C (C·Θ̇)/(C·J⁻¹C), C = (−1, 1, 0, …). work holds at least n·(n + 1). */
+void pl_project_velocity(double *x, const double *bp, double *work, int64_t n)
+{{
+    const int64_t s = n + 1;
+    for (int64_t i = 0; i < n; i++) {{
+        for (int64_t j = 0; j < n; j++)
+            work[i * s + j] = i == j ? bp[n + i] : {c(impact)};
+        work[i * s + n] = 0.0;
+    }}
+    work[n] = -1.0;
+    work[s + n] = 1.0;
+    pl_solve_into(work, n, 1, s);
+    const double lam = (x[n + 1] - x[n]) / (work[s + n] - work[n]);
+    for (int64_t i = 0; i < n; i++)
+        x[n + i] -= work[i * s + n] * lam;
+}}
+"""
+
+
+# ---------------------------------------------------------------------------
+# Event values
+# ---------------------------------------------------------------------------
+
+#: The C statements that compute what a quantity needs (in this order when several do).
+_STEPS = {
+    "feedback": """const double *fb = y;
+        if (cx->delay > 0.0) {
+            pl_history_at(cx->hist, cx->before, t - cx->delay, cx->sc_x);
+            fb = cx->sc_x;
+        }
+        double st = 0.0, sd = 0.0;
+        for (int64_t j = 0; j < n; j++) {
+            st += cx->E[idx * n + j] * fb[j];
+            sd += cx->E[idx * n + j] * fb[n + j];
+        }""",
+    "pair_gains": """const double *gn = cx->gains;
+        const double pk = gn[GAIN_IMMEDIATE_STIFFNESS * p + idx]
+                          + gn[GAIN_DELAYED_STIFFNESS * p + idx];
+        const double pv = gn[GAIN_IMMEDIATE_VISCOSITY * p + idx]
+                          + gn[GAIN_DELAYED_VISCOSITY * p + idx];""",
+    "inputs": "pl_inputs_at(cx, t, cx->sc_inp);",
+    "moment": """const double *tk = md->tm, *tl = md->tm + n * n;
+        double tau = cx->sc_inp[2 + idx];
+        for (int64_t k = 0; k < n; k++)
+            tau += tk[idx * n + k] * y[k] + tl[idx * n + k] * y[n + k];""",
+    "free": "pl_rhs(md, y, cx->sc_out, cx->sc_inp, 0);",
+    "response": "pl_rhs(md, y, cx->sc_out, cx->sc_inp, locked);",
+}
+
+
+def _cog_step() -> str:
+    term = dynamics.load_formula(symbols("bp[i]"), symbols("y[i]"), 1, 0, SYMPY)
+    return f"""double xc = 0.0;
+        for (int64_t i = 0; i < n; i++)
+            xc += {c(term)};
+        xc /= bp[2 * n + n * n + 1];"""
+
+
+def _reaction_step() -> str:
+    term = kinematics.cog_acceleration_terms_formula(
+        *symbols("bp[i]", "y[i]", "y[n + i]", "cx->sc_out[n + i]"), SYMPY)[1]
+    return f"""double fy = bp[2 * n + n * n + 1] * (bp[2 * n + n * n] + cx->sc_inp[1]);
+        for (int64_t i = 0; i < n; i++)
+            fy += {c(term)};"""
+
+
+#: quantity -> (the steps it needs, its C expression)
+_QUANTITIES = {
+    "link_angle": ((), "y[idx]"),
+    "max_link_angle": ((), "fpar[F_MAX_ANGLE]"),
+    "toe": ((), "fpar[F_TOE]"),
+    "heel": ((), "fpar[F_HEEL]"),
+    "stop_angle": ((), "fpar[F_STOP_ANGLE]"),
+    "side": ((), "side"),
+    "limit": ((), "md->lim[idx]"),
+    "cog_x": (("cog",), "xc"),
+    "stretch": (("feedback",), "st"),
+    "stretch_rate": (("feedback",), "sd"),
+    "pair_stiffness": (("pair_gains",), "pk"),
+    "pair_viscosity": (("pair_gains",), "pv"),
+    "moment": (("inputs", "moment"), "tau"),
+    "knee_angle": ((), "(y[1] - y[0])"),
+    "free_knee_acceleration": (("inputs", "free"), "(cx->sc_out[n + 1] - cx->sc_out[n])"),
+    "ankle_moment": (("inputs", "response", "reaction"), "md->tau[0]"),
+    "vertical_reaction": (("inputs", "response", "reaction"), "fy"),
+}
+_ORDER = ("feedback", "pair_gains", "cog", "inputs", "moment", "free", "response", "reaction")
+
+
+def _events() -> str:
+    steps = {**_STEPS, "cog": _cog_step(), "reaction": _reaction_step()}
+    groups: dict = {}
+    for kind in ev.EVENT_KINDS:
+        groups.setdefault(switched.EVENT_VALUES[kind.code], []).append(kind)
+    cases = []
+    for formula, kinds in groups.items():
+        names = [p for p in inspect.signature(formula).parameters if p != "xp"]
+        needed = {s for name in names for s in _QUANTITIES[name][0]}
+        args = [symbols(_QUANTITIES[name][1]) for name in names]
+        lines = [f"    case EV_{k.name.upper().replace('-', '_')}:" for k in kinds]
+        lines[-1] += " {"
+        lines += [f"        {steps[s]}" for s in _ORDER if s in needed]
+        lines += [f"        g = {c(formula(*args, xp=SYMPY))};", "        break;", "    }"]
+        cases.append("\n".join(lines))
+    body = "\n".join(cases)
+    return f"""
+/* The value of an event function (model.switched.EVENT_VALUES, plus the kind's offset of
+ * model.events) at (t, y) with the segment's switches. */
+double pl_event_value(const pl_ctx *cx, int64_t kind, int64_t idx, double side, double t,
+                      const double *y, int locked)
+{{
+    const pl_model *md = cx->md;
+    const int64_t n = md->n, p = cx->p;
+    const double *bp = md->bp, *fpar = cx->fpar;
+    (void)bp;
+    (void)p;
+    (void)locked;
+    (void)side;
+    double g = 0.0;
+    switch (kind) {{
+{body}
+    default:
+        break;
+    }}
+    return g + cx->ev_offset[kind];
+}}
+"""
+
+
+def generate() -> str:
+    """The text of ``csrc/pl_model.c``."""
+    return HEADER + _platform() + _tilt() + _inputs() + _rhs() + _events()
