@@ -16,4 +16,10 @@ public names are exported by :mod:`posturelab` itself. Signs, frames and units:
 
 from .._lazy import submodule_getattr  # noqa: E402
 
+# The anthropometric body presets (paper-1link, paper-2link, winter-…) register themselves in
+# body.BODY_PRESETS when their module is imported. Python runs this file before any module of
+# the package, so importing it here makes the presets whole whichever module is imported first,
+# without body.py importing anthropometry.py (which imports body.py).
+from . import anthropometry  # noqa: E402, F401
+
 __getattr__ = submodule_getattr(__name__, __path__)

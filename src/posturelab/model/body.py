@@ -342,9 +342,3 @@ def get_body(name: str) -> Body:
         known = ", ".join(sorted(BODY_PRESETS))
         raise UnknownNameError(f"unknown body preset {name!r}; known presets: {known}") from None
     return preset.factory()
-
-
-# The anthropometric presets (paper-1link, paper-2link, winter-…) register themselves when
-# their module is imported: import it here, after every name above exists, so that
-# BODY_PRESETS is whole whichever module is imported first.
-from . import anthropometry  # noqa: E402, F401, I001
