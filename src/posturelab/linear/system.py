@@ -362,30 +362,51 @@ def effective_muscles(muscles: MuscleSet, one_sided: OneSided) -> MuscleSet:
     raise ParameterError(f"one_sided must be 'active' or 'inactive', got {one_sided!r}")
 
 
+#: Rows per matrix product in :func:`joint_matrices`: small enough that BLAS runs it on
+#: one thread (its threads cost more than they save on products this thin). [-]
+_PRODUCT_ROWS = 4096
+
+
 def joint_matrices(gains: np.ndarray, selection: np.ndarray) -> np.ndarray:
-    """Eᵀ diag(g) E for every row of ``gains`` (M, P): shape (M, N, N); a column that is
-    zero in every row adds nothing. [units of the gains]"""
-    gains = np.asarray(gains, dtype=float)
+    """Eᵀ diag(g) E for every row g of ``gains`` (M, P): shape (M, N, N). [units of the
+    gains]"""
+    gains = np.ascontiguousarray(gains, dtype=float)
+    P, n = selection.shape
+    outer = (selection[:, :, None] * selection[:, None, :]).reshape(P, n * n)
     m = gains.shape[0]
-    n = selection.shape[1]
-    out = np.zeros((m, n, n))
-    for p in range(selection.shape[0]):
-        column = gains[:, p]
-        if not column.any():
-            continue
-        nz = np.flatnonzero(selection[p])
-        for r in nz:
-            for c in nz:
-                out[:, r, c] += (selection[p, r] * selection[p, c]) * column
-    return out
+    out = np.empty((m, n * n))
+    for lo in range(0, m, _PRODUCT_ROWS):
+        np.matmul(gains[lo:lo + _PRODUCT_ROWS], outer, out=out[lo:lo + _PRODUCT_ROWS])
+    return out.reshape(m, n, n)
 
 
-def _joint_or_zero(gains: np.ndarray, selection: np.ndarray) -> np.ndarray:
-    """:func:`joint_matrices`, or one shared zero matrix when every gain is 0."""
-    if not gains.any():
+def _joint_or_zero(gains: np.ndarray | None, selection: np.ndarray) -> np.ndarray:
+    """:func:`joint_matrices`, or one shared zero matrix when there are no gains."""
+    if gains is None:
         n = selection.shape[1]
         return np.zeros((1, n, n))
     return joint_matrices(gains, selection)
+
+
+def _split(stiffness, viscosity, active_stiffness, active_viscosity) -> list:
+    """The gains by when they act for a positive delay, [k_i, l_i, k_a, l_a] (None: zero):
+    :func:`posturelab.model.muscles.feedback_gains` applied as the linear map it is, its
+    matrix read from unit gains (so that a block of many sets costs a few additions)."""
+    unit = np.eye(4)
+    active = active_stiffness is not None
+    weights = feedback_gains(unit[0], unit[1], unit[2] if active else None,
+                             unit[3] if active else None, 1.0)  # (4 slots, 4 inputs)
+    if not np.isin(weights, (0.0, 1.0)).all():
+        raise AssertionError("feedback_gains is expected to place or sum the gains")
+    inputs = (stiffness, viscosity, active_stiffness, active_viscosity)
+    out = []
+    for row in weights:
+        terms = [inputs[i] for i in np.flatnonzero(row)]
+        total = terms[0] if terms else None
+        for term in terms[1:]:
+            total = total + term
+        out.append(total)
+    return out
 
 
 def _gain_rows(name: str, value, pairs: int) -> np.ndarray:
@@ -480,20 +501,24 @@ def linear_system(body: Body | BodyArrays, muscles: MuscleSet, *, stiffness=None
     if tau.ndim != 1 or np.any(tau < 0):
         raise ParameterError("delay [s] must be >= 0, a scalar or shape (M,)")
     # the split for a positive delay (at τ = 0 the delayed part acts at once: e^0 = 1)
-    split = feedback_gains(k, v, ka, va, 1.0)
+    split = _split(k, v, ka, va)
     E = muscles.selection_matrix
-    immediate_k = _joint_or_zero(split[:, 0], E)
-    gravity = np.zeros((gravity_torque.shape[0], E.shape[1], E.shape[1]))
-    index = np.arange(E.shape[1])
-    gravity[:, index, index] = gravity_torque
+    n = E.shape[1]
+    stiff = _joint_or_zero(split[0], E)
+    index = np.arange(n)
+    stiff = np.array(np.broadcast_to(stiff, (max(stiff.shape[0], jac.shape[0]), n, n)))
+    stiff[:, index, index] -= gravity_torque
     tilt = None
     if inputs:
+        shape = np.broadcast_shapes(*(g.shape for g in split if g is not None))
+        gains = np.stack([np.zeros(shape) if g is None else np.broadcast_to(g, shape)
+                          for g in split], axis=-2)
         weight = np.atleast_1d(np.asarray(proprioceptive_weight, dtype=float))
-        tilt = -tilt_pair_gains(split, muscles.spans_foot, tau, weight) @ E
+        tilt = -tilt_pair_gains(gains, muscles.spans_foot, tau, weight) @ E
     system = LinearSystem(
-        inertia=jac, stiffness=immediate_k - gravity, viscosity=_joint_or_zero(split[:, 1], E),
-        delayed_stiffness=_joint_or_zero(split[:, 2], E),
-        delayed_viscosity=_joint_or_zero(split[:, 3], E), delay=tau, tilt_input=tilt,
+        inertia=jac, stiffness=stiff, viscosity=_joint_or_zero(split[1], E),
+        delayed_stiffness=_joint_or_zero(split[2], E),
+        delayed_viscosity=_joint_or_zero(split[3], E), delay=tau, tilt_input=tilt,
         translation_input=-coefficients)
     system.n_sets  # noqa: B018 (checks that the arrays agree on M)
     return system
