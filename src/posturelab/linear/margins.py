@@ -262,14 +262,17 @@ def _pencil(m: int, J, S, L, K, La) -> tuple[np.ndarray, np.ndarray]:
     e0 = project(_kron(S, S) - _kron(K, K))
     o1 = project(_kron(L, J) - _kron(J, L))
     o0 = project(_kron(L, S) - _kron(S, L) + _kron(K, La) - _kron(La, K))
-    upper = np.zeros((size, size), dtype=bool)
-    upper[:ns, ns:] = True
-    lower = upper.T
-    diagonal = ~(upper | lower)
-    t2 = np.broadcast_to(np.where(diagonal, e2, 0.0) + np.where(lower, o1, 0.0),
-                         (m, size, size))
-    t1 = np.where(diagonal, e1, 0.0) + np.where(upper, o1, 0.0) + np.where(lower, o0, 0.0)
-    t0 = np.where(diagonal, e0, 0.0) + np.where(upper, o0, 0.0)
+    # T2 = [[E2_ss, 0], [O1_as, E2_aa]], T1 = [[E1_ss, O1_sa], [O0_as, E1_aa]],
+    # T0 = [[E0_ss, O0_sa], [0, E0_aa]] (E's off-diagonal and O's diagonal blocks are 0)
+    t2 = np.array(np.broadcast_to(e2, (m, size, size)))
+    t2[:, :ns, ns:] = 0.0
+    t2[:, ns:, :ns] = o1[:, ns:, :ns]
+    t1 = e1.copy()
+    t1[:, :ns, ns:] = o1[:, :ns, ns:]
+    t1[:, ns:, :ns] = o0[:, ns:, :ns]
+    t0 = e0.copy()
+    t0[:, :ns, ns:] = o0[:, :ns, ns:]
+    t0[:, ns:, :ns] = 0.0
     companion = np.zeros((m, 2 * size, 2 * size))
     companion[:, :size, size:] = np.eye(size)
     companion[:, size:, :] = -np.linalg.solve(t2, np.concatenate([t0, t1], axis=-1))
