@@ -30,8 +30,9 @@ compiled function (:mod:`._batch_kernels`, ``nogil=True``), called on blocks of 
 from a small thread pool (one thread per core, ``NUMBA_NUM_THREADS``); it is safe to
 call from several Python threads at once. A stability map starts each set's
 root iteration from the roots of its neighbour along x (a row starts afresh), which
-takes a third of the iterations. The first call in a fresh environment compiles (a few
-seconds); later processes load the cached machine code (:mod:`posturelab._jit`).
+takes about a third of the time of starting afresh (same roots to rounding). The first
+call in a fresh environment compiles (a few seconds); later processes load the cached
+machine code (:mod:`posturelab._jit`).
 
 Stability margin
 ----------------
