@@ -125,3 +125,9 @@ def test_bad_arguments():
         linear_system(body, layout, one_sided="both")
     with pytest.raises(ParameterError, match="without its inputs"):
         linear_system(body, layout, inputs=False).frequency_response([1.0], "tilt", np.ones(3))
+
+
+def test_the_system_gives_the_rightmost_roots_at_its_delay():
+    body, muscles = pl.paper_body(), pl.paper_muscles("1")
+    np.testing.assert_array_equal(linear_system(body, muscles, delay=0.002).rightmost_roots(4),
+                                  pl.rightmost_roots(body, muscles, 0.002, 4))

@@ -59,6 +59,7 @@ __all__ = [
     "characteristic_function",
     "delay_margin",
     "rightmost_roots",
+    "system_rightmost_roots",
     "MAX_DELAY_FOR_ROOTS",
 ]
 
@@ -347,10 +348,19 @@ def rightmost_roots(body: Body, muscles: MuscleSet, delay: float, count: int = 6
         Real part descending. [1/s]
     """
     delay = float_in_range("delay [s]", delay, 0.0, MAX_DELAY_FOR_ROOTS, unit="s")
+    return system_rightmost_roots(delayed_system(body, muscles, one_sided), delay, count,
+                                  nodes=nodes)
+
+
+def system_rightmost_roots(system: LinearSystem, delay: float, count: int = 6, *,
+                           nodes: int = 40) -> np.ndarray:
+    """:func:`rightmost_roots` of a one-set :class:`~posturelab.linear.system.LinearSystem`
+    at delay τ [s] (its gains split for a positive delay; τ = 0 gives the poles). [1/s]"""
     if isinstance(nodes, bool) or not isinstance(nodes, int | np.integer) \
             or not 4 <= nodes <= 200:
         raise ParameterError(f"nodes must be an integer in [4, 200], got {nodes!r}")
-    system = delayed_system(body, muscles, one_sided)
+    if system.n_sets != 1:
+        raise ParameterError(f"rightmost roots are of one set, the system has {system.n_sets}")
     A0, A1 = (a[0] for a in system.first_order())
     m = A0.shape[0]
     if isinstance(count, bool) or not isinstance(count, int | np.integer) \

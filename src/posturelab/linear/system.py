@@ -336,6 +336,13 @@ class LinearSystem:
             theta = np.linalg.solve(D, rhs[..., None])[..., 0]
         return theta @ c
 
+    def rightmost_roots(self, count: int = 6, *, nodes: int = 40) -> np.ndarray:
+        """The ``count`` rightmost characteristic roots of a one-set system at its delay,
+        real part descending (:func:`posturelab.linear.delay.rightmost_roots`). [1/s]"""
+        from .delay import system_rightmost_roots
+
+        return system_rightmost_roots(self, float(self.delay[0]), count, nodes=nodes)
+
     def delay_margins(self):
         """The delay margin of every set (:func:`posturelab.linear.margins.delay_margins`)."""
         from .margins import delay_margins
