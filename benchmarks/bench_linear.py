@@ -5,7 +5,9 @@ Run:  python benchmarks/bench_linear.py [--sets 1000000] [--repeats 7]
 Everything is measured in this one run on this machine:
 
 * the batched stable flags (Routh–Hurwitz) and all poles (Aberth–Ehrlich) of
-  ``--sets`` random parameter sets of the paper model, median of ``--repeats``;
+  ``--sets`` random parameter sets of the paper model, median of ``--repeats``; and
+  the stability map of the command's plane with about as many sets (each set's roots
+  started from its neighbour's);
 * a plain baseline: build the stacked 6×6 state matrices with numpy and call
   ``numpy.linalg.eigvals`` on them. It is measured on a subset
   (``--baseline-sets``, default 20,000) and scaled linearly to ``--sets`` —
@@ -133,6 +135,9 @@ def first_call_times(cache_dir: str, runs: int) -> list[tuple[float, float, floa
         out.append((wall, imp, call))
     return out
 
+
+#: The axes of the map the command draws (COMMAND). [N·m/rad]
+MAP_AXES = (("stiffness:ankle", 0.0, 2000.0), ("stiffness:gastrocnemius", 0.0, 1000.0))
 
 COMMAND = ["stability-map", "--x", "stiffness:ankle:0:2000", "--y",
            "stiffness:gastrocnemius:0:1000",
@@ -302,6 +307,8 @@ def main() -> None:
     batch_linear.batch_analyse(stiffness[:10], ratio[:10])  # load compiled code
     batch_linear.batch_stable(stiffness[:10], ratio[:10])
 
+    map_resolution = max(2, round(args.sets ** 0.5))  # a map of about as many sets
+    batch_linear.stability_map(*MAP_AXES, 2)
     nb = min(args.baseline_sets, args.sets)
     scale = args.sets / nb
     medians, results = median_times({
@@ -309,6 +316,7 @@ def main() -> None:
         "stable": lambda: batch_linear.batch_stable(stiffness, ratio),
         "max": lambda: batch_linear.batch_analyse(stiffness, ratio),
         "poles": lambda: batch_linear.batch_analyse(stiffness, ratio, keep_poles=True),
+        "map": lambda: batch_linear.stability_map(*MAP_AXES, map_resolution),
     }, args.repeats)
     t_base = medians["baseline"] * scale
     t_stable, t_max, t_poles = medians["stable"], medians["max"], medians["poles"]
@@ -335,6 +343,9 @@ def main() -> None:
     ]
     for label, t in rows:
         print(f"{label:<56}{t:>11.3f}{1e6 * t / args.sets:>14.3f}{t_base / t:>9.1f}×")
+    t_map, map_sets = medians["map"], map_resolution ** 2
+    print(f"{f'stability_map {map_resolution}², roots warm-started':<56}{t_map:>11.3f}"
+          f"{1e6 * t_map / map_sets:>14.3f}{t_base * map_sets / args.sets / t_map:>9.1f}×")
     if not args.skip_command:
         t_cmd = statistics.median(command_times(3))
         base_cmd = t_base * COMMAND_SETS / args.sets  # the baseline for as many sets
