@@ -17,7 +17,7 @@ import posturelab as pl
 from posturelab.errors import ParameterError
 from posturelab.linear import BatchDelayMargin, batch_delay_margin, linear_system
 from posturelab.linear.delay import delay_margin
-from posturelab.linear.margins import _one_link, _pencil
+from posturelab.linear.margins import _one_link, _pencil, delay_margins
 from posturelab.model.muscles import MusclePair, MuscleSet
 
 RTOL = 1e-8
@@ -131,7 +131,7 @@ def test_one_set_from_the_muscles_and_the_system_method():
     out = batch_delay_margin(body, muscles)
     single = delay_margin(body, muscles)
     assert_same_margin(out, 0, single)
-    again = linear_system(body, muscles).delay_margins()
+    again = delay_margins(linear_system(body, muscles))
     np.testing.assert_array_equal(again.delay_margin, out.delay_margin)
 
 

@@ -10,6 +10,7 @@ import pytest
 import posturelab as pl
 from posturelab.errors import ParameterError
 from posturelab.linear import finite_difference_state_matrix, linear_system
+from posturelab.linear.delay import system_rightmost_roots
 from posturelab.linear.system import BodyArrays, joint_matrices
 from posturelab.model.dynamics import mass_matrix
 from posturelab.model.muscles import STIFFNESS_CASES
@@ -129,5 +130,6 @@ def test_bad_arguments():
 
 def test_the_system_gives_the_rightmost_roots_at_its_delay():
     body, muscles = pl.paper_body(), pl.paper_muscles("1")
-    np.testing.assert_array_equal(linear_system(body, muscles, delay=0.002).rightmost_roots(4),
+    system = linear_system(body, muscles)
+    np.testing.assert_array_equal(system_rightmost_roots(system, 0.002, 4),
                                   pl.rightmost_roots(body, muscles, 0.002, 4))

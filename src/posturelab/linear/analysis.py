@@ -25,7 +25,7 @@ from .._validation import finite_array
 from ..model.body import Body
 from ..model.dynamics import mass_matrix, platform_vector, state_derivative
 from ..model.muscles import MuscleSet, feedback_pair_torques, muscle_set_gains
-from .system import OneSided, effective_muscles, linear_system
+from .system import OneSided, effective_muscles, linear_system, sorted_poles
 
 __all__ = [
     "LinearAnalysis",
@@ -93,14 +93,6 @@ def finite_difference_state_matrix(
         e[j] = step
         A[:, j] = (f(e) - f(-e)) / (2 * step)
     return A
-
-
-def sorted_poles(eigenvalues: np.ndarray) -> np.ndarray:
-    """Sort poles by real part ascending; a conjugate pair lists +imag first. [1/s]"""
-    ev = np.asarray(eigenvalues, dtype=complex)
-    # Round for the sort key only, so conjugates with equal real parts stay together.
-    order = np.lexsort((-ev.imag, np.round(ev.real, 9)), axis=-1)
-    return np.take_along_axis(ev, order, axis=-1)
 
 
 @dataclass(frozen=True)

@@ -45,6 +45,7 @@ import numpy as np
 
 from ..model.body import Body
 from ..model.muscles import MuscleSet
+from .delay_batch import _threads
 from .system import BodyArrays, LinearSystem, OneSided, linear_system
 
 __all__ = ["BatchDelayMargin", "batch_delay_margin", "delay_margins"]
@@ -168,8 +169,6 @@ def delay_margins(system: LinearSystem) -> BatchDelayMargin:
             block(lo)
     else:
         from concurrent.futures import ThreadPoolExecutor
-
-        from .delay_batch import _threads
 
         with ThreadPoolExecutor(max_workers=min(len(starts), _threads())) as pool:
             for _ in pool.map(block, starts):

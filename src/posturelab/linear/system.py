@@ -21,7 +21,8 @@ every set); :func:`linear_system` builds it once from a body and a muscle set (i
 gains, or arrays of gains for a batch). Everything linear derives from it, as
 python-control derives poles and frequency responses from one ``StateSpace``: the state
 matrix and poles (:mod:`.analysis`), the characteristic matrix Δ(s), the rightmost roots
-and the delay margin (:mod:`.delay`, :mod:`.delay_batch`, :mod:`.margins`), the verdict
+(:func:`posturelab.linear.delay.system_rightmost_roots`) and the delay margins
+(:func:`posturelab.linear.margins.delay_margins`; :mod:`.delay`, :mod:`.delay_batch`), the verdict
 about upright (:mod:`.verdict`), the batched maps (:mod:`.batch`, whose compiled kernels
 take the matrices of :meth:`LinearSystem.without_delay`) and the model FRFs
 (:mod:`posturelab.frequency.model`).
@@ -40,7 +41,8 @@ from ..model.body import Body, upright_matrices
 from ..model.muscles import MuscleSet, feedback_gains
 from ..model.tilt import tilt_pair_gains
 
-__all__ = ["BodyArrays", "LinearSystem", "linear_system", "OneSided", "INPUTS"]
+__all__ = ["BodyArrays", "LinearSystem", "linear_system", "sorted_poles", "OneSided",
+           "INPUTS"]
 
 OneSided = Literal["active", "inactive"]
 
@@ -254,8 +256,6 @@ class LinearSystem:
     def poles(self) -> np.ndarray:
         """The poles at τ = 0 of every set, shape (M, 2N), real part ascending (as
         :func:`posturelab.linear.sorted_poles`). [1/s]"""
-        from .analysis import sorted_poles
-
         return sorted_poles(np.linalg.eigvals(self.state_matrix()))
 
     def characteristic_matrix(self, s, delay=None) -> np.ndarray:
@@ -336,18 +336,13 @@ class LinearSystem:
             theta = np.linalg.solve(D, rhs[..., None])[..., 0]
         return theta @ c
 
-    def rightmost_roots(self, count: int = 6, *, nodes: int = 40) -> np.ndarray:
-        """The ``count`` rightmost characteristic roots of a one-set system at its delay,
-        real part descending (:func:`posturelab.linear.delay.rightmost_roots`). [1/s]"""
-        from .delay import system_rightmost_roots
 
-        return system_rightmost_roots(self, float(self.delay[0]), count, nodes=nodes)
-
-    def delay_margins(self):
-        """The delay margin of every set (:func:`posturelab.linear.margins.delay_margins`)."""
-        from .margins import delay_margins
-
-        return delay_margins(self)
+def sorted_poles(eigenvalues: np.ndarray) -> np.ndarray:
+    """Sort poles by real part ascending; a conjugate pair lists +imag first. [1/s]"""
+    ev = np.asarray(eigenvalues, dtype=complex)
+    # Round for the sort key only, so conjugates with equal real parts stay together.
+    order = np.lexsort((-ev.imag, np.round(ev.real, 9)), axis=-1)
+    return np.take_along_axis(ev, order, axis=-1)
 
 
 def _add(a: np.ndarray, b: np.ndarray) -> np.ndarray:
