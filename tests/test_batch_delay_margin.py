@@ -160,3 +160,17 @@ def test_bad_gains_raise_parameter_error():
         batch_delay_margin(body, layout, stiffness=np.ones((3, 5)))
     with pytest.raises(ParameterError, match=">= 0"):
         batch_delay_margin(body, layout, stiffness=-np.ones((3, 5)), viscosity_ratio=0.2)
+
+
+def test_a_body_per_set(rng):
+    from posturelab.linear.system import BodyArrays
+
+    body = pl.paper_body()
+    scale = rng.uniform(0.8, 1.2, (6, 1))
+    arrays = BodyArrays(body.masses * scale, body.lengths, body.com_distances, body.inertias)
+    k = np.tile(pl.paper_muscles("1").stiffnesses, (6, 1))
+    out = batch_delay_margin(arrays, pl.paper_muscles("1"), stiffness=k, viscosity_ratio=0.25)
+    for i in range(6):
+        one = pl.Body.from_arrays(arrays.masses[i], body.lengths, body.com_distances,
+                                  body.inertias, gravity=float(arrays.gravity))
+        assert_same_margin(out, i, delay_margin(one, pl.paper_muscles("1")))

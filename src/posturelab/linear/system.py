@@ -471,7 +471,8 @@ def linear_system(body: Body | BodyArrays, muscles: MuscleSet, *, stiffness=None
             raise ParameterError(f"muscle set is for {muscles.n_links} links but the body "
                                  f"has {body.n_links}")
         jac, gravity_torque = body.upright_matrices()
-        coefficients = gravity_torque / np.broadcast_to(body.gravity, (jac.shape[0],))[:, None]
+        coefficients = BodyArrays(body.masses, body.lengths, body.com_distances,
+                                  body.inertias, 1.0).upright_matrices()[1]  # a [kg·m]
     else:
         raise ParameterError(f"body must be a Body or BodyArrays, got {type(body).__name__}")
     muscles = effective_muscles(muscles, one_sided)
