@@ -12,7 +12,8 @@ gains has K_i = L_i = 0: its whole feedback is delayed). Its characteristic matr
 
     Δ(s) = s² J0 − g A + K_i + s L_i + (K_a + s L_a) e^{−sτ},
 
-and the roots of det Δ(s) = 0 are the characteristic roots (infinitely many; finitely
+(the matrices of the one linear system, :mod:`posturelab.linear.system`), and the roots of
+det Δ(s) = 0 are the characteristic roots (infinitely many; finitely
 many to the right of any vertical line: the equation is of retarded type).
 
 **Delay margin.** The smallest τ > 0 at which a root reaches the imaginary axis, s = iω.

@@ -1,6 +1,7 @@
 """Delayed linear stability of many parameter sets at once (numpy, stacked).
 
-For M gain sets on one body and pair layout, at one feedback delay τ, the rightmost
+For M gain sets on one body and pair layout, at one feedback delay τ (one
+:class:`~posturelab.linear.system.LinearSystem` of M sets), the rightmost
 characteristic root of each set (posturelab.linear.delay states the equation) is found by
 the spectral discretisation of :func:`posturelab.linear.delay.rightmost_roots`, stacked
 over the sets (one ``numpy.linalg.eigvals`` call on an (M, 2N(n+1), 2N(n+1)) array), then
