@@ -53,7 +53,7 @@ __all__ = ["BatchDelayMargin", "batch_delay_margin", "delay_margins"]
 #: A candidate z is on the unit circle when ||z| − 1| is at most this. [-]
 _UNIT_CIRCLE = 1e-6
 #: A candidate λ = −ω² is real when |Im λ| is at most this times |λ|. [-]
-_REAL = 1e-6
+_REAL = 1e-4
 #: Sets per stacked eigenvalue call (a block of the thread pool). [-]
 _CHUNK = 1024
 
