@@ -1,11 +1,13 @@
-"""Benchmark: batched linear stability (posturelab.linear.batch) against plain numpy.
+"""Benchmark: batched linear analysis (posturelab.linear) against plain baselines.
 
 Run:  python benchmarks/bench_linear.py [--sets 1000000] [--repeats 7]
 
 Everything is measured in this one run on this machine:
 
 * the batched stable flags (Routh–Hurwitz) and all poles (Aberth–Ehrlich) of
-  ``--sets`` random parameter sets of the paper model, median of ``--repeats``;
+  ``--sets`` random parameter sets of the paper model, median of ``--repeats``; and
+  the stability map of the command's plane with about as many sets (each set's roots
+  started from its neighbour's);
 * a plain baseline: build the stacked 6×6 state matrices with numpy and call
   ``numpy.linalg.eigvals`` on them. It is measured on a subset
   (``--baseline-sets``, default 20,000) and scaled linearly to ``--sets`` —
@@ -17,7 +19,16 @@ Everything is measured in this one run on this machine:
   ``python -c "import ...; first call"``;
 * the whole ``posturelab stability-map`` command at resolution 1000 (10⁶ sets:
   start-up, kernel, CSV and PNG), a fresh process each time with the numba cache
-  warm, median of 3 after one warm-up run (``--skip-command`` leaves it out).
+  warm, median of 3 after one warm-up run (``--skip-command`` leaves it out), against
+  numpy eigvals of the same number of sets; and where its time goes: a fresh process
+  that times each phase in turn (start-up, loading the kernels, the map, the CSV,
+  matplotlib and the PNG; the command overlaps the map with matplotlib's import and
+  the CSV with the PNG);
+* batched delay margins (``posturelab.linear.batch_delay_margin``: the closed form for
+  one link, the delay pencil for three) against the single-set ``delay_margin`` on a
+  subset of the same sets (``--margin-baseline-sets``), with the largest relative
+  difference between the two (``--skip-margins`` leaves it out). Goals: >= 1e5
+  one-link and >= 1e4 three-link sets per second.
 
 Random sets: each pair stiffness uniform in [0, 1500] N·m/rad, 15 % of them
 set to 0 (pairs switched off, as in Table I); viscosity ratio uniform in
@@ -38,14 +49,16 @@ import time
 import numpy as np
 
 from posturelab.linear import batch as batch_linear
-from posturelab.linear import sorted_poles
-from posturelab.model.body import paper_body
+from posturelab.linear import batch_delay_margin, sorted_poles
+from posturelab.linear.delay import delay_margin
+from posturelab.model.body import get_body, paper_body
 from posturelab.model.dynamics import mass_matrix
-from posturelab.model.muscles import paper_muscles
+from posturelab.model.muscles import MusclePair, MuscleSet, paper_muscles
 
 FIRST_CALL = (
     "import time; t0 = time.perf_counter(); import numpy as np; "
-    "from posturelab.linear.batch import batch_analyse, batch_stable; t1 = time.perf_counter(); "
+    "from posturelab.linear.batch import batch_analyse, batch_stable; "
+    "t1 = time.perf_counter(); "
     "k = np.array([[500.0, 300, 300, 300, 300]]); batch_stable(k); batch_analyse(k); "
     "t2 = time.perf_counter(); print(f'{t1 - t0:.3f} {t2 - t1:.3f}')"
 )
@@ -123,6 +136,9 @@ def first_call_times(cache_dir: str, runs: int) -> list[tuple[float, float, floa
     return out
 
 
+#: The axes of the map the command draws (COMMAND). [N·m/rad]
+MAP_AXES = (("stiffness:ankle", 0.0, 2000.0), ("stiffness:gastrocnemius", 0.0, 1000.0))
+
 COMMAND = ["stability-map", "--x", "stiffness:ankle:0:2000", "--y",
            "stiffness:gastrocnemius:0:1000",
            "--resolution", "1000"]
@@ -144,6 +160,121 @@ def command_times(runs: int) -> list[float]:
     return out
 
 
+#: A fresh process timing each phase of the stability-map command in turn. [s]
+PHASES = """
+import io, sys, time
+t0 = time.perf_counter()
+import posturelab.cli.stability_map as command
+from posturelab.linear.batch import stability_map
+t1 = time.perf_counter()
+x, y = ("stiffness:ankle", 0, 2000), ("stiffness:gastrocnemius", 0, 1000)
+stability_map(x, y, 2).write_csv(io.StringIO())
+t2 = time.perf_counter()
+smap = stability_map(x, y, 1000)
+t3 = time.perf_counter()
+with open(sys.argv[1] + ".csv", "w", encoding="utf-8", newline="") as stream:
+    smap.write_csv(stream)
+t4 = time.perf_counter()
+try:
+    from posturelab.viz.plots import plot_stability_map
+except ImportError:
+    plot_stability_map = command.plot_stability_map
+import matplotlib.figure
+t5 = time.perf_counter()
+with open(sys.argv[1] + ".png", "wb") as stream:
+    plot_stability_map(smap, stream, "png")
+t6 = time.perf_counter()
+print(t1 - t0, t2 - t1, t3 - t2, t4 - t3, t5 - t4, t6 - t5)
+"""
+PHASE_NAMES = ("start-up (imports)", "loading the compiled kernels", "the map (10⁶ sets)",
+               "the CSV", "importing matplotlib", "the PNG")
+
+
+def phase_times(runs: int) -> list[list[float]]:
+    """Each phase of the command, in fresh processes (PHASES), ``runs`` times. [s]"""
+    out = []
+    with tempfile.TemporaryDirectory(prefix="posturelab-phases-") as folder:
+        for _ in range(runs):
+            proc = subprocess.run([sys.executable, "-c", PHASES, os.path.join(folder, "m")],
+                                  capture_output=True, text=True, check=True)
+            out.append([float(v) for v in proc.stdout.split()])
+    return out
+
+
+def startup_time(runs: int) -> float:
+    """Median wall time of ``python -c "import posturelab.cli"`` in a fresh process. [s]"""
+    times = []
+    for _ in range(runs):
+        t = time.perf_counter()
+        subprocess.run([sys.executable, "-c", "import posturelab.cli"], check=True)
+        times.append(time.perf_counter() - t)
+    return statistics.median(times)
+
+
+def margin_sets(count: int, n_links: int, seed: int = 2024) -> dict:
+    """Random gain sets with an intrinsic and an active (delayed) part: three links, the
+    paper's five pairs (stiffness uniform in [0, 1500] N·m/rad, viscosity 0.25 s of it;
+    active stiffness in [0, 1500], active viscosity 0.3 s of it); one link, an ankle pair
+    (active stiffness in [0.5, 3] mgh, active viscosity in [0, 600] N·m·s/rad, a small
+    intrinsic part)."""
+    rng = np.random.default_rng(seed)
+    if n_links == 3:
+        k = rng.uniform(0.0, 1500.0, (count, 5))
+        ka = rng.uniform(0.0, 1500.0, (count, 5))
+        return dict(stiffness=k, viscosity=0.25 * k, active_stiffness=ka,
+                    active_viscosity=0.3 * ka)
+    mgh = get_body("paper-1link").load_stiffness
+    ki = rng.uniform(0.0, 0.2, (count, 1)) * mgh
+    return dict(stiffness=ki, viscosity=0.1 * ki,
+                active_stiffness=rng.uniform(0.5, 3.0, (count, 1)) * mgh,
+                active_viscosity=rng.uniform(0.0, 600.0, (count, 1)))
+
+
+def one_set(n_links: int, gains: dict, i: int) -> MuscleSet:
+    if n_links == 3:
+        return paper_muscles(**{name: value[i] for name, value in gains.items()})
+    return MuscleSet((MusclePair("ankle", 0, 1, gains["stiffness"][i, 0],
+                                 gains["viscosity"][i, 0],
+                                 active_stiffness=gains["active_stiffness"][i, 0],
+                                 active_viscosity=gains["active_viscosity"][i, 0]),), 1)
+
+
+def margin_rows(repeats: int, baseline_sets: int) -> None:
+    """Batched delay margins against the single-set delay_margin (module notes)."""
+    print()
+    print(f"batched delay margins, median of {repeats} (interleaved); baseline: "
+          f"delay_margin one set at a time on {baseline_sets} of the sets")
+    head = (f"{'bodies':<34}{'sets':>9}{'batched [sets/s]':>18}{'single [sets/s]':>17}"
+            f"{'speed-up':>10}{'max rel. diff':>15}  goal")
+    print(head)
+    print("-" * len(head))
+    for n_links, count, goal in ((1, 100_000, 1e5), (3, 10_000, 1e4)):
+        body = get_body("paper-1link") if n_links == 1 else paper_body()
+        layout = one_set(n_links, margin_sets(1, n_links), 0)
+        gains = margin_sets(count, n_links)
+        nb = min(baseline_sets, count)
+        batch_delay_margin(body, layout, **{k: v[:10] for k, v in gains.items()})
+
+        def single(nb=nb, body=body, gains=gains, n_links=n_links):
+            return [delay_margin(body, one_set(n_links, gains, i)) for i in range(nb)]
+
+        medians, results = median_times({
+            "batched": lambda body=body, layout=layout, gains=gains:
+                batch_delay_margin(body, layout, **gains),
+            "single": single,
+        }, repeats)
+        out, ref = results["batched"], results["single"]
+        diff = 0.0
+        for i, d in enumerate(ref):
+            if d.stable_without_delay and np.isfinite(d.delay_margin):
+                diff = max(diff, abs(out.delay_margin[i] / d.delay_margin - 1),
+                           abs(out.crossing_frequency[i] / d.crossing_frequency - 1))
+        rate, base = count / medians["batched"], nb / medians["single"]
+        label = "one link (closed form)" if n_links == 1 else "three links (delay pencil)"
+        print(f"{label:<34}{count:>9,}{rate:>18,.0f}{base:>17,.0f}{rate / base:>9.0f}×"
+              f"{diff:>15.1e}  >= {goal:,.0f}/s: {'ok' if rate >= goal else 'MISSED'}")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sets", type=int, default=1_000_000)
@@ -153,6 +284,9 @@ def main() -> None:
                         help="skip the cold-compile / cached-load subprocess timings")
     parser.add_argument("--skip-command", action="store_true",
                         help="skip timing the whole stability-map command")
+    parser.add_argument("--skip-margins", action="store_true",
+                        help="skip the batched delay margins")
+    parser.add_argument("--margin-baseline-sets", type=int, default=40)
     args = parser.parse_args()
 
     print(f"machine: {machine()}")
@@ -173,6 +307,8 @@ def main() -> None:
     batch_linear.batch_analyse(stiffness[:10], ratio[:10])  # load compiled code
     batch_linear.batch_stable(stiffness[:10], ratio[:10])
 
+    map_resolution = max(2, round(args.sets ** 0.5))  # a map of about as many sets
+    batch_linear.stability_map(*MAP_AXES, 2)
     nb = min(args.baseline_sets, args.sets)
     scale = args.sets / nb
     medians, results = median_times({
@@ -180,6 +316,7 @@ def main() -> None:
         "stable": lambda: batch_linear.batch_stable(stiffness, ratio),
         "max": lambda: batch_linear.batch_analyse(stiffness, ratio),
         "poles": lambda: batch_linear.batch_analyse(stiffness, ratio, keep_poles=True),
+        "map": lambda: batch_linear.stability_map(*MAP_AXES, map_resolution),
     }, args.repeats)
     t_base = medians["baseline"] * scale
     t_stable, t_max, t_poles = medians["stable"], medians["max"], medians["poles"]
@@ -206,11 +343,20 @@ def main() -> None:
     ]
     for label, t in rows:
         print(f"{label:<56}{t:>11.3f}{1e6 * t / args.sets:>14.3f}{t_base / t:>9.1f}×")
+    t_map, map_sets = medians["map"], map_resolution ** 2
+    print(f"{f'stability_map {map_resolution}², roots warm-started':<56}{t_map:>11.3f}"
+          f"{1e6 * t_map / map_sets:>14.3f}{t_base * map_sets / args.sets / t_map:>9.1f}×")
     if not args.skip_command:
         t_cmd = statistics.median(command_times(3))
         base_cmd = t_base * COMMAND_SETS / args.sets  # the baseline for as many sets
         print(f"{'stability-map command, resolution 1000 (warm, whole)':<56}{t_cmd:>11.3f}"
-              f"{1e6 * t_cmd / COMMAND_SETS:>14.3f}{base_cmd / t_cmd:>9.1f}×")
+              f"{1e6 * t_cmd / COMMAND_SETS:>14.3f}{base_cmd / t_cmd:>9.1f}×"
+              f"   (goal 1.5 s: {'ok' if t_cmd <= 1.5 else 'MISSED'})")
+        phases = np.median(np.array(phase_times(3)), axis=0)
+        print(f"  where it goes (each phase in turn, fresh processes, median of 3; "
+              f"python -c 'import posturelab.cli' alone: {startup_time(3):.2f} s):")
+        for name, t in zip(PHASE_NAMES, phases, strict=True):
+            print(f"    {name:<34}{t:>7.3f} s")
     print()
     print(f"agreement with numpy eigvals on {nb:,} sets:")
     print(f"  poles |Δλ|/max(1,|λ|): max {err.max():.2e}, 99.9th percentile "
@@ -225,6 +371,8 @@ def main() -> None:
           f"max-real-only run equals all-poles run: "
           f"{bool(np.array_equal(res_max.max_real_part, res.max_real_part))}")
     print(f"  fraction stable: {res.stable.mean():.3f}")
+    if not args.skip_margins:
+        margin_rows(args.repeats, args.margin_baseline_sets)
     print(f"load average at end: {', '.join(f'{v:.2f}' for v in os.getloadavg())}")
 
 

@@ -25,7 +25,7 @@ from posturelab.linear.batch import (
     parameter_grid,
     stability_map,
 )
-from posturelab.model.body import Body
+from posturelab.model.body import Body, paper_body
 from posturelab.model.muscles import (
     PAPER_PAIR_NAMES,
     STIFFNESS_CASES,
@@ -416,3 +416,28 @@ def test_write_csv_of_a_computed_map_is_the_percent_format_text():
     stream = io.StringIO()
     smap.write_csv(stream, rows_per_block=50)
     assert stream.getvalue() == reference_csv(smap)
+
+
+def test_warm_started_map_roots_equal_cold_ones_and_do_not_depend_on_threads():
+    """A map starts each set's root iteration from its x-neighbour's roots: the same
+    largest real parts to rounding and the same flags as starting afresh, and the same bits
+    whatever the number of threads (each thread's block starts a row)."""
+    from posturelab.linear import _batch_kernels as kernels
+    from posturelab.linear.batch import _analyse
+    from posturelab.linear.system import linear_system
+
+    grid = parameter_grid(("stiffness:ankle", 0, 2000), ("stiffness:gastrocnemius", 0, 1000),
+                          (150, 60))
+    stiffness, ratio = grid.rows()
+    system = linear_system(paper_body(), paper_muscles("1"), stiffness=stiffness,
+                           viscosity_ratio=ratio, inputs=False)
+    cold = _analyse(system, keep_poles=True)
+    warm = _analyse(system, keep_poles=True, chain=150)
+    np.testing.assert_array_equal(warm.stable, cold.stable)
+    np.testing.assert_allclose(warm.max_real_part, cold.max_real_part, rtol=1e-9, atol=1e-12)
+    assert pole_error(warm.poles, cold.poles) < POLE_RTOL
+    one = kernels.run(kernels.MODE_POLES, system.without_delay(), system.n_sets, chain=150,
+                      threads=1)
+    two = kernels.run(kernels.MODE_POLES, system.without_delay(), system.n_sets, chain=150,
+                      threads=2)
+    np.testing.assert_array_equal(one["max_real"], two["max_real"])

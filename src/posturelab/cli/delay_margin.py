@@ -105,7 +105,7 @@ def _unstable_sides(body, muscles) -> list[dict]:
         if side.status != "unstable":
             continue
         system = delayed_system(body, _side_muscles(muscles, frozenset(side.engaged)))
-        static = float(np.linalg.det(system.stiffness + system.delayed_stiffness)) < 0
+        static = float(np.linalg.det(system.without_delay()[2][0])) < 0  # det(K − g A)
         z = side.rightmost_root
         found.append({"engaged": list(side.engaged), "slack": list(side.slack),
                       "rightmost_root_without_delay": {"re": float(z.real),

@@ -1,7 +1,8 @@
 """The linearised model's frequency response, exact (the delay as e^{−sτ}, no Padé).
 
-About upright with the platform at rest, for s = 2πi f (conventions.md, and the equation of
-:mod:`posturelab.linear.delay`):
+About upright with the platform at rest, for s = 2πi f (conventions.md), the frequency
+response of the one linear system
+(:meth:`posturelab.linear.system.LinearSystem.frequency_response`):
 
     Δ(s) Θ(s) = b(s) u(s),   Δ(s) = s² J0 − g A + K_i + s L_i + (K_a + s L_a) e^{−sτ}
 
@@ -26,9 +27,9 @@ import numpy as np
 
 from .._validation import finite_array
 from ..errors import ParameterError, UnknownNameError
+from ..linear.system import INPUTS, linear_system
 from ..model.body import Body
-from ..model.dynamics import mass_matrix
-from ..model.muscles import MuscleSet, feedback_gains
+from ..model.muscles import MuscleSet
 from ..parameters import QUANTITIES, check_value
 
 #: Highest frequency a model FRF is taken at. [Hz]
@@ -36,8 +37,6 @@ MAX_FREQUENCY = 1e4
 
 __all__ = ["model_frf", "model_frf_batch", "output_vector", "output_names", "INPUTS"]
 
-#: Inputs of a model FRF.
-INPUTS = ("tilt", "translation")
 
 
 def output_names(n_links: int) -> tuple[str, ...]:
@@ -123,14 +122,13 @@ def model_frf_batch(body: Body, muscles: MuscleSet, frequencies, stiffness, visc
         bad = ~((values >= QUANTITIES[name].low) & (values <= QUANTITIES[name].high))
         if np.any(bad):  # the parameter table's bounds (NaN fails too)
             check_value(name, float(values[np.argmax(bad)]))
-    g = feedback_gains(k, viscosity, active_stiffness, active_viscosity, np.ones(M))
-    if M > _CHUNK:  # bound the memory of one evaluation
-        H = np.concatenate([
-            _frf(body, muscles, f, g[lo:lo + _CHUNK], tau[lo:lo + _CHUNK], w[lo:lo + _CHUNK],
-                 input, c) for lo in range(0, M, _CHUNK)])
-    else:
-        with np.errstate(all="ignore"):
-            H = _frf(body, muscles, f, g, tau, w, input, c)
+    system = linear_system(body, muscles, stiffness=k, viscosity=viscosity,
+                           active_stiffness=active_stiffness, active_viscosity=active_viscosity,
+                           delay=tau, proprioceptive_weight=w)
+    with np.errstate(all="ignore"):
+        H = system.frequency_response(f, input, c)
+    if input == "tilt":
+        H = -H  # the literature's sign: H = −y/α
     if not np.all(np.isfinite(H)):
         raise ParameterError("the model FRF is not finite at some frequency (a resonance "
                              "exactly at it, or gains beyond what the model can take)")
@@ -148,41 +146,6 @@ def _gains(name: str, value, pairs: int, rows: int | None = None) -> np.ndarray:
     if np.any(g < 0):
         raise ParameterError(f"{name} must be >= 0, got {float(g.min()):g}")
     return g
-
-
-#: Parameter sets per evaluation of :func:`_frf`. [-]
-_CHUNK = 32_768
-
-
-def _frf(body, muscles, f, g, tau, w, input, c) -> np.ndarray:
-    """The FRFs of the gain rows ``g`` (M, 4, P) (module notes), shape (M, F)."""
-    M = g.shape[0]
-    E = muscles.selection_matrix
-    n = body.n_links
-
-    def joint(rows):  # Eᵀ diag(rows) E, (M, N, N)
-        return np.einsum("pi,mp,pj->mij", E, rows, E)
-
-    J0 = mass_matrix(body, np.zeros(n))
-    S = joint(g[:, 0]) - body.gravity * np.diag(body.gravity_coefficients)
-    Li, Ka, La = joint(g[:, 1]), joint(g[:, 2]), joint(g[:, 3])
-    s = (2j * np.pi * f)[None, :, None, None]
-    ex = np.exp(-s * tau[:, None, None, None])
-    D = s * s * J0 + S[:, None] + s * Li[:, None] + (Ka[:, None] + s * La[:, None]) * ex
-    s1 = s[..., 0]  # (1, F, 1)
-    if input == "tilt":
-        foot = muscles.spans_foot.astype(float)
-        immediate = (g[:, 0][:, None] + s1 * g[:, 1][:, None]) * foot          # (M, F, P)
-        delayed = w[:, None, None] * (g[:, 2][:, None] + s1 * g[:, 3][:, None]) * foot * ex[..., 0]
-        b = -(immediate + delayed) @ E                                  # (M, F, N)
-    else:
-        b = np.broadcast_to(-(s1 * s1) * body.gravity_coefficients, (M, f.size, n))
-    if n == 1:  # a scalar equation: no solve
-        theta = b / D[..., 0]
-    else:
-        theta = np.linalg.solve(D, b[..., None])[..., 0]
-    y = theta @ c
-    return -y if input == "tilt" else y
 
 
 def model_frf(body: Body, muscles: MuscleSet, frequencies, *, input: str = "tilt",

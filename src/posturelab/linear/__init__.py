@@ -1,7 +1,13 @@
-"""Linear analysis about upright: state matrix, poles, stability, disturbance sensitivity.
+"""Linear analysis about upright: state matrix, poles, stability, delay margins, disturbance
+sensitivity.
 
-:mod:`.analysis` handles one parameter set (numpy); :mod:`.batch` evaluates
-millions of sets at once with compiled kernels (imported on first use).
+Everything derives from one batched delayed linear system (:mod:`.system`:
+:func:`linear_system` builds a :class:`LinearSystem` from a body and muscles, or from
+arrays of gains). :mod:`.analysis` handles one parameter set (numpy); :mod:`.delay` the
+delay margin and rightmost roots of one set; :mod:`.margins` the delay margins of many
+sets (:func:`batch_delay_margin`); :mod:`.batch` evaluates millions of sets at once with
+compiled kernels (imported on first use); :mod:`.verdict` gives the one verdict about
+upright.
 """
 
 from .._lazy import submodule_getattr  # noqa: E402
@@ -15,5 +21,7 @@ from .analysis import (
     sorted_poles,
     state_matrix,
 )
+from .margins import BatchDelayMargin, batch_delay_margin
+from .system import LinearSystem, linear_system
 
 __getattr__ = submodule_getattr(__name__, __path__)

@@ -3,11 +3,11 @@
 :func:`parameter_grid` sweeps two named parameters (:data:`GRID_PARAMETERS`: the
 paper's five pair stiffnesses [N·m/rad] and the viscosity ratio [s]; or, for any body,
 the pairs of a base muscle set) over ranges, every other parameter taken from a Table I
-case (or from the base muscle set); :func:`stability_map` evaluates
-the largest real part of the poles [1/s] and the stable flag at every point with
-:func:`posturelab.linear.batch.batch_analyse`, and :meth:`StabilityMap.write_csv`
-writes it as CSV. The public names are those of :mod:`posturelab.linear.batch`.
-This module imports no numba: the batch kernels are imported when a map is computed.
+case (or from the base muscle set); :func:`posturelab.linear.batch.stability_map`
+evaluates the largest real part of the poles [1/s] and the stable flag at every point,
+and :meth:`StabilityMap.write_csv` writes it as CSV. The public names are those of
+:mod:`posturelab.linear.batch`. This module imports no numba and nothing of
+:mod:`posturelab.linear.batch`.
 """
 
 from __future__ import annotations
@@ -20,7 +20,6 @@ import numpy as np
 
 from .._validation import nonnegative_float
 from ..errors import ParameterError, UnknownNameError
-from ..model.body import Body, paper_body
 from ..model.muscles import (
     DEFAULT_VISCOSITY_RATIO,
     PAPER_PAIR_NAMES,
@@ -37,7 +36,6 @@ __all__ = [
     "ParameterGrid",
     "StabilityMap",
     "parameter_grid",
-    "stability_map",
 ]
 
 #: The parameter table's quantities a grid can sweep (:mod:`posturelab.parameters`).
@@ -401,69 +399,3 @@ def _ascii_buffer(stream):
         return None
     stream.flush()
     return stream.buffer
-
-
-def stability_map(
-    x: ParameterRange | tuple[str, float, float],
-    y: ParameterRange | tuple[str, float, float],
-    resolution: int | tuple[int, int] = 200,
-    *,
-    case: str = "1",
-    viscosity_ratio: float | None = None,
-    body: Body | None = None,
-    progress: Callable[[int, int], None] | None = None,
-    muscles: MuscleSet | None = None,
-) -> StabilityMap:
-    """Largest real part and stability over a two-parameter grid of pair gains.
-
-    Parameters
-    ----------
-    x, y, resolution, case, viscosity_ratio, muscles
-        As in :func:`parameter_grid`; ``muscles`` (its pairs, any number of links) is
-        needed for a body other than three links.
-    body : Body, optional
-        The body; the paper's by default.
-    progress : callable(done, total), optional
-        Called after each block of sets with the number of sets done and the
-        total. [-]
-
-    Returns
-    -------
-    StabilityMap
-    """
-    from .batch import batch_analyse  # imports numba
-
-    grid = parameter_grid(x, y, resolution, case=case, viscosity_ratio=viscosity_ratio,
-                          muscles=muscles)
-    body = paper_body() if body is None else body
-    if not isinstance(body, Body):
-        raise ParameterError(f"body must be a Body, got {type(body).__name__}")
-    layout = muscles
-    if layout is None:
-        if body.n_links != 3:
-            raise ParameterError(f"a map over Table I's pairs is for three links; this body "
-                                 f"has {body.n_links}: give muscles (its pairs)")
-        from ..model.muscles import paper_muscles
-
-        layout = paper_muscles("1")
-    elif layout.n_links != body.n_links:
-        raise ParameterError(f"muscle set is for {layout.n_links} links but the body has "
-                             f"{body.n_links}")
-    ny, nx = grid.shape
-    max_real = np.empty((ny, nx))
-    stable = np.empty((ny, nx), dtype=bool)
-    rows_per_block = max(1, 131_072 // nx)
-    done = 0
-    if progress is not None:
-        progress(0, grid.size)
-    for start in range(0, ny, rows_per_block):
-        stop = min(ny, start + rows_per_block)
-        stiffness, ratio = grid.rows(start, stop)
-        res = batch_analyse(stiffness, ratio, body=body, muscles=layout)
-        max_real[start:stop] = res.max_real_part.reshape(stop - start, nx)
-        stable[start:stop] = res.stable.reshape(stop - start, nx)
-        done += (stop - start) * nx
-        if progress is not None:
-            progress(done, grid.size)
-    return StabilityMap(grid, max_real, stable, body.name)
-

@@ -4,7 +4,9 @@ Everything per parameter set runs in one compiled entry point, :func:`batch_kern
 (``nogil=True``), in one of three modes: the coefficients of the characteristic
 polynomial p(s) = det(s² J0 + s L + K − g diag(a)) (ascending powers), the
 Routh–Hurwitz stable flags, or all 2N roots (Aberth–Ehrlich) with the largest
-real part and the flag. The helpers it calls are kernels without a Python wrapper
+real part and the flag. The matrices come from the one linear system
+(:meth:`posturelab.linear.system.LinearSystem.without_delay`); the kernels do not
+build them. The helpers it calls are kernels without a Python wrapper
 (:func:`posturelab._jit.kernel`); the mathematics is described in
 :mod:`posturelab.linear.batch`.
 
@@ -13,10 +15,8 @@ a small thread pool (one thread per core, ``NUMBA_NUM_THREADS``): measured as fa
 as ``parallel=True``/``prange`` on two cores, it compiles in half the time and is
 safe to call from several Python threads at once.
 
-The kernels are compiled without floating-point contraction (``fastmath=False``):
-every result is bit-for-bit what it was when this code lived in ``batch.py``, so a
-stability map's CSV does not change with the compiler's choice of fused
-multiply-adds.
+The kernels are compiled without floating-point contraction (``fastmath=False``), so a
+stability map's CSV does not change with the compiler's choice of fused multiply-adds.
 
 Units: stiffness [N·m/rad], viscosity [N·m·s/rad], viscosity ratio [s], inertia
 [kg·m²], gravity torque per angle g·a [N·m/rad], poles [1/s].
@@ -35,37 +35,13 @@ from .._jit import kernel
 STABILITY_MARGIN = 1e-9
 
 MAX_ITERATIONS = 80  # Aberth iterations before the caller falls back to eigvals [-]
+WARM_ITERATIONS = 12  # Aberth iterations from a neighbour's roots before a cold start [-]
 MIN_BLOCK = 4096  # fewest parameter sets worth a thread of their own [-]
 _EPS = float(np.finfo(float).eps)
 
 MODE_COEFFICIENTS = 0  # characteristic polynomial coefficients only
 MODE_FLAGS = 1  # Routh–Hurwitz flags only
 MODE_POLES = 2  # roots: largest real part and flags (and the poles if asked)
-
-
-@kernel(fastmath=False)
-def _set_matrices(i, E_rows, E_cols, E_pair, E_weight, stiffness, viscosity, ratio,
-                  use_ratio, inertia, gravity_torque, jac, damp, load):
-    """J0, L and K − g·diag(a) of set ``i`` into ``jac``, ``damp``, ``load``."""
-    n = jac.shape[0]
-    b = i if inertia.shape[0] > 1 else 0
-    r = ratio[i if ratio.shape[0] > 1 else 0]
-    for row in range(n):
-        for col in range(n):
-            jac[row, col] = inertia[b, row, col]
-            damp[row, col] = 0.0
-            load[row, col] = 0.0
-        load[row, row] = -gravity_torque[b, row]
-    vi = i if viscosity.shape[0] > 1 else 0
-    for t in range(E_rows.shape[0]):
-        p = E_pair[t]
-        w = E_weight[t]
-        ks = stiffness[i, p]
-        load[E_rows[t], E_cols[t]] += w * ks
-        if use_ratio:
-            damp[E_rows[t], E_cols[t]] += w * (r * ks)
-        else:
-            damp[E_rows[t], E_cols[t]] += w * viscosity[vi, p]
 
 
 @kernel(fastmath=False)
@@ -228,22 +204,8 @@ def start_directions(degree: int) -> np.ndarray:
 
 
 @kernel(fastmath=False)
-def _aberth(coef, roots, done, hull, logs, directions, max_iterations):
-    """All roots of the real polynomial ``coef`` (ascending) into ``roots``.
-
-    ``directions`` is :func:`start_directions` of the full degree. Returns True
-    on convergence. Exact zero roots are split off first.
-    """
-    deg_full = coef.shape[0] - 1
-    low = 0
-    while low < deg_full and coef[low] == 0.0:
-        roots[low] = 0.0
-        low += 1
-    c = coef[low:]
-    deg = deg_full - low
-    z = roots[low:]
-    if deg == 0:
-        return True
+def _start(c, deg, deg_full, z, hull, logs, directions):
+    """Aberth starting points of ``c`` (degree ``deg``) into ``z``."""
     # Starting points from the Newton polygon (upper convex hull of (j, log|c_j|)):
     # a hull segment from a to b holds b − a roots of modulus (|c_a|/|c_b|)^(1/(b−a)).
     nh = 0
@@ -271,6 +233,29 @@ def _aberth(coef, roots, done, hull, logs, directions, max_iterations):
             else:
                 angle = 2.0 * math.pi * t / m + 2.0 * math.pi * a / deg + 0.7
                 z[a + t] = complex(radius * math.cos(angle), radius * math.sin(angle))
+
+
+@kernel(fastmath=False)
+def _aberth(coef, roots, done, hull, logs, directions, max_iterations, warm):
+    """All roots of the real polynomial ``coef`` (ascending) into ``roots``.
+
+    ``directions`` is :func:`start_directions` of the full degree. Returns True
+    on convergence. Exact zero roots are split off first. ``warm``: start from the
+    values in ``roots`` (the roots of a neighbouring polynomial) instead of the
+    Newton polygon's (when no root is zero).
+    """
+    deg_full = coef.shape[0] - 1
+    low = 0
+    while low < deg_full and coef[low] == 0.0:
+        roots[low] = 0.0
+        low += 1
+    c = coef[low:]
+    deg = deg_full - low
+    z = roots[low:]
+    if deg == 0:
+        return True
+    if not (warm and low == 0):
+        _start(c, deg, deg_full, z, hull, logs, directions)
     for j in range(deg):
         done[j] = False
     remaining = deg
@@ -349,15 +334,18 @@ def _tidy_roots(roots, paired, sort):
 
 
 @kernel(nogil=True, entry=True, fastmath=False)
-def batch_kernel(start, stop, mode, E_rows, E_cols, E_pair, E_weight, stiffness, viscosity,
-                  ratio, use_ratio, inertia, gravity_torque, masks, mask_start, directions,
-                  max_iterations, keep_poles, coefficients, poles, max_real, stable, converged):
-    """Sets ``start:stop`` in one of three modes (one compiled function, GIL released)."""
+def batch_kernel(start, stop, mode, inertia, damp, load, masks, mask_start, directions,
+                 max_iterations, keep_poles, chain, coefficients, poles, max_real, stable,
+                 converged):
+    """Sets ``start:stop`` in one of three modes (one compiled function, GIL released).
+
+    ``inertia``, ``damp`` and ``load`` are J0, L and K − g diag(a) of
+    :meth:`posturelab.linear.system.LinearSystem.without_delay`, each with a first axis
+    of M sets or 1 (shared). With ``chain`` > 0, the roots of set i start from those of
+    set i − 1 unless i is a multiple of ``chain`` (neighbouring sets of a map).
+    """
     n = inertia.shape[1]
     if start < stop:
-        jac = np.empty((n, n))
-        damp = np.empty((n, n))
-        load = np.empty((n, n))
         minors = np.zeros((1 << n, 2 * n + 1))
         coef = np.empty(2 * n + 1)
         shifted = np.empty(2 * n + 1)
@@ -368,20 +356,30 @@ def batch_kernel(start, stop, mode, E_rows, E_cols, E_pair, E_weight, stiffness,
         done = np.empty(2 * n, dtype=np.bool_)
         hull = np.empty(2 * n + 1, dtype=np.int64)
         logs = np.empty(2 * n + 1)
+        previous = False  # the roots of set i − 1 are in ``roots``
         for i in range(start, stop):
-            _set_matrices(i, E_rows, E_cols, E_pair, E_weight, stiffness, viscosity, ratio,
-                          use_ratio, inertia, gravity_torque, jac, damp, load)
+            jac = inertia[i if inertia.shape[0] > 1 else 0]
+            d = damp[i if damp.shape[0] > 1 else 0]
+            k = load[i if load.shape[0] > 1 else 0]
             if n == 3:
-                _polynomial_determinant3(jac, damp, load, coef)
+                _polynomial_determinant3(jac, d, k, coef)
             else:
-                _polynomial_determinant(jac, damp, load, masks, mask_start, minors, coef)
+                _polynomial_determinant(jac, d, k, masks, mask_start, minors, coef)
             if mode == MODE_COEFFICIENTS:
                 for j in range(2 * n + 1):
                     coefficients[i, j] = coef[j]
             elif mode == MODE_FLAGS:
                 stable[i] = _routh_stable(coef, shifted, row_a, row_b, row_c)
             else:
-                converged[i] = _aberth(coef, roots, done, hull, logs, directions, max_iterations)
+                ok = False
+                if previous and chain > 0 and i % chain != 0:
+                    ok = _aberth(coef, roots, done, hull, logs, directions, WARM_ITERATIONS,
+                                 True)
+                if not ok:
+                    ok = _aberth(coef, roots, done, hull, logs, directions, max_iterations,
+                                 False)
+                converged[i] = ok
+                previous = ok and coef[0] != 0.0
                 _tidy_roots(roots, done, keep_poles)
                 top = roots[0].real
                 for j in range(1, 2 * n):
@@ -394,23 +392,31 @@ def batch_kernel(start, stop, mode, E_rows, E_cols, E_pair, E_weight, stiffness,
                         poles[i, j] = roots[j]
 
 
-def run(mode: int, inputs: tuple, n_sets: int, n_links: int, *, keep_poles: bool = False,
-        max_iterations: int = MAX_ITERATIONS) -> dict[str, np.ndarray]:
+def run(mode: int, matrices: tuple, n_sets: int, *, keep_poles: bool = False,
+        max_iterations: int = MAX_ITERATIONS, chain: int = 0,
+        threads: int | None = None) -> dict[str, np.ndarray]:
     """Allocate the outputs of ``mode`` (size-1 placeholders for the others) and run it.
 
     Parameters
     ----------
     mode : int
         MODE_COEFFICIENTS, MODE_FLAGS or MODE_POLES.
-    inputs : tuple
-        The kernel's inputs from ``E_rows`` to ``mask_start`` (``_Prepared.args()`` of
-        :mod:`posturelab.linear.batch`).
-    n_sets, n_links : int
-        Number of parameter sets M and of links N. [-]
+    matrices : tuple of numpy.ndarray
+        (J0, L, K − g diag(a)), each (M or 1, N, N): the system without delay
+        (:meth:`posturelab.linear.system.LinearSystem.without_delay`). [kg·m²],
+        [N·m·s/rad], [N·m/rad]
+    n_sets : int
+        Number of parameter sets M. [-]
     keep_poles : bool, optional
         MODE_POLES: also return all 2N poles of every set. [1/s]
     max_iterations : int, optional
         Aberth iterations before a set counts as not converged. [-]
+    chain : int, optional
+        Warm-start the roots of each set from the previous one, restarting at every
+        multiple of ``chain`` (0: never); the blocks of the thread pool start at such
+        multiples, so the result does not depend on the number of threads. [-]
+    threads : int, optional
+        At most this many threads (default: one per core). [-]
 
     Returns
     -------
@@ -421,7 +427,7 @@ def run(mode: int, inputs: tuple, n_sets: int, n_links: int, *, keep_poles: bool
     """
     from numba import config
 
-    n = n_links
+    n = matrices[0].shape[-1]
 
     def size(wanted: bool) -> int:
         return n_sets if wanted else 1
@@ -434,17 +440,37 @@ def run(mode: int, inputs: tuple, n_sets: int, n_links: int, *, keep_poles: bool
         "stable": np.empty(size(mode != MODE_COEFFICIENTS), dtype=np.bool_),
         "converged": np.empty(size(mode == MODE_POLES), dtype=np.bool_),
     }
-    args = (mode, *inputs, start_directions(2 * n), int(max_iterations), bool(keep_poles),
-            out["coefficients"], out["poles"], out["max_real"], out["stable"], out["converged"])
-    threads = max(1, min(config.NUMBA_NUM_THREADS, n_sets // MIN_BLOCK))
+    masks, mask_start = subset_tables(n)
+    args = (mode, *(np.ascontiguousarray(m, dtype=float) for m in matrices), masks, mask_start,
+            start_directions(2 * n), int(max_iterations), bool(keep_poles), int(chain),
+            out["coefficients"], out["poles"], out["max_real"], out["stable"],
+            out["converged"])
+    limit = config.NUMBA_NUM_THREADS if threads is None else threads
+    threads = max(1, min(limit, n_sets // MIN_BLOCK))
     if threads == 1:
         batch_kernel(0, n_sets, *args)
         return out
     # Blocks of sets on a thread pool: the kernel releases the GIL (nogil=True).
     bounds = np.linspace(0, n_sets, 4 * threads + 1).astype(np.int64)
+    if chain > 0:  # each block starts a chain
+        bounds = np.unique(np.minimum(n_sets, (bounds + chain - 1) // chain * chain))
     with ThreadPoolExecutor(max_workers=threads) as pool:
         jobs = [pool.submit(batch_kernel, int(a), int(b), *args)
                 for a, b in zip(bounds[:-1], bounds[1:], strict=True)]
         for job in jobs:
             job.result()
     return out
+
+
+def subset_tables(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Column subsets by size (sizes 1..N−1 all, size N only the full set), for the
+    general determinant expansion."""
+    masks: list[int] = []
+    start = [0, 0]
+    for size in range(1, n + 1):
+        if size < n:
+            masks.extend(s for s in range(1 << n) if bin(s).count("1") == size)
+        else:
+            masks.append((1 << n) - 1)
+        start.append(len(masks))
+    return np.array(masks, dtype=np.int64), np.array(start, dtype=np.int64)

@@ -18,15 +18,14 @@ removed); :func:`analyse_both_sides` gives both.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Literal
 
 import numpy as np
 
 from .._validation import finite_array
-from ..errors import ParameterError
 from ..model.body import Body
 from ..model.dynamics import mass_matrix, platform_vector, state_derivative
 from ..model.muscles import MuscleSet, feedback_pair_torques, muscle_set_gains
+from .system import OneSided, effective_muscles, linear_system, sorted_poles
 
 __all__ = [
     "LinearAnalysis",
@@ -38,15 +37,8 @@ __all__ = [
     "disturbance_sensitivity",
 ]
 
-OneSided = Literal["active", "inactive"]
-
-
 def _effective(muscles: MuscleSet, one_sided: OneSided) -> MuscleSet:
-    if one_sided == "active":
-        return muscles.as_two_sided()
-    if one_sided == "inactive":
-        return muscles.without_one_sided()
-    raise ParameterError(f"one_sided must be 'active' or 'inactive', got {one_sided!r}")
+    return effective_muscles(muscles, one_sided)
 
 
 def state_matrix(body: Body, muscles: MuscleSet, one_sided: OneSided = "active") -> np.ndarray:
@@ -65,20 +57,11 @@ def state_matrix(body: Body, muscles: MuscleSet, one_sided: OneSided = "active")
     -------
     numpy.ndarray, shape (2N, 2N)
         d[Θ, Θ̇]/dt = A [Θ, Θ̇]; upper-right block [-], lower-left [1/s²],
-        lower-right [1/s].
+        lower-right [1/s]. (:meth:`posturelab.linear.system.LinearSystem.state_matrix`
+        without delay.)
     """
     _check_match(body, muscles)
-    m = _effective(muscles, one_sided)
-    n = body.n_links
-    J0 = mass_matrix(body, np.zeros(n))
-    gains = muscle_set_gains(m, 0.0)  # without a delay: intrinsic + active
-    E = m.selection_matrix
-    stiff = body.gravity * np.diag(body.gravity_coefficients) - E.T @ (gains[0][:, None] * E)
-    A = np.zeros((2 * n, 2 * n))
-    A[:n, n:] = np.eye(n)
-    A[n:, :n] = np.linalg.solve(J0, stiff)
-    A[n:, n:] = -np.linalg.solve(J0, E.T @ (gains[1][:, None] * E))
-    return A
+    return linear_system(body, muscles, one_sided=one_sided, inputs=False).state_matrix()[0]
 
 
 def finite_difference_state_matrix(
@@ -110,14 +93,6 @@ def finite_difference_state_matrix(
         e[j] = step
         A[:, j] = (f(e) - f(-e)) / (2 * step)
     return A
-
-
-def sorted_poles(eigenvalues: np.ndarray) -> np.ndarray:
-    """Sort poles by real part ascending; a conjugate pair lists +imag first. [1/s]"""
-    ev = np.asarray(eigenvalues, dtype=complex)
-    # Round for the sort key only, so conjugates with equal real parts stay together.
-    order = np.lexsort((-ev.imag, np.round(ev.real, 9)), axis=-1)
-    return np.take_along_axis(ev, order, axis=-1)
 
 
 @dataclass(frozen=True)

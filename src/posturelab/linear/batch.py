@@ -23,11 +23,16 @@ expansion along rows, memoised over column subsets: 2ᴺ minors, any N), then
   iteration does not converge (not seen in practice) is recomputed with
   ``numpy.linalg.eigvals`` of its state matrix.
 
-Everything per set runs in one compiled function (:mod:`._batch_kernels`,
-``nogil=True``), called on blocks of sets from a small thread pool (one thread
-per core, ``NUMBA_NUM_THREADS``); it is safe to call from several Python threads
-at once. The first call in a fresh environment compiles (a few seconds); later
-processes load the cached machine code (:mod:`posturelab._jit`).
+The matrices J0, L and K − g diag(a) of every set are those of the one linear
+system (:class:`posturelab.linear.system.LinearSystem`, built by
+:func:`posturelab.linear.system.linear_system`); everything else per set runs in one
+compiled function (:mod:`._batch_kernels`, ``nogil=True``), called on blocks of sets
+from a small thread pool (one thread per core, ``NUMBA_NUM_THREADS``); it is safe to
+call from several Python threads at once. A stability map starts each set's
+root iteration from the roots of its neighbour along x (a row starts afresh), which
+takes about a third of the time of starting afresh (same roots to rounding). The first
+call in a fresh environment compiles (a few seconds); later processes load the cached
+machine code (:mod:`posturelab._jit`).
 
 Stability margin
 ----------------
@@ -54,7 +59,7 @@ Parameter grids
 ---------------
 :func:`parameter_grid` and :func:`stability_map` sweep two named parameters
 (:data:`GRID_PARAMETERS`: the paper's five pair stiffnesses and the viscosity
-ratio) over ranges, every other parameter taken from a Table I case; they are
+ratio) over ranges, every other parameter taken from a Table I case; the grid is
 defined in :mod:`._batch_grid` (which imports no numba) and public here.
 """
 
@@ -62,7 +67,8 @@ defined in :mod:`._batch_grid` (which imports no numba) and public here.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -78,11 +84,12 @@ from ._batch_grid import (
     ParameterRange,
     StabilityMap,
     parameter_grid,
-    stability_map,
 )
 from ._batch_kernels import MAX_ITERATIONS as _MAX_ITERATIONS
 from ._batch_kernels import STABILITY_MARGIN
+from ._batch_kernels import subset_tables as _subset_tables  # noqa: F401 (tests use it)
 from .analysis import sorted_poles
+from .system import BodyArrays, LinearSystem, linear_system
 
 __all__ = [
     "STABILITY_MARGIN",
@@ -100,165 +107,18 @@ __all__ = [
     "stability_map",
 ]
 
+#: Parameter sets per system built and evaluated at once (bounds the memory of a call). [-]
+_BLOCK = 65_536
+
 
 # ---------------------------------------------------------------------------
-# Inputs
+# Inputs: the one linear system of each block of sets
 # ---------------------------------------------------------------------------
 
 
-@dataclass(frozen=True)
-class BodyArrays:
-    """Body parameters per parameter set, for sweeps over the body itself.
-
-    Each per-link array has shape (N,) (shared by every set) or (M, N) (one
-    row per set); ``gravity`` is a scalar or shape (M,).
-
-    Parameters
-    ----------
-    masses : array_like, shape (N,) or (M, N)
-        Link masses, lowest link first. [kg]
-    lengths : array_like, shape (N,) or (M, N)
-        Link lengths. [m]
-    com_distances : array_like, shape (N,) or (M, N)
-        Centre-of-mass distances from each link's lower joint, in [0, length]. [m]
-    inertias : array_like, shape (N,) or (M, N)
-        Inertias about each centre of mass. [kg·m²]
-    gravity : float or array_like, shape (M,)
-        Gravitational acceleration, > 0. [m/s²]
-    """
-
-    masses: np.ndarray
-    lengths: np.ndarray
-    com_distances: np.ndarray
-    inertias: np.ndarray
-    gravity: float | np.ndarray = 9.81
-
-    def __post_init__(self) -> None:
-        fields = {}
-        for name, unit in (("masses", "kg"), ("lengths", "m"), ("com_distances", "m"),
-                           ("inertias", "kg·m²")):
-            arr = finite_array(f"{name} [{unit}]", getattr(self, name))
-            if arr.ndim not in (1, 2) or arr.shape[-1] < 1:
-                raise ParameterError(
-                    f"{name} [{unit}] must have shape (N,) or (M, N), got shape {arr.shape}"
-                )
-            fields[name] = arr
-        n_links = {a.shape[-1] for a in fields.values()}
-        if len(n_links) != 1:
-            raise ParameterError(
-                "masses, lengths, com_distances and inertias must have the same number of "
-                f"links (last axis), got {sorted(n_links)}"
-            )
-        for name in ("masses", "lengths", "inertias"):
-            if np.any(fields[name] <= 0):
-                raise ParameterError(f"{name} must be > 0, got {fields[name].min():g}")
-        com = fields["com_distances"]
-        if np.any(com < 0) or np.any(com > fields["lengths"]):
-            raise ParameterError("com_distances [m] must lie in [0, length] for every link")
-        gravity = finite_array("gravity [m/s²]", self.gravity)
-        if gravity.ndim > 1 or np.any(gravity <= 0):
-            raise ParameterError("gravity [m/s²] must be > 0, a scalar or shape (M,)")
-        for name, arr in fields.items():
-            arr.setflags(write=False)
-            object.__setattr__(self, name, arr)
-        gravity.setflags(write=False)
-        object.__setattr__(self, "gravity", gravity)
-
-    @classmethod
-    def from_body(cls, body: Body) -> BodyArrays:
-        """The parameters of one :class:`~posturelab.model.body.Body`, shared by every set."""
-        return cls(body.masses, body.lengths, body.com_distances, body.inertias, body.gravity)
-
-    @property
-    def n_links(self) -> int:
-        """Number of links N. [-]"""
-        return int(self.masses.shape[-1])
-
-    def set_count(self) -> int | None:
-        """Number of sets M the per-set arrays describe, or None when all are shared."""
-        counts = {a.shape[0] for a in (self.masses, self.lengths, self.com_distances,
-                                       self.inertias) if a.ndim == 2}
-        if self.gravity.ndim == 1:
-            counts.add(self.gravity.shape[0])
-        if len(counts) > 1:
-            raise ParameterError(f"body arrays disagree on the number of sets: {sorted(counts)}")
-        return counts.pop() if counts else None
-
-    def upright_matrices(self) -> tuple[np.ndarray, np.ndarray]:
-        """J(0) and g·a per set: shapes (B, N, N) [kg·m²] and (B, N) [N·m/rad], B = M or 1."""
-        count = self.set_count()
-        size = 1 if count is None else count
-        n = self.n_links
-
-        def per_set(arr: np.ndarray) -> np.ndarray:
-            return np.broadcast_to(arr, (size, n)) if arr.ndim == 1 else arr
-
-        masses, lengths, com, inertias = (per_set(arr) for arr in (
-            self.masses, self.lengths, self.com_distances, self.inertias))
-        mass_above = np.cumsum(masses[:, ::-1], axis=1)[:, ::-1] - masses  # Σ_{j>i} m_j
-        gravity_coefficients = masses * com + mass_above * lengths  # a_i [kg·m]
-        jac = np.empty((size, n, n))
-        for i in range(n):
-            jac[:, i, i] = (inertias[:, i] + masses[:, i] * com[:, i] ** 2
-                            + mass_above[:, i] * lengths[:, i] ** 2)
-            for j in range(i + 1, n):
-                jac[:, i, j] = jac[:, j, i] = lengths[:, i] * gravity_coefficients[:, j]
-        gravity = np.broadcast_to(self.gravity, (size,))
-        return jac, np.ascontiguousarray(gravity[:, None] * gravity_coefficients)
-
-
-@dataclass(frozen=True)
-class _Prepared:
-    E_rows: np.ndarray
-    E_cols: np.ndarray
-    E_pair: np.ndarray
-    E_weight: np.ndarray
-    stiffness: np.ndarray
-    viscosity: np.ndarray
-    ratio: np.ndarray
-    use_ratio: bool
-    inertia: np.ndarray
-    gravity_torque: np.ndarray
-    masks: np.ndarray
-    mask_start: np.ndarray
-
-    def args(self) -> tuple:
-        return (self.E_rows, self.E_cols, self.E_pair, self.E_weight, self.stiffness,
-                self.viscosity, self.ratio, self.use_ratio, self.inertia, self.gravity_torque,
-                self.masks, self.mask_start)
-
-    @property
-    def n_sets(self) -> int:
-        return int(self.stiffness.shape[0])
-
-    @property
-    def n_links(self) -> int:
-        return int(self.inertia.shape[1])
-
-
-def _run_kernel(prep: _Prepared, mode: int, *, keep_poles: bool = False,
-                max_iterations: int = _MAX_ITERATIONS) -> dict[str, np.ndarray]:
-    """Run the compiled kernel in ``mode`` on the prepared sets (see ``_batch_kernels.run``)."""
-    return _kernels.run(mode, prep.args(), prep.n_sets, prep.n_links, keep_poles=keep_poles,
-                        max_iterations=max_iterations)
-
-
-def _subset_tables(n: int) -> tuple[np.ndarray, np.ndarray]:
-    """Column subsets by size (sizes 1..N−1 all, size N only the full set)."""
-    masks: list[int] = []
-    start = [0, 0]
-    for size in range(1, n + 1):
-        if size < n:
-            masks.extend(s for s in range(1 << n) if bin(s).count("1") == size)
-        else:
-            masks.append((1 << n) - 1)
-        start.append(len(masks))
-    return np.array(masks, dtype=np.int64), np.array(start, dtype=np.int64)
-
-
-def _prepare(
-    pair_stiffness, viscosity_ratio, pair_viscosity, body, muscles
-) -> _Prepared:
+def _gains(pair_stiffness, viscosity_ratio, pair_viscosity, body, muscles):
+    """Checked inputs: (body, muscles, stiffness (M, P), viscosity (M or 1, P) or None,
+    ratio (M or 1,) or None)."""
     muscles = paper_muscles("1") if muscles is None else muscles
     if not isinstance(muscles, MuscleSet):
         raise ParameterError(f"muscles must be a MuscleSet, got {type(muscles).__name__}")
@@ -274,6 +134,7 @@ def _prepare(
     n_pairs = len(muscles.pairs)
     stiffness = _gain_array("pair_stiffness [N·m/rad]", pair_stiffness, n_pairs)
     n_sets = stiffness.shape[0]
+    ratio = viscosity = None
     if pair_viscosity is not None:
         if viscosity_ratio is not None:
             raise ParameterError("give viscosity_ratio or pair_viscosity, not both")
@@ -283,10 +144,7 @@ def _prepare(
                 f"pair_viscosity [N·m·s/rad] must have {n_sets} rows (one per set), "
                 f"got {viscosity.shape[0]}"
             )
-        ratio = np.zeros(1)
-        use_ratio = False
     else:
-        viscosity = np.zeros((1, n_pairs))
         ratio = finite_array("viscosity_ratio [s]",
                              DEFAULT_VISCOSITY_RATIO if viscosity_ratio is None
                              else viscosity_ratio)
@@ -298,31 +156,40 @@ def _prepare(
             )
         if np.any(ratio < 0):
             raise ParameterError(f"viscosity_ratio [s] must be >= 0, got {ratio.min():g}")
-        use_ratio = True
     body_sets = body.set_count()
     if body_sets is not None and body_sets != n_sets:
         raise ParameterError(
             f"body arrays describe {body_sets} sets but pair_stiffness has {n_sets} rows"
         )
-    inertia, gravity_torque = body.upright_matrices()
-    E = muscles.selection_matrix
-    rows, cols, pairs, weights = [], [], [], []
-    for p in range(n_pairs):
-        nz = np.flatnonzero(E[p])
-        for r in nz:
-            for c in nz:
-                rows.append(r)
-                cols.append(c)
-                pairs.append(p)
-                weights.append(E[p, r] * E[p, c])
-    masks, mask_start = _subset_tables(body.n_links)
-    return _Prepared(
-        np.array(rows, dtype=np.int64), np.array(cols, dtype=np.int64),
-        np.array(pairs, dtype=np.int64), np.array(weights, dtype=float),
-        stiffness, np.ascontiguousarray(viscosity, dtype=float), ratio, use_ratio,
-        np.ascontiguousarray(inertia, dtype=float),
-        np.ascontiguousarray(gravity_torque, dtype=float), masks, mask_start,
-    )
+    return body, muscles, stiffness, viscosity, ratio
+
+
+def _rows(arr: np.ndarray | None, lo: int, hi: int):
+    return arr if arr is None or arr.shape[0] == 1 else arr[lo:hi]
+
+
+def _body_rows(body: BodyArrays, lo: int, hi: int) -> BodyArrays:
+    if body.set_count() is None:
+        return body
+    return BodyArrays(*(a[lo:hi] if a.ndim == 2 else a for a in (
+        body.masses, body.lengths, body.com_distances, body.inertias)),
+        body.gravity[lo:hi] if body.gravity.ndim == 1 else body.gravity)
+
+
+def _systems(pair_stiffness, viscosity_ratio, pair_viscosity, body, muscles):
+    """The checked inputs as linear systems of blocks of at most _BLOCK sets:
+    (M, [(lo, hi, LinearSystem), ...])."""
+    body, muscles, k, v, ratio = _gains(pair_stiffness, viscosity_ratio, pair_viscosity,
+                                        body, muscles)
+    m = k.shape[0]
+    blocks = []
+    for lo in range(0, max(m, 1), _BLOCK):
+        hi = min(m, lo + _BLOCK)
+        system = linear_system(_body_rows(body, lo, hi), muscles, stiffness=k[lo:hi],
+                               viscosity=_rows(v, lo, hi), viscosity_ratio=_rows(ratio, lo, hi),
+                               inputs=False)
+        blocks.append((lo, hi, system))
+    return m, blocks
 
 
 def _gain_array(name: str, value, n_pairs: int) -> np.ndarray:
@@ -342,6 +209,31 @@ def _gain_array(name: str, value, n_pairs: int) -> np.ndarray:
     if arr.size and arr.min() < 0:
         raise ParameterError(f"{name} must be >= 0, got {arr.min():g}")
     return np.ascontiguousarray(arr)
+
+
+def _run(system: LinearSystem, mode: int, **options) -> dict[str, np.ndarray]:
+    """The compiled kernel in ``mode`` on the system's matrices without delay."""
+    return _kernels.run(mode, system.without_delay(), system.n_sets, **options)
+
+
+def _blocks(m: int, blocks, mode: int, **options) -> dict[str, np.ndarray]:
+    """:func:`_run` on every block, the outputs concatenated."""
+    if len(blocks) == 1:
+        out = _run(blocks[0][2], mode, **options)
+        if m == 0:
+            out = {key: val[:0] if val.shape[0] == 1 and key in _FILLED[mode] else val
+                   for key, val in out.items()}
+        return out
+    parts = [_run(system, mode, **options) for _, _, system in blocks]
+    return {key: (np.concatenate([p[key] for p in parts]) if key in _FILLED[mode]
+                  else parts[0][key]) for key in parts[0]}
+
+
+_FILLED = {
+    _kernels.MODE_COEFFICIENTS: {"coefficients"},
+    _kernels.MODE_FLAGS: {"stable"},
+    _kernels.MODE_POLES: {"poles", "max_real", "stable", "converged"},
+}
 
 
 # ---------------------------------------------------------------------------
@@ -406,8 +298,8 @@ def characteristic_polynomials(
         ``c[:, j]`` multiplies s^j (ascending powers); ``c[:, 2N] = det J0``.
         Units: [(N·m/rad)^N · s^j] (a determinant of N×N torque-per-angle entries).
     """
-    prep = _prepare(pair_stiffness, viscosity_ratio, pair_viscosity, body, muscles)
-    return _run_kernel(prep, _kernels.MODE_COEFFICIENTS)["coefficients"]
+    m, blocks = _systems(pair_stiffness, viscosity_ratio, pair_viscosity, body, muscles)
+    return _blocks(m, blocks, _kernels.MODE_COEFFICIENTS)["coefficients"]
 
 
 def batch_stable(
@@ -431,8 +323,8 @@ def batch_stable(
         True when every pole has real part < −δ (module notes); equal to
         ``batch_analyse(...).stable`` except within rounding of that boundary.
     """
-    prep = _prepare(pair_stiffness, viscosity_ratio, pair_viscosity, body, muscles)
-    return _run_kernel(prep, _kernels.MODE_FLAGS)["stable"]
+    m, blocks = _systems(pair_stiffness, viscosity_ratio, pair_viscosity, body, muscles)
+    return _blocks(m, blocks, _kernels.MODE_FLAGS)["stable"]
 
 
 def batch_analyse(
@@ -459,53 +351,41 @@ def batch_analyse(
     -------
     BatchLinearAnalysis
     """
-    prep = _prepare(pair_stiffness, viscosity_ratio, pair_viscosity, body, muscles)
-    out = _run_kernel(prep, _kernels.MODE_POLES, keep_poles=keep_poles,
-                      max_iterations=_max_iterations)
+    m, blocks = _systems(pair_stiffness, viscosity_ratio, pair_viscosity, body, muscles)
+    parts = [_analyse(system, keep_poles=keep_poles, max_iterations=_max_iterations)
+             for _, _, system in blocks]
+    if len(parts) == 1:
+        res = parts[0]
+        if m == 0:
+            return BatchLinearAnalysis(res.stable[:0], res.max_real_part[:0],
+                                       None if res.poles is None else res.poles[:0])
+        return res
+    return BatchLinearAnalysis(
+        stable=np.concatenate([p.stable for p in parts]),
+        max_real_part=np.concatenate([p.max_real_part for p in parts]),
+        poles=np.concatenate([p.poles for p in parts]) if keep_poles else None)
+
+
+def _analyse(system: LinearSystem, *, keep_poles: bool = False,
+             max_iterations: int = _MAX_ITERATIONS, chain: int = 0,
+             threads: int | None = None) -> BatchLinearAnalysis:
+    """Poles of the sets of ``system`` (:func:`batch_analyse`); ``chain``, ``threads``: as
+    :func:`posturelab.linear._batch_kernels.run`."""
+    out = _run(system, _kernels.MODE_POLES, keep_poles=keep_poles,
+               max_iterations=max_iterations, chain=chain, threads=threads)
     poles = out["poles"] if keep_poles else None
     bad = np.flatnonzero(~out["converged"])
     if bad.size:
-        _eigvals_fallback(prep, bad, poles, out["max_real"], out["stable"])
+        _eigvals_fallback(system, bad, poles, out["max_real"], out["stable"])
     return BatchLinearAnalysis(stable=out["stable"], max_real_part=out["max_real"], poles=poles)
 
 
-def _subset(prep: _Prepared, index: np.ndarray) -> _Prepared:
-    """The prepared inputs of the sets ``index`` only."""
-    def rows(arr: np.ndarray) -> np.ndarray:
-        return np.ascontiguousarray(arr[index]) if arr.shape[0] > 1 else arr
-
-    return replace(prep, stiffness=rows(prep.stiffness), viscosity=rows(prep.viscosity),
-                   ratio=rows(prep.ratio), inertia=rows(prep.inertia),
-                   gravity_torque=rows(prep.gravity_torque))
-
-
-def _state_matrices(prep: _Prepared) -> np.ndarray:
-    """State matrices A (M, 2N, 2N), built as :func:`posturelab.linear.state_matrix` does."""
-    n, n_sets = prep.n_links, prep.n_sets
-    stiff = np.zeros((n_sets, n, n))
-    visc = np.zeros((n_sets, n, n))
-    ratio = np.broadcast_to(prep.ratio, (n_sets,))
-    for r, c, p, w in zip(prep.E_rows, prep.E_cols, prep.E_pair, prep.E_weight, strict=True):
-        stiff[:, r, c] += w * prep.stiffness[:, p]
-        if prep.use_ratio:
-            visc[:, r, c] += w * (ratio * prep.stiffness[:, p])
-        else:
-            visc[:, r, c] += w * np.broadcast_to(prep.viscosity[:, p], (n_sets,))
-    inertia = np.broadcast_to(prep.inertia, (n_sets, n, n))
-    gravity = np.broadcast_to(prep.gravity_torque, (n_sets, n))
-    out = np.zeros((n_sets, 2 * n, 2 * n))
-    out[:, :n, n:] = np.eye(n)
-    out[:, n:, :n] = np.linalg.solve(inertia, gravity[:, :, None] * np.eye(n) - stiff)
-    out[:, n:, n:] = -np.linalg.solve(inertia, visc)
-    return out
-
-
-def _eigvals_fallback(prep: _Prepared, index: np.ndarray, poles: np.ndarray | None,
+def _eigvals_fallback(system: LinearSystem, index: np.ndarray, poles: np.ndarray | None,
                       max_real: np.ndarray, stable: np.ndarray) -> None:
     """Recompute some sets with numpy eigvals of the state matrix (the single-case method)."""
-    sub = _subset(prep, index)
-    coefs = _run_kernel(sub, _kernels.MODE_COEFFICIENTS)["coefficients"]
-    ev = sorted_poles(np.linalg.eigvals(_state_matrices(sub)))
+    sub = system[index]
+    coefs = _run(sub, _kernels.MODE_COEFFICIENTS)["coefficients"]
+    ev = sorted_poles(np.linalg.eigvals(sub.state_matrix()))
     max_real[index] = ev.real.max(axis=1)
     stable[index] = max_real[index] < np.array([-_margin_py(c) for c in coefs])
     if poles is not None:
@@ -518,3 +398,88 @@ def _margin_py(coef: np.ndarray) -> float:
     return STABILITY_MARGIN * max(1.0, abs(coef[-2]) / lead, math.sqrt(abs(coef[-3]) / lead))
 
 
+# ---------------------------------------------------------------------------
+# Stability maps
+# ---------------------------------------------------------------------------
+
+#: Parameter sets per block of a stability map (one system and one kernel call each). [-]
+_MAP_BLOCK = 16_384
+
+
+def stability_map(
+    x: ParameterRange | tuple[str, float, float],
+    y: ParameterRange | tuple[str, float, float],
+    resolution: int | tuple[int, int] = 200,
+    *,
+    case: str = "1",
+    viscosity_ratio: float | None = None,
+    body: Body | None = None,
+    progress: Callable[[int, int], None] | None = None,
+    muscles: MuscleSet | None = None,
+) -> StabilityMap:
+    """Largest real part and stability over a two-parameter grid of pair gains.
+
+    Parameters
+    ----------
+    x, y, resolution, case, viscosity_ratio, muscles
+        As in :func:`parameter_grid`; ``muscles`` (its pairs, any number of links) is
+        needed for a body other than three links.
+    body : Body, optional
+        The body; the paper's by default.
+    progress : callable(done, total), optional
+        Called after each block of sets with the number of sets done and the
+        total. [-]
+
+    Returns
+    -------
+    StabilityMap
+    """
+    from concurrent.futures import ThreadPoolExecutor
+
+    from numba import config
+
+    grid = parameter_grid(x, y, resolution, case=case, viscosity_ratio=viscosity_ratio,
+                          muscles=muscles)
+    body = paper_body() if body is None else body
+    if not isinstance(body, Body):
+        raise ParameterError(f"body must be a Body, got {type(body).__name__}")
+    layout = muscles
+    if layout is None:
+        if body.n_links != 3:
+            raise ParameterError(f"a map over Table I's pairs is for three links; this body "
+                                 f"has {body.n_links}: give muscles (its pairs)")
+        layout = paper_muscles("1")
+    elif layout.n_links != body.n_links:
+        raise ParameterError(f"muscle set is for {layout.n_links} links but the body has "
+                             f"{body.n_links}")
+    ny, nx = grid.shape
+    max_real = np.empty((ny, nx))
+    stable = np.empty((ny, nx), dtype=bool)
+    rows_per_block = max(1, _MAP_BLOCK // nx)
+
+    def block(start: int) -> int:
+        """Rows start … of the grid: their system, then their poles, each row a chain."""
+        stop = min(ny, start + rows_per_block)
+        stiffness, ratio = grid.rows(start, stop)
+        system = linear_system(body, layout, stiffness=stiffness, viscosity_ratio=ratio,
+                               inputs=False)
+        res = _analyse(system, chain=nx, threads=1)
+        max_real[start:stop] = res.max_real_part.reshape(stop - start, nx)
+        stable[start:stop] = res.stable.reshape(stop - start, nx)
+        return (stop - start) * nx
+
+    starts = range(0, ny, rows_per_block)
+    done = 0
+    if progress is not None:
+        progress(0, grid.size)
+    threads = max(1, min(config.NUMBA_NUM_THREADS, len(starts)))
+    with ThreadPoolExecutor(max_workers=threads) as pool:
+        try:
+            for count in pool.map(block, starts):
+                done += count
+                if progress is not None:
+                    progress(done, grid.size)
+        except BaseException:  # Ctrl-C: drop the blocks not started
+            pool.shutdown(wait=True, cancel_futures=True)
+            raise
+    return StabilityMap(grid, max_real, stable, body.name)

@@ -12,7 +12,8 @@ gains has K_i = L_i = 0: its whole feedback is delayed). Its characteristic matr
 
     Δ(s) = s² J0 − g A + K_i + s L_i + (K_a + s L_a) e^{−sτ},
 
-and the roots of det Δ(s) = 0 are the characteristic roots (infinitely many; finitely
+(the matrices of the one linear system, :mod:`posturelab.linear.system`), and the roots of
+det Δ(s) = 0 are the characteristic roots (infinitely many; finitely
 many to the right of any vertical line: the equation is of retarded type).
 
 **Delay margin.** The smallest τ > 0 at which a root reaches the imaginary axis, s = iω.
@@ -45,10 +46,10 @@ import numpy as np
 from .._validation import float_in_range
 from ..errors import ParameterError
 from ..model.body import Body
-from ..model.dynamics import mass_matrix
-from ..model.muscles import MuscleSet, muscle_set_gains
+from ..model.muscles import MuscleSet
 from ..parameters import MAX_FEEDBACK_DELAY
-from .analysis import OneSided, _check_match, _effective
+from .analysis import _check_match
+from .system import LinearSystem, OneSided, linear_system
 
 __all__ = [
     "DelayedSystem",
@@ -59,6 +60,7 @@ __all__ = [
     "characteristic_function",
     "delay_margin",
     "rightmost_roots",
+    "system_rightmost_roots",
     "MAX_DELAY_FOR_ROOTS",
 ]
 
@@ -66,52 +68,14 @@ __all__ = [
 MAX_DELAY_FOR_ROOTS = MAX_FEEDBACK_DELAY
 
 
-@dataclass(frozen=True, eq=False)
-class DelayedSystem:
-    """The linearised delayed chain, as matrices (N × N).
-
-    Attributes
-    ----------
-    inertia : numpy.ndarray
-        J0, the mass matrix at upright. [kg·m²]
-    stiffness : numpy.ndarray
-        −g A + K_i: gravity's negative stiffness plus the intrinsic stiffness. [N·m/rad]
-    viscosity : numpy.ndarray
-        L_i. [N·m·s/rad]
-    delayed_stiffness : numpy.ndarray
-        K_a. [N·m/rad]
-    delayed_viscosity : numpy.ndarray
-        L_a. [N·m·s/rad]
-    """
-
-    inertia: np.ndarray
-    stiffness: np.ndarray
-    viscosity: np.ndarray
-    delayed_stiffness: np.ndarray
-    delayed_viscosity: np.ndarray
-
-    @property
-    def n_links(self) -> int:
-        """N. [-]"""
-        return self.inertia.shape[0]
-
-    def first_order(self) -> tuple[np.ndarray, np.ndarray]:
-        """(A0, A1), 2N × 2N: d/dt [Θ, Θ̇] = A0 x(t) + A1 x(t − τ). [1/s², 1/s]"""
-        n = self.n_links
-        inv = np.linalg.inv(self.inertia)
-        A0 = np.zeros((2 * n, 2 * n))
-        A0[:n, n:] = np.eye(n)
-        A0[n:, :n] = -inv @ self.stiffness
-        A0[n:, n:] = -inv @ self.viscosity
-        A1 = np.zeros((2 * n, 2 * n))
-        A1[n:, :n] = -inv @ self.delayed_stiffness
-        A1[n:, n:] = -inv @ self.delayed_viscosity
-        return A0, A1
+#: The linearised delayed chain: one :class:`~posturelab.linear.system.LinearSystem`.
+DelayedSystem = LinearSystem
 
 
 def delayed_system(body: Body, muscles: MuscleSet, one_sided: OneSided = "active"
-                   ) -> DelayedSystem:
-    """The matrices of the linearised delayed chain (see the module notes).
+                   ) -> LinearSystem:
+    """The linearised delayed chain of one body and muscle set, as a
+    :class:`~posturelab.linear.system.LinearSystem` of one set (see the module notes).
 
     Parameters
     ----------
@@ -123,23 +87,12 @@ def delayed_system(body: Body, muscles: MuscleSet, one_sided: OneSided = "active
         How a one-sided pair is linearised (:func:`posturelab.analyse`).
     """
     _check_match(body, muscles)
-    m = _effective(muscles, one_sided)
-    n = body.n_links
-    g = muscle_set_gains(m, 1.0)  # the split for any positive delay
-    E = m.selection_matrix
-
-    def joint(row: np.ndarray) -> np.ndarray:
-        return E.T @ (row[:, None] * E)
-
-    return DelayedSystem(
-        inertia=mass_matrix(body, np.zeros(n)),
-        stiffness=joint(g[0]) - body.gravity * np.diag(body.gravity_coefficients),
-        viscosity=joint(g[1]), delayed_stiffness=joint(g[2]), delayed_viscosity=joint(g[3]),
-    )
+    return linear_system(body, muscles, one_sided=one_sided, inputs=False)
 
 
-def characteristic_matrix(system: DelayedSystem, s, delay: float) -> np.ndarray:
-    """Δ(s) = s² J0 − g A + K_i + s L_i + (K_a + s L_a) e^{−sτ}, shape s.shape + (N, N).
+def characteristic_matrix(system: LinearSystem, s, delay: float) -> np.ndarray:
+    """Δ(s) = s² J0 − g A + K_i + s L_i + (K_a + s L_a) e^{−sτ} of a one-set system,
+    shape s.shape + (N, N).
 
     Parameters
     ----------
@@ -148,14 +101,24 @@ def characteristic_matrix(system: DelayedSystem, s, delay: float) -> np.ndarray:
     delay : float
         τ. [s]
     """
-    s = np.asarray(s, dtype=complex)[..., None, None]
-    return (s * s * system.inertia + system.stiffness + s * system.viscosity
-            + (system.delayed_stiffness + s * system.delayed_viscosity) * np.exp(-s * delay))
+    return system.characteristic_matrix(np.asarray(s, dtype=complex)[None], delay)[0]
 
 
-def characteristic_function(system: DelayedSystem, s, delay: float) -> np.ndarray:
+def characteristic_function(system: LinearSystem, s, delay: float) -> np.ndarray:
     """det Δ(s), the characteristic quasi-polynomial, at ``s``. [(N·m/rad)^N]"""
     return np.linalg.det(characteristic_matrix(system, s, delay))
+
+
+def _matrices(system: LinearSystem) -> tuple[np.ndarray, ...]:
+    """(J0, S, L_i, K_a, L_a) of a one-set system, each (N, N)."""
+    return tuple(x[0] for x in (system.inertia, system.stiffness, system.viscosity,
+                                system.delayed_stiffness, system.delayed_viscosity))
+
+
+def _slope(system: LinearSystem, s: complex, delay: float) -> np.ndarray:
+    """dΔ/ds at ``s`` for delay τ. [N·m·s/rad]"""
+    J0, _, Li, Ka, La = _matrices(system)
+    return 2 * s * J0 + Li + (La - delay * (Ka + s * La)) * np.exp(-s * delay)
 
 
 @dataclass(frozen=True)
@@ -247,7 +210,7 @@ def _crossing_candidates(A0: np.ndarray, A1: np.ndarray) -> list[tuple[complex, 
     return out
 
 
-def _polish(system: DelayedSystem, omega: float, delay: float) -> tuple[float, float] | None:
+def _polish(system: LinearSystem, omega: float, delay: float) -> tuple[float, float] | None:
     """Newton on det Δ(iω, τ) = 0 in (ω, τ) from a candidate; None if it does not converge."""
     # a fixed scale: Hadamard's bound on |det Δ| at the candidate
     scale = max(float(np.prod(np.linalg.norm(characteristic_matrix(system, 1j * omega, delay),
@@ -276,17 +239,15 @@ def _polish(system: DelayedSystem, omega: float, delay: float) -> tuple[float, f
     return w, t
 
 
-def _direction(system: DelayedSystem, omega: float, delay: float) -> int:
+def _direction(system: LinearSystem, omega: float, delay: float) -> int:
     """sign Re ds/dτ at the root s = iω for delay τ (left and right null vectors of Δ)."""
     s = 1j * omega
     D = characteristic_matrix(system, s, delay)
     u, _, vh = np.linalg.svd(D)
     right, left = vh[-1].conj(), u[:, -1]
-    ex = np.exp(-s * delay)
-    d_tau = -s * (system.delayed_stiffness + s * system.delayed_viscosity) * ex
-    d_s = (2 * s * system.inertia + system.viscosity
-           + (system.delayed_viscosity - delay * (system.delayed_stiffness
-                                                  + s * system.delayed_viscosity)) * ex)
+    _, _, _, Ka, La = _matrices(system)
+    d_tau = -s * (Ka + s * La) * np.exp(-s * delay)
+    d_s = _slope(system, s, delay)
     ds_dtau = -(left.conj() @ d_tau @ right) / (left.conj() @ d_s @ right)
     return 1 if ds_dtau.real > 0 else -1
 
@@ -326,7 +287,7 @@ def delay_margin(body: Body, muscles: MuscleSet, *, max_delay: float = 2.0,
     """
     max_delay = float_in_range("max_delay [s]", max_delay, 0.0, 1e3, unit="s")
     system = delayed_system(body, muscles, one_sided)
-    A0, A1 = system.first_order()
+    A0, A1 = (a[0] for a in system.first_order())
     stable0 = bool(np.all(np.linalg.eigvals(A0 + A1).real < 0))
     if not stable0:
         return DelayMargin(False, None, None, ())
@@ -388,11 +349,20 @@ def rightmost_roots(body: Body, muscles: MuscleSet, delay: float, count: int = 6
         Real part descending. [1/s]
     """
     delay = float_in_range("delay [s]", delay, 0.0, MAX_DELAY_FOR_ROOTS, unit="s")
+    return system_rightmost_roots(delayed_system(body, muscles, one_sided), delay, count,
+                                  nodes=nodes)
+
+
+def system_rightmost_roots(system: LinearSystem, delay: float, count: int = 6, *,
+                           nodes: int = 40) -> np.ndarray:
+    """:func:`rightmost_roots` of a one-set :class:`~posturelab.linear.system.LinearSystem`
+    at delay τ [s] (its gains split for a positive delay; τ = 0 gives the poles). [1/s]"""
     if isinstance(nodes, bool) or not isinstance(nodes, int | np.integer) \
             or not 4 <= nodes <= 200:
         raise ParameterError(f"nodes must be an integer in [4, 200], got {nodes!r}")
-    system = delayed_system(body, muscles, one_sided)
-    A0, A1 = system.first_order()
+    if system.n_sets != 1:
+        raise ParameterError(f"rightmost roots are of one set, the system has {system.n_sets}")
+    A0, A1 = (a[0] for a in system.first_order())
     m = A0.shape[0]
     if isinstance(count, bool) or not isinstance(count, int | np.integer) \
             or not 1 <= count <= m * nodes:
@@ -418,14 +388,11 @@ def rightmost_roots(body: Body, muscles: MuscleSet, delay: float, count: int = 6
     return roots[:count]
 
 
-def _newton_root(system: DelayedSystem, s: complex, delay: float) -> complex | None:
+def _newton_root(system: LinearSystem, s: complex, delay: float) -> complex | None:
     """Newton on det Δ(s) = 0: s ← s − 1/tr(Δ(s)⁻¹ Δ'(s))."""
     for _ in range(60):
         D = characteristic_matrix(system, s, delay)
-        ex = np.exp(-s * delay)
-        dD = (2 * s * system.inertia + system.viscosity
-              + (system.delayed_viscosity - delay * (system.delayed_stiffness
-                                                     + s * system.delayed_viscosity)) * ex)
+        dD = _slope(system, s, delay)
         try:
             tr = np.trace(np.linalg.solve(D, dD))
         except np.linalg.LinAlgError:

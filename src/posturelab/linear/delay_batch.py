@@ -1,6 +1,7 @@
 """Delayed linear stability of many parameter sets at once (numpy, stacked).
 
-For M gain sets on one body and pair layout, at one feedback delay τ, the rightmost
+For M gain sets on one body and pair layout, at one feedback delay τ (one
+:class:`~posturelab.linear.system.LinearSystem` of M sets), the rightmost
 characteristic root of each set (posturelab.linear.delay states the equation) is found by
 the spectral discretisation of :func:`posturelab.linear.delay.rightmost_roots`, stacked
 over the sets (one ``numpy.linalg.eigvals`` call on an (M, 2N(n+1), 2N(n+1)) array), then
@@ -22,9 +23,9 @@ import numpy as np
 from .._validation import float_in_range
 from ..errors import ParameterError
 from ..model.body import Body
-from ..model.dynamics import mass_matrix
-from ..model.muscles import MuscleSet, feedback_gains
+from ..model.muscles import MuscleSet
 from .delay import MAX_DELAY_FOR_ROOTS, _chebyshev
+from .system import LinearSystem, linear_system
 
 __all__ = ["batch_rightmost_root", "batch_delay_stable", "DelayStabilityMap",
            "delay_stability_map", "MAX_DELAY_MAP_RESOLUTION"]
@@ -37,22 +38,6 @@ __all__ = ["batch_rightmost_root", "batch_delay_stable", "DelayStabilityMap",
 MAX_DELAY_MAP_RESOLUTION = 300
 #: Sets per stacked eigenvalue call (bounds the memory of one call). [-]
 _CHUNK = 1024
-
-
-def _joint(E: np.ndarray, rows: np.ndarray) -> np.ndarray:
-    """Eᵀ diag(rows) E for rows (M, P): (M, N, N)."""
-    return np.einsum("pi,mp,pj->mij", E, rows, E)
-
-
-def _system(body: Body, muscles: MuscleSet, stiffness, viscosity, active_stiffness,
-            active_viscosity):
-    """Stacked matrices: J0 (N, N) and (M, N, N) stiffness − gA, L_i, K_a, L_a."""
-    k = np.atleast_2d(np.asarray(stiffness, dtype=float))
-    g = feedback_gains(k, viscosity, active_stiffness, active_viscosity, np.ones(k.shape[0]))
-    E = muscles.selection_matrix
-    G = body.gravity * np.diag(body.gravity_coefficients)
-    return (mass_matrix(body, np.zeros(body.n_links)), _joint(E, g[:, 0]) - G,
-            _joint(E, g[:, 1]), _joint(E, g[:, 2]), _joint(E, g[:, 3]))
 
 
 def batch_rightmost_root(body: Body, muscles: MuscleSet, stiffness, viscosity,
@@ -87,18 +72,11 @@ def batch_rightmost_root(body: Body, muscles: MuscleSet, stiffness, viscosity,
     if isinstance(nodes, bool) or not isinstance(nodes, int | np.integer) \
             or not 4 <= nodes <= 64:
         raise ParameterError(f"nodes must be an integer in [4, 64], got {nodes!r}")
-    J0, S, Li, Ka, La = _system(body, muscles, stiffness, viscosity, active_stiffness,
-                                active_viscosity)
-    M, n = S.shape[0], body.n_links
-    inv = np.linalg.inv(J0)
-    m = 2 * n
-    A0 = np.zeros((M, m, m))
-    A0[:, :n, n:] = np.eye(n)
-    A0[:, n:, :n] = -inv @ S
-    A0[:, n:, n:] = -inv @ Li
-    A1 = np.zeros((M, m, m))
-    A1[:, n:, :n] = -inv @ Ka
-    A1[:, n:, n:] = -inv @ La
+    system = linear_system(body, muscles, stiffness=stiffness, viscosity=viscosity,
+                           active_stiffness=active_stiffness,
+                           active_viscosity=active_viscosity, delay=delay, inputs=False)
+    A0, A1 = system.first_order()
+    M, m = A0.shape[0], A0.shape[1]
     roots = np.empty(M, dtype=complex)
     if delay == 0.0:
         for lo in range(0, M, _CHUNK):
@@ -140,7 +118,7 @@ def batch_rightmost_root(body: Body, muscles: MuscleSet, stiffness, viscosity,
         chunk(0)
         if progress is not None:
             progress(M, M)
-    return _newton(J0, S, Li, Ka, La, roots, delay)
+    return _newton(system, roots)
 
 
 def _threads() -> int:
@@ -153,12 +131,11 @@ def _threads() -> int:
         return max(1, os.cpu_count() or 1)
 
 
-def _newton(J0, S, Li, Ka, La, s, delay, steps: int = 8) -> np.ndarray:
-    """A few stacked Newton steps s ← s − f/f' on f(s) = det Δ(s), f' by a central
-    difference (a singular Δ does not stop the stack)."""
+def _newton(system: LinearSystem, s: np.ndarray, steps: int = 8) -> np.ndarray:
+    """A few stacked Newton steps s ← s − f/f' on f(s) = det Δ(s) of each set, f' by a
+    central difference (a singular Δ does not stop the stack)."""
     def f(z):
-        z = z[:, None, None]
-        return np.linalg.det(z * z * J0 + S + z * Li + (Ka + z * La) * np.exp(-z * delay))
+        return np.linalg.det(system.characteristic_matrix(z))
 
     s = s.copy()
     for _ in range(steps):

@@ -5,6 +5,9 @@ Every command and view that says whether upright is stable (``posturelab poles``
 ``simulate`` and its ``linear_stability``, ``sweep``, the explorer, the reproduction report)
 asks :func:`upright_verdict`, so that they cannot disagree.
 
+Each side is one :class:`~posturelab.linear.system.LinearSystem`; its verdict is that of
+its rightmost characteristic roots.
+
 **The delay.** With a feedback delay τ > 0 the verdict is that of the characteristic roots
 of the delay equation (:func:`posturelab.linear.delay.rightmost_roots`): the pair gains
 are then the whole delayed feedback (no active gains) or the intrinsic part acting at once
@@ -39,6 +42,7 @@ from ..errors import ParameterError
 from ..model.body import Body
 from ..model.muscles import MusclePair, MuscleSet
 from .analysis import _check_match
+from .system import linear_system
 
 __all__ = ["MARGINAL", "UprightSide", "UprightVerdict", "upright_verdict"]
 
@@ -230,7 +234,7 @@ def upright_verdict(body: Body, muscles: MuscleSet, feedback_delay: float = 0.0,
     >>> [s.status for s in v.sides], round(v.side(engaged=False).rightmost_root.real, 3)
     (['stable', 'unstable'], 1.169)
     """
-    from .delay import MAX_DELAY_FOR_ROOTS, rightmost_roots
+    from .delay import MAX_DELAY_FOR_ROOTS, system_rightmost_roots
 
     _check_match(body, muscles)
     delay = float_in_range("feedback_delay [s]", feedback_delay, 0.0, MAX_DELAY_FOR_ROOTS,
@@ -246,8 +250,8 @@ def upright_verdict(body: Body, muscles: MuscleSet, feedback_delay: float = 0.0,
     for flags in itertools.product((True, False), repeat=len(names)):
         engaged = tuple(n for n, f in zip(names, flags, strict=True) if f)
         slack = tuple(n for n, f in zip(names, flags, strict=True) if not f)
-        roots = rightmost_roots(body, _side_muscles(muscles, frozenset(engaged)), delay, count,
-                                nodes=nodes)
+        side = linear_system(body, _side_muscles(muscles, frozenset(engaged)), inputs=False)
+        roots = system_rightmost_roots(side, delay, count, nodes=nodes)
         top = complex(roots[0])
         sides.append(UprightSide(engaged, slack, _status(top), top,
                                  tuple(complex(z) for z in roots)))

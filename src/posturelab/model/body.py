@@ -256,6 +256,43 @@ class Body:
             )
         return "\n".join(lines)
 
+    def upright_matrices(self) -> tuple[np.ndarray, np.ndarray]:
+        """J(0) [kg·m²], shape (N, N), and g·a [N·m/rad], shape (N,): the inertia matrix and
+        gravity's stiffness per link upright (:func:`upright_matrices` of this body)."""
+        return upright_matrices(self.masses, self.lengths, self.com_distances, self.inertias,
+                                self.gravity)
+
+
+def upright_matrices(masses, lengths, com_distances, inertias, gravity
+                     ) -> tuple[np.ndarray, np.ndarray]:
+    """The inertia matrix upright J(0) and gravity's stiffness per link g·a, batched.
+
+    J_ii = I_i + m_i k_i² + (Σ_{j>i} m_j) l_i², J_ij = l_min(i,j) a_max(i,j) for i != j, and
+    a_i = m_i k_i + (Σ_{j>i} m_j) l_i (the formulas of :class:`Body`, in the same order).
+
+    Parameters
+    ----------
+    masses, lengths, com_distances, inertias : array_like, shape (..., N)
+        [kg], [m], [m], [kg·m²]
+    gravity : float or array_like, shape (...)
+        [m/s²]
+
+    Returns
+    -------
+    (numpy.ndarray, numpy.ndarray)
+        J(0), shape (..., N, N) [kg·m²]; g·a, shape (..., N) [N·m/rad].
+    """
+    m, l, k, inertia = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (
+        masses, lengths, com_distances, inertias)))
+    n = m.shape[-1]
+    above = np.concatenate([np.cumsum(m[..., ::-1], axis=-1)[..., ::-1][..., 1:],
+                            np.zeros(m.shape[:-1] + (1,))], axis=-1)
+    a = m * k + above * l
+    index = np.arange(n)
+    jac = l[..., np.minimum.outer(index, index)] * a[..., np.maximum.outer(index, index)]
+    jac[..., index, index] = inertia + m * k**2 + above * l**2
+    return jac, np.asarray(gravity, dtype=float)[..., None] * a
+
 
 def _ro(a: np.ndarray) -> np.ndarray:
     a.setflags(write=False)
