@@ -23,16 +23,26 @@ over which the response of a periodic stimulus is independent (Pintelon and Scho
 *System Identification*, 2nd ed. 2012, ch. 2: the sample variance over periods; Zoubir
 and Iskander, *Bootstrap Techniques for Signal Processing*, 2004, for the bootstrap of
 independent blocks). With C cycles there are only C(2C − 1, C) distinct resamples: 2
-cycles give 3, 5 give 126; the bands mean little below about 5 cycles (then the
-analytic circles of the estimate, whose F quantile knows the degrees of freedom, are the
-better bounds).
+cycles give 3, 5 give 126. And the bootstrap of few cycles is narrow: over 100 seeded
+trials of a known system with white noise in the response (the tests), the 95 % bands
+held the true band FRF as follows (pointwise per band; simultaneous, all 11 at once):
+
+    cycles        5      8      12     20
+    pointwise     89 %   91 %   92 %   93 %
+    simultaneous  70 %   83 %   88 %   94 %
+
+Below about 12 cycles the analytic circles of the estimate (whose F quantile knows the
+degrees of freedom; measured 95 %) are the better pointwise bounds.
 
 **Two groups compared** (:func:`compare_frf_groups`). Group A has n_a subjects' FRFs, B
 n_b, each over the same B bands. Per band k, the difference of the group means
 Δ_k = H̄_A,k − H̄_B,k with percentile intervals of Re Δ_k and Im Δ_k from an unpaired
 bootstrap (subjects resampled with replacement within each group, seeded; after Lippi
 2025, "Unpaired test for the comparison of frequency response functions groups",
-arXiv:2505.23778). The global test is a permutation test (the group labels shuffled,
+arXiv:2505.23778), each group's resampled mean deviation scaled by √(n/(n − 1)) as for the
+cycles above. They remain a little narrow for small groups (the normal, not Student's,
+quantile): for 10 subjects per group the tests measure 93 % coverage of each part for
+95 % asked. The global test is a permutation test (the group labels shuffled,
 seeded) of the statistic
 
     T = Σ_k  n_a n_b / (n_a + n_b) · Δ_kᵀ S_k⁻¹ Δ_k
@@ -458,13 +468,15 @@ def compare_frf_groups(a, b, *, permutations: int = 10_000, resamples: int = 200
             np.put_along_axis(in_a, order, True, axis=1)
             exceed += int(np.sum(permutation_statistics(Z, in_a) >= T * (1 - 1e-12)))
         p, drawn = (1 + exceed) / (1 + P), P
-    diff = A.mean(axis=0) - Bm.mean(axis=0)
+    ma, mb = A.mean(axis=0), Bm.mean(axis=0)
+    diff = ma - mb
     boot = np.empty((R, Z.shape[1]), dtype=complex)
     step = max(1, _CHUNK_NUMBERS // max(1, N * Z.shape[1]))
     for lo in range(0, R, step):
         n = min(step, R - lo)
-        boot[lo:lo + n] = (A[rng.integers(0, na, (n, na))].mean(axis=1)
-                           - Bm[rng.integers(0, nb, (n, nb))].mean(axis=1))
+        boot[lo:lo + n] = diff + (
+            math.sqrt(na / (na - 1)) * (A[rng.integers(0, na, (n, na))].mean(axis=1) - ma)
+            - math.sqrt(nb / (nb - 1)) * (Bm[rng.integers(0, nb, (n, nb))].mean(axis=1) - mb))
     tail = (1 - q) / 2
 
     def interval(v):
@@ -472,5 +484,5 @@ def compare_frf_groups(a, b, *, permutations: int = 10_000, resamples: int = 200
                         axis=1)
 
     return GroupComparison(fa, diff, interval(boot.real), interval(boot.imag),
-                           A.mean(axis=0), Bm.mean(axis=0), T, float(p), int(drawn),
+                           ma, mb, T, float(p), int(drawn),
                            splits <= P, na, nb, R, s, q)
