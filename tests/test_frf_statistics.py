@@ -206,3 +206,9 @@ def test_compare_frf_command(tmp_path, model_frfs):
     assert text.returncode == 0 and "p = " in text.stdout
     one_line_exit_2(cli("compare-frf", "--a", *map(str, a), "--b", *map(str, b),
                         "--permutations", "2000000"), "permutations", "1,000,000")
+    other = json.loads(a[0].read_text())
+    other["response_sign"] = 1
+    a[0].write_text(json.dumps(other))
+    b[0].write_text(json.dumps({**json.loads(b[0].read_text()), "response_sign": -1}))
+    one_line_exit_2(cli("compare-frf", "--a", *map(str, a), "--b", *map(str, b)),
+                    "different response signs")

@@ -68,9 +68,18 @@ def add_trial_arguments(p: argparse.ArgumentParser) -> None:
 def read_frfs(paths: list[str], args: argparse.Namespace) -> list:
     """Each file's FRF, read as ``posturelab fit-frf`` reads a condition (a trial CSV or an
     FRF JSON)."""
+    from ..errors import ParameterError
     from .fit_frf import _condition
 
-    return [_condition(path, args) for path in paths]
+    frfs = [_condition(path, args) for path in paths]
+    signs = {int(f.response_sign) for f in frfs if getattr(f, "response_sign", None) is not None}
+    if len(signs) > 1:
+        raise ParameterError("the FRFs were taken with different response signs ("
+                             + ", ".join(f"{p!r}: {int(f.response_sign):+d}" for p, f in
+                                         zip(paths, frfs, strict=True)
+                                         if getattr(f, "response_sign", None) is not None)[:200]
+                             + "); compare FRFs of one sign convention")
+    return frfs
 
 
 def run(args: argparse.Namespace) -> int:
