@@ -67,26 +67,33 @@ def add_trial_arguments(p: argparse.ArgumentParser) -> None:
 
 def read_frfs(paths: list[str], args: argparse.Namespace) -> list:
     """Each file's FRF, read as ``posturelab fit-frf`` reads a condition (a trial CSV or an
-    FRF JSON)."""
-    from ..errors import ParameterError
+    FRF JSON); FRFs that state different response signs are refused."""
     from .fit_frf import _condition
 
     frfs = [_condition(path, args) for path in paths]
-    signs = {int(f.response_sign) for f in frfs if getattr(f, "response_sign", None) is not None}
-    if len(signs) > 1:
-        raise ParameterError("the FRFs were taken with different response signs ("
-                             + ", ".join(f"{p!r}: {int(f.response_sign):+d}" for p, f in
-                                         zip(paths, frfs, strict=True)
-                                         if getattr(f, "response_sign", None) is not None)[:200]
-                             + "); compare FRFs of one sign convention")
+    one_sign(paths, frfs)
     return frfs
+
+
+def one_sign(paths: list[str], frfs: list) -> None:
+    """Refuse FRFs that state different response signs (in one line, naming the files)."""
+    from ..errors import ParameterError
+
+    stated = [(p, int(f.response_sign)) for p, f in zip(paths, frfs, strict=True)
+              if getattr(f, "response_sign", None) is not None]
+    if len({s for _, s in stated}) > 1:
+        raise ParameterError(("the FRFs were taken with different response signs ("
+                              + ", ".join(f"{p!r}: {s:+d}" for p, s in stated))[:250]
+                             + "); compare FRFs of one sign convention")
 
 
 def run(args: argparse.Namespace) -> int:
     from ..frequency.statistics import compare_frf_groups
     from ._common import print_json
 
-    result = compare_frf_groups(read_frfs(args.a, args), read_frfs(args.b, args),
+    a, b = read_frfs(args.a, args), read_frfs(args.b, args)
+    one_sign(args.a + args.b, a + b)
+    result = compare_frf_groups(a, b,
                                 permutations=args.permutations, resamples=args.resamples,
                                 level=args.level, seed=args.seed)
     if args.json:
