@@ -50,7 +50,7 @@ def group(name: str, rng: np.random.Generator) -> list:
     body = pl.get_body("paper-1link")
     preset = get_controller("peterka-2002")
     out = []
-    for k in range(SUBJECTS):
+    for _ in range(SUBJECTS):
         subject = replace(
             preset, active_stiffness=preset.active_stiffness * rng.lognormal(0, 0.15),
             active_viscosity=preset.active_viscosity * rng.lognormal(0, 0.15),
