@@ -212,3 +212,16 @@ def test_compare_frf_command(tmp_path, model_frfs):
     b[0].write_text(json.dumps({**json.loads(b[0].read_text()), "response_sign": -1}))
     one_line_exit_2(cli("compare-frf", "--a", *map(str, a), "--b", *map(str, b)),
                     "different response signs")
+
+
+def test_several_trials_pool_their_cycles(rng):
+    """Two trials of 6 cycles give the bands of one trial of their 12 cycles (the same
+    cycles, the same seeded resamples)."""
+    x, y, fs = _periodic_trial(rng, 12, 0.3)
+    half = x.size // 2
+    one = bootstrap_frf_bands(x, y, fs, 20.0, resamples=300, seed=4)
+    two = bootstrap_frf_bands([x[:half], x[half:]], [y[:half], y[half:]], fs, 20.0,
+                              resamples=300, seed=4)
+    np.testing.assert_allclose(two.radius, one.radius, rtol=1e-12)
+    np.testing.assert_allclose(two.frf, one.frf, rtol=1e-12)
+    assert two.n_cycles == one.n_cycles == 12
