@@ -28,6 +28,9 @@ SUBCOMMANDS: dict[str, str] = {
     "frf": "frf",
     "frf-model": "frf_model",
     "fit-frf": "fit_frf",
+    "compare-frf": "compare_frf",
+    "likeness": "likeness",
+    "likeness-reference": "likeness_reference",
     "compare": "compare",
     "explore": "explore",
 }
@@ -50,6 +53,10 @@ SUBCOMMAND_HELP: dict[str, str] = {
                  "delay)",
     "fit-frf": "fit controller gains, delay and sensory weight to FRFs (one or several "
                "conditions)",
+    "compare-frf": "compare two groups of FRFs band by band, with a permutation test over all "
+                   "bands",
+    "likeness": "human-likeness score of an FRF: its distance to a human reference (COMTEST)",
+    "likeness-reference": "build a human-likeness reference from one's own cohort of FRFs",
     "compare": "overlay saved runs (posturelab simulate --out) in one figure, and tabulate them",
     "explore": "explore the model interactively in the web browser (a local page)",
 }
