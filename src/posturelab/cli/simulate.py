@@ -6,13 +6,12 @@ import argparse
 import math
 import sys
 
-import numpy as np
-
 from ..errors import ParameterError
 from ..model.options import FOOT_FROM_LITERATURE, BaseOfSupport, FallCriteria, KneeModel
 from ..model.platform import MAX_PLATFORM_SPEED, NoDisturbance, VelocityStep, read_profile_csv
 from ..paper.printed import BACKWARD_INITIAL_STATE
 from ..scenarios import Scenario, builtin_scenario, builtin_scenario_names, load_scenario
+from ..simulation.options import RunOptions
 from . import UsageError
 from ._common import (
     FIGURE_SUFFIXES,
@@ -179,7 +178,9 @@ MODEL_OPTIONS = ("case", "stiffness", "disturbance", "speed", "platform_profile"
 
 
 def scenario_from_args(args: argparse.Namespace, command: str = "simulate") -> Scenario:
-    """Build the scenario the arguments describe (a file, a built-in, or the options).
+    """The scenario the arguments describe: a file, a built-in, or the model options, with
+    the run's options (:class:`~posturelab.simulation.options.RunOptions`) the command line
+    changes (:func:`run_options_from_args`).
 
     ``command`` names the subcommand in usage errors.
     """
@@ -193,52 +194,80 @@ def scenario_from_args(args: argparse.Namespace, command: str = "simulate") -> S
         sc = load_scenario(args.scenario) if args.scenario else builtin_scenario(args.builtin)
     else:
         sc = _scenario_from_options(args, command)
-    overrides = {}
-    for name in ("duration", "rtol", "atol", "sample_rate", "max_steps", "time_limit"):
-        value = getattr(args, name)
-        if value is not None:
-            overrides[name] = value
-    if overrides:
-        sc = sc.replace(**overrides)
+    return sc.replace(options=run_options_from_args(args, sc, command))
+
+
+def run_options_from_args(args: argparse.Namespace, sc: Scenario,
+                          command: str = "simulate") -> RunOptions:
+    """The scenario's run options with those the command line gives: each option's flag read
+    here once, then checked by :class:`~posturelab.simulation.options.RunOptions` (a bad
+    value names the flag)."""
+    base = sc.options
+    n = sc.body.n_links
+    fall = base.fall
     if args.max_link_angle is not None or args.foot != "none" or args.centre_of_pressure:
         with naming_option("--max-link-angle" if args.max_link_angle is not None
                            else "--foot"):
-            sc = sc.replace(fall=FallCriteria(
+            fall = FallCriteria(
                 args.max_link_angle if args.max_link_angle is not None
-                else sc.fall.max_link_angle,
-                _foot(args.foot) if args.foot != "none" else sc.fall.base_of_support,
-                args.centre_of_pressure or sc.fall.centre_of_pressure))
-    feedback = feedback_options_from_args(args)
-    if feedback:
-        sc = sc.replace(**feedback)
+                else fall.max_link_angle,
+                _foot(args.foot) if args.foot != "none" else fall.base_of_support,
+                args.centre_of_pressure or fall.centre_of_pressure)
+    feedback_delay, proprioceptive_weight = feedback_from_args(args, base)
+    description = base.description
+    tilt = base.tilt
     if args.tilt is not None:
-        if sc.tilt is not None:
+        if tilt is not None:
             raise UsageError(f"{command}: the experiment already has a tilt; give --tilt or "
                              "a tilt column, not both")
         with naming_option("--tilt"):
             tilt = parse_tilt(args.tilt)
-        sc = sc.replace(tilt=tilt, description=f"{sc.description}, {tilt.describe()}")
+        description = f"{description}, {tilt.describe()}"
+    tilt_axis_depth = base.tilt_axis_depth
     if args.tilt_axis_depth is not None:
-        depth = args.tilt_axis_depth
-        if not (math.isfinite(depth) and 0 <= depth <= 1):
-            raise ParameterError(f"--tilt-axis-depth [m] must be in [0, 1], got {depth:g}")
-        sc = sc.replace(tilt_axis_depth=float(depth))
+        tilt_axis_depth = args.tilt_axis_depth
+        if not (math.isfinite(tilt_axis_depth) and 0 <= tilt_axis_depth <= 1):
+            raise ParameterError(f"--tilt-axis-depth [m] must be in [0, 1], got "
+                                 f"{tilt_axis_depth:g}")
+    torque_limits = base.torque_limits
     if args.torque_limits:
-        sc = sc.replace(torque_limits=tuple(
-            parse_limit_list(args.torque_limits, "--torque-limits [N·m]", sc.body.n_links)))
+        torque_limits = tuple(parse_limit_list(args.torque_limits, "--torque-limits [N·m]", n))
     with naming_option("--motor-noise"):
-        noise = motor_noise_from_args(args, sc.body.n_links)
-    if noise is not None:
-        if sc.motor_noise is not None:
+        motor_noise = motor_noise_from_args(args, n)
+    if motor_noise is not None:
+        if base.motor_noise is not None:
             raise UsageError(f"{command}: the experiment already has motor noise; give "
                              "--motor-noise or [motor_noise], not both")
-        sc = sc.replace(motor_noise=noise, description=f"{sc.description}, {noise.describe()}")
-    if args.knee != "free":
-        sc = sc.replace(knee=KneeModel(args.knee))
-    if args.rates_from != "upright":
-        sc = sc.replace(rates_from=args.rates_from)
-    _check_numbers(sc)
-    return sc
+        description = f"{description}, {motor_noise.describe()}"
+    else:
+        motor_noise = base.motor_noise
+    with naming_given_options(args):
+        return base.replace(
+            duration=_given(args.duration, base.duration),
+            rtol=_given(args.rtol, base.rtol), atol=_given(args.atol, base.atol),
+            sample_rate=_given(args.sample_rate, base.sample_rate),
+            max_steps=_given(args.max_steps, base.max_steps),
+            time_limit=_given(args.time_limit, base.time_limit),
+            fall=fall, feedback_delay=feedback_delay,
+            proprioceptive_weight=proprioceptive_weight, tilt=tilt,
+            tilt_axis_depth=tilt_axis_depth, torque_limits=torque_limits,
+            motor_noise=motor_noise, description=description,
+            knee=KneeModel(args.knee) if args.knee != "free" else base.knee,
+            rates_from=args.rates_from if args.rates_from != "upright" else base.rates_from)
+
+
+def _given(value, default):
+    """A flag's value, or ``default`` when the flag was not given (None)."""
+    return default if value is None else value
+
+
+def feedback_from_args(args: argparse.Namespace, base: RunOptions) -> tuple[float, float]:
+    """(feedback_delay [s], proprioceptive_weight [-]): --feedback-delay and
+    --proprioceptive-weight (or --controller's), checked against the parameter table; the
+    scenario's own when not given."""
+    given = feedback_options_from_args(args)
+    return (given.get("feedback_delay", base.feedback_delay),
+            given.get("proprioceptive_weight", base.proprioceptive_weight))
 
 
 def motor_noise_from_args(args: argparse.Namespace, n_joints: int):
@@ -259,14 +288,6 @@ def motor_noise_from_args(args: argparse.Namespace, n_joints: int):
         raise ParameterError(f"--motor-noise [N·m] takes at most {n_joints} values (one per "
                              f"joint), got {len(sigma)}")
     return MotorNoise(tuple(sigma), args.motor_noise_cutoff, seed=args.seed or 0)
-
-
-def _check_numbers(sc: Scenario) -> None:
-    from ..simulation.setup import MAX_DURATION
-
-    if not 0 < sc.duration <= MAX_DURATION:
-        raise ParameterError(f"--duration: duration [s] must be in (0, {MAX_DURATION:.0f}] s, "
-                             f"got {sc.duration:g}")
 
 
 def _foot(text: str) -> BaseOfSupport:
@@ -316,10 +337,10 @@ def _scenario_from_options(args: argparse.Namespace, command: str) -> Scenario:
         label += f", body {body.name}"
     what = disturbance.describe() + (f", {tilt.describe()}" if tilt is not None else "")
     return Scenario(
-        name="cli", description=f"{label}, {what}", source="command line",
-        body=body, muscles=muscles, disturbance=disturbance, duration=5.0,
-        initial_state=np.array(posture + rates), rates_from="upright", knee=KneeModel(),
-        fall=FallCriteria(), case=args.case, tilt=tilt,
+        name="cli", source="command line", body=body, muscles=muscles,
+        disturbance=disturbance, case=args.case,
+        options=RunOptions(initial_state=tuple(posture + rates), tilt=tilt,
+                           description=f"{label}, {what}"),
     )
 
 
@@ -362,7 +383,7 @@ def run(args: argparse.Namespace) -> int:
     outputs = [p for p in (args.out, args.plot, args.animate) if p]
     check_writable(outputs, {args.out: (".csv",), args.plot: FIGURE_SUFFIXES,
                              args.animate: (".gif",)})
-    if sc.time_limit is None:
+    if sc.options.time_limit is None:
         sc = sc.replace(time_limit=DEFAULT_TIME_LIMIT)
     with naming_given_options(args):
         result = sc.run(engine=args.engine)
@@ -372,7 +393,7 @@ def run(args: argparse.Namespace) -> int:
         from ..viz.plots import plot_run_overview, save_figure
 
         fig = plot_run_overview(result, link_names=[s.name for s in sc.body.segments],
-                                base_of_support=sc.fall.base_of_support)
+                                base_of_support=sc.options.fall.base_of_support)
         save_figure(fig, args.plot)
     if args.animate:
         from ..viz.animation import animate
@@ -380,7 +401,7 @@ def run(args: argparse.Namespace) -> int:
         animate(result, sc.body, args.animate)
     from ..linear.verdict import upright_verdict
 
-    verdict = upright_verdict(sc.body, sc.muscles, sc.feedback_delay)
+    verdict = upright_verdict(sc.body, sc.muscles, sc.options.feedback_delay)
     outcome = result.outcome
     if args.json:
         print_json({**result.summary(), "engine": args.engine,
@@ -388,8 +409,8 @@ def run(args: argparse.Namespace) -> int:
     else:
         peaks = ", ".join(f"{x:.4f}" for x in result.max_abs_theta)
         print(f"outcome: {outcome.message}")  # first, as the help and README say
-        if sc.description.strip():
-            print(sc.description.strip())
+        if sc.options.description.strip():
+            print(sc.options.description.strip())
         print(f"status: {result.status} ({result.message})")
         print(f"engine: {args.engine}")
         print(f"linear model: {verdict.describe()}")
