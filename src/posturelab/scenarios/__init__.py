@@ -83,6 +83,12 @@ Schema (every table optional except where noted; units in brackets)::
     atol = 1e-10
     sample_rate = 1000.0                 # [Hz]
     method = "Radau"                     # default: the engine's own (DOP853 on the reference)
+    max_steps = 1000000                  # step budget [-] (default 1e6 + 1e4 per second)
+    time_limit = 60.0                    # wall-clock budget [s] (default none)
+    max_switches = 10000                 # more switches fail the run (chattering) [-]
+
+Each run option's key is :data:`posturelab.scenarios._parse.OPTION_KEYS`; the options are
+:class:`~posturelab.simulation.options.RunOptions`.
 """
 
 from __future__ import annotations

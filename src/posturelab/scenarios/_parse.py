@@ -67,8 +67,12 @@ OPTION_KEYS: dict[str, str] = {
     "tilt_axis_depth": "tilt.axis_depth", "motor_noise": "motor_noise",
     "method": "solver.method", "rtol": "solver.rtol", "atol": "solver.atol",
     "sample_rate": "solver.sample_rate", "max_steps": "solver.max_steps",
-    "time_limit": "solver.time_limit", "description": "description",
+    "time_limit": "solver.time_limit", "max_switches": "solver.max_switches",
+    "description": "description",
 }
+#: The options a scenario file leaves out. (Its tolerances are :data:`SCENARIO_RTOL` and
+#: :data:`SCENARIO_ATOL` on either engine, not each engine's own.)
+DEFAULTS = RunOptions()
 #: A scenario's tolerances when its [solver] gives none, on either engine. [-], [rad, rad/s]
 SCENARIO_RTOL, SCENARIO_ATOL = 1e-8, 1e-10
 
@@ -136,11 +140,13 @@ def parse_tables(data: dict, base_dir: Path, origin: str) -> Scenario:
     st = data.get("solver", {})
     options = run_options(
         origin, duration=duration, initial_state=initial,
-        rates_from=it.get("rates_from", "upright"), knee=knee, fall=fall,
+        rates_from=it.get("rates_from", DEFAULTS.rates_from), knee=knee, fall=fall,
         torque_limits=torque_limits, feedback_delay=delay, proprioceptive_weight=weight,
         tilt=tilt, tilt_axis_depth=tilt_table.get("axis_depth", 0.0), motor_noise=noise,
         method=st.get("method"), rtol=st.get("rtol", SCENARIO_RTOL),
-        atol=st.get("atol", SCENARIO_ATOL), sample_rate=st.get("sample_rate", 1000.0),
+        atol=st.get("atol", SCENARIO_ATOL),
+        sample_rate=st.get("sample_rate", DEFAULTS.sample_rate),
+        max_switches=st.get("max_switches", DEFAULTS.max_switches),
         max_steps=st.get("max_steps"), time_limit=st.get("time_limit"),
         description=str(data.get("description", "")))
     return Scenario(name=str(data.get("name", Path(origin).stem)),

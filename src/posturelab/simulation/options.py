@@ -24,7 +24,7 @@ from typing import Any, Literal
 
 import numpy as np
 
-from .._validation import finite_array, float_in_range
+from .._validation import finite_array
 from ..errors import ParameterError
 from ..model.noise import MotorNoise
 from ..model.options import FallCriteria, KneeModel
@@ -305,7 +305,15 @@ def _setting(name: str, value: Any) -> float:
     q = RUN_SETTINGS[name]
     unit = "" if q.unit in ("-", "rad, rad/s") else q.unit
     label = f"{name} [{unit}]" if unit else name
-    return float_in_range(label, value, q.low, q.high, include_low=not q.low_open, unit=unit)
+    within = f"{q.interval()}{' ' + unit if unit else ''}"
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        raise ParameterError(f"{label} must be a number in {within}, got {value!r:.60}") from None
+    low_ok = q.low < number if q.low_open else q.low <= number
+    if isinstance(value, bool) or not (low_ok and number <= q.high and math.isfinite(number)):
+        raise ParameterError(f"{label} must be in {within}, got {number!r}")
+    return number
 
 
 def _is_integer(value: Any) -> bool:
