@@ -10,7 +10,13 @@ from ..errors import ParameterError
 from ..model.options import FOOT_FROM_LITERATURE, BaseOfSupport, FallCriteria, KneeModel
 from ..model.platform import MAX_PLATFORM_SPEED, NoDisturbance, VelocityStep, read_profile_csv
 from ..paper.printed import BACKWARD_INITIAL_STATE
-from ..scenarios import Scenario, builtin_scenario, builtin_scenario_names, load_scenario
+from ..scenarios import (
+    SCENARIO_DEFAULTS,
+    Scenario,
+    builtin_scenario,
+    builtin_scenario_names,
+    load_scenario,
+)
 from ..simulation.options import RunOptions
 from . import UsageError
 from ._common import (
@@ -339,8 +345,8 @@ def _scenario_from_options(args: argparse.Namespace, command: str) -> Scenario:
     return Scenario(
         name="cli", source="command line", body=body, muscles=muscles,
         disturbance=disturbance, case=args.case,
-        options=RunOptions(initial_state=tuple(posture + rates), tilt=tilt,
-                           description=f"{label}, {what}"),
+        options=SCENARIO_DEFAULTS.replace(initial_state=tuple(posture + rates), tilt=tilt,
+                                          description=f"{label}, {what}"),
     )
 
 

@@ -118,6 +118,11 @@ __all__ = [
 ]
 
 
+#: A scenario's run options where it gives none: :class:`RunOptions`' defaults, but the
+#: tolerances 1e-8 [-] and 1e-10 [rad, rad/s] on either engine (not each engine's own).
+SCENARIO_DEFAULTS = RunOptions(rtol=1e-8, atol=1e-10)
+
+
 @dataclass(frozen=True, init=False)
 class Scenario:
     """Everything one simulation needs: the model, the platform motion and the run's options.
@@ -137,9 +142,9 @@ class Scenario:
     muscles : MuscleSet
     disturbance : Disturbance
     options : RunOptions
-        The run's options. A scenario's ``method`` (``solver.method``) may name a scipy
-        method that only the reference engine has; running it on the compiled engine
-        (Radau, RK45, RK23) raises.
+        The run's options (by default :data:`SCENARIO_DEFAULTS`). A scenario's ``method``
+        (``solver.method``) may name a scipy method that only the reference engine has;
+        running it on the compiled engine (Radau, RK45, RK23) raises.
     case : str or None
         The Table I case, when the muscles come from one.
     """
@@ -149,7 +154,7 @@ class Scenario:
     body: Body
     muscles: MuscleSet
     disturbance: Disturbance
-    options: RunOptions = RunOptions()
+    options: RunOptions = SCENARIO_DEFAULTS
     case: str | None = None
 
     def __init__(self, name: str, source: str, body: Body, muscles: MuscleSet,
@@ -158,7 +163,7 @@ class Scenario:
         """``Scenario(name, source, body, muscles, disturbance, options, case)``; run options
         may also be given by name (``duration=2.0, feedback_delay=0.1``, the former
         fields), replacing those of ``options``."""
-        options = RunOptions() if options is None else options
+        options = SCENARIO_DEFAULTS if options is None else options
         if option_values:
             options = options.replace(**option_values)
         for field, value in (("name", name), ("source", source), ("body", body),

@@ -70,11 +70,7 @@ OPTION_KEYS: dict[str, str] = {
     "time_limit": "solver.time_limit", "max_switches": "solver.max_switches",
     "description": "description",
 }
-#: The options a scenario file leaves out. (Its tolerances are :data:`SCENARIO_RTOL` and
-#: :data:`SCENARIO_ATOL` on either engine, not each engine's own.)
-DEFAULTS = RunOptions()
-#: A scenario's tolerances when its [solver] gives none, on either engine. [-], [rad, rad/s]
-SCENARIO_RTOL, SCENARIO_ATOL = 1e-8, 1e-10
+
 
 
 def run_options(origin: str, **fields) -> RunOptions:
@@ -93,6 +89,7 @@ def run_options(origin: str, **fields) -> RunOptions:
 def parse_tables(data: dict, base_dir: Path, origin: str) -> Scenario:
     """A scenario from its tables (types already checked by
     :func:`posturelab.scenarios.schema.check_types`)."""
+    from . import SCENARIO_DEFAULTS as DEFAULTS
     from . import Scenario
 
     duration = finite_float("duration [s]", data["duration"])
@@ -143,8 +140,8 @@ def parse_tables(data: dict, base_dir: Path, origin: str) -> Scenario:
         rates_from=it.get("rates_from", DEFAULTS.rates_from), knee=knee, fall=fall,
         torque_limits=torque_limits, feedback_delay=delay, proprioceptive_weight=weight,
         tilt=tilt, tilt_axis_depth=tilt_table.get("axis_depth", 0.0), motor_noise=noise,
-        method=st.get("method"), rtol=st.get("rtol", SCENARIO_RTOL),
-        atol=st.get("atol", SCENARIO_ATOL),
+        method=st.get("method"), rtol=st.get("rtol", DEFAULTS.rtol),
+        atol=st.get("atol", DEFAULTS.atol),
         sample_rate=st.get("sample_rate", DEFAULTS.sample_rate),
         max_switches=st.get("max_switches", DEFAULTS.max_switches),
         max_steps=st.get("max_steps"), time_limit=st.get("time_limit"),
