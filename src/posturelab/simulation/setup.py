@@ -44,15 +44,8 @@ from ..model.options import FallCriteria, KneeModel, torque_limit_array
 from ..model.platform import Disturbance, NoDisturbance
 from ..model.tilt import Tilt, axis_translation, tilt_pair_gains
 from ..parameters import MAX_DURATION, MAX_FEEDBACK_DELAY, MAX_STEP_BUDGET, MAX_TIME_LIMIT
-from .messages import IMPLICIT_METHODS, outcome_message
-from .options import (
-    BASE_STEP_BUDGET,
-    MAX_OUTPUT_SAMPLES,
-    OPTION_NAMES,
-    STEP_BUDGET_PER_SECOND,
-    RunOptions,
-    default_step_budget,
-)
+from .messages import outcome_message
+from .options import MAX_OUTPUT_SAMPLES, OPTION_NAMES, RunOptions, default_step_budget
 from .outcome import check_starts_within
 
 __all__ = [
@@ -83,8 +76,6 @@ DELAY_BREAKPOINT_MULTIPLES = 5
 #: the one declaration; this mapping is for reading).
 RUN_OPTIONS: dict[str, object] = {name: RunOptions.__dataclass_fields__[name].default
                                   for name in OPTION_NAMES}
-# (former names kept importable: BASE_STEP_BUDGET, STEP_BUDGET_PER_SECOND, IMPLICIT_METHODS)
-_ = (BASE_STEP_BUDGET, STEP_BUDGET_PER_SECOND, IMPLICIT_METHODS)
 
 Status = Literal["completed", "fell", "failed"]
 
@@ -314,17 +305,6 @@ def initial_state_for(
         gen = -platform_vector(body, ref) * dv[0] + gravity_vector(body, ref) * dv[1]
         x0[n:] += np.linalg.solve(J, gen)
     return x0
-
-
-def check_step_budget(max_steps, duration: float) -> int:
-    """A run's step budget: an integer in [1, :data:`MAX_STEP_BUDGET`], or None for
-    :func:`default_step_budget`. [-]"""
-    return RunOptions(duration=duration, max_steps=max_steps).step_budget
-
-
-def check_time_limit(time_limit) -> float:
-    """A run's wall-clock budget in (0, :data:`MAX_TIME_LIMIT`] [s]; None for none (inf)."""
-    return RunOptions(time_limit=time_limit).wall_clock_limit
 
 
 def prepare_run(body: Body, muscles: MuscleSet, disturbance: Disturbance | None = None,
