@@ -80,14 +80,15 @@ def simulate(body: Body, muscles: MuscleSet, disturbance: Disturbance | None = N
     >>> fall.outcome.kind, round(fall.fall_time, 2)  # [s]
     ('fell', 1.19)
     """
-    options = options if options is not None else RunOptions()
     if duration is not None:
         keywords["duration"] = duration
-    if keywords:
-        unknown = [k for k in keywords if k not in OPTION_NAMES]
-        if unknown:
-            raise ParameterError(f"unknown option {unknown[0]!r} of simulate(); known: "
-                                 f"{', '.join(OPTION_NAMES)}")
+    unknown = [k for k in keywords if k not in OPTION_NAMES]
+    if unknown:
+        raise ParameterError(f"unknown option {unknown[0]!r} of simulate(); known: "
+                             f"{', '.join(OPTION_NAMES)}")
+    if options is None:
+        options = RunOptions(**keywords)
+    elif keywords:
         options = options.replace(**keywords)
     return run_setup(prepare_run(body, muscles, disturbance, options))
 
