@@ -24,7 +24,7 @@ from ._common import (
     add_muscle_arguments,
     body_from_args,
     check_writable,
-    feedback_options_from_args,
+    feedback_from_args,
     muscles_from_args,
     naming_given_options,
     naming_option,
@@ -219,7 +219,7 @@ def run_options_from_args(args: argparse.Namespace, sc: Scenario,
                 else fall.max_link_angle,
                 _foot(args.foot) if args.foot != "none" else fall.base_of_support,
                 args.centre_of_pressure or fall.centre_of_pressure)
-    feedback_delay, proprioceptive_weight = feedback_from_args(args, base)
+    feedback_delay, proprioceptive_weight = feedback_from_args(args)
     description = base.description
     tilt = base.tilt
     if args.tilt is not None:
@@ -229,12 +229,6 @@ def run_options_from_args(args: argparse.Namespace, sc: Scenario,
         with naming_option("--tilt"):
             tilt = parse_tilt(args.tilt)
         description = f"{description}, {tilt.describe()}"
-    tilt_axis_depth = base.tilt_axis_depth
-    if args.tilt_axis_depth is not None:
-        tilt_axis_depth = args.tilt_axis_depth
-        if not (math.isfinite(tilt_axis_depth) and 0 <= tilt_axis_depth <= 1):
-            raise ParameterError(f"--tilt-axis-depth [m] must be in [0, 1], got "
-                                 f"{tilt_axis_depth:g}")
     torque_limits = base.torque_limits
     if args.torque_limits:
         torque_limits = tuple(parse_limit_list(args.torque_limits, "--torque-limits [N·m]", n))
@@ -254,9 +248,11 @@ def run_options_from_args(args: argparse.Namespace, sc: Scenario,
             sample_rate=_given(args.sample_rate, base.sample_rate),
             max_steps=_given(args.max_steps, base.max_steps),
             time_limit=_given(args.time_limit, base.time_limit),
-            fall=fall, feedback_delay=feedback_delay,
-            proprioceptive_weight=proprioceptive_weight, tilt=tilt,
-            tilt_axis_depth=tilt_axis_depth, torque_limits=torque_limits,
+            fall=fall, feedback_delay=_given(feedback_delay, base.feedback_delay),
+            proprioceptive_weight=_given(proprioceptive_weight, base.proprioceptive_weight),
+            tilt=tilt,
+            tilt_axis_depth=_given(args.tilt_axis_depth, base.tilt_axis_depth),
+            torque_limits=torque_limits,
             motor_noise=motor_noise, description=description,
             knee=KneeModel(args.knee) if args.knee != "free" else base.knee,
             rates_from=args.rates_from if args.rates_from != "upright" else base.rates_from)
@@ -265,15 +261,6 @@ def run_options_from_args(args: argparse.Namespace, sc: Scenario,
 def _given(value, default):
     """A flag's value, or ``default`` when the flag was not given (None)."""
     return default if value is None else value
-
-
-def feedback_from_args(args: argparse.Namespace, base: RunOptions) -> tuple[float, float]:
-    """(feedback_delay [s], proprioceptive_weight [-]): --feedback-delay and
-    --proprioceptive-weight (or --controller's), checked against the parameter table; the
-    scenario's own when not given."""
-    given = feedback_options_from_args(args)
-    return (given.get("feedback_delay", base.feedback_delay),
-            given.get("proprioceptive_weight", base.proprioceptive_weight))
 
 
 def motor_noise_from_args(args: argparse.Namespace, n_joints: int):
