@@ -10,6 +10,7 @@ from ..errors import ParameterError
 from ..model.options import FOOT_FROM_LITERATURE, BaseOfSupport, FallCriteria, KneeModel
 from ..model.platform import MAX_PLATFORM_SPEED, NoDisturbance, VelocityStep, read_profile_csv
 from ..paper.printed import BACKWARD_INITIAL_STATE
+from ..parameters import RUN_SETTINGS
 from ..scenarios import (
     SCENARIO_DEFAULTS,
     Scenario,
@@ -142,7 +143,8 @@ def add_experiment_arguments(p: argparse.ArgumentParser) -> None:
                      "or peterka-2002-242 (Peterka 2002's 242-state, 60.5 s one)). A tilt "
                      "column [rad] in --platform-profile does the same from data.")
     src.add_argument("--tilt-axis-depth", type=float, default=None, metavar="M",
-                     help="the tilt axis this far below the ankle [m], in [0, 1] (default 0: "
+                     help="the tilt axis this far below the ankle [m], in "
+                     f"{RUN_SETTINGS['tilt_axis_depth'].interval()} (default 0: "
                      "about the ankle; then the ankle moves with the surface). Needs a tilt "
                      "without rate jumps (not prts).")
     src.add_argument("--motor-noise", metavar="SIGMA[,SIGMA...]",
@@ -161,7 +163,8 @@ def add_experiment_arguments(p: argparse.ArgumentParser) -> None:
     src.add_argument("--max-link-angle", type=float, default=None, metavar="RAD",
                      help="fall when any |θ_i| exceeds this [rad] (default π/3).")
     run = p.add_argument_group("integration")
-    run.add_argument("--duration", type=float, default=None, help="simulated time [s] (default 5).")
+    run.add_argument("--duration", type=float, default=None,
+                     help=f"simulated time [s] (default {SCENARIO_DEFAULTS.duration:g}).")
     run.add_argument("--rtol", type=float, default=None,
                      help="relative tolerance (default: the scenario's, 1e-8 unless it says "
                      "otherwise, on either engine; sweep: 1e-6).")
@@ -169,7 +172,8 @@ def add_experiment_arguments(p: argparse.ArgumentParser) -> None:
                      help="absolute tolerance [rad, rad/s] (default: the scenario's, 1e-10 "
                      "unless it says otherwise; sweep: 1e-9).")
     run.add_argument("--sample-rate", type=float, default=None,
-                     help="output samples per second [Hz] (default 1000).")
+                     help="output samples per second [Hz] (default "
+                     f"{SCENARIO_DEFAULTS.sample_rate:g}).")
     run.add_argument("--max-steps", type=int, default=None, metavar="N",
                      help="step budget of each run: after N accepted integrator steps it "
                      "stops as failed (default 1e6 + 1e4 per simulated second).")
