@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import math
 import sys
+from typing import TypeVar
 
 from ..errors import ParameterError
 from ..model.options import FOOT_FROM_LITERATURE, BaseOfSupport, FallCriteria, KneeModel
@@ -63,6 +64,8 @@ the centre of pressure [m] after the first stimulus cycle (or over the second ha
 run shorter than two cycles).
 """
 
+
+T = TypeVar("T")
 
 #: The wall-clock budget of one `simulate` run when neither --time-limit nor the scenario
 #: gives one: nothing legitimate takes this long on either engine. [s]
@@ -262,7 +265,7 @@ def run_options_from_args(args: argparse.Namespace, sc: Scenario,
             rates_from=args.rates_from if args.rates_from != "upright" else base.rates_from)
 
 
-def _given(value, default):
+def _given(value: T | None, default: T) -> T:
     """A flag's value, or ``default`` when the flag was not given (None)."""
     return default if value is None else value
 
