@@ -212,7 +212,7 @@ def simulate_batch(
     options: RunOptions | None = None,
     feedback_delay: float | np.ndarray | None = None,
     proprioceptive_weight: float | np.ndarray | None = None,
-    torque_limits: np.ndarray | None = None,
+    torque_limits: np.ndarray | tuple[float, ...] | None = None,
     active_stiffness: np.ndarray | None = None,
     active_viscosity: np.ndarray | None = None,
     disturbance_scale: np.ndarray | None = None,
@@ -284,8 +284,8 @@ def simulate_batch(
     BatchResult
     """
     check_model(body, muscles)
-    shared = _shared_options(options, duration, initial_state, keywords)
-    method = shared.method
+    common = _shared_options(options, duration, initial_state, keywords)
+    method = common.method
     if method is not None:
         check_method(method)
     if muscles is None:
@@ -321,11 +321,11 @@ def simulate_batch(
                 raise ParameterError(f"{label} must have the shape of stiffness, "
                                      f"{kd_all.shape}, got {arr.shape}")
     if feedback_delay is None:
-        feedback_delay = shared.feedback_delay
+        feedback_delay = common.feedback_delay
     if proprioceptive_weight is None:
-        proprioceptive_weight = shared.proprioceptive_weight
+        proprioceptive_weight = common.proprioceptive_weight
     if torque_limits is None:
-        torque_limits = shared.torque_limits
+        torque_limits = common.torque_limits
     delays = _per_run("feedback_delay [s]", feedback_delay, M, None)
     weights = _per_run("proprioceptive_weight [-]", proprioceptive_weight, M, None)
     lims = (np.full((M, n), math.inf) if torque_limits is None
@@ -336,12 +336,12 @@ def simulate_batch(
     def level_setup(factor: float, delay: float, limits) -> RunSetup:
         """A single run's set-up: the batch's options with this delay and these limits."""
         d = disturbance if disturbance is None or factor == 1.0 else disturbance.scaled(factor)
-        return prepare_run(body, muscles, d, shared.replace(
+        return prepare_run(body, muscles, d, common.replace(
             feedback_delay=delay, torque_limits=limits, proprioceptive_weight=weight))
 
     for w in np.unique(weights):  # each checked as a single run's would be
-        shared.replace(proprioceptive_weight=float(w))
-    weight = float(weights[0]) if M else shared.proprioceptive_weight
+        common.replace(proprioceptive_weight=float(w))
+    weight = float(weights[0]) if M else common.proprioceptive_weight
 
     # every run's delay and limits are checked as a single run's would be
     for d in np.unique(delays):
