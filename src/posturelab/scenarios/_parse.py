@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -42,9 +41,8 @@ from ..model.tilt import (
 )
 from ..parameters import check_value
 from ..simulation.options import RunOptions
-
-if TYPE_CHECKING:
-    from . import Scenario
+from ._scenario import SCENARIO_DEFAULTS as DEFAULTS
+from ._scenario import Scenario
 
 __all__ = ["OPTION_KEYS", "parse_tables", "run_options"]
 
@@ -89,8 +87,6 @@ def run_options(origin: str, **fields) -> RunOptions:
 def parse_tables(data: dict, base_dir: Path, origin: str) -> Scenario:
     """A scenario from its tables (types already checked by
     :func:`posturelab.scenarios.schema.check_types`)."""
-    from . import SCENARIO_DEFAULTS as DEFAULTS
-    from . import Scenario
 
     duration = finite_float("duration [s]", data["duration"])
     body = _parse_body(data.get("body", {}), origin)
