@@ -2,10 +2,24 @@
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import Protocol
 
-if TYPE_CHECKING:
-    from .setup import RunSetup
+
+class RunSetup(Protocol):
+    """What the words of an outcome read of a run's set-up
+    (:class:`posturelab.simulation.setup.RunSetup`)."""
+
+    @property
+    def duration(self) -> float: ...  # [s]
+
+    @property
+    def max_switches(self) -> int: ...  # [-]
+
+    @property
+    def max_steps(self) -> int: ...  # [-]
+
+    @property
+    def time_limit(self) -> float: ...  # [s]
 
 __all__ = ["IMPLICIT_METHODS", "outcome_message"]
 
