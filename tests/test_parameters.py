@@ -294,12 +294,12 @@ def test_explorer_names_and_bounds_are_the_table_s():
 def test_scenario_muscle_keys_are_table_quantities():
     """A scenario file's [muscles] keys that carry values are the table's quantities (the
     names of a case, the pairs, the gastrocnemius' form and a controller preset aside)."""
-    import posturelab.scenarios as scenarios
+    import msgspec
 
-    text = Path(scenarios.__file__).read_text(encoding="utf-8")
-    keys = re.search(r'_table\(data, "muscles", \(([^)]*)\)', text).group(1)
-    keys = set(re.findall(r'"([a-z_]+)"', keys)) - {"case", "pairs", "gastrocnemius",
-                                                     "controller"}
+    from posturelab.scenarios.schema import MusclesTable
+
+    keys = {f.name for f in msgspec.structs.fields(MusclesTable)} - {
+        "case", "pairs", "gastrocnemius", "controller"}
     assert keys <= set(QUANTITIES), keys - set(QUANTITIES)
 
 

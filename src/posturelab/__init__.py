@@ -52,6 +52,7 @@ PUBLIC_NAMES: dict[str, tuple[str, ...]] = {
                              "load_scenario"),
     "posturelab.simulation": ("FOOT_FROM_LITERATURE", "BaseOfSupport", "FallCriteria",
                               "KneeModel", "base_of_support_for_height", "simulate"),
+    "posturelab.simulation.options": ("RunOptions",),
     "posturelab.simulation.results": ("DerivedSeries", "SimulationResult"),
 }
 _MODULE_OF_NAME = {name: module for module, names in PUBLIC_NAMES.items() for name in names}
@@ -125,5 +126,5 @@ __all__ = [
     "SimulationResult", "DerivedSeries", "Scenario", "builtin_scenario",
     "builtin_scenario_names", "load_scenario",
     "FOOT_FROM_LITERATURE", "BaseOfSupport", "FallCriteria", "KneeModel",
-    "base_of_support_for_height", "simulate",
+    "base_of_support_for_height", "simulate", "RunOptions",
 ]

@@ -52,6 +52,11 @@ __all__ = [
     "unit",
     "names_for",
     "markdown_table",
+    "RUN_SETTINGS",
+    "MAX_DURATION",
+    "MAX_TIME_LIMIT",
+    "MAX_STEP_BUDGET",
+    "MAX_AXIS_DEPTH",
 ]
 
 #: Largest neural delay of the muscle feedback anywhere in posturelab (simulation, linear
@@ -342,3 +347,31 @@ def markdown_table() -> str:
     rows += ["", "| former spelling | name | where |", "|---|---|---|"]
     rows += [f"| `{old}` | `{new}` | {where} |" for old, (new, where) in RENAMED.items()]
     return "\n".join(rows) + "\n"
+
+
+#: Longest run (a day). [s]
+MAX_DURATION = 86_400.0
+#: The longest wall-clock time limit a run may ask for (a week). [s]
+MAX_TIME_LIMIT = 604_800.0
+#: The largest step budget a run may ask for. [-]
+MAX_STEP_BUDGET = 10_000_000_000
+#: Deepest tilt axis below the ankle. [m]
+MAX_AXIS_DEPTH = 1.0
+
+#: The settings of one run that no command varies by name: their units and the values a run
+#: accepts (:class:`posturelab.simulation.options.RunOptions` reads its bounds here and, for
+#: ``feedback_delay`` and ``proprioceptive_weight``, in :data:`QUANTITIES`).
+RUN_SETTINGS: dict[str, Quantity] = {q.name: q for q in (
+    Quantity("duration", "s", 0.0, MAX_DURATION, "simulated time", low_open=True),
+    Quantity("tilt_axis_depth", "m", 0.0, MAX_AXIS_DEPTH,
+             "distance of the tilt axis below the ankle (0: the ankle's own axis)"),
+    Quantity("rtol", "-", 1e-14, 1e-1, "relative tolerance of the integrator"),
+    Quantity("atol", "rad, rad/s", 1e-16, 1e-1, "absolute tolerance of the integrator"),
+    Quantity("sample_rate", "Hz", 1.0, 1e6, "output samples per second"),
+    Quantity("time_limit", "s", 0.0, MAX_TIME_LIMIT,
+             "wall-clock budget of the integration", low_open=True),
+    Quantity("max_steps", "-", 1.0, float(MAX_STEP_BUDGET),
+             "step budget: accepted integrator steps before the run stops as failed"),
+    Quantity("max_switches", "-", 0.0, math.inf,
+             "switches (one-sided pairs, knee stop, saturation) before the run fails"),
+)}

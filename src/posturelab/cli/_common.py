@@ -226,22 +226,35 @@ def muscles_from_args(args: argparse.Namespace, body=None):
                        active_viscosity_ratio=active_ratio, gastrocnemius=args.gastrocnemius)
 
 
-def feedback_options_from_args(args: argparse.Namespace) -> dict:
-    """``feedback_delay`` [s] and ``proprioceptive_weight`` [-] given on the command line (or
-    by --controller), checked; keys absent when not given."""
+def feedback_from_args(args: argparse.Namespace) -> tuple[float | None, float | None]:
+    """(feedback_delay [s], proprioceptive_weight [-]) given on the command line (or by
+    --controller), each checked against the parameter table and named by its flag; None
+    where not given."""
     from ..model.controllers import get_controller
     from ..parameters import check_value
 
-    out = {}
+    delay: float | None = None
+    weight: float | None = None
     if getattr(args, "controller", None) is not None:
-        out.update(get_controller(args.controller).run_options())
-    delay = getattr(args, "feedback_delay", None)
+        controller = get_controller(args.controller)
+        delay, weight = controller.feedback_delay, controller.proprioceptive_weight
+    if getattr(args, "feedback_delay", None) is not None:
+        delay = check_value("feedback_delay", args.feedback_delay, "--feedback-delay")
+    if getattr(args, "proprioceptive_weight", None) is not None:
+        weight = check_value("proprioceptive_weight", args.proprioceptive_weight,
+                             "--proprioceptive-weight")
+    return delay, weight
+
+
+def feedback_options_from_args(args: argparse.Namespace) -> dict:
+    """:func:`feedback_from_args` as keywords: ``feedback_delay`` [s] and
+    ``proprioceptive_weight`` [-], each absent when not given."""
+    delay, weight = feedback_from_args(args)
+    out = {}
     if delay is not None:
-        out["feedback_delay"] = check_value("feedback_delay", delay, "--feedback-delay")
-    weight = getattr(args, "proprioceptive_weight", None)
+        out["feedback_delay"] = delay
     if weight is not None:
-        out["proprioceptive_weight"] = check_value("proprioceptive_weight", weight,
-                                                   "--proprioceptive-weight")
+        out["proprioceptive_weight"] = weight
     return out
 
 
@@ -298,7 +311,8 @@ def naming_option(option: str):
 #: it on the command line.
 RUN_SETTING_OPTIONS = {"duration [s]": "--duration", "rtol": "--rtol", "atol": "--atol",
                        "sample_rate [Hz]": "--sample-rate", "max_steps": "--max-steps",
-                       "time_limit [s]": "--time-limit"}
+                       "time_limit [s]": "--time-limit",
+                       "tilt_axis_depth [m]": "--tilt-axis-depth"}
 #: The message prefix of a check of the body or the gains (model/) -> the option.
 MODEL_FIELD_OPTIONS = {"height [m]": "--height", "mass [kg]": "--mass",
                        "muscle pair '*' active stiffness": "--active-stiffness",

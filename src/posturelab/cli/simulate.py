@@ -5,21 +5,28 @@ from __future__ import annotations
 import argparse
 import math
 import sys
-
-import numpy as np
+from typing import TypeVar
 
 from ..errors import ParameterError
 from ..model.options import FOOT_FROM_LITERATURE, BaseOfSupport, FallCriteria, KneeModel
 from ..model.platform import MAX_PLATFORM_SPEED, NoDisturbance, VelocityStep, read_profile_csv
 from ..paper.printed import BACKWARD_INITIAL_STATE
-from ..scenarios import Scenario, builtin_scenario, builtin_scenario_names, load_scenario
+from ..parameters import RUN_SETTINGS
+from ..scenarios import (
+    SCENARIO_DEFAULTS,
+    Scenario,
+    builtin_scenario,
+    builtin_scenario_names,
+    load_scenario,
+)
+from ..simulation.options import RunOptions
 from . import UsageError
 from ._common import (
     FIGURE_SUFFIXES,
     add_muscle_arguments,
     body_from_args,
     check_writable,
-    feedback_options_from_args,
+    feedback_from_args,
     muscles_from_args,
     naming_given_options,
     naming_option,
@@ -57,6 +64,8 @@ the centre of pressure [m] after the first stimulus cycle (or over the second ha
 run shorter than two cycles).
 """
 
+
+T = TypeVar("T")
 
 #: The wall-clock budget of one `simulate` run when neither --time-limit nor the scenario
 #: gives one: nothing legitimate takes this long on either engine. [s]
@@ -137,7 +146,8 @@ def add_experiment_arguments(p: argparse.ArgumentParser) -> None:
                      "or peterka-2002-242 (Peterka 2002's 242-state, 60.5 s one)). A tilt "
                      "column [rad] in --platform-profile does the same from data.")
     src.add_argument("--tilt-axis-depth", type=float, default=None, metavar="M",
-                     help="the tilt axis this far below the ankle [m], in [0, 1] (default 0: "
+                     help="the tilt axis this far below the ankle [m], in "
+                     f"{RUN_SETTINGS['tilt_axis_depth'].interval()} (default 0: "
                      "about the ankle; then the ankle moves with the surface). Needs a tilt "
                      "without rate jumps (not prts).")
     src.add_argument("--motor-noise", metavar="SIGMA[,SIGMA...]",
@@ -156,7 +166,8 @@ def add_experiment_arguments(p: argparse.ArgumentParser) -> None:
     src.add_argument("--max-link-angle", type=float, default=None, metavar="RAD",
                      help="fall when any |θ_i| exceeds this [rad] (default π/3).")
     run = p.add_argument_group("integration")
-    run.add_argument("--duration", type=float, default=None, help="simulated time [s] (default 5).")
+    run.add_argument("--duration", type=float, default=None,
+                     help=f"simulated time [s] (default {SCENARIO_DEFAULTS.duration:g}).")
     run.add_argument("--rtol", type=float, default=None,
                      help="relative tolerance (default: the scenario's, 1e-8 unless it says "
                      "otherwise, on either engine; sweep: 1e-6).")
@@ -164,7 +175,8 @@ def add_experiment_arguments(p: argparse.ArgumentParser) -> None:
                      help="absolute tolerance [rad, rad/s] (default: the scenario's, 1e-10 "
                      "unless it says otherwise; sweep: 1e-9).")
     run.add_argument("--sample-rate", type=float, default=None,
-                     help="output samples per second [Hz] (default 1000).")
+                     help="output samples per second [Hz] (default "
+                     f"{SCENARIO_DEFAULTS.sample_rate:g}).")
     run.add_argument("--max-steps", type=int, default=None, metavar="N",
                      help="step budget of each run: after N accepted integrator steps it "
                      "stops as failed (default 1e6 + 1e4 per simulated second).")
@@ -179,7 +191,9 @@ MODEL_OPTIONS = ("case", "stiffness", "disturbance", "speed", "platform_profile"
 
 
 def scenario_from_args(args: argparse.Namespace, command: str = "simulate") -> Scenario:
-    """Build the scenario the arguments describe (a file, a built-in, or the options).
+    """The scenario the arguments describe: a file, a built-in, or the model options, with
+    the run's options (:class:`~posturelab.simulation.options.RunOptions`) the command line
+    changes (:func:`run_options_from_args`).
 
     ``command`` names the subcommand in usage errors.
     """
@@ -193,52 +207,67 @@ def scenario_from_args(args: argparse.Namespace, command: str = "simulate") -> S
         sc = load_scenario(args.scenario) if args.scenario else builtin_scenario(args.builtin)
     else:
         sc = _scenario_from_options(args, command)
-    overrides = {}
-    for name in ("duration", "rtol", "atol", "sample_rate", "max_steps", "time_limit"):
-        value = getattr(args, name)
-        if value is not None:
-            overrides[name] = value
-    if overrides:
-        sc = sc.replace(**overrides)
+    return sc.replace(options=run_options_from_args(args, sc, command))
+
+
+def run_options_from_args(args: argparse.Namespace, sc: Scenario,
+                          command: str = "simulate") -> RunOptions:
+    """The scenario's run options with those the command line gives: each option's flag read
+    here once, then checked by :class:`~posturelab.simulation.options.RunOptions` (a bad
+    value names the flag)."""
+    base = sc.options
+    n = sc.body.n_links
+    fall = base.fall
     if args.max_link_angle is not None or args.foot != "none" or args.centre_of_pressure:
         with naming_option("--max-link-angle" if args.max_link_angle is not None
                            else "--foot"):
-            sc = sc.replace(fall=FallCriteria(
+            fall = FallCriteria(
                 args.max_link_angle if args.max_link_angle is not None
-                else sc.fall.max_link_angle,
-                _foot(args.foot) if args.foot != "none" else sc.fall.base_of_support,
-                args.centre_of_pressure or sc.fall.centre_of_pressure))
-    feedback = feedback_options_from_args(args)
-    if feedback:
-        sc = sc.replace(**feedback)
+                else fall.max_link_angle,
+                _foot(args.foot) if args.foot != "none" else fall.base_of_support,
+                args.centre_of_pressure or fall.centre_of_pressure)
+    feedback_delay, proprioceptive_weight = feedback_from_args(args)
+    description = base.description
+    tilt = base.tilt
     if args.tilt is not None:
-        if sc.tilt is not None:
+        if tilt is not None:
             raise UsageError(f"{command}: the experiment already has a tilt; give --tilt or "
                              "a tilt column, not both")
         with naming_option("--tilt"):
             tilt = parse_tilt(args.tilt)
-        sc = sc.replace(tilt=tilt, description=f"{sc.description}, {tilt.describe()}")
-    if args.tilt_axis_depth is not None:
-        depth = args.tilt_axis_depth
-        if not (math.isfinite(depth) and 0 <= depth <= 1):
-            raise ParameterError(f"--tilt-axis-depth [m] must be in [0, 1], got {depth:g}")
-        sc = sc.replace(tilt_axis_depth=float(depth))
+        description = f"{description}, {tilt.describe()}"
+    torque_limits = base.torque_limits
     if args.torque_limits:
-        sc = sc.replace(torque_limits=tuple(
-            parse_limit_list(args.torque_limits, "--torque-limits [N·m]", sc.body.n_links)))
+        torque_limits = tuple(parse_limit_list(args.torque_limits, "--torque-limits [N·m]", n))
     with naming_option("--motor-noise"):
-        noise = motor_noise_from_args(args, sc.body.n_links)
-    if noise is not None:
-        if sc.motor_noise is not None:
+        motor_noise = motor_noise_from_args(args, n)
+    if motor_noise is not None:
+        if base.motor_noise is not None:
             raise UsageError(f"{command}: the experiment already has motor noise; give "
                              "--motor-noise or [motor_noise], not both")
-        sc = sc.replace(motor_noise=noise, description=f"{sc.description}, {noise.describe()}")
-    if args.knee != "free":
-        sc = sc.replace(knee=KneeModel(args.knee))
-    if args.rates_from != "upright":
-        sc = sc.replace(rates_from=args.rates_from)
-    _check_numbers(sc)
-    return sc
+        description = f"{description}, {motor_noise.describe()}"
+    else:
+        motor_noise = base.motor_noise
+    with naming_given_options(args):
+        return base.replace(
+            duration=_given(args.duration, base.duration),
+            rtol=_given(args.rtol, base.rtol), atol=_given(args.atol, base.atol),
+            sample_rate=_given(args.sample_rate, base.sample_rate),
+            max_steps=_given(args.max_steps, base.max_steps),
+            time_limit=_given(args.time_limit, base.time_limit),
+            fall=fall, feedback_delay=_given(feedback_delay, base.feedback_delay),
+            proprioceptive_weight=_given(proprioceptive_weight, base.proprioceptive_weight),
+            tilt=tilt,
+            tilt_axis_depth=_given(args.tilt_axis_depth, base.tilt_axis_depth),
+            torque_limits=torque_limits,
+            motor_noise=motor_noise, description=description,
+            knee=KneeModel(args.knee) if args.knee != "free" else base.knee,
+            rates_from=args.rates_from if args.rates_from != "upright" else base.rates_from)
+
+
+def _given(value: T | None, default: T) -> T:
+    """A flag's value, or ``default`` when the flag was not given (None)."""
+    return default if value is None else value
 
 
 def motor_noise_from_args(args: argparse.Namespace, n_joints: int):
@@ -259,14 +288,6 @@ def motor_noise_from_args(args: argparse.Namespace, n_joints: int):
         raise ParameterError(f"--motor-noise [N·m] takes at most {n_joints} values (one per "
                              f"joint), got {len(sigma)}")
     return MotorNoise(tuple(sigma), args.motor_noise_cutoff, seed=args.seed or 0)
-
-
-def _check_numbers(sc: Scenario) -> None:
-    from ..simulation.setup import MAX_DURATION
-
-    if not 0 < sc.duration <= MAX_DURATION:
-        raise ParameterError(f"--duration: duration [s] must be in (0, {MAX_DURATION:.0f}] s, "
-                             f"got {sc.duration:g}")
 
 
 def _foot(text: str) -> BaseOfSupport:
@@ -316,10 +337,10 @@ def _scenario_from_options(args: argparse.Namespace, command: str) -> Scenario:
         label += f", body {body.name}"
     what = disturbance.describe() + (f", {tilt.describe()}" if tilt is not None else "")
     return Scenario(
-        name="cli", description=f"{label}, {what}", source="command line",
-        body=body, muscles=muscles, disturbance=disturbance, duration=5.0,
-        initial_state=np.array(posture + rates), rates_from="upright", knee=KneeModel(),
-        fall=FallCriteria(), case=args.case, tilt=tilt,
+        name="cli", source="command line", body=body, muscles=muscles,
+        disturbance=disturbance, case=args.case,
+        options=SCENARIO_DEFAULTS.replace(initial_state=tuple(posture + rates), tilt=tilt,
+                                          description=f"{label}, {what}"),
     )
 
 
@@ -362,7 +383,7 @@ def run(args: argparse.Namespace) -> int:
     outputs = [p for p in (args.out, args.plot, args.animate) if p]
     check_writable(outputs, {args.out: (".csv",), args.plot: FIGURE_SUFFIXES,
                              args.animate: (".gif",)})
-    if sc.time_limit is None:
+    if sc.options.time_limit is None:
         sc = sc.replace(time_limit=DEFAULT_TIME_LIMIT)
     with naming_given_options(args):
         result = sc.run(engine=args.engine)
@@ -372,7 +393,7 @@ def run(args: argparse.Namespace) -> int:
         from ..viz.plots import plot_run_overview, save_figure
 
         fig = plot_run_overview(result, link_names=[s.name for s in sc.body.segments],
-                                base_of_support=sc.fall.base_of_support)
+                                base_of_support=sc.options.fall.base_of_support)
         save_figure(fig, args.plot)
     if args.animate:
         from ..viz.animation import animate
@@ -380,7 +401,7 @@ def run(args: argparse.Namespace) -> int:
         animate(result, sc.body, args.animate)
     from ..linear.verdict import upright_verdict
 
-    verdict = upright_verdict(sc.body, sc.muscles, sc.feedback_delay)
+    verdict = upright_verdict(sc.body, sc.muscles, sc.options.feedback_delay)
     outcome = result.outcome
     if args.json:
         print_json({**result.summary(), "engine": args.engine,
@@ -388,8 +409,8 @@ def run(args: argparse.Namespace) -> int:
     else:
         peaks = ", ".join(f"{x:.4f}" for x in result.max_abs_theta)
         print(f"outcome: {outcome.message}")  # first, as the help and README say
-        if sc.description.strip():
-            print(sc.description.strip())
+        if sc.options.description.strip():
+            print(sc.options.description.strip())
         print(f"status: {result.status} ({result.message})")
         print(f"engine: {args.engine}")
         print(f"linear model: {verdict.describe()}")

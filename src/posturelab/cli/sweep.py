@@ -10,6 +10,7 @@ import time
 from ..errors import ParameterError
 from ..model.muscles import DEFAULT_VISCOSITY_RATIO
 from ..parameters import PAPER_JOINTS, PAPER_PAIRS
+from ..simulation.tolerances import DEFAULT_ATOL, DEFAULT_RTOL
 from ..studies.sweep import (
     MAX_RUNS,
     OUTCOME_COLUMNS,
@@ -217,17 +218,15 @@ def _keep_finished(args: argparse.Namespace, exc: SweepInterrupted) -> int:
 
 def _run_simulations(args: argparse.Namespace, scenario, varies, ratio) -> int:
     """The ordinary sweep: one simulation per parameter set."""
-    tolerances = {}
-    if args.rtol is not None:
-        tolerances["rtol"] = scenario.rtol
-    if args.atol is not None:
-        tolerances["atol"] = scenario.atol
+    # (a sweep's own tolerances unless --rtol / --atol, which the scenario now holds)
+    rtol = DEFAULT_RTOL if args.rtol is None else scenario.options.rtol
+    atol = DEFAULT_ATOL if args.atol is None else scenario.options.atol
     total = _runs(varies)
     with naming_given_options(args):
         result, elapsed = _with_progress(args, total, lambda progress: run_sweep(
             scenario, varies, viscosity_ratio=ratio, workers=args.workers,
             scheduler=args.scheduler, chunk_size=args.chunk_size, progress=progress,
-            **tolerances))
+            rtol=rtol, atol=atol))
     result.write(args.out)
     o = result.outcomes
     shape = " × ".join(str(v.count) for v in varies)
@@ -276,7 +275,7 @@ def _check_experiment_length(args: argparse.Namespace, protocol, scenario) -> No
     run."""
     from ..simulation.setup import MAX_DURATION
 
-    tilt = scenario.tilt
+    tilt = scenario.options.tilt
     if tilt is None or not hasattr(tilt, "cycle"):
         return  # (prts_sweep says the tilt must be a PRTS)
     cycles = protocol.cycles + protocol.discard

@@ -36,7 +36,7 @@ import numpy as np
 
 from .._validation import finite_array, finite_float, float_in_range
 from ..errors import ParameterError
-from ..parameters import MAX_TILT
+from ..parameters import MAX_AXIS_DEPTH, MAX_TILT
 from .prts import (  # the sequences (stated in .prts)
     DEFAULT_PRTS,
     PETERKA_2002_CITATION,
@@ -75,8 +75,7 @@ __all__ = [
 ]
 
 # MAX_TILT [rad], the largest |α| a profile may reach: the parameter table's
-#: Largest distance of the tilt axis below the ankle. [m]
-MAX_AXIS_DEPTH = 1.0
+# MAX_AXIS_DEPTH [m], the deepest tilt axis below the ankle: the parameter table's.
 
 
 

@@ -18,6 +18,7 @@ from typing import Literal
 import msgspec
 
 from ..errors import ScenarioError
+from ..simulation.options import REFERENCE_METHODS
 
 __all__ = ["ScenarioFile", "check_types", "json_schema"]
 
@@ -154,14 +155,15 @@ class LimitsTable(_Table):
 
 class SolverTable(_Table):
     """``[solver]``: tolerances [-], [rad, rad/s], output rate [Hz], scipy method, step
-    budget [-], wall-clock time limit [s]."""
+    budget [-], wall-clock time limit [s], most switches before a run fails [-]."""
 
     rtol: float | None = None
     atol: float | None = None
     sample_rate: float | None = None
-    method: Literal["DOP853", "RK45", "RK23", "Radau", "BDF", "LSODA"] | None = None
+    method: Literal[REFERENCE_METHODS] | None = None  # type: ignore[valid-type]
     max_steps: int | None = None
     time_limit: float | None = None
+    max_switches: int | None = None
 
 
 class MotorNoiseTable(_Table):

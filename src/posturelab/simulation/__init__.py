@@ -20,6 +20,7 @@ NAMES: dict[str, tuple[str, ...]] = {
                                  "HEEL_FRACTION_OF_FOOT", "BaseOfSupport", "FallCriteria",
                                  "KneeMode", "KneeModel", "base_of_support_for_height"),
     "posturelab.simulation.engines": ("ENGINES", "simulate"),
+    "posturelab.simulation.options": ("RunOptions",),
     "posturelab.simulation.results": ("DerivedSeries", "SimulationResult"),
     "posturelab.simulation.setup": ("RunSetup", "initial_state_for", "prepare_run"),
 }

@@ -1,27 +1,30 @@
-"""The set-up of a run, shared by both engines: validation, the initial state, the knee at
-its stop, which pairs act and which joints saturate at the start, a fall at the start, the
-output grid and the breakpoints; and the words of each outcome.
+"""The set-up of a run, shared by both engines: the initial state, the knee at its stop,
+which pairs act and which joints saturate at the start, a fall at the start, the output grid
+and the breakpoints.
 
-:func:`prepare_run` turns the arguments of :func:`posturelab.simulate` into a frozen
-:class:`RunSetup`; the reference and the compiled engines take that object and
-differ only in how they integrate. :func:`model_response` evaluates the model
-(numpy, :mod:`posturelab.model.dynamics`) with the switches of a run applied; the
-reference engine's right-hand side is this function.
+:func:`prepare_run` turns a body, muscles, a disturbance and the run's
+:class:`~posturelab.simulation.options.RunOptions` (checked when they were made) into a frozen
+:class:`RunSetup`; the reference and the compiled engines take that object and differ only in
+how they integrate. :func:`model_response` evaluates the model (numpy,
+:mod:`posturelab.model.dynamics`) with the switches of a run applied; the reference engine's
+right-hand side is this function. The words of each outcome are in
+:mod:`posturelab.simulation.messages`.
 """
 
 from __future__ import annotations
 
 import functools
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Literal
 
 import numpy as np
 
-from .._validation import finite_array, float_in_range
+from .._validation import finite_array
 from ..errors import ParameterError
 from ..model import switched
 from ..model.body import Body
+from ..model.checks import check_model
 from ..model.dynamics import (
     constrained_velocity,
     gravity_vector,
@@ -33,18 +36,15 @@ from ..model.muscles import MuscleSet, muscle_set_gains
 from ..model.noise import MotorNoise, TorqueSeries, motor_noise_series, torque_at
 from ..model.options import FallCriteria, KneeModel, torque_limit_array
 from ..model.platform import Disturbance, NoDisturbance
-from ..model.tilt import (
-    MAX_AXIS_DEPTH,
-    Tilt,
-    axis_translation,
-    check_proprioceptive_weight,
-    tilt_pair_gains,
-)
-from ..parameters import MAX_FEEDBACK_DELAY  # the parameter table's bound
+from ..model.tilt import Tilt, axis_translation, tilt_pair_gains
+from ..parameters import MAX_DURATION, MAX_FEEDBACK_DELAY, MAX_STEP_BUDGET, MAX_TIME_LIMIT
+from .messages import outcome_message
+from .options import MAX_OUTPUT_SAMPLES, OPTION_NAMES, RunOptions, default_step_budget
 from .outcome import check_starts_within
 
 __all__ = [
     "RunSetup",
+    "RunOptions",
     "RUN_OPTIONS",
     "prepare_run",
     "initial_state_for",
@@ -65,28 +65,11 @@ __all__ = [
 #: k = 1 … this many (the order of the default integrators), and at t_i + kτ after each knee
 #: impact t_i (the impact changes the rates at once). [-]
 DELAY_BREAKPOINT_MULTIPLES = 5
-#: Longest run (a day). [s]
-MAX_DURATION = 86_400.0
-#: Most output samples of one run (duration × sample_rate + 1). [-]
-MAX_OUTPUT_SAMPLES = 20_000_000
-#: The step budget of a run when none is given: this many accepted integrator steps … [-]
-BASE_STEP_BUDGET = 1_000_000
-#: … and this many more per simulated second. [1/s]
-STEP_BUDGET_PER_SECOND = 10_000
-#: The largest step budget a run may ask for. [-]
-MAX_STEP_BUDGET = 10_000_000_000
-#: The longest wall-clock time limit a run may ask for (a week). [s]
-MAX_TIME_LIMIT = 604_800.0
 
-
-def default_step_budget(duration: float) -> int:
-    """The step budget of a run of ``duration`` [s] when none is given. [-]
-
-    10⁶ accepted steps plus 10⁴ per simulated second: a hundred times what the
-    stiffest legitimate runs need (delayed feedback and motor noise cap the
-    step near 1 ms), so that only a runaway integration meets it.
-    """
-    return int(BASE_STEP_BUDGET + STEP_BUDGET_PER_SECOND * math.ceil(duration))
+#: The options of a run and their defaults, read from :class:`RunOptions` (its fields are
+#: the one declaration; this mapping is for reading).
+RUN_OPTIONS: dict[str, object] = {name: RunOptions.__dataclass_fields__[name].default
+                                  for name in OPTION_NAMES}
 
 Status = Literal["completed", "fell", "failed"]
 
@@ -95,36 +78,23 @@ Status = Literal["completed", "fell", "failed"]
 class RunSetup:
     """Everything both engines share about one run (built by :func:`prepare_run`).
 
+    The run's options are :attr:`options` (a :class:`RunOptions`); the properties
+    ``duration``, ``feedback_delay``, ``tilt``, ``knee``, ``fall``, ``rtol``, ``atol``, … read
+    them (the tolerances, step budget and time limit resolved to numbers).
+
     Attributes
     ----------
     body : Body
     muscles : MuscleSet
     disturbance : Disturbance
-    duration : float
-        Simulated time. [s]
-    knee : KneeModel
-    fall : FallCriteria
+    options : RunOptions
+        The run's options as given (checked).
     torque_limits : numpy.ndarray, shape (N,), or None
         Largest net muscle moment per joint, ``inf`` where none; None if none limit. [N·m]
-    feedback_delay : float
-        Neural delay τ of the muscle feedback; 0 for none. [s]
     gains : numpy.ndarray, shape (4, P)
         The pair gains by when they act (:func:`posturelab.model.muscles.feedback_gains`):
         immediate stiffness and viscosity, delayed stiffness and viscosity.
         [N·m/rad], [N·m·s/rad], [N·m/rad], [N·m·s/rad]
-    rtol, atol : float
-        Integrator tolerances [-], [rad, rad/s].
-    sample_rate : float
-        Output samples per second. [Hz]
-    max_switches : int
-        More switches than this fail the run (chattering). [-]
-    max_steps : int
-        The step budget: more accepted integrator steps than this end the run as
-        failed. [-]
-    time_limit : float
-        The wall-clock budget of the integration; ``inf`` for none. [s]
-    description : str
-        The run in words.
     before : numpy.ndarray, shape (2N,)
         ``[Θ, Θ̇]`` before any velocity step: what delayed feedback sees for t < 0.
         [rad], [rad/s]
@@ -152,41 +122,24 @@ class RunSetup:
         Why the run falls at t = 0 (a fall criterion already violated), else None.
     knee_row : numpy.ndarray, shape (N,), or None
         The row C of the knee constraint when the knee can lock. [-]
-    rates_from : {"upright", "posture"}
-        Where J⁻¹H was evaluated for a velocity step.
-    tilt : Tilt or None
-        The support-surface tilt α(t) (:mod:`posturelab.model.tilt`), None for none.
-    proprioceptive_weight : float
-        W of the active part's error for pairs that span the foot. [-]
     tilt_gains : numpy.ndarray, shape (4, P), or None
         Pair gains on α(t), α̇(t), α(t − τ), α̇(t − τ)
         (:func:`posturelab.model.tilt.tilt_pair_gains`); None without a tilt.
         [N·m/rad], [N·m·s/rad], [N·m/rad], [N·m·s/rad]
-    tilt_axis_depth : float
-        Distance of the tilt axis below the ankle (0: the ankle's own axis). [m]
     velocity_jump : (float, float)
         The ankle's velocity change at t = 0: the disturbance's step and the start of a
         tilt about an axis below the ankle. [m/s]
-    motor_noise : MotorNoise or None
-        The motor noise of the run (:mod:`posturelab.model.noise`), None for none.
     motor_torque : TorqueSeries or None
-        Its realisation over the run: added to each joint's moment before the limits. [N·m]
+        The motor noise's realisation over the run: added to each joint's moment before the
+        limits. [N·m]
     """
 
     body: Body
     muscles: MuscleSet
     disturbance: Disturbance
-    duration: float
-    knee: KneeModel
-    fall: FallCriteria
+    options: RunOptions
     torque_limits: np.ndarray | None
-    feedback_delay: float
     gains: np.ndarray
-    rtol: float
-    atol: float
-    sample_rate: float
-    max_switches: int
-    description: str
     before: np.ndarray
     x0: np.ndarray
     locked0: bool
@@ -198,27 +151,99 @@ class RunSetup:
     max_step: float
     fall_at_start: str | None
     knee_row: np.ndarray | None
-    rates_from: str = "upright"
-    tilt: Tilt | None = None
-    proprioceptive_weight: float = 1.0
     tilt_gains: np.ndarray | None = None
-    tilt_axis_depth: float = 0.0
     velocity_jump: tuple[float, float] = (0.0, 0.0)
-    motor_noise: MotorNoise | None = None
     motor_torque: TorqueSeries | None = None
-    max_steps: int = BASE_STEP_BUDGET
-    time_limit: float = math.inf
 
     @property
     def n_links(self) -> int:
         """N. [-]"""
         return self.body.n_links
 
+    @property
+    def duration(self) -> float:
+        """Simulated time. [s]"""
+        return self.options.duration
+
+    @property
+    def feedback_delay(self) -> float:
+        """Neural delay τ of the muscle feedback; 0 for none. [s]"""
+        return self.options.feedback_delay
+
+    @property
+    def tilt(self) -> Tilt | None:
+        """The support-surface tilt α(t), None for none."""
+        return self.options.tilt
+
+    @property
+    def proprioceptive_weight(self) -> float:
+        """W of the active part's error for pairs that span the foot. [-]"""
+        return self.options.proprioceptive_weight
+
+    @property
+    def tilt_axis_depth(self) -> float:
+        """Distance of the tilt axis below the ankle (0: the ankle's own axis). [m]"""
+        return self.options.tilt_axis_depth
+
+    @property
+    def knee(self) -> KneeModel:
+        """The knee model."""
+        return self.options.knee
+
+    @property
+    def fall(self) -> FallCriteria:
+        """The fall criteria."""
+        return self.options.fall
+
+    @property
+    def rates_from(self) -> str:
+        """Where J⁻¹H was evaluated for a velocity step."""
+        return self.options.rates_from
+
+    @property
+    def motor_noise(self) -> MotorNoise | None:
+        """The motor noise of the run, None for none."""
+        return self.options.motor_noise
+
+    @property
+    def rtol(self) -> float:
+        """Relative tolerance (the engine's default unless given). [-]"""
+        return self.options.tolerances[0]
+
+    @property
+    def atol(self) -> float:
+        """Absolute tolerance (the engine's default unless given). [rad, rad/s]"""
+        return self.options.tolerances[1]
+
+    @property
+    def sample_rate(self) -> float:
+        """Output samples per second. [Hz]"""
+        return self.options.sample_rate
+
+    @property
+    def max_switches(self) -> int:
+        """More switches than this fail the run (chattering). [-]"""
+        return self.options.max_switches
+
+    @property
+    def max_steps(self) -> int:
+        """The step budget: more accepted integrator steps end the run as failed. [-]"""
+        return self.options.step_budget
+
+    @property
+    def time_limit(self) -> float:
+        """The wall-clock budget of the integration; ``inf`` for none. [s]"""
+        return self.options.wall_clock_limit
+
+    @property
+    def description(self) -> str:
+        """The run in words (the disturbance's own unless the options give some)."""
+        return self.options.description or self.disturbance.describe()
+
     def with_fall_criteria(self, **changes) -> RunSetup:
         """The same set-up with some fall criteria changed (fall_at_start recomputed)."""
-        from dataclasses import replace
-
-        new = replace(self, fall=replace(self.fall, **changes), fall_at_start=None)
+        options = self.options.replace(fall=replace(self.fall, **changes))
+        new = replace(self, options=options, fall_at_start=None)
         object.__setattr__(new, "fall_at_start", _fall_at_start(new))
         return new
 
@@ -276,67 +301,23 @@ def initial_state_for(
     return x0
 
 
-def check_step_budget(max_steps, duration: float) -> int:
-    """A run's step budget: an integer in [1, :data:`MAX_STEP_BUDGET`], or None for
-    :func:`default_step_budget`. [-]"""
-    if max_steps is None:
-        return default_step_budget(duration)
-    if isinstance(max_steps, bool) or not isinstance(max_steps, int | np.integer) \
-            or not 1 <= max_steps <= MAX_STEP_BUDGET:
-        raise ParameterError(f"max_steps must be an integer in [1, {MAX_STEP_BUDGET:,}], got "
-                             f"{max_steps!r:.60}")
-    return int(max_steps)
-
-
-def check_time_limit(time_limit) -> float:
-    """A run's wall-clock budget in (0, :data:`MAX_TIME_LIMIT`] [s]; None for none (inf)."""
-    if time_limit is None:
-        return math.inf
-    return float_in_range("time_limit [s]", time_limit, 0.0, MAX_TIME_LIMIT, include_low=False,
-                          unit="s")
-
-
-def _expect(name: str, value, kind: type) -> None:
-    if not isinstance(value, kind):
-        raise ParameterError(f"{name} must be a {kind.__name__}, got {type(value).__name__} "
-                             f"{value!r:.60}")
-
-
-#: The keyword options of a run and their defaults (meanings and units:
-#: :func:`posturelab.simulate`).
-RUN_OPTIONS: dict[str, object] = {
-    "initial_state": None, "rates_from": "upright", "knee": None, "fall": None,
-    "torque_limits": None, "feedback_delay": 0.0, "rtol": 1e-8, "atol": 1e-10,
-    "sample_rate": 1000.0, "max_switches": 10_000, "description": "", "tilt": None,
-    "proprioceptive_weight": 1.0, "tilt_axis_depth": 0.0, "motor_noise": None,
-    "max_steps": None, "time_limit": None,
-}
-
-
-def _frozen(value):
-    """A hashable form of an option value (arrays and lists as tuples)."""
-    if isinstance(value, np.ndarray | list | tuple):
-        return tuple(np.asarray(value, dtype=float).ravel().tolist())
-    return value
-
-
-@functools.lru_cache(maxsize=128)
-def _prepare_cached(body, muscles, disturbance, duration, frozen_options) -> RunSetup:
-    options = dict(frozen_options)
-    for key in ("initial_state", "torque_limits"):
-        if options.get(key) is not None:
-            options[key] = np.array(options[key])
-    return _prepare(body, muscles, disturbance, duration, **options)
-
-
 def prepare_run(body: Body, muscles: MuscleSet, disturbance: Disturbance | None = None,
-                duration: float = 5.0, **options) -> RunSetup:
-    """Validate the arguments of a run and work out everything both engines share.
+                options: RunOptions | float | None = None, **keywords) -> RunSetup:
+    """Check a run against its body and muscles and work out everything both engines share.
 
-    Parameters are those of :func:`posturelab.simulate` (units there); the keyword
-    options and their defaults are :data:`RUN_OPTIONS`. A set-up is immutable, so the
-    same arguments (when every one is hashable: a measured profile is not) return the
-    same object, computed once.
+    Parameters
+    ----------
+    body : Body
+    muscles : MuscleSet
+    disturbance : Disturbance, optional
+        Platform motion; none by default.
+    options : RunOptions, optional
+        The run's options (default ``RunOptions()``). A number here is the duration [s] and
+        ``keywords`` the other options (the former call, ``prepare_run(body, muscles, d,
+        5.0, feedback_delay=0.1)``).
+
+    A set-up is immutable, so the same arguments (when every one is hashable: a measured
+    profile is not) return the same object, computed once.
 
     Raises
     ------
@@ -344,84 +325,53 @@ def prepare_run(body: Body, muscles: MuscleSet, disturbance: Disturbance | None 
         An unknown option, an argument of the wrong type or outside its range, the knee
         beyond its stop, a muscle set for another number of links.
     """
-    try:
-        key = tuple(sorted((k, _frozen(v)) for k, v in options.items()))
-        return _prepare_cached(body, muscles, disturbance, duration, key)
-    except TypeError:  # something unhashable (a measured profile): set up afresh
-        return _prepare(body, muscles, disturbance, duration, **options)
-
-
-def _prepare(body: Body, muscles: MuscleSet, disturbance: Disturbance | None = None,
-             duration: float = 5.0, **options) -> RunSetup:
-    """:func:`prepare_run` without the memo."""
-    from .._validation import reject_unknown_keys
-
-    reject_unknown_keys("the options of a run", options, RUN_OPTIONS)
-    o = {**RUN_OPTIONS, **options}
-    initial_state, rates_from = o["initial_state"], o["rates_from"]
-    knee, fall, torque_limits = o["knee"], o["fall"], o["torque_limits"]
-    rtol, atol, sample_rate = o["rtol"], o["atol"], o["sample_rate"]
-    max_switches, description = o["max_switches"], o["description"]
-    tilt = o["tilt"]
-    weight = check_proprioceptive_weight(o["proprioceptive_weight"])
-    depth = float_in_range("tilt_axis_depth [m]", o["tilt_axis_depth"], 0.0, MAX_AXIS_DEPTH,
-                           unit="m")
-    if tilt is not None:
-        _expect("tilt", tilt, Tilt)
-        if muscles.one_sided_mask.any():
-            raise ParameterError("a platform tilt cannot be combined with one-sided pairs "
-                                 "(make them two-sided)")
-        if depth > 0 and not tilt.rate_is_continuous:
-            raise ParameterError("a tilt about an axis below the ankle needs a tilt rate "
-                                 "without jumps (sine, raised cosine or measured), not "
-                                 f"{type(tilt).__name__}")
-    elif depth > 0:
-        raise ParameterError("tilt_axis_depth [m] needs a tilt")
-    _expect("body", body, Body)
-    _expect("muscles", muscles, MuscleSet)
+    if not isinstance(options, RunOptions):
+        if options is not None:
+            keywords = {"duration": options, **keywords}
+        options = RunOptions.from_keywords("a run", **keywords)
+    elif keywords:
+        options = options.replace(**keywords)
     disturbance = NoDisturbance() if disturbance is None else disturbance
-    _expect("disturbance", disturbance, Disturbance)
-    knee = KneeModel() if knee is None else knee
-    _expect("knee", knee, KneeModel)
-    fall = FallCriteria() if fall is None else fall
-    _expect("fall", fall, FallCriteria)
-    if muscles.n_links != body.n_links:
-        raise ParameterError(
-            f"muscle set is for {muscles.n_links} links but the body has {body.n_links}"
-        )
-    duration = float_in_range("duration [s]", duration, 0.0, MAX_DURATION, include_low=False,
-                              unit="s")
+    if _hashable((body, muscles, disturbance, options)):
+        return _prepare_memo(body, muscles, disturbance, options)
+    return _prepare(body, muscles, disturbance, options)
+
+
+def _hashable(value) -> bool:
+    """Whether ``value`` can key the memo (a measured profile, holding arrays, cannot)."""
+    try:
+        hash(value)
+    except TypeError:
+        return False
+    return True
+
+
+def _prepare(body: Body, muscles: MuscleSet, disturbance: Disturbance,
+             options: RunOptions) -> RunSetup:
+    """:func:`prepare_run` without the memo: the checks that need the model, then the start."""
+    check_model(body, muscles)
+    if not isinstance(disturbance, Disturbance):
+        raise ParameterError(f"disturbance must be a Disturbance, got "
+                             f"{type(disturbance).__name__} {disturbance!r:.60}")
+    tilt, depth, delay = options.tilt, options.tilt_axis_depth, options.feedback_delay
+    duration, knee = options.duration, options.knee
+    if tilt is not None and muscles.one_sided_mask.any():
+        raise ParameterError("a platform tilt cannot be combined with one-sided pairs "
+                             "(make them two-sided)")
     check_starts_within(disturbance, tilt, duration)
-    noise = o["motor_noise"]
-    motor_torque = None
-    if noise is not None:
-        _expect("motor_noise", noise, MotorNoise)
-        motor_torque = motor_noise_series(noise, duration, body.n_links)
-    rtol = float_in_range("rtol", rtol, 1e-14, 1e-1)
-    atol = float_in_range("atol", atol, 1e-16, 1e-1)
-    sample_rate = float_in_range("sample_rate [Hz]", sample_rate, 1.0, 1e6, unit="Hz")
-    samples = math.floor(duration * sample_rate) + 1
-    if samples > MAX_OUTPUT_SAMPLES:
-        raise ParameterError(f"duration [s] × sample_rate [Hz] = {duration:g} × {sample_rate:g} "
-                             f"gives {samples:,} output samples; at most "
-                             f"{MAX_OUTPUT_SAMPLES:,} (lower the sample rate or the duration)")
-    if isinstance(max_switches, bool) or not isinstance(max_switches, int | np.integer) \
-            or max_switches < 0:
-        raise ParameterError(f"max_switches must be an integer >= 0, got {max_switches!r}")
-    max_steps = check_step_budget(o["max_steps"], duration)
-    time_limit = check_time_limit(o["time_limit"])
+    noise = options.motor_noise
+    motor_torque = None if noise is None else motor_noise_series(noise, duration, body.n_links)
     n = body.n_links
     if knee.mode != "free" and n < 2:
         raise ParameterError("knee mode 'locked' or 'stop' needs a body with at least 2 links")
-    delay = float_in_range("feedback_delay [s]", o["feedback_delay"], 0.0, MAX_FEEDBACK_DELAY,
-                           unit="s")
-    limits = torque_limit_array(torque_limits, n)
+    limits = torque_limit_array(options.torque_limits, n)
+    initial_state = options.initial_state
     before = (np.zeros(2 * n) if initial_state is None
               else finite_array("initial_state [rad, rad/s]", initial_state, (2 * n,)).copy())
     jump = (0.0, 0.0)
     if tilt is not None and depth > 0:  # the ankle starts moving with the surface's rate
         jump = tuple(float(v) for v in axis_translation(tilt, depth, 0.0)[1])
-    x0 = initial_state_for(body, disturbance, initial_state, rates_from, jump)
+    x0 = initial_state_for(body, disturbance, before, options.rates_from, jump)
     knee_row = knee_constraint_row(n) if knee.mode != "free" else None
     locked0 = knee.mode == "locked"
     if knee.mode == "stop":
@@ -440,13 +390,10 @@ def _prepare(body: Body, muscles: MuscleSet, disturbance: Disturbance | None = N
     tilt_gains = None
     if tilt is not None:
         tilt_gains = tilt_pair_gains(muscle_set_gains(muscles, 1.0), muscles.spans_foot, delay,
-                                     weight)
+                                     options.proprioceptive_weight)
         tilt_gains.setflags(write=False)
-    moments0 = start_moments(muscles, x0, before, active0, gains)
-    if tilt is not None:
-        moments0 = moments0 + tilt_torques(tilt, tilt_gains, delay, 0.0) @ muscles.crossing_matrix
-    if motor_torque is not None:
-        moments0 = moments0 + torque_at(motor_torque, 0.0)
+    moments0 = moments_at_start(muscles, x0, before, active0, gains, delay, tilt, tilt_gains,
+                                motor_torque)
     saturation0 = start_saturation(moments0, limits)
     corners = set(disturbance.breakpoints)
     if tilt is not None:  # the tilt's corners, and where the delayed part feels them
@@ -461,21 +408,39 @@ def _prepare(body: Body, muscles: MuscleSet, disturbance: Disturbance | None = N
     for arr in (before, x0, active0, saturation0, breakpoints, delay_bps, gains):
         arr.setflags(write=False)
     setup = RunSetup(
-        body=body, muscles=muscles, disturbance=disturbance, duration=duration, knee=knee,
-        fall=fall, torque_limits=limits, feedback_delay=delay, gains=gains, rtol=rtol, atol=atol,
-        sample_rate=sample_rate, max_switches=int(max_switches),
-        description=description or disturbance.describe(), before=before, x0=x0,
-        locked0=bool(locked0), active0=active0, saturation0=saturation0,
-        grid=output_grid(duration, sample_rate), breakpoints=breakpoints,
+        body=body, muscles=muscles, disturbance=disturbance, options=options,
+        torque_limits=limits, gains=gains, before=before, x0=x0, locked0=bool(locked0),
+        active0=active0, saturation0=saturation0,
+        grid=output_grid(duration, options.sample_rate), breakpoints=breakpoints,
         delay_breakpoints=delay_bps, max_step=max_step, fall_at_start=None, knee_row=knee_row,
-        rates_from=rates_from, tilt=tilt, proprioceptive_weight=weight, tilt_gains=tilt_gains,
-        tilt_axis_depth=depth, velocity_jump=tuple(
+        tilt_gains=tilt_gains, velocity_jump=tuple(
             float(a + b) for a, b in zip(disturbance.velocity_change, jump, strict=True)),
-        motor_noise=noise, motor_torque=motor_torque, max_steps=max_steps,
-        time_limit=time_limit,
+        motor_torque=motor_torque,
     )
     object.__setattr__(setup, "fall_at_start", _fall_at_start(setup))
     return setup
+
+
+_prepare_memo = functools.lru_cache(maxsize=128)(_prepare)
+
+
+def moments_at_start(muscles: MuscleSet, state: np.ndarray, before: np.ndarray,
+                     active: np.ndarray, gains: np.ndarray, delay: float,
+                     tilt: Tilt | None = None, tilt_gains: np.ndarray | None = None,
+                     motor_torque: TorqueSeries | None = None) -> np.ndarray:
+    """Unsaturated joint moments at t = 0 of one run, or of runs that share a delay (a batch):
+    the pairs' feedback (:func:`start_moments`, ``state``, ``before`` (..., 2N), ``active``
+    (..., P), ``gains`` (..., 4, P)), the tilt's part with ``tilt_gains`` (..., 4, P) and the
+    motor noise. Returns (..., N). [N·m]
+
+    ``delay`` is the runs' feedback delay τ. [s]
+    """
+    moments = start_moments(muscles, state, before, active, gains)
+    if tilt is not None:
+        moments = moments + tilt_torques(tilt, tilt_gains, delay, 0.0) @ muscles.crossing_matrix
+    if motor_torque is not None:
+        moments = moments + torque_at(motor_torque, 0.0)
+    return moments
 
 
 # The switched model lives in posturelab.model.switched; these are its run-level forms.
@@ -601,51 +566,3 @@ def fall_at_start_by_posture(setup: RunSetup) -> str | None:
     if setup.fall.centre_of_pressure:
         return _fall_at_start(setup.with_fall_criteria(centre_of_pressure=False))
     return setup.fall_at_start
-
-
-#: The implicit integrators (of scipy's solve_ivp and the compiled engine's Radau IIA).
-IMPLICIT_METHODS = ("Radau", "BDF", "LSODA")
-
-
-def outcome_message(status: str, t: float, setup: RunSetup, *, fall_reason: str = "",
-                    detail: str = "", method: str | None = None) -> str:
-    """The words of a run's outcome.
-
-    Parameters
-    ----------
-    status : str
-        What happened: one of "completed", "fell", "step-too-small", "non-finite",
-        "chattering", "no-memory", "step-budget", "time-budget", "failed" ("failed" takes
-        its words from ``detail``).
-    t : float
-        When it happened (the fall, the failure). [s]
-    method : str, optional
-        The integrator that ran ("Radau", "RK45", "DOP853", …): a spent step budget suggests
-        an implicit method only to a run that had an explicit one.
-    """
-    if status == "completed":
-        return f"ran to {setup.duration:g} s"
-    if status == "fell":
-        when = "0 s" if t == 0.0 else f"{t:.4f} s"
-        return f"fell at t = {when}: {fall_reason}"
-    if status == "step-too-small":
-        return (f"integrator failed at t = {t:.6g} s: required step size is less than "
-                "spacing between numbers")
-    if status == "non-finite":
-        return f"state diverged (non-finite) at t = {t:.6g} s"
-    if status == "chattering":
-        return f"more than {setup.max_switches} switches by t = {t:.6g} s (chattering)"
-    if status == "no-memory":
-        return f"ran out of memory at t = {t:.6g} s"
-    if status == "step-budget":
-        if method in IMPLICIT_METHODS:
-            advice = f"raise max_steps; the {method} method that ran is already implicit"
-        else:
-            advice = ("raise max_steps; for very stiff or viscous gains an implicit method "
-                      "such as Radau needs far fewer steps")
-        return (f"stopped at t = {t:.6g} s: the step budget of {setup.max_steps:,} integrator "
-                f"steps ran out ({advice})")
-    if status == "time-budget":
-        return (f"stopped at t = {t:.6g} s: the time limit of {setup.time_limit:g} s "
-                "(wall clock) ran out (raise time_limit)")
-    return detail

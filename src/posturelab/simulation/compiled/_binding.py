@@ -12,6 +12,7 @@ from __future__ import annotations
 import ctypes
 import functools
 import importlib.util
+import threading
 
 from ...errors import PostureLabError
 from ._layout import OUT_FIELDS, RUN_FIELDS
@@ -73,9 +74,20 @@ def built_source_files(lib: ctypes.CDLL) -> list[str]:
     return [name for name in recorded().decode().split(",") if name]
 
 
+#: Held while the engine loads: threads that call :func:`library` first at once (a sweep's
+#: threads) would otherwise see the extension half imported (its ``__spec__`` not yet set).
+_LOADING = threading.Lock()
+
+
 @functools.cache
 def library() -> ctypes.CDLL:
     """The loaded engine, its functions typed."""
+    with _LOADING:
+        return _load()
+
+
+def _load() -> ctypes.CDLL:
+    """Load the engine and type its functions (:func:`library`, once)."""
     spec = importlib.util.find_spec("posturelab.simulation.compiled._engine")
     if spec is None or spec.origin is None:
         raise PostureLabError(
