@@ -48,13 +48,14 @@ def max_cohort_workers() -> int:
 
 def read_frf_file(path, *, stimulus: str | None = None, response: str | None = None,
                   cycle_length: float | None = None, discard_cycles: int = 0,
-                  response_sign: int = -1, input: str = "tilt"):
+                  response_sign: int = -1, input: str = "tilt", what: str = "FRF JSON"):
     """One condition's FRF from a file: ``.json`` an FRF table
     (:func:`posturelab.frequency.table.read_frf_json`: what ``posturelab frf --json`` writes,
     or gain and phase with optional standard errors), anything else a trial CSV whose
     ``stimulus`` and ``response`` columns are estimated over cycles of ``cycle_length`` [s]
     (:func:`posturelab.frequency.estimate_frf`), the response multiplied by
-    ``response_sign`` (−1: posturelab's tilt convention).
+    ``response_sign`` (−1: posturelab's tilt convention). ``what`` names a JSON file in
+    messages.
 
     Raises
     ------
@@ -64,7 +65,7 @@ def read_frf_file(path, *, stimulus: str | None = None, response: str | None = N
     if str(path).lower().endswith(".json"):
         from .table import read_frf_json
 
-        return read_frf_json(path, "FRF JSON")
+        return read_frf_json(path, what)
     from .._validation import float_in_range
     from .data import read_series_csv
     from .estimate import estimate_frf, whole_cycles

@@ -111,6 +111,8 @@ class ConditionComparison:
     general, restricted : FRFFit
         The two fits.
     warnings : tuple of str
+    amplitude_unit : str
+        ``"rad"`` (a tilt) or ``"m"`` (a translation).
     """
 
     parameter: str
@@ -133,6 +135,7 @@ class ConditionComparison:
     general: FRFFit
     restricted: FRFFit
     warnings: tuple = ()
+    amplitude_unit: str = "rad"
 
     @property
     def significant(self) -> bool:
@@ -159,6 +162,7 @@ class ConditionComparison:
 
         return {
             "parameter": self.parameter, "unit": self.unit,
+            "amplitude_unit": self.amplitude_unit,
             "test": "likelihood ratio, shared against per-condition",
             "conditions": [
                 {"condition": k + 1, "label": lab, "amplitude": num(a), "vision": v,
@@ -335,4 +339,5 @@ def compare_conditions(body, muscles, data, free, *, parameter: str = "proprioce
         general.determined[idx], float(restricted.estimates[j]),
         restricted.confidence_intervals[j].copy(), float(delta_s), float(statistic), r,
         float(nu), distribution, p_value, general, restricted,
-        tuple(warnings) + general.warnings)
+        tuple(warnings) + general.warnings,
+        "m" if fit_options.get("input", "tilt") == "translation" else "rad")
