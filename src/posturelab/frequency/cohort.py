@@ -33,7 +33,7 @@ from ..errors import ParameterError, PostureLabError
 from .fit import check_fit_request
 
 __all__ = ["CohortFit", "SubjectFit", "fit_cohort", "read_frf_file", "max_cohort_workers",
-           "MAX_SUBJECTS"]
+           "csv_text", "MAX_SUBJECTS"]
 
 #: Most subjects one cohort may have. [-]
 MAX_SUBJECTS = 100_000
@@ -169,10 +169,15 @@ class CohortFit:
 
     def write(self, path) -> None:
         """Write the table to ``path`` (.csv or .parquet by its suffix), atomically: an
-        interrupted write leaves nothing (:func:`posturelab.studies.sweep.write_table`)."""
-        from ..studies.sweep import write_table
+        interrupted write leaves nothing. CSV: text cells quoted where they need it (a
+        reason may hold commas), NaN an empty cell, numbers exact (17 digits)."""
+        from .._files import atomic_write_text
+        from ..studies.sweep import table_format, write_table
 
-        write_table(path, self.columns(), self.column_units())
+        if table_format(path) == "csv":
+            atomic_write_text(path, csv_text(self.columns()))
+        else:
+            write_table(path, self.columns(), self.column_units())
 
     def summary(self) -> dict:
         """Per parameter: ``unit``, ``subjects`` (fitted, failed left out), ``determined``,
@@ -193,6 +198,28 @@ class CohortFit:
         return {"subjects": len(self.subjects), "parameters": out,
                 "failed": [{"subject": s.subject, "reason": s.reason}
                            for s in self.subjects if s.failed]}
+
+
+def csv_text(columns) -> str:
+    """A table as CSV (the csv module's quoting): booleans true/false, NaN an empty cell,
+    numbers with 17 significant digits, text as it is."""
+    import csv
+    import io
+
+    cells = []
+    for _, values in columns:
+        values = np.asarray(values)
+        if values.dtype == bool:
+            cells.append(["true" if v else "false" for v in values])
+        elif values.dtype.kind in "US":
+            cells.append([str(v) for v in values])
+        else:
+            cells.append(["" if math.isnan(v) else repr(float(v)) for v in values.tolist()])
+    buf = io.StringIO()
+    writer = csv.writer(buf, lineterminator="\n")
+    writer.writerow([name for name, _ in columns])
+    writer.writerows(zip(*cells, strict=True))
+    return buf.getvalue()
 
 
 @dataclass(frozen=True)
@@ -343,6 +370,10 @@ def _in_processes(task: _CohortTask, items: list, workers: int, progress) -> lis
     import multiprocessing
     import sys
     from concurrent.futures import ProcessPoolExecutor, as_completed
+
+    import scipy.linalg  # noqa: F401  (loaded once here: forked workers inherit them)
+    import scipy.optimize  # noqa: F401
+    import scipy.stats  # noqa: F401
 
     context = multiprocessing.get_context("fork" if sys.platform.startswith("linux")
                                           else None)

@@ -182,7 +182,7 @@ class ConditionComparison:
 
     def write(self, path) -> None:
         """Write the table to ``path`` atomically: ``.json`` (:meth:`to_dict`) or ``.csv``
-        (:meth:`columns`, the test's result in a ``#`` line above the header)."""
+        (:meth:`columns`, quoted where a cell needs it)."""
         from pathlib import Path
 
         from .._files import atomic_write_text
@@ -194,9 +194,9 @@ class ConditionComparison:
             atomic_write_text(path, json.dumps(self.to_dict(), indent=2, ensure_ascii=False)
                               + "\n")
         elif suffix == ".csv":
-            from ..studies.sweep import table_csv_text
+            from .cohort import csv_text
 
-            atomic_write_text(path, table_csv_text(self.columns()))
+            atomic_write_text(path, csv_text(self.columns()))
         else:
             raise ParameterError(f"the comparison table must end in .json or .csv, got "
                                  f"{str(path)!r}")

@@ -48,7 +48,8 @@ def plot_reweighting(comparison, ax=None) -> Figure:
         ax.errorbar(x[order], est[order], yerr=[est[order] - ci[order, 0],
                                                 ci[order, 1] - est[order]],
                     color=color, marker=marker, capsize=3, lw=1.2,
-                    label="conditions" if v is None else f"eyes {v}")
+                    label=f"eyes {v}" if v is not None else (
+                        "vision not given" if any(comparison.vision) else "per condition"))
     lo, hi = comparison.shared_interval
     ax.axhspan(lo, hi, color="0.5", alpha=0.15, lw=0)
     ax.axhline(comparison.shared_estimate, color="0.4", ls="--", lw=1.0,
