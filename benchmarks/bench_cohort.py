@@ -27,7 +27,7 @@ import numpy as np
 
 import posturelab as pl
 from posturelab.frequency import estimate_frf, model_frf
-from posturelab.frequency.cohort import fit_cohort, max_cohort_workers
+from posturelab.frequency.cohort import fit_cohort, usable_cpus
 from posturelab.frequency.fit import fit_frf
 from posturelab.model.controllers import get_controller
 from posturelab.model.tilt import PRTSTilt
@@ -76,7 +76,7 @@ def best_of(repeats: int, runs: dict) -> dict:
 
 def main() -> None:
     repeats = int(sys.argv[1]) if len(sys.argv) > 1 else 3
-    workers = max_cohort_workers()
+    workers = usable_cpus()
     print("posturelab cohort benchmark")
     print(f"  {platform.python_version()} on {platform.machine()}, {os.cpu_count()} CPUs "
           f"({workers} usable); load average {os.getloadavg()[0]:.2f}; best of {repeats}")

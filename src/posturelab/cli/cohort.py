@@ -21,7 +21,7 @@ posturelab fit-frf reads one with --stimulus, --response, --cycle-length, or an 
 what posturelab frf --json writes, or a table of gain and phase with or without standard
 errors); the body, the starting gains and --free, --bounds are as for posturelab fit-frf,
 and every subject starts from them. The fits run in --workers processes (default one per
-CPU, at most that many; each subject is one task, so the results do not depend on it).
+CPU, at most four per CPU; each subject is one task, so the results do not depend on it).
 
 --out TABLE.csv|.parquet gets one row per subject and parameter: subject (the file's name
 without its suffix), parameter, unit, value, standard_error, ci95_low, ci95_high (95 %),
@@ -53,7 +53,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--plot", metavar="FIG.png",
                    help="draw each parameter's distribution over the subjects (PNG/SVG/PDF).")
     p.add_argument("--workers", type=int, default=None, metavar="N",
-                   help="worker processes (default: one per CPU, at most that many).")
+                   help="worker processes (default: one per CPU; at most four per CPU).")
     p.add_argument("--progress", action="store_true",
                    help="draw a progress bar on standard error even when it is not a "
                    "terminal.")
@@ -79,7 +79,7 @@ def run(args: argparse.Namespace) -> int:
                              **({args.plot: FIGURE_SUFFIXES} if args.plot else {})})
     limit = max_cohort_workers()
     if args.workers is not None and not 1 <= args.workers <= limit:
-        raise ParameterError(f"--workers must be an integer in 1 … {limit} (one per CPU), "
+        raise ParameterError(f"--workers must be an integer in 1 … {limit} (4 × the CPUs), "
                              f"got {args.workers}")
     body = body_from_args(args)
     muscles = muscles_from_args(args, body)

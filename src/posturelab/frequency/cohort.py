@@ -5,8 +5,9 @@ parameter, and a summary.
 an :class:`~posturelab.frequency.table.FRFTable`, or a file :func:`read_frf_file` reads: a
 trial CSV, the JSON ``posturelab frf --json`` writes, or a table of gain and phase with or
 without standard errors) and fits each with :func:`posturelab.frequency.fit.fit_frf` from the
-same starting body, gains and options, in worker processes (at most one per CPU; each subject
-is one task, so the table does not depend on how many ran at once). A subject whose file
+same starting body, gains and options, in worker processes (by default one per CPU this
+process may use, at most four per CPU; each subject is one task, so the table does not
+depend on how many ran at once). A subject whose file
 cannot be read or whose fit fails gets rows saying why (``failed``, ``reason``) and never
 stops the others; a fit whose optimiser did not converge keeps its values, marked failed
 with the optimiser's message.
@@ -33,17 +34,23 @@ from ..errors import ParameterError, PostureLabError
 from .fit import check_fit_request
 
 __all__ = ["CohortFit", "SubjectFit", "fit_cohort", "read_frf_file", "max_cohort_workers",
-           "csv_text", "MAX_SUBJECTS"]
+           "usable_cpus", "csv_text", "MAX_SUBJECTS"]
 
 #: Most subjects one cohort may have. [-]
 MAX_SUBJECTS = 100_000
 
 
-def max_cohort_workers() -> int:
-    """The most worker processes a cohort fit starts: one per CPU. [-]"""
+def usable_cpus() -> int:
+    """The CPUs this process may run on (its affinity where the system says). [-]"""
     if hasattr(os, "sched_getaffinity"):
         return max(1, len(os.sched_getaffinity(0)))
     return max(1, os.cpu_count() or 1)
+
+
+def max_cohort_workers() -> int:
+    """The most worker processes a cohort fit starts: four per usable CPU (as a sweep's
+    ``--workers``); the default is one per CPU. [-]"""
+    return 4 * usable_cpus()
 
 
 def read_frf_file(path, *, stimulus: str | None = None, response: str | None = None,
@@ -293,8 +300,8 @@ def fit_cohort(body, muscles, subjects: Sequence, free, *, names=None,
     names : sequence of str, optional
         The subjects' names (default: a file's stem, else ``subject k``).
     workers : int, optional
-        Worker processes, 1 … :func:`max_cohort_workers` (default: that many, at most one per
-        subject); 1 fits here, in turn. [-]
+        Worker processes, 1 … :func:`max_cohort_workers` (default: one per usable CPU, at
+        most one per subject); 1 fits here, in turn. [-]
     progress : callable(done, total), optional
         Called after each subject.
     reader : dict, optional
@@ -327,10 +334,10 @@ def fit_cohort(body, muscles, subjects: Sequence, free, *, names=None,
                                                 fit_options.get("bounds"))
     limit = max_cohort_workers()
     if workers is None:
-        workers = min(limit, len(subjects))
+        workers = min(usable_cpus(), len(subjects))
     if isinstance(workers, bool) or not isinstance(workers, int | np.integer) \
             or not 1 <= workers <= limit:
-        raise ParameterError(f"--workers must be an integer in 1 … {limit} (one per CPU), got "
+        raise ParameterError(f"--workers must be an integer in 1 … {limit} (4 × the CPUs), got "
                              f"{workers!r}")
     labels = _subject_names(subjects, names)
     options = {**fit_options, "bounds": bounds or None}

@@ -17,7 +17,7 @@ function                      what                                         paper
 ============================  ==========================================  ==========
 
 The functions live in :mod:`.run_figures` (runs), :mod:`.maps` (parameter planes),
-:mod:`.frequency` (frequency responses), :mod:`.cohort` (conditions and cohorts) and
+:mod:`.frequency` (frequency responses), :mod:`posturelab.viz.cohort` (conditions and cohorts) and
 :mod:`.figure` (new figures, colours, saving);
 this module gathers them under one name.
 
