@@ -362,8 +362,13 @@ _TASK: _CohortTask | None = None
 
 
 def _set_task(task: _CohortTask) -> None:
+    """A worker's start: its task, and Ctrl-C left to the parent (which cancels the rest),
+    so that a worker never dies halfway with a traceback of its own."""
+    import signal
+
     global _TASK
     _TASK = task
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 def _fit_chunk(items: list) -> list:
