@@ -87,7 +87,7 @@ def plot_cohort(cohort, parameters=None) -> Figure:
     """
     names = list(parameters or cohort.parameters)
     n = len(names)
-    cols = min(n, 3)
+    cols = n if n <= 3 else (2 if n == 4 else 3)
     rows = -(-n // cols)
     fig, axes = new_figure(rows, cols, figsize=(3.2 * cols, 3.4 * rows))
     axes = np.atleast_1d(axes).ravel()
