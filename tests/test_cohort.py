@@ -203,10 +203,12 @@ def test_the_cohort_command_writes_the_table_summary_and_figure(cohort_files, tm
                and r["reason"].endswith("needs frf, or gain and phase_deg")
                for r in rows if r["subject"] == "s06")
     assert (tmp_path / "c.png").read_bytes()[:4] == b"\x89PNG"
-    p = cli("cohort", *data[:8], *CONTROLLER, "--free", ",".join(FREE), "--out",
+    # several files after one --data (as a shell pattern gives them)
+    p = cli("cohort", "--data", *paths[:4], *CONTROLLER, "--free", ",".join(FREE), "--out",
             str(tmp_path / "plain.csv"), "--workers", "1")
     assert p.returncode == 0, p.stderr
-    assert "median" in p.stdout and "quartiles" in p.stdout
+    assert "to 4 subject(s); 0 failed" in p.stdout and "quartiles" in p.stdout
+    assert len((tmp_path / "plain.csv").read_text().splitlines()) == 1 + 4 * len(FREE)
 
 
 def test_the_cohort_command_refuses_before_any_fit(cohort_files, tmp_path):

@@ -16,7 +16,7 @@ from ._common import (
 from .fit_frf import _bounds, _names, add_fit_arguments, reader_options
 
 DESCRIPTION = """\
-Fit the same model to every subject's FRF: each --data is one subject (a trial CSV, read as
+Fit the same model to every subject's FRF: each --data FILE is one subject (a trial CSV, read as
 posturelab fit-frf reads one with --stimulus, --response, --cycle-length, or an FRF JSON:
 what posturelab frf --json writes, or a table of gain and phase with or without standard
 errors); the body, the starting gains and --free, --bounds are as for posturelab fit-frf,
@@ -35,7 +35,7 @@ written only when every fit is done, each atomically (Ctrl-C leaves none half-wr
 Why a command and not fit-frf --each: fit-frf's --data are one subject's conditions; here
 each --data is a subject, and the output is a table.
 
-Example: posturelab cohort --data s01.json --data s02.json --data s03.json \\
+Example: posturelab cohort --data s01.json s02.json s03.json \\
              --controller peterka-2002 --free active_stiffness:ankle,feedback_delay,\\
 proprioceptive_weight --out cohort.csv --plot cohort.png
 """
@@ -43,8 +43,9 @@ proprioceptive_weight --out cohort.csv --plot cohort.png
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     """The options of ``posturelab cohort``."""
-    p.add_argument("--data", required=True, action="append", metavar="FILE",
-                   help="one subject: trial.csv or frf.json (repeat for each subject).")
+    p.add_argument("--data", required=True, action="extend", nargs="+", metavar="FILE",
+                   help="subjects, one file each: trial.csv or frf.json (several after one "
+                   "--data, as a shell pattern gives them, or --data repeated).")
     add_fit_arguments(p, per_condition=False)
     p.add_argument("--out", required=True, metavar="TABLE.csv|TABLE.parquet",
                    help="the table: one row per subject and parameter (.csv or .parquet).")
