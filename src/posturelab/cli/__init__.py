@@ -31,6 +31,7 @@ SUBCOMMANDS: dict[str, str] = {
     "compare-frf": "compare_frf",
     "likeness": "likeness",
     "likeness-reference": "likeness_reference",
+    "cohort": "cohort",
     "compare": "compare",
     "explore": "explore",
 }
@@ -57,6 +58,8 @@ SUBCOMMAND_HELP: dict[str, str] = {
                    "bands",
     "likeness": "human-likeness score of an FRF: its distance to a human reference (COMTEST)",
     "likeness-reference": "build a human-likeness reference from one's own cohort of FRFs",
+    "cohort": "fit the same model to every subject's FRF in parallel; a table per subject "
+              "and parameter, a summary",
     "compare": "overlay saved runs (posturelab simulate --out) in one figure, and tabulate them",
     "explore": "explore the model interactively in the web browser (a local page)",
 }

@@ -50,6 +50,16 @@ widens the intervals by a model error it states;
 warns when a band's coherence is below 0.5. Bounds must lie within each parameter's range;
 a name given twice or a bound for a parameter not fitted is refused.
 
+Reweighting (posturelab.frequency.reweighting): --compare NAME (e.g. proprioceptive_weight)
+fits NAME once per condition and once shared by all, the rest as asked, and tests whether it
+differs by a likelihood ratio: ΔS = S_shared − S_per-condition (the whitened residuals' sums
+of squares) against χ²(C − 1) for known standard errors, F(C − 1, ν) for ones estimated with
+ν degrees of freedom. It prints NAME per condition against the stimulus amplitude (peak to
+peak: --amplitudes, else a trial's measured) and vision (--vision open,closed,...), the
+shared value and the test ("reweighting" in --json, with "p_value"); --compare-out writes
+the table (.json with the test, or .csv), --compare-plot the figure. Peterka (2002) found
+the proprioceptive weight falling as the tilt grows.
+
 Example: posturelab fit-frf --data trial.csv --stimulus tilt --response com_angle \\
              --cycle-length 20 --discard-cycles 1 --controller peterka-2002 \\
              --free active_stiffness:ankle,active_viscosity:ankle,feedback_delay
@@ -60,6 +70,33 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     """The options of ``posturelab fit-frf``."""
     p.add_argument("--data", required=True, action="append", metavar="FILE",
                    help="a condition: trial.csv or frf.json (repeat for several).")
+    add_fit_arguments(p, per_condition=True)
+    p.add_argument("--json", action="store_true", help="print one JSON object.")
+    p.add_argument("--plot", metavar="BODE.png",
+                   help="write a Bode plot of every condition with its fitted model (PNG/SVG/"
+                   "PDF).")
+    p.add_argument("--compare", metavar="NAME",
+                   help="fit NAME per condition and shared, and test the difference (a "
+                   "likelihood-ratio test: \"reweighting\" in --json, with its p_value); "
+                   "e.g. proprioceptive_weight.")
+    p.add_argument("--amplitudes", metavar="A1,A2,...",
+                   help="with --compare: each condition's stimulus amplitude, peak to peak "
+                   "[rad for a tilt, m for a translation] (default: a trial's measured, a "
+                   "table's unknown).")
+    p.add_argument("--vision", metavar="open|closed,...",
+                   help="with --compare: each condition's vision, open or closed (or - for "
+                   "not given).")
+    p.add_argument("--compare-out", metavar="TABLE.json|.csv",
+                   help="with --compare: write the per-condition table (and the test, in "
+                   "JSON).")
+    p.add_argument("--compare-plot", metavar="FIG.png",
+                   help="with --compare: draw NAME against the stimulus amplitude with its "
+                   "intervals (PNG/SVG/PDF).")
+    add_muscle_arguments(p)
+
+
+def add_fit_arguments(p: argparse.ArgumentParser, *, per_condition: bool) -> None:
+    """How a trial CSV is read and what is fitted (``fit-frf`` and ``cohort`` share them)."""
     p.add_argument("--stimulus", metavar="COLUMN", help="stimulus column of a trial CSV.")
     p.add_argument("--response", metavar="COLUMN", help="response column of a trial CSV.")
     p.add_argument("--cycle-length", type=float, metavar="SECONDS", help="of a trial CSV [s].")
@@ -78,38 +115,30 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    "stiffness:PAIR, viscosity:PAIR, active_stiffness:PAIR, "
                    "active_viscosity:PAIR, feedback_delay, proprioceptive_weight (e.g. "
                    "active_stiffness:ankle,feedback_delay).")
-    p.add_argument("--per-condition", default="", metavar="NAMES",
-                   help="parameters with one value per condition (names as --free).")
+    if per_condition:
+        p.add_argument("--per-condition", default="", metavar="NAMES",
+                       help="parameters with one value per condition (names as --free).")
     p.add_argument("--bounds", default="", metavar="NAME=LO:HI,...",
                    help="bounds of fitted parameters, replacing the defaults (e.g. "
                    "active_stiffness:ankle=0:2000,feedback_delay=0.05:0.3 [N·m/rad], [s]); "
                    "within the table's ranges.")
-    p.add_argument("--json", action="store_true", help="print one JSON object.")
-    p.add_argument("--plot", metavar="BODE.png",
-                   help="write a Bode plot of every condition with its fitted model (PNG/SVG/"
-                   "PDF).")
-    add_muscle_arguments(p)
+
+
+def reader_options(args: argparse.Namespace) -> dict:
+    """:func:`posturelab.frequency.cohort.read_frf_file`'s options from the command line."""
+    from .frf import response_sign
+
+    return {"stimulus": args.stimulus, "response": args.response,
+            "cycle_length": args.cycle_length, "discard_cycles": args.discard_cycles,
+            "response_sign": response_sign(args.response_sign), "input": args.input}
 
 
 def _condition(path: str, args: argparse.Namespace):
+    from ..frequency.cohort import read_frf_file
+
     if path.lower().endswith(".json"):
-        from ..frequency.table import read_frf_json
-
-        return read_frf_json(path, "--data FRF JSON")
-    from .._validation import float_in_range
-    from ..frequency.data import read_series_csv
-    from ..frequency.estimate import estimate_frf, whole_cycles
-    from .frf import response_sign
-
-    if args.stimulus is None or args.response is None or args.cycle_length is None:
-        raise ParameterError("a trial CSV needs --stimulus, --response and --cycle-length")
-    float_in_range("--cycle-length [s]", args.cycle_length, 1e-3, 1e5, unit="s")
-    stim, resp = args.stimulus.strip().lower(), args.response.strip().lower()
-    fs, cols = read_series_csv(path, [stim, resp],
-                               {stim: ("rad",) if args.input == "tilt" else ("m",)})
-    x, y, _ = whole_cycles(cols[stim], cols[resp], fs, args.cycle_length)
-    return estimate_frf(x, y, fs, args.cycle_length, discard_cycles=args.discard_cycles,
-                        response_sign=response_sign(args.response_sign))
+        return read_frf_file(path, what="--data FRF JSON")
+    return read_frf_file(path, **reader_options(args))
 
 
 def _names(text: str) -> list[str]:
@@ -138,19 +167,41 @@ def run(args: argparse.Namespace) -> int:
     from ..frequency.fit import check_fit_request, fit_frf
     from .frf import check_plot_path
 
-    refuse_input_as_output({"--data": args.data}, {"--plot": args.plot})
+    refuse_input_as_output({"--data": args.data}, {"--plot": args.plot,
+                                                   "--compare-out": args.compare_out,
+                                                   "--compare-plot": args.compare_plot})
     check_plot_path(args.plot)
+    compare = _compare_request(args)
     body = body_from_args(args)
     muscles = muscles_from_args(args, body)
     options = feedback_options_from_args(args)
-    check_fit_request(muscles, _names(args.free), _names(args.per_condition),
-                      _bounds(args.bounds))  # the names first, before any data are read
+    free, per = _names(args.free), _names(args.per_condition)
+    checked = check_fit_request(muscles, free, per, None)  # the names first, before any data
+    if compare is not None:
+        compare["parameter"] = check_fit_request(muscles, [args.compare])[0][0]
+        moved = [n for n in checked[0] + checked[1] if n != compare["parameter"]]
+        check_fit_request(muscles, moved, [compare["parameter"]], _bounds(args.bounds))
+    else:
+        check_fit_request(muscles, free, per, _bounds(args.bounds))
     conditions = [_condition(path, args) for path in args.data]
-    fit = fit_frf(body, muscles, conditions, _names(args.free), input=args.input,
-                  output=args.output.strip().lower(),
-                  feedback_delay=options.get("feedback_delay", 0.0),
-                  proprioceptive_weight=options.get("proprioceptive_weight", 1.0),
-                  per_condition=_names(args.per_condition), bounds=_bounds(args.bounds))
+    fit_options = dict(input=args.input, output=args.output.strip().lower(),
+                       feedback_delay=options.get("feedback_delay", 0.0),
+                       proprioceptive_weight=options.get("proprioceptive_weight", 1.0),
+                       bounds=_bounds(args.bounds))
+    comparison = None
+    if compare is not None:
+        from pathlib import Path
+
+        from ..frequency.reweighting import compare_conditions
+
+        compare.pop("out"), compare.pop("plot")
+        comparison = compare_conditions(body, muscles, conditions, free, per_condition=per,
+                                        labels=[Path(p).name for p in args.data],
+                                        **compare, **fit_options)
+        fit = comparison.general
+        _write_comparison(comparison, args)
+    else:
+        fit = fit_frf(body, muscles, conditions, free, per_condition=per, **fit_options)
     if args.plot:
         from pathlib import Path
 
@@ -178,8 +229,9 @@ def run(args: argparse.Namespace) -> int:
              for p, c in zip(args.data, conditions, strict=True)]
     if args.json:
         out = fit.to_dict()
+        extra = {} if comparison is None else {"reweighting": comparison.to_dict()}
         print_json({**out, "conditions": kinds, "response_sign": signs,
-                    "warnings": sign_warnings + out["warnings"]})
+                    "warnings": sign_warnings + out["warnings"], **extra})
         return 0
     print(f"fitted {len(fit.names)} parameter(s) to {len(conditions)} condition(s); fit error "
           f"{fit.fit_error:.3g} (√(χ²/dof); about 1 when the model explains the data)")
@@ -207,6 +259,75 @@ def run(args: argparse.Namespace) -> int:
         print(f"warning: {w}")
     if not fit.success:
         print(f"warning: the optimiser did not converge: {fit.message}")
-    if args.plot:
-        print(f"wrote {args.plot}")
+    if comparison is not None:
+        _print_comparison(comparison)
+    for path in (args.plot, args.compare_out, args.compare_plot):
+        if path:
+            print(f"wrote {path}")
     return 0
+
+
+def _compare_request(args: argparse.Namespace) -> dict | None:
+    """--compare and its options, checked before any work (None without --compare)."""
+    given = [o for o, v in (("--amplitudes", args.amplitudes), ("--vision", args.vision),
+                            ("--compare-out", args.compare_out),
+                            ("--compare-plot", args.compare_plot)) if v]
+    if not args.compare:
+        if given:
+            raise ParameterError(f"{given[0]} needs --compare NAME")
+        return None
+    if len(args.data) < 2:
+        raise ParameterError("--compare needs at least two conditions (--data given once)")
+    from .frf import check_plot_path
+
+    check_plot_path(args.compare_plot)
+    if args.compare_out:
+        from ._common import check_writable
+
+        check_writable([args.compare_out], {args.compare_out: (".json", ".csv")})
+    amplitudes = vision = None
+    if args.amplitudes:
+        items = [a.strip() for a in args.amplitudes.split(",")]
+        try:
+            amplitudes = [None if a in ("", "-") else float(a) for a in items]
+        except ValueError:
+            raise ParameterError(f"--amplitudes must be numbers [rad or m] (or -), got "
+                                 f"{args.amplitudes!r}"[:200]) from None
+        if len(amplitudes) != len(args.data):
+            raise ParameterError(f"--amplitudes gives {len(amplitudes)} value(s) for "
+                                 f"{len(args.data)} --data")
+    if args.vision:
+        vision = [None if v.strip() in ("", "-") else v.strip().lower()
+                  for v in args.vision.split(",")]
+        if len(vision) != len(args.data):
+            raise ParameterError(f"--vision gives {len(vision)} label(s) for "
+                                 f"{len(args.data)} --data")
+    return {"amplitudes": amplitudes, "vision": vision, "out": args.compare_out,
+            "plot": args.compare_plot}
+
+
+def _write_comparison(comparison, args: argparse.Namespace) -> None:
+    if args.compare_out:
+        comparison.write(args.compare_out)
+    if args.compare_plot:
+        from ..viz.plots import plot_reweighting, save_figure
+
+        save_figure(plot_reweighting(comparison), args.compare_plot)
+
+
+def _print_comparison(c) -> None:
+    print(f"{c.parameter} per condition [{c.unit}] (95 % CI; amplitude peak to peak "
+          f"[{c.amplitude_unit}]):")
+    for k, (label, a, v, e, (lo, hi)) in enumerate(zip(
+            c.labels, c.amplitudes, c.vision, c.estimates, c.confidence_intervals,
+            strict=True)):
+        seen = "" if v is None else f", eyes {v}"
+        print(f"  #{k + 1} {label}: {e:.4g} ({lo:.4g} … {hi:.4g}); amplitude {a:.4g}{seen}")
+    lo, hi = c.shared_interval
+    print(f"  shared: {c.shared_estimate:.4g} ({lo:.4g} … {hi:.4g})")
+    verdict = "differs" if c.significant else "no significant difference"
+    print(f"likelihood-ratio test of one shared {c.parameter} against one per condition: "
+          f"ΔS = {c.likelihood_ratio:.4g}, statistic {c.statistic:.4g} ~ {c.distribution}, "
+          f"p = {c.p_value:.3g} ({verdict} at p < 0.05)")
+    for w in c.warnings[:len(c.warnings) - len(c.general.warnings)]:
+        print(f"warning: {w}")

@@ -144,6 +144,12 @@ class FRFFit:
     clipped : numpy.ndarray of bool, shape (K,)
         Whether the interval was clipped to the parameter's accepted range (the parameter
         table) or its search interval.
+    objective : float
+        S = Σ u², the squared whitened residuals at the estimates with the model error δ:
+        what the fit minimised (nested fits' S compare in a likelihood-ratio test). [-]
+    residual_dof, noise_dof : float
+        2B − K, and ν, the degrees of freedom of the noise the intervals use (module notes;
+        the residual dof for ``"relative"``, ∞ for known standard errors). [-]
     """
 
     names: tuple[str, ...]
@@ -163,6 +169,9 @@ class FRFFit:
     at_bound: tuple = ()
     search_bounds: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
     clipped: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=bool))
+    objective: float = math.nan
+    residual_dof: float = math.nan
+    noise_dof: float = math.inf
 
     def unit(self, name: str) -> str:
         """Unit of a fitted parameter."""
@@ -357,7 +366,8 @@ def check_fit_request(muscles: MuscleSet, free, per_condition=(), bounds=None) -
 
 def fit_frf(body: Body, muscles: MuscleSet, data, free, *, input: str = "tilt",
             output: str = "com_angle", feedback_delay: float = 0.0,
-            proprioceptive_weight: float = 1.0, per_condition=(), bounds=None) -> FRFFit:
+            proprioceptive_weight: float = 1.0, per_condition=(), bounds=None,
+            model_error: float | None = None) -> FRFFit:
     """Fit controller parameters to one or several FRFs (module notes).
 
     Parameters
@@ -379,6 +389,9 @@ def fit_frf(body: Body, muscles: MuscleSet, data, free, *, input: str = "tilt",
     bounds : dict of name -> (low, high), optional
         Each within the parameter table's bounds (docs/parameters.md); defaults: the
         table's search intervals (gains [0, 1e5], delay [0, 1] s, W [0, 1]).
+    model_error : float, optional
+        A relative model error δ to allow from the start instead of the one a mismatch
+        would choose (module notes; nested fits compared under one error model). [-]
 
     Raises
     ------
@@ -484,13 +497,14 @@ def fit_frf(body: Body, muscles: MuscleSet, data, free, *, input: str = "tilt",
     dof = max(m - K, 1)
     weighting = "+".join(dict.fromkeys(t.kind for t in targets))
     relative = weighting == "relative"
-    sol = solve(x0 / scale, 0.0)
+    delta = 0.0 if model_error is None else float_in_range("model_error [-]", model_error,
+                                                           0.0, 1e3)
+    sol = solve(x0 / scale, delta)
     p = sol.x * scale
     total = chi2_sum(p, 0.0)
     fit_error = math.sqrt(total / dof)
     mismatch = not relative and total > float(chi2.ppf(1.0 - MISMATCH_P, dof))
-    delta = 0.0
-    if mismatch:
+    if mismatch and model_error is None:
         for _ in range(2):  # the model error that makes the fit error 1, then refit
             a, b = -14.0, 2.0
             values = model(p)
@@ -543,7 +557,8 @@ def fit_frf(body: Body, muscles: MuscleSet, data, free, *, input: str = "tilt",
     return FRFFit(tuple(labels), p, se, ci, determined, float(fit_error), bool(sol.success),
                   str(sol.message), tuple(warnings), tuple(model(p, dense=True)), weighting,
                   bool(mismatch), float(delta), systematic, sides,
-                  np.stack([lo, hi], axis=1), clipped)
+                  np.stack([lo, hi], axis=1), clipped, float(u_all @ u_all), float(dof),
+                  float(nu))
 
 
 def _systematic_bound(J: np.ndarray, targets: list, delta: float, seen: np.ndarray

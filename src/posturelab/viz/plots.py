@@ -17,7 +17,8 @@ function                      what                                         paper
 ============================  ==========================================  ==========
 
 The functions live in :mod:`.run_figures` (runs), :mod:`.maps` (parameter planes),
-:mod:`.frequency` (frequency responses) and :mod:`.figure` (new figures, colours, saving);
+:mod:`.frequency` (frequency responses), :mod:`posturelab.viz.cohort` (conditions and cohorts) and
+:mod:`.figure` (new figures, colours, saving);
 this module gathers them under one name.
 
 Conventions (see :mod:`posturelab.conventions`): angles are absolute from the
@@ -27,6 +28,7 @@ ankle, x forward.
 
 from __future__ import annotations
 
+from .cohort import plot_cohort, plot_reweighting
 from .figure import (
     LINK_COLORS,
     PAIR_COLORS,
@@ -62,6 +64,8 @@ __all__ = [
     "plot_bode",
     "plot_prts_cycles",
     "plot_compare",
+    "plot_reweighting",
+    "plot_cohort",
     "unique_legend",
     "LINK_COLORS",
     "RUN_COLORS",
