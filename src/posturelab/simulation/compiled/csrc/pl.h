@@ -179,6 +179,9 @@ struct pl_method {
                    int locked, double *h_next, int64_t *evals);
     void (*commit)(pl_method *me);
     void (*release)(pl_method *me);
+    /* after a step onto a breakpoint: the first stage again, from the inputs just after it */
+    void (*refresh)(pl_method *me, const pl_model *md, const double *x, const double *inp,
+                    int locked, int64_t *evals);
 };
 int pl_explicit_init(pl_method *me, const pl_run *run, int64_t n);
 int pl_radau_init(pl_method *me, int64_t n);

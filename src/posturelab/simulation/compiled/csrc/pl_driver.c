@@ -103,9 +103,12 @@ static int64_t segment_events(const pl_run *run, const double *sat, const double
     return k;
 }
 
-/* Times at which the delayed feedback is not smooth after the start: kτ after each knee
- * impact, k = 1 … delay_multiples (the impact changes the rates at once, the muscles feel it
- * τ later, its derivatives 2τ, … later), sorted. Steps land on them as on the breakpoints. */
+/* Times at which the delayed feedback is not smooth after the start: kτ after each
+ * breakpoint and each knee impact, k = 1 … delay_multiples (a corner of the stimulus or an
+ * impact changes the rates or accelerations at once, the muscles feel it τ later, its
+ * derivatives 2τ, … later), sorted. Steps land on them as on the breakpoints: an integrator
+ * of order 5 that steps across a jump in a low derivative keeps an error its estimate does
+ * not see. */
 typedef struct {
     double *t;
     int64_t n, cap, next;
@@ -145,6 +148,13 @@ static double next_stop(const pl_run *run, int64_t bi, int64_t di, const jump_li
     return t_stop;
 }
 
+/* How far inside a step its inputs are taken at a breakpoint it starts or ends on: far
+ * beyond the rounding of t ± τ, and a negligible part of the step. [s] */
+static double side_of(double t, double h)
+{
+    return fmin(1e-3 * h, 64.0 * EPS * (1.0 + fabs(t)));
+}
+
 int64_t pl_integrate(const pl_run *run, pl_out *out)
 {
     const int64_t n = run->n, m = 2 * n, T = run->n_grid, width = 2 + n;
@@ -176,11 +186,19 @@ int64_t pl_integrate(const pl_run *run, pl_out *out)
                                          : pl_explicit_init(&me, run, n);
     ok = ok && alloc_buffers(&b, n, run->p, me.n_nodes, run->n_slots);
     ok = ok && pl_history_init(&hist, m, delay > 0.0 ? 256 : 1);
+    for (int64_t i = 0; delay > 0.0 && i < run->n_bps; i++)  /* the breakpoints' echoes */
+        for (int64_t k = 1; ok && k <= run->delay_multiples; k++) {
+            const double echo = run->bps[i] + k * delay;
+            if (echo >= duration)
+                break;
+            ok = jump_add(&jumps, echo);
+        }
     if (!ok) {
         if (me.release)
             me.release(&me);
         free_buffers(&b);
         pl_history_free(&hist);
+        free(jumps.t);
         res[R_STATUS] = PL_NO_MEMORY;
         return PL_NO_MEMORY;
     }
@@ -200,7 +218,7 @@ int64_t pl_integrate(const pl_run *run, pl_out *out)
     double t = 0.0, h = 0.0, fall_time = NAN, last_outside = NAN;
     int64_t status = PL_COMPLETED, fall_kind = -1, fall_index = -1, n_switches = 0;
     int64_t n_steps = 0, n_rejected = 0, n_evals = 0, gi = 0, bi = 0, di = 1, n_ev = 0;
-    int any_outside = 0, final_outside = 0, fall_sample = 0, restart = 1;
+    int any_outside = 0, final_outside = 0, fall_sample = 0, restart = 1, at_stop = 0;
 
     while (t < duration) {
         if (restart) {  /* a smooth segment starts (t = 0, or after a switch) */
@@ -219,10 +237,14 @@ int64_t pl_integrate(const pl_run *run, pl_out *out)
                 locked = 0;  /* at its stop, but the muscles pull the knee off it at once */
             n_ev = segment_events(run, b.sat, b.active, locked, b.ev_kind, b.ev_index,
                                   b.ev_side);
+            /* at a stop the inputs may jump: the events start from their values just
+             * before it (an event that the jump fires is found at the next step's start), the
+             * integrator from the inputs just after it */
+            const double side = at_stop ? side_of(t, INFINITY) : 0.0;
             for (int64_t e = 0; e < n_ev; e++)
-                b.g_old[e] = pl_event_value(&cx, b.ev_kind[e], b.ev_index[e], b.ev_side[e], t,
-                                            x, locked);
-            pl_inputs_at(&cx, t, inp);
+                b.g_old[e] = pl_event_value(&cx, b.ev_kind[e], b.ev_index[e], b.ev_side[e],
+                                            t - side, x, locked);
+            pl_inputs_at(&cx, t + side, inp);
             h = me.start(&me, &md, t, x, next_stop(run, bi, di, &jumps, duration), max_step,
                          rtol, atol, locked, inp, &n_evals);
             restart = 0;
@@ -249,9 +271,16 @@ int64_t pl_integrate(const pl_run *run, pl_out *out)
         }
         const double t_new = landing ? t_stop : t + h;
         if (has_inputs)
-            for (int64_t k = 0; k < me.n_nodes; k++)
-                pl_inputs_at(&cx, me.nodes[k] == 1.0 ? t_new : t + me.nodes[k] * h,
-                             inp + k * width);
+            for (int64_t k = 0; k < me.n_nodes; k++) {
+                /* the inputs may jump at a breakpoint: a step onto one takes them just
+                 * before it at its end, a step from one just after it at its start */
+                double tk = me.nodes[k] == 1.0 ? t_new : t + me.nodes[k] * h;
+                if (landing && me.nodes[k] == 1.0)
+                    tk = t_new - side_of(t_new, h);
+                else if (at_stop && me.nodes[k] == 0.0)
+                    tk = t + side_of(t, h);
+                pl_inputs_at(&cx, tk, inp + k * width);
+            }
         double h_next;
         if (!me.attempt(&me, &md, t, h, x, y, Q, inp, rtol, atol, locked, &h_next, &n_evals)) {
             n_rejected++;
@@ -264,12 +293,14 @@ int64_t pl_integrate(const pl_run *run, pl_out *out)
             break;
         }
 
-        /* events that fired in (t, t_new]: the earliest root on the interpolant */
+        /* events that fired in (t, t_new]: the earliest root on the interpolant (on a
+         * stop, their values just before it, as the step saw its inputs) */
         int64_t ev_hit = -1;
         double t_ev = t_new;
+        const double t_look = landing ? t_new - side_of(t_new, h) : t_new;
         for (int64_t e = 0; e < n_ev; e++) {
             const int64_t kind = b.ev_kind[e];
-            const double gn = pl_event_value(&cx, kind, b.ev_index[e], b.ev_side[e], t_new, y,
+            const double gn = pl_event_value(&cx, kind, b.ev_index[e], b.ev_side[e], t_look, y,
                                              locked);
             const double go = b.g_old[e];
             b.g_new[e] = gn;
@@ -285,6 +316,14 @@ int64_t pl_integrate(const pl_run *run, pl_out *out)
             } else if (root < t_ev) {
                 t_ev = root;  /* a tie within 1e-12 s: the earlier-listed event wins */
             }
+        }
+        int ev_at_stop = 0;  /* an event on a stop happens there (a jump of the inputs) */
+        if (ev_hit >= 0 && at_stop && t_ev <= t + 1e-12 * fmax(1.0, fabs(t))) {
+            t_ev = t;
+            ev_at_stop = 1;
+        } else if (ev_hit >= 0 && landing && t_ev >= t_new - 1e-12 * fmax(1.0, fabs(t_new))) {
+            t_ev = t_new;
+            ev_at_stop = 1;
         }
 
         /* output samples in [t, end of this piece], as the reference selects them */
@@ -428,20 +467,20 @@ int64_t pl_integrate(const pl_run *run, pl_out *out)
                 x[1] = x[0] + stop_angle;
                 pl_project_velocity(x, run->bp, b.work, n);
                 locked = 1;
-                int stored = 1;
-                for (int64_t k = 1; delay > 0.0 && k <= run->delay_multiples; k++)
-                    if (t_ev + k * delay < duration)
-                        stored = stored && jump_add(&jumps, t_ev + k * delay);
-                if (!stored) {
-                    status = PL_NO_MEMORY;
-                    break;
-                }
             } else if (kind == EV_KNEE_LEAVES_STOP) {
                 locked = 0;
             } else if (kind == EV_SATURATES) {
                 b.sat[j] = b.ev_side[ev_hit];
             } else if (kind == EV_LETS_GO) {
                 b.sat[j] = 0.0;
+            }
+            int stored = 1;  /* the switch's echoes: the muscles feel it τ, 2τ, … later */
+            for (int64_t k = 1; delay > 0.0 && k <= run->delay_multiples; k++)
+                if (t_ev + k * delay < duration)
+                    stored = stored && jump_add(&jumps, t_ev + k * delay);
+            if (!stored) {
+                status = PL_NO_MEMORY;
+                break;
             }
             int finite = 1;
             for (int64_t i = 0; i < m; i++)
@@ -451,6 +490,7 @@ int64_t pl_integrate(const pl_run *run, pl_out *out)
                 break;
             }
             restart = 1;
+            at_stop = ev_at_stop;
             continue;
         }
 
@@ -466,12 +506,17 @@ int64_t pl_integrate(const pl_run *run, pl_out *out)
         me.commit(&me);
         memcpy(b.g_old, b.g_new, sizeof(double) * n_ev);
         pl_set_base(x, b.base, n);
+        at_stop = landing;
         if (landing) {
             while (bi < run->n_bps && run->bps[bi] <= t + 1e-12)
                 bi++;
             while (delay > 0.0 && di <= run->delay_multiples && di * delay <= t + 1e-12)
                 di++;
             jump_pass(&jumps, t);
+            if (has_inputs && t < duration) {  /* the first stage from just after it */
+                pl_inputs_at(&cx, t + side_of(t, h_next), inp);
+                me.refresh(&me, &md, x, inp, locked, &n_evals);
+            }
         }
         h = h_next;
     }
