@@ -148,6 +148,22 @@ static double next_stop(const pl_run *run, int64_t bi, int64_t di, const jump_li
     return t_stop;
 }
 
+/* Whether breakpoint i is another's first echo (the set-up lists a tilt's corners t_k and
+ * t_k + τ): its own echoes are the other's. */
+static int is_echo(const pl_run *run, int64_t i)
+{
+    const double want = run->bps[i] - run->delay, tol = 1e-12 * fmax(1.0, run->bps[i]);
+    int64_t lo = 0, hi = i;  /* the first of bps[0 .. i) at or after want − tol */
+    while (lo < hi) {
+        const int64_t mid = (lo + hi) >> 1;
+        if (run->bps[mid] < want - tol)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo < i && run->bps[lo] <= want + tol;
+}
+
 /* How far inside a step its inputs are taken at a breakpoint it starts or ends on: far
  * beyond the rounding of t ± τ, and a negligible part of the step. [s] */
 static double side_of(double t, double h)
@@ -187,7 +203,7 @@ int64_t pl_integrate(const pl_run *run, pl_out *out)
     ok = ok && alloc_buffers(&b, n, run->p, me.n_nodes, run->n_slots);
     ok = ok && pl_history_init(&hist, m, delay > 0.0 ? 256 : 1);
     for (int64_t i = 0; delay > 0.0 && i < run->n_bps; i++)  /* the breakpoints' echoes */
-        for (int64_t k = 1; ok && k <= run->delay_multiples; k++) {
+        for (int64_t k = 1; ok && k <= run->delay_multiples && !is_echo(run, i); k++) {
             const double echo = run->bps[i] + k * delay;
             if (echo >= duration)
                 break;
