@@ -281,6 +281,9 @@ def render_figures(runs: PaperRuns, link_names: list[str],
         import multiprocessing
         from concurrent.futures import ProcessPoolExecutor
 
+        from .checks import frf_experiment
+
+        frf_experiment()  # (two figures and a finding use it: computed once, before forking)
         _SHARED = (runs, link_names)
         try:
             with ProcessPoolExecutor(max_workers=min(processes, len(FIGURE_STEPS)),

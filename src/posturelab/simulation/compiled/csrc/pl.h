@@ -156,6 +156,9 @@ typedef struct {
 int pl_history_init(pl_history *hist, int64_t m, int64_t cap);
 int pl_history_add(pl_history *hist, double t, double h, const double *x, const double *Q);
 void pl_history_at(const pl_history *hist, const double *before, double s, double *out);
+void pl_history_drop(pl_history *hist);  /* the last step out again (overlapping steps) */
+void pl_history_extrapolate(const pl_history *hist, double t, double h, const double *x,
+                            double *Q);
 void pl_history_free(pl_history *hist);
 
 /* dense output of a step: x + Q·(σ, σ², σ³, σ⁴) */

@@ -5,8 +5,11 @@
  * event functions at the step's end, finds the earliest root on its dense output, and either
  * ends the run (a fall) or applies the switch and restarts the integrator, as the reference
  * engine does. With a feedback delay τ each kept step's dense output goes to the history,
- * the inputs of every stage include the delayed joint moments, steps are at most τ long and
- * land on kτ (k = 1 … delay_multiples). */
+ * the inputs of every stage include the delayed joint moments, steps are at most τ long (or,
+ * for a delay below OVERLAP_BELOW, overlap their own past) and land on kτ (k = 1 …
+ * delay_multiples). Steps also land on every breakpoint and on its echoes kτ later, and on
+ * the echoes of every switch: the inputs are taken just before a stop at a step's end and
+ * just after it at the next step's start. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -17,6 +20,14 @@
 #define EPS 2.220446049250313e-16
 #define SAMPLE_BLOCK 64  /* samples evaluated together */
 #define CLOCK_EVERY 256  /* attempted steps between looks at the clock (a time limit) */
+/* Overlapping steps: below this delay [s] a step may be longer than τ (otherwise it is at
+ * most τ, and the past it needs is computed before it starts). Its delayed states inside
+ * itself then come from its own dense output, first the last step's carried on, then its
+ * own, iterated until the end state moves by less than OVERLAP_TOL of the tolerance; a step
+ * that does not settle within OVERLAP_ITERATIONS tries is halved. */
+#define OVERLAP_BELOW 1e-4
+#define OVERLAP_TOL 1e-2
+#define OVERLAP_ITERATIONS 8
 
 /* Seconds on a clock that only moves forward (wall-clock seconds without one). [s] */
 static double wall_seconds(void)
@@ -31,7 +42,7 @@ static double wall_seconds(void)
 
 typedef struct {
     double *tm, *sat, *base, *work, *tau, *active, *x, *y, *Q, *inp, *g_old, *g_new, *sc_out,
-        *sc_inp, *sc_x, *ys, *ev_side, *block;
+        *sc_inp, *sc_x, *ys, *ev_side, *block, *Qg, *yp;
     int64_t *ev_kind, *ev_index;
 } buffers;
 
@@ -39,7 +50,7 @@ static void free_buffers(buffers *b)
 {
     double *d[] = {b->tm, b->sat, b->base, b->work, b->tau, b->active, b->x, b->y, b->Q,
                    b->inp, b->g_old, b->g_new, b->sc_out, b->sc_inp, b->sc_x, b->ys,
-                   b->ev_side, b->block};
+                   b->ev_side, b->block, b->Qg, b->yp};
     for (size_t k = 0; k < sizeof(d) / sizeof(d[0]); k++)
         free(d[k]);
     free(b->ev_kind);
@@ -70,7 +81,9 @@ static int alloc_buffers(buffers *b, int64_t n, int64_t p, int64_t n_nodes, int6
     b->sc_x = calloc(m, sizeof(double));
     b->ys = calloc(m, sizeof(double));
     b->block = calloc(m * SAMPLE_BLOCK, sizeof(double));
-    return b->tm && b->sat && b->base && b->work && b->tau && b->active && b->x && b->y
+    b->Qg = calloc(4 * m, sizeof(double));
+    b->yp = calloc(m, sizeof(double));
+    return b->Qg && b->yp && b->tm && b->sat && b->base && b->work && b->tau && b->active && b->x && b->y
            && b->Q && b->inp && b->g_old && b->g_new && b->ev_side && b->ev_kind
            && b->ev_index && b->sc_out && b->sc_inp && b->sc_x && b->ys && b->block;
 }
@@ -179,7 +192,8 @@ int64_t pl_integrate(const pl_run *run, pl_out *out)
     const double settle_tol = fpar[F_SETTLE_TOL], stop_angle = fpar[F_STOP_ANGLE];
     const double delay = run->delay;
     double max_step = fpar[F_MAX_STEP];
-    if (delay > 0.0)
+    const int overlapping = delay > 0.0 && delay < OVERLAP_BELOW;
+    if (delay > 0.0 && !overlapping)
         max_step = fmin(max_step, delay);  /* the method of steps: the past is computed */
     const int64_t max_switches = run->ipar[I_MAX_SWITCHES];
     const int64_t max_steps = run->ipar[I_MAX_STEPS];
@@ -286,25 +300,59 @@ int64_t pl_integrate(const pl_run *run, pl_out *out)
             break;
         }
         const double t_new = landing ? t_stop : t + h;
-        if (has_inputs)
-            for (int64_t k = 0; k < me.n_nodes; k++) {
-                /* the inputs may jump at a breakpoint: a step onto one takes them just
-                 * before it at its end, a step from one just after it at its start */
-                double tk = me.nodes[k] == 1.0 ? t_new : t + me.nodes[k] * h;
-                if (landing && me.nodes[k] == 1.0)
-                    tk = t_new - side_of(t_new, h);
-                else if (at_stop && me.nodes[k] == 0.0)
-                    tk = t + side_of(t, h);
-                pl_inputs_at(&cx, tk, inp + k * width);
+        const int overlap = overlapping && h > delay;  /* its past reaches into itself */
+        if (overlap) {
+            pl_history_extrapolate(&hist, t, h, x, b.Qg);
+            if (!pl_history_add(&hist, t, h, x, b.Qg)) {
+                status = PL_NO_MEMORY;
+                break;
             }
+            for (int64_t i = 0; i < m; i++)
+                b.yp[i] = x[i] + b.Qg[4 * i] + b.Qg[4 * i + 1] + b.Qg[4 * i + 2]
+                          + b.Qg[4 * i + 3];
+        }
         double h_next;
-        if (!me.attempt(&me, &md, t, h, x, y, Q, inp, rtol, atol, locked, &h_next, &n_evals)) {
+        int accepted = 0, settled = !overlap;
+        for (int64_t it = 0;; it++) {
+            if (has_inputs)
+                for (int64_t k = 0; k < me.n_nodes; k++) {
+                    /* the inputs may jump at a breakpoint: a step onto one takes them just
+                     * before it at its end, a step from one just after it at its start */
+                    double tk = me.nodes[k] == 1.0 ? t_new : t + me.nodes[k] * h;
+                    if (landing && me.nodes[k] == 1.0)
+                        tk = t_new - side_of(t_new, h);
+                    else if (at_stop && me.nodes[k] == 0.0)
+                        tk = t + side_of(t, h);
+                    pl_inputs_at(&cx, tk, inp + k * width);
+                }
+            accepted = me.attempt(&me, &md, t, h, x, y, Q, inp, rtol, atol, locked, &h_next,
+                                  &n_evals);
+            if (!accepted || !overlap)
+                break;
+            pl_history_drop(&hist);  /* the step's past inside itself: its own output */
+            pl_history_add(&hist, t, h, x, Q);  /* (the slot exists: cannot fail) */
+            double change = 0.0;
+            for (int64_t i = 0; i < m; i++) {
+                const double d = (y[i] - b.yp[i]) / (atol + rtol * fmax(fabs(x[i]), fabs(y[i])));
+                change += d * d;
+                b.yp[i] = y[i];
+            }
+            if (change / m <= OVERLAP_TOL * OVERLAP_TOL) {
+                settled = 1;
+                break;
+            }
+            if (it + 1 >= OVERLAP_ITERATIONS)
+                break;
+        }
+        if (!accepted || !settled) {
+            if (overlap)
+                pl_history_drop(&hist);
             n_rejected++;
-            h = h_next;
+            h = accepted ? 0.5 * h : h_next;  /* (not settled: a shorter step) */
             continue;
         }
         n_steps++;
-        if (delay > 0.0 && !pl_history_add(&hist, t, h, x, Q)) {
+        if (delay > 0.0 && !overlap && !pl_history_add(&hist, t, h, x, Q)) {
             status = PL_NO_MEMORY;
             break;
         }
