@@ -402,7 +402,18 @@ int64_t pl_integrate(const pl_run *run, pl_out *out)
          * component at a time (independent samples: the evaluations overlap), then the
          * outcomes sample by sample; the same code for a single run and a batch row */
         const int64_t comps = out->samples ? m : n;
-        for (int64_t g0 = gi; g0 < g_end; g0 += SAMPLE_BLOCK) {
+        /* a batch row keeps outcomes only: a step whose angles stay, by the bound |x| + Σ|q|
+         * of its interpolant on [t, t + h], within both the peaks so far and the settling
+         * band changes neither (its samples are not evaluated; the outcomes are the same) */
+        int quiet = !out->samples && !out->fb && !inclusive && g_end > gi;
+        for (int64_t i = 0; quiet && i < n; i++) {
+            const double *q = Q + 4 * i;
+            const double bound = fabs(x[i]) + fabs(q[0]) + fabs(q[1]) + fabs(q[2]) + fabs(q[3]);
+            quiet = bound <= out->peak[i] && bound <= settle_tol;
+        }
+        if (quiet)
+            final_outside = 0;
+        for (int64_t g0 = gi; !quiet && g0 < g_end; g0 += SAMPLE_BLOCK) {
             const int64_t g1 = g0 + SAMPLE_BLOCK < g_end ? g0 + SAMPLE_BLOCK : g_end;
             const int64_t len = g1 - g0;
             const double inv_h = 1.0 / h;
