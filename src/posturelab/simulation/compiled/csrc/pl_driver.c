@@ -83,9 +83,10 @@ static int alloc_buffers(buffers *b, int64_t n, int64_t p, int64_t n_nodes, int6
     b->block = calloc(m * SAMPLE_BLOCK, sizeof(double));
     b->Qg = calloc(4 * m, sizeof(double));
     b->yp = calloc(m, sizeof(double));
-    return b->Qg && b->yp && b->tm && b->sat && b->base && b->work && b->tau && b->active && b->x && b->y
+    return b->tm && b->sat && b->base && b->work && b->tau && b->active && b->x && b->y
            && b->Q && b->inp && b->g_old && b->g_new && b->ev_side && b->ev_kind
-           && b->ev_index && b->sc_out && b->sc_inp && b->sc_x && b->ys && b->block;
+           && b->ev_index && b->sc_out && b->sc_inp && b->sc_x && b->ys && b->block && b->Qg
+           && b->yp;
 }
 
 /* The events of a smooth segment: the slots (posturelab.model.events.event_slots) whose
@@ -333,7 +334,8 @@ int64_t pl_integrate(const pl_run *run, pl_out *out)
             pl_history_add(&hist, t, h, x, Q);  /* (the slot exists: cannot fail) */
             double change = 0.0;
             for (int64_t i = 0; i < m; i++) {
-                const double d = (y[i] - b.yp[i]) / (atol + rtol * fmax(fabs(x[i]), fabs(y[i])));
+                const double sc = atol + rtol * fmax(fabs(x[i]), fabs(y[i]));
+                const double d = (y[i] - b.yp[i]) / sc;
                 change += d * d;
                 b.yp[i] = y[i];
             }
