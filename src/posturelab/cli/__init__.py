@@ -28,6 +28,7 @@ SUBCOMMANDS: dict[str, str] = {
     "frf": "frf",
     "frf-model": "frf_model",
     "fit-frf": "fit_frf",
+    "design": "design",
     "compare": "compare",
     "explore": "explore",
 }
@@ -50,6 +51,8 @@ SUBCOMMAND_HELP: dict[str, str] = {
                  "delay)",
     "fit-frf": "fit controller gains, delay and sensory weight to FRFs (one or several "
                "conditions)",
+    "design": "predict the standard errors of a PRTS experiment's fit before running it "
+              "(Fisher information), and optimise its design",
     "compare": "overlay saved runs (posturelab simulate --out) in one figure, and tabulate them",
     "explore": "explore the model interactively in the web browser (a local page)",
 }

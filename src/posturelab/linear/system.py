@@ -459,7 +459,7 @@ def linear_system(body: Body | BodyArrays, muscles: MuscleSet, *, stiffness=None
     -------
     LinearSystem
     """
-    from .._validation import check_model
+    from ..model.checks import check_model
 
     if isinstance(body, Body):
         check_model(body, muscles)
