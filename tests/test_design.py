@@ -14,9 +14,9 @@ from posturelab.frequency.design import (
     band_noise_covariance,
     frf_derivatives,
     model_band_frf,
-    optimise_design,
     predict_errors,
 )
+from posturelab.frequency.design_search import optimise_design
 from posturelab.frequency.experiment import prts_experiment
 from posturelab.frequency.fit import fit_frf
 from posturelab.model.controllers import get_controller

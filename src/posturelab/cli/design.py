@@ -23,7 +23,8 @@ estimated band FRFs: white --sensor-noise RAD on the recorded angle, and --motor
 SIGMA[,SIGMA...] N·m per joint (optionally low-passed at --motor-noise-cutoff HZ) through the
 closed loop, for --cycles N analysed cycles (plus --discard, default 1) of --tilt
 prts:AMPLITUDE_RAD[:STATE_DURATION_S][:SEQUENCE] recorded at --sample-rate HZ
-(posturelab.frequency.design states the derivation and its sources). The errors fall as
+(posturelab.frequency.design states the derivation and its sources;
+posturelab.frequency.design_search the search). The errors fall as
 1/(amplitude × √cycles) under the linear model.
 
 --optimise searches the state duration (--state-durations LO:HI s, default 0.1:0.5), the
@@ -97,11 +98,11 @@ def _pair(text: str | None, option: str, default):
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..frequency.design import (
+    from ..frequency.design import predict_errors
+    from ..frequency.design_search import (
         AMPLITUDE_RANGE,
         STATE_DURATION_RANGE,
         optimise_design,
-        predict_errors,
     )
     from ..linear.verdict import upright_verdict
     from ._common import naming_option, parse_tilt
