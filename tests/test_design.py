@@ -183,3 +183,22 @@ def test_cli_json_gives_the_api_errors(model):
                         "--sensor-noise", "0.001", "--budget", "100"), "--optimise")
     one_line_exit_2(cli("design", "--controller", "peterka-2002", "--free", "nonsense",
                         "--sensor-noise", "0.001"), "nonsense")
+
+
+def test_the_design_guide_python_runs(tmp_path):
+    """docs/guide/design.rst's Python, as written."""
+    import re
+    import subprocess
+    import sys
+    import textwrap
+    from pathlib import Path
+
+    text = (Path(__file__).resolve().parents[1] / "docs" / "guide" / "design.rst").read_text(
+        encoding="utf-8")
+    blocks = re.findall(r"\.\. code-block:: python\n\n((?:(?:   .*)?\n)+)", text)
+    code = "\n".join(textwrap.dedent(b) for b in blocks)
+    assert "predict_errors(" in code
+    p = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True,
+                       text=True, timeout=300)
+    assert p.returncode == 0, p.stderr
+    assert "feedback_delay" in p.stdout
