@@ -202,3 +202,21 @@ def test_the_design_guide_python_runs(tmp_path):
                        text=True, timeout=300)
     assert p.returncode == 0, p.stderr
     assert "feedback_delay" in p.stdout
+
+
+def test_cli_optimise_within_budget_and_its_refusals():
+    p = cli("design", "--controller", "peterka-2002", "--free", ",".join(FREE),
+            "--sensor-noise", "0.001", "--motor-noise", "2", "--optimise", "--budget", "150",
+            "--targets", "feedback_delay", "--grid", "3", "--json")
+    assert p.returncode == 0, p.stderr
+    out = json.loads(p.stdout)
+    assert out["design"]["duration"] <= 150
+    assert out["optimised"]["targets"] == ["feedback_delay"]
+    assert out["optimised"]["objective"] == pytest.approx(
+        out["parameters"]["feedback_delay"]["relative_error"] ** 2, rel=1e-9)
+    base = ("design", "--controller", "peterka-2002", "--free", "feedback_delay")
+    one_line_exit_2(cli(*base, "--sensor-noise", "-1"), "--sensor-noise")
+    one_line_exit_2(cli(*base, "--sensor-noise", "0.001", "--cycles", "1"), "--cycles")
+    one_line_exit_2(cli(*base, "--sensor-noise", "0.001", "--optimise", "--budget", "100",
+                        "--amplitudes", "0.1:0.01"), "--amplitudes")
+    one_line_exit_2(cli(*base, "--sensor-noise", "0.001", "--optimise"), "--budget")

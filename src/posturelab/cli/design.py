@@ -92,9 +92,33 @@ def _names(text: str) -> list[str]:
 
 
 def _pair(text: str | None, option: str, default):
+    """LO:HI of ``option``, checked against the search's range (the option named)."""
+    from ..frequency.design_search import _range
+
     if text is None:
         return default
-    return tuple(parse_float_list(text.replace(":", ","), option, 2))
+    unit = "[rad]" if option == "--amplitudes" else "[s]"
+    values = parse_float_list(text.replace(":", ","), f"{option} LO:HI {unit}", 2)
+    low, high = ((1e-4, 0.5) if option == "--amplitudes" else (0.01, 10.0))
+    return _range(f"{option} LO:HI {unit}", values, low, high)
+
+
+def _check_numbers(args: argparse.Namespace) -> None:
+    """The numbers given, each named by its option."""
+    from .._validation import float_in_range
+    from ..frequency.design import MAX_CYCLES
+    from ..frequency.design_search import MAX_GRID
+
+    float_in_range("--sensor-noise [rad]", args.sensor_noise, 0.0, 1.0, unit="rad")
+    float_in_range("--sample-rate [Hz]", args.sample_rate, 1.0, 1e5, unit="Hz")
+    for option, value, least, most in (("--cycles", args.cycles, 2, MAX_CYCLES),
+                                       ("--discard", args.discard, 0, MAX_CYCLES),
+                                       ("--grid", args.grid, 2, MAX_GRID)):
+        if not least <= value <= most:
+            raise ParameterError(f"{option} must be an integer in [{least}, {most}], got "
+                                 f"{value}")
+    if args.budget is not None:
+        float_in_range("--budget [s]", args.budget, 1e-3, 86_400.0, unit="s")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -116,6 +140,7 @@ def run(args: argparse.Namespace) -> int:
     with naming_option("--motor-noise"):
         noise = motor_noise_from_args(args, body.n_links)
     free = _names(args.free)
+    _check_numbers(args)
     verdict = upright_verdict(body, muscles, options.get("feedback_delay", 0.0))
     if not verdict.side(engaged=True).status == "stable":
         raise ParameterError(f"the loop is {verdict.describe()}: its FRF is not measurable "
@@ -130,9 +155,8 @@ def run(args: argparse.Namespace) -> int:
         result = optimise_design(
             body, muscles, free, budget=args.budget,
             targets=None if args.targets is None else _names(args.targets), tilt=tilt,
-            amplitude_range=_pair(args.amplitudes, "--amplitudes LO:HI [rad]",
-                                  AMPLITUDE_RANGE),
-            state_duration_range=_pair(args.state_durations, "--state-durations LO:HI [s]",
+            amplitude_range=_pair(args.amplitudes, "--amplitudes", AMPLITUDE_RANGE),
+            state_duration_range=_pair(args.state_durations, "--state-durations",
                                        STATE_DURATION_RANGE), grid=args.grid, **common)
         prediction, out = result.best, result.to_dict()
     else:
