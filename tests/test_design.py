@@ -59,6 +59,28 @@ def test_band_variance_matches_simulated_experiments(model):
     assert abs(np.mean(ratio) - 1) < 0.15, ratio
 
 
+def test_motor_noise_through_a_three_link_chain_matches_simulated_experiments():
+    """Motor noise at the knee and hip only (the joint-torque map Eᵀ matters), the leg angle
+    recorded: V against the scatter over 30 seeded experiments of the paper's body."""
+    from posturelab.model.body import paper_body
+    from posturelab.model.muscles import paper_muscles
+
+    body, muscles = paper_body(), paper_muscles("1")
+    tilt = PRTSTilt.named("posturelab-80", 0.02)
+    seeds = 30
+    frfs = np.array([prts_experiment(
+        body, muscles, tilt=tilt, cycles=2, discard=1, seed=seed, output="theta1",
+        motor_noise=MotorNoise((0.0, 2.0, 3.0), 2.0, seed=seed)).estimate.frf
+        for seed in range(seeds)])
+    spread = np.sum(np.abs(frfs - frfs.mean(axis=0)) ** 2, axis=0) / (seeds - 1)
+    predicted = np.diag(band_noise_covariance(
+        body, muscles, tilt, 2, output="theta1",
+        motor_noise=MotorNoise((0.0, 2.0, 3.0), 2.0))["covariance"])
+    ratio = spread / predicted
+    assert np.all((ratio > 0.5) & (ratio < 1.7)), ratio  # 2(30 − 1) dof: ±19 % (1 sd)
+    assert abs(np.mean(ratio) - 1) < 0.15, ratio
+
+
 def test_predicted_errors_within_25_percent_of_the_spread_of_40_fits(model):
     """Simulated experiments (compiled engine, motor and sensor noise), estimated and fitted
     by fit_frf: the spread of the fitted values against the predicted standard errors."""
