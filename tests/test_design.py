@@ -187,6 +187,12 @@ def test_refusals(model):
                        **options)
     with pytest.raises(ParameterError, match="cycles"):
         predict_errors(body, muscles, FREE, cycles=1, sensor_noise=0.001, **options)
+    with pytest.raises(ParameterError, match="not measurable"):  # τ beyond the delay margin
+        predict_errors(body, muscles, FREE, sensor_noise=0.001,
+                       feedback_delay=0.4, proprioceptive_weight=1.0)
+    with pytest.raises(ParameterError, match="samples"):
+        predict_errors(body, muscles, FREE, sensor_noise=0.001, sample_rate=20_000.0,
+                       **options)
 
 
 def test_cli_json_gives_the_api_errors(model):

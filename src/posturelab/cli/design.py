@@ -128,7 +128,6 @@ def run(args: argparse.Namespace) -> int:
         STATE_DURATION_RANGE,
         optimise_design,
     )
-    from ..linear.verdict import upright_verdict
     from ._common import naming_option, parse_tilt
     from .simulate import motor_noise_from_args
 
@@ -141,10 +140,6 @@ def run(args: argparse.Namespace) -> int:
         noise = motor_noise_from_args(args, body.n_links)
     free = _names(args.free)
     _check_numbers(args)
-    verdict = upright_verdict(body, muscles, options.get("feedback_delay", 0.0))
-    if not verdict.side(engaged=True).status == "stable":
-        raise ParameterError(f"the loop is {verdict.describe()}: its FRF is not measurable "
-                             "(a periodic-stimulus experiment would fall)")
     common = dict(discard=args.discard, sensor_noise=args.sensor_noise, motor_noise=noise,
                   sample_rate=args.sample_rate, output=args.output.strip().lower(),
                   feedback_delay=options.get("feedback_delay", 0.0),

@@ -70,10 +70,13 @@ from ..model.body import Body
 from ..model.muscles import MuscleSet
 
 __all__ = ["DesignPrediction", "predict_errors", "band_noise_covariance", "model_band_frf",
-           "frf_derivatives", "motor_noise_gain", "MAX_CYCLES"]
+           "frf_derivatives", "motor_noise_gain", "MAX_CYCLES",
+           "MAX_CYCLE_SAMPLES"]
 
 #: Most cycles a design may have. [-]
 MAX_CYCLES = 10_000
+#: Most samples per cycle (f_s × T) a design may have. [-]
+MAX_CYCLE_SAMPLES = 200_000
 #: Relative step of the central differences (module notes). [-]
 RELATIVE_STEP = 1e-5
 #: Largest condition number of the Fisher information taken as invertible. [-]
@@ -172,6 +175,9 @@ def _check_design(tilt, cycles: int, discard: int, sample_rate: float):
         raise ParameterError(f"the cycle of {tilt.cycle:g} s is {L:g} samples at {fs:g} Hz, not a "
                              "whole number: choose a state duration that is a whole number of "
                              "samples")
+    if L > MAX_CYCLE_SAMPLES:
+        raise ParameterError(f"a cycle of {tilt.cycle:g} s at {fs:g} Hz is {L:.0f} samples; at "
+                             f"most {MAX_CYCLE_SAMPLES:,} (lower the sample rate)")
     return fs, int(round(L))
 
 
@@ -423,6 +429,17 @@ def _fisher(D: np.ndarray, V: np.ndarray) -> np.ndarray:
     return 2.0 * (D.real.T @ cho_solve(factor, D.real) + D.imag.T @ cho_solve(factor, D.imag))
 
 
+def _check_stable(body: Body, muscles: MuscleSet, feedback_delay: float) -> None:
+    """Refuse a loop that is not stable about upright at its delay (no measurable FRF)."""
+    from ..linear.verdict import upright_verdict
+
+    verdict = upright_verdict(body, muscles, feedback_delay)
+    if verdict.side(engaged=True).status != "stable":
+        raise ParameterError(f"the loop is {verdict.describe()}: its FRF is not measurable "
+                             "(a periodic-stimulus experiment would fall); change the gains or "
+                             "the feedback delay")
+
+
 def _model_options(feedback_delay, proprioceptive_weight, output) -> dict:
     from ..parameters import check_value
 
@@ -468,6 +485,7 @@ def predict_errors(body: Body, muscles: MuscleSet, free, *, tilt=None, cycles: i
         raise ParameterError("predict_errors needs a Body and a MuscleSet")
     tilt = PRTSTilt.named("posturelab-80", 0.035) if tilt is None else tilt
     _check_design(tilt, cycles, discard, sample_rate)
+    _check_stable(body, muscles, feedback_delay)
     model = _model_options(feedback_delay, proprioceptive_weight, output)
     names, specs = _specs(muscles, free)
     noise = band_noise_covariance(body, muscles, tilt, int(cycles), sensor_noise=sensor_noise,
