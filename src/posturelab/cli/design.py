@@ -16,7 +16,8 @@ from ._common import (
 
 DESCRIPTION = """\
 Predict, before the experiment, the standard error of each --free parameter that a fit of
-the model FRF (posturelab fit-frf) to a PRTS tilt experiment will give: the Fisher
+the model FRF (posturelab fit-frf) to a PRTS tilt experiment will give, for a subject whose
+parameters are those the body and controller options below state: the Fisher
 information of the exact model FRF (the delay as e^{−sτ}) under the stated noise, 2 Re(Dᴴ
 V⁻¹ D) with D = ∂H/∂θ over the bands (central differences) and V the covariance of the
 estimated band FRFs: white --sensor-noise RAD on the recorded angle, and --motor-noise
