@@ -159,3 +159,56 @@ def test_fit_frf_recovers_torque_feedback_from_a_synthetic_frf():
                   torque_feedback_gain=1.2, torque_feedback_time_constant=25.0)
     assert fit.names[-2:] == ("torque_feedback_gain", "torque_feedback_time_constant")
     np.testing.assert_allclose(fit.estimates, list(truth.values()), rtol=1e-5)
+
+
+def test_rightmost_roots_with_a_delay_zero_the_characteristic_matrix():
+    """With a delay the rightmost roots (collocation over the 3N-state first-order form, then
+    Newton on det Δ with g(s)) make Δ(s) singular, and at τ → 0 tend to the poles."""
+    from posturelab.linear.delay import system_rightmost_roots
+
+    system = linear_system(BODY, TRUE, delay=PRESET.feedback_delay,
+                           torque_feedback_gain=SOURCE_GAIN,
+                           torque_feedback_time_constant=SOURCE_TIME_CONSTANT)
+    roots = system_rightmost_roots(system, PRESET.feedback_delay, count=3)
+    for r in roots:
+        D = system.characteristic_matrix(np.array([r]))[0, 0, 0]
+        assert abs(D) <= 1e-8 * abs(system.characteristic_matrix(np.array([abs(r) + 1]))[0, 0, 0])
+    small = system_rightmost_roots(system, 1e-7, count=3)
+    poles = linear_system(BODY, TRUE, delay=0.0, torque_feedback_gain=SOURCE_GAIN,
+                          torque_feedback_time_constant=SOURCE_TIME_CONSTANT).poles()[0]
+    np.testing.assert_allclose(np.sort_complex(small), np.sort_complex(poles), rtol=1e-4)
+
+
+def test_frf_model_and_fit_frf_commands_take_torque_feedback(capsys, tmp_path):
+    """frf-model --torque-feedback-gain/--torque-feedback-time-constant prints model_frf's
+    numbers; fit-frf frees both by name on that table (noise-free: back to 1e-6); an
+    unstable loop is refused in one line."""
+    import json
+
+    from posturelab.cli import main
+
+    code = main(["frf-model", "--controller", "icm-pmc5664365", "--bands", "peterka",
+                 "--torque-feedback-gain", "1.7", "--torque-feedback-time-constant", "17.4",
+                 "--json"])
+    out = capsys.readouterr().out
+    obj = json.loads(out)
+    H = model_frf(BODY, TRUE, obj["frequency"], feedback_delay=PRESET.feedback_delay,
+                  proprioceptive_weight=PRESET.proprioceptive_weight,
+                  torque_feedback_gain=1.7, torque_feedback_time_constant=17.4)
+    assert code == 0
+    np.testing.assert_allclose([complex(z["re"], z["im"]) for z in obj["frf"]], H, rtol=1e-12)
+    table = tmp_path / "frf.json"
+    table.write_text(out, encoding="utf-8")
+    code = main(["fit-frf", "--data", str(table), "--controller", "icm-pmc5664365",
+                 "--free", "torque_feedback_gain,torque_feedback_time_constant",
+                 "--torque-feedback-gain", "1.0", "--torque-feedback-time-constant", "30",
+                 "--json"])
+    fit = json.loads(capsys.readouterr().out)
+    assert code == 0
+    estimates = {p["name"]: p["estimate"] for p in fit["parameters"]}
+    np.testing.assert_allclose([estimates["torque_feedback_gain"],
+                                estimates["torque_feedback_time_constant"]], [1.7, 17.4],
+                               rtol=1e-6)
+    code = main(["frf-model", "--controller", "icm-pmc5664365", "--bands", "peterka",
+                 "--torque-feedback-gain", "4.9", "--torque-feedback-time-constant", "1"])
+    assert code == 2 and "unstable" in capsys.readouterr().err
