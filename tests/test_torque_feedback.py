@@ -283,3 +283,33 @@ def test_fit_frees_torque_feedback_on_a_tilted_run():
                         engine="reference",
                         viscosity_ratio=TRUE.viscosities[0] / TRUE.stiffnesses[0])
     np.testing.assert_allclose(fit.estimates, [1.7, 5.0], rtol=0.01)
+
+
+def test_explorer_views_take_torque_feedback():
+    """The explorer's controls take K_t and τ_t: its FRF is model_frf's with them, its poles
+    the first-order form's with the filter states, its run on the reference engine; K_t > 0
+    without a delay and τ_t = 0 are refused naming the control."""
+    from posturelab.explore import compute_views, parse_parameters
+    from posturelab.explore.views import FRF_FREQUENCIES
+
+    fields = {"controller": "icm-pmc5664365", "body": "paper, one link", "perturbation": "tilt",
+              "duration": 2.0, "torque_feedback_gain": 1.7,
+              "torque_feedback_time_constant": 17.4}
+    p = parse_parameters(fields)
+    views = compute_views(p)
+    body = pl.get_body("paper-1link")
+    muscles = PRESET.muscles(body)
+    H = model_frf(body, muscles, FRF_FREQUENCIES, feedback_delay=PRESET.feedback_delay,
+                  proprioceptive_weight=PRESET.proprioceptive_weight,
+                  torque_feedback_gain=1.7, torque_feedback_time_constant=17.4)
+    np.testing.assert_allclose(views["frf"]["gain"], np.abs(H), rtol=1e-6)
+    poles = linear_system(body, muscles, delay=0.0, torque_feedback_gain=1.7,
+                          torque_feedback_time_constant=17.4).poles()[0]
+    np.testing.assert_allclose(sorted(z["re"] for z in views["poles"]), np.sort(poles.real),
+                               rtol=1e-9)
+    assert views["stable"] and views["delay_margin_note"]
+    for bad, field in (({"torque_feedback_time_constant": 0.0}, "torque_feedback_time_constant"),
+                       ({"feedback_delay": 0.0}, "torque_feedback_gain")):
+        with pytest.raises(ParameterError) as info:
+            parse_parameters({**fields, **bad})
+        assert info.value.field == field
