@@ -62,23 +62,6 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--json", action="store_true", help="print one JSON object.")
 
 
-def _refuse_unstable_with_torque_feedback(body, muscles, delay: float, torque_feedback: dict
-                                         ) -> None:
-    """Refuse a loop with torque feedback whose rightmost root about upright (the
-    first-order form with the filter states; one-sided pairs engaged) is not in the left
-    half-plane."""
-    from ..linear.delay import system_rightmost_roots
-    from ..linear.system import linear_system
-
-    system = linear_system(body, muscles, delay=delay, inputs=False, **torque_feedback)
-    root = complex(system_rightmost_roots(system, delay, count=1)[0])
-    if root.real >= 0:
-        raise ParameterError(f"the loop with torque feedback is unstable about upright "
-                             f"(rightmost root {root.real:.4g}{root.imag:+.4g}j 1/s): its FRF "
-                             "is not measurable; change the gains, --feedback-delay or the "
-                             "torque feedback")
-
-
 def run(args: argparse.Namespace) -> int:
     import numpy as np
 
@@ -104,14 +87,11 @@ def run(args: argparse.Namespace) -> int:
     from ..linear.verdict import upright_verdict
 
     delay = options.get("feedback_delay", 0.0)
-    if torque_feedback.get("torque_feedback_gain", 0.0) > 0:
-        _refuse_unstable_with_torque_feedback(body, muscles, delay, torque_feedback)
-    else:
-        verdict = upright_verdict(body, muscles, delay)
-        if not verdict.side(engaged=True).status == "stable":
-            raise ParameterError(f"the loop is {verdict.describe()}: its FRF is not "
-                                 "measurable (a periodic-stimulus experiment would fall); "
-                                 "change the gains or --feedback-delay")
+    verdict = upright_verdict(body, muscles, delay, **torque_feedback)
+    if not verdict.side(engaged=True).status == "stable":
+        raise ParameterError(f"the loop is {verdict.describe()}: its FRF is not measurable "
+                             "(a periodic-stimulus experiment would fall); change the gains, "
+                             "--feedback-delay or the torque feedback")
     H = model_frf(body, muscles, f, input=args.input, output=args.output.strip().lower(),
                   feedback_delay=delay,
                   proprioceptive_weight=options.get("proprioceptive_weight", 1.0),

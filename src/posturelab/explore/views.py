@@ -344,10 +344,9 @@ def compute_views(p: dict) -> dict:
         when the loop is not stable at τ, else ``note`` None); ``run`` (outcome words,
         time [s], link angles [rad], CoG position [m] and velocity [m/s], joint positions
         [m] of the stick figure and the surface tilt [rad] at :data:`FRAME_RATE`).
-        With torque feedback (``torque_feedback_gain`` > 0) ``stable``, ``verdict``,
-        ``poles`` and ``roots`` are the linear system's with its filter states
-        (``linear_stability`` stays the verdict without it), ``delay_margin_note`` says
-        the margin is not computed, and the run is on the reference engine.
+        With torque feedback (``torque_feedback_gain`` > 0) the verdict, ``poles`` and
+        ``roots`` are the linear system's with its filter states, ``delay_margin_note``
+        says the margin is not computed, and the run is on the reference engine.
     """
     import posturelab as pl
 
@@ -360,23 +359,17 @@ def compute_views(p: dict) -> dict:
                        "torque_feedback_time_constant": p["torque_feedback_time_constant"]}
     lin, margin = _linear(body, muscles)
     # the one verdict about upright (posturelab poles, simulate and the report give it too)
-    verdict = pl.upright_verdict(body, muscles, delay)
+    verdict = pl.upright_verdict(body, muscles, delay, **torque_feedback)
     engaged = verdict.side(engaged=True)  # the side the model FRF linearises
     roots = engaged.roots
-    stable, words, status = verdict.stable, verdict.describe(), engaged.status
+    status = engaged.status
     poles = lin.poles
     margin_note = None
-    if p["torque_feedback_gain"] > 0:  # the linear system with the filter states
-        from ..linear.delay import system_rightmost_roots
+    if p["torque_feedback_gain"] > 0:  # the poles with the filter states
         from ..linear.system import linear_system
 
-        system = linear_system(body, muscles, delay=delay, inputs=False, **torque_feedback)
-        poles = system.poles()[0]
-        roots = system_rightmost_roots(system, delay, count=2 * body.n_links)
-        status = "stable" if roots[0].real < 0 else "unstable"
-        stable = status == "stable"
-        words = (f"{status} about upright with torque feedback (one-sided pairs engaged; "
-                 f"rightmost root {roots[0].real:.3g} 1/s)")
+        poles = linear_system(body, muscles, delay=0.0, inputs=False,
+                              **torque_feedback).poles()[0]
         margin_note = "not computed with torque feedback"
     if status == "stable":
         frf = model_frf(body, muscles, FRF_FREQUENCIES, input="tilt", output="com_angle",
@@ -401,8 +394,8 @@ def compute_views(p: dict) -> dict:
 
     outcome = run.outcome
     return {
-        "stable": stable,
-        "verdict": words,
+        "stable": verdict.stable,
+        "verdict": verdict.describe(),
         "linear_stability": verdict.to_dict(),
         "body": body.name,
         "n_links": body.n_links,
