@@ -409,7 +409,10 @@ def run(args: argparse.Namespace) -> int:
         animate(result, sc.body, args.animate)
     from ..linear.verdict import upright_verdict
 
-    verdict = upright_verdict(sc.body, sc.muscles, sc.options.feedback_delay)
+    verdict = upright_verdict(
+        sc.body, sc.muscles, sc.options.feedback_delay,
+        torque_feedback_gain=sc.options.torque_feedback_gain,
+        torque_feedback_time_constant=sc.options.torque_feedback_time_constant)
     outcome = result.outcome
     if args.json:
         print_json({**result.summary(), "engine": args.engine,
