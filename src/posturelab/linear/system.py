@@ -324,7 +324,8 @@ class LinearSystem:
         return lag / (lag - gain)
 
     def poles(self) -> np.ndarray:
-        """The poles at τ = 0 of every set, shape (M, 2N), real part ascending (as
+        """The poles at τ = 0 of every set, shape (M, 2N) (M, 3N with torque feedback: the
+        eigenvalues of :meth:`state_matrix`), real part ascending (as
         :func:`posturelab.linear.sorted_poles`). [1/s]"""
         return sorted_poles(np.linalg.eigvals(self.state_matrix()))
 
