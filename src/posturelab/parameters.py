@@ -32,6 +32,9 @@ __all__ = [
     "Quantity",
     "QUANTITIES",
     "MAX_FEEDBACK_DELAY",
+    "MAX_TORQUE_FEEDBACK_GAIN",
+    "MAX_TORQUE_FEEDBACK_TIME_CONSTANT",
+    "TORQUE_FEEDBACK_TIME_CONSTANT",
     "MAX_PAIR_STIFFNESS",
     "MAX_PAIR_VISCOSITY",
     "MAX_VISCOSITY_RATIO",
@@ -63,6 +66,17 @@ __all__ = [
 #: analysis, FRF model, fits, scenarios, the command line, the explorer): posturelab's
 #: bound, five to ten times the 0.1–0.2 s of human postural feedback. [s]
 MAX_FEEDBACK_DELAY = 1.0
+#: Torque feedback after Peterka 2002 (J Neurophysiol 88:1097–1118; docs/design.md, "Torque
+#: feedback"): the corrective (active) torque fed back positively through K_t/(τ_t s + 1).
+#: Largest gain K_t: about three times the 1.70 of PMC5664365 Table 1 (K_F = 0.0018 rad/(N·m)
+#: times K_P = 943.9 N·m/rad, the form's static loop gain); posturelab's bound. [-]
+MAX_TORQUE_FEEDBACK_GAIN = 5.0
+#: Largest time constant τ_t: a filter slower than the longest PRTS cycle by far (Peterka
+#: 2018's P18 in balancepy uses the integrator K_t/s, the limit τ_t → ∞); posturelab's
+#: bound. [s]
+MAX_TORQUE_FEEDBACK_TIME_CONSTANT = 1000.0
+#: The default τ_t: 17.4 s, PMC5664365 Table 1 (τ_F). [s]
+TORQUE_FEEDBACK_TIME_CONSTANT = 17.4
 #: Largest pair stiffness, intrinsic or active: 10⁵ times a standing adult's mgh. [N·m/rad]
 MAX_PAIR_STIFFNESS = 1e8
 #: Largest pair viscosity, intrinsic or active. [N·m·s/rad]
@@ -159,6 +173,12 @@ QUANTITIES: dict[str, Quantity] = {q.name: q for q in (
     Quantity("proprioceptive_weight", "-", 0.0, 1.0,
              "W: under a tilt α the active error of pairs spanning the foot is θ + W·α "
              "(1: relative to the foot, 0: to the vertical)", "", 1.0),
+    Quantity("torque_feedback_gain", "-", 0.0, MAX_TORQUE_FEEDBACK_GAIN,
+             "K_t: the active torque fed back positively through K_t/(τ_t s + 1) (Peterka "
+             "2002; 0: none; K_t = K_F·K_P of the source's K_F [rad/(N·m)])", "", 3.0),
+    Quantity("torque_feedback_time_constant", "s", 0.0, MAX_TORQUE_FEEDBACK_TIME_CONSTANT,
+             "τ_t of the torque feedback's low-pass filter (default 17.4 s, PMC5664365 "
+             "Table 1)", "", 200.0, low_open=True),
     Quantity("torque_limit", "N·m", 0.0, math.inf,
              "largest net muscle moment at a joint (inf: none)", "joint", low_open=True),
     Quantity("disturbance_scale", "-", 0.0, MAX_DISTURBANCE_SCALE,

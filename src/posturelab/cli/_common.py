@@ -258,6 +258,36 @@ def feedback_options_from_args(args: argparse.Namespace) -> dict:
     return out
 
 
+def add_torque_feedback_arguments(p: argparse.ArgumentParser) -> None:
+    """--torque-feedback-gain and --torque-feedback-time-constant (Peterka 2002's torque
+    feedback, docs/design.md), for the commands whose model takes it."""
+    from ..parameters import QUANTITIES
+
+    gain, lag = QUANTITIES["torque_feedback_gain"], QUANTITIES["torque_feedback_time_constant"]
+    fb = p.add_argument_group("torque feedback (Peterka 2002)")
+    fb.add_argument("--torque-feedback-gain", type=float, default=None, metavar="K",
+                    help=f"K_t in {gain.interval()}: the active torque fed back positively "
+                    "through K_t/(τ_t s + 1) (default 0: none; K_t = K_F·K_P of the "
+                    "source's K_F [rad/(N·m)]).")
+    fb.add_argument("--torque-feedback-time-constant", type=float, default=None,
+                    metavar="SECONDS", help=f"τ_t [s] in {lag.interval()} (default 17.4, "
+                    "PMC5664365 Table 1).")
+
+
+def torque_feedback_options_from_args(args: argparse.Namespace) -> dict:
+    """``torque_feedback_gain`` [-] and ``torque_feedback_time_constant`` [s] given on the
+    command line, checked against the parameter table and named by their flags; absent
+    when not given."""
+    from ..parameters import check_value
+
+    out = {}
+    for name in ("torque_feedback_gain", "torque_feedback_time_constant"):
+        value = getattr(args, name, None)
+        if value is not None:
+            out[name] = check_value(name, value, "--" + name.replace("_", "-"))
+    return out
+
+
 def parse_tilt(text: str):
     """``--tilt``: ``sine:AMPLITUDE_RAD:FREQUENCY_HZ[:PHASE_RAD]``,
     ``raised-cosine:AMPLITUDE_RAD:DURATION_S[:START_S]`` or

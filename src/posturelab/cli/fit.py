@@ -35,7 +35,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    "as sweep --vary and fit-frf --free): stiffness:PAIR, viscosity:PAIR, "
                    "active_stiffness:PAIR, active_viscosity:PAIR (PAIR " + ", ".join(PAPER_PAIRS)
                    + " on the paper's body), viscosity_ratio, feedback_delay, "
-                   "proprioceptive_weight.")
+                   "proprioceptive_weight, torque_feedback_gain, torque_feedback_time_constant "
+                   "(the torque feedback with --engine reference; its starting values from the "
+                   "scenario's [muscles]).")
     g.add_argument("--engine", choices=ENGINES, default="compiled",
                    help="engine inside the fit: compiled (default) or reference (scipy); "
                    "either at the scenario's tolerances and solver.method; fast is a "

@@ -8,10 +8,12 @@ from ..errors import ParameterError
 from ..parameters import MAX_FEEDBACK_DELAY
 from ._common import (
     add_muscle_arguments,
+    add_torque_feedback_arguments,
     body_from_args,
     feedback_options_from_args,
     muscles_from_args,
     print_json,
+    torque_feedback_options_from_args,
 )
 
 DESCRIPTION = f"""\
@@ -28,10 +30,12 @@ per condition, NAME#1, NAME#2, … in the order of --data (the output lists the 
 "conditions" in --json, each --data path and its kind, trial or table).
 Names (the parameter table's, as for sweep --vary and fit --free): stiffness:PAIR,
 viscosity:PAIR (intrinsic), active_stiffness:PAIR, active_viscosity:PAIR (:PAIR may be left
-out on a body with one pair), feedback_delay, proprioceptive_weight. The body and the
+out on a body with one pair), feedback_delay, proprioceptive_weight, torque_feedback_gain,
+torque_feedback_time_constant (Peterka 2002's torque feedback; starting values from
+--torque-feedback-gain and --torque-feedback-time-constant). The body and the
 starting values come from the options below (as in posturelab simulate); --bounds
 NAME=LO:HI,... replaces the defaults (gains 0 … 1e5, delay 0 … {MAX_FEEDBACK_DELAY:g} s,
-W 0 … 1); each must lie within the table's bounds (docs/parameters.md).
+W 0 … 1, K_t 0 … 3, τ_t 0.5 … 200 s); each must lie within the table's bounds (docs/parameters.md).
 
 Weighting (printed, and "weighting" in --json; posturelab.frequency.fit): every band by
 its own precision: a trial's by the variance of its estimate from the scatter of its
@@ -93,6 +97,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="with --compare: draw NAME against the stimulus amplitude with its "
                    "intervals (PNG/SVG/PDF).")
     add_muscle_arguments(p)
+    add_torque_feedback_arguments(p)
 
 
 def add_fit_arguments(p: argparse.ArgumentParser, *, per_condition: bool) -> None:
@@ -113,7 +118,8 @@ def add_fit_arguments(p: argparse.ArgumentParser, *, per_condition: bool) -> Non
     p.add_argument("--free", required=True, metavar="NAMES",
                    help="parameters shared by the conditions, comma separated, from "
                    "stiffness:PAIR, viscosity:PAIR, active_stiffness:PAIR, "
-                   "active_viscosity:PAIR, feedback_delay, proprioceptive_weight (e.g. "
+                   "active_viscosity:PAIR, feedback_delay, proprioceptive_weight, "
+                   "torque_feedback_gain, torque_feedback_time_constant (e.g. "
                    "active_stiffness:ankle,feedback_delay).")
     if per_condition:
         p.add_argument("--per-condition", default="", metavar="NAMES",
@@ -187,7 +193,8 @@ def run(args: argparse.Namespace) -> int:
     fit_options = dict(input=args.input, output=args.output.strip().lower(),
                        feedback_delay=options.get("feedback_delay", 0.0),
                        proprioceptive_weight=options.get("proprioceptive_weight", 1.0),
-                       bounds=_bounds(args.bounds))
+                       bounds=_bounds(args.bounds),
+                       **torque_feedback_options_from_args(args))
     comparison = None
     if compare is not None:
         from pathlib import Path

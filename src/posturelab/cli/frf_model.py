@@ -7,11 +7,13 @@ import argparse
 from ..errors import ParameterError
 from ._common import (
     add_muscle_arguments,
+    add_torque_feedback_arguments,
     body_from_args,
     feedback_options_from_args,
     muscles_from_args,
     parse_float_list,
     print_json,
+    torque_feedback_options_from_args,
 )
 from .frf import BAND_CHOICES
 
@@ -27,6 +29,9 @@ historical name, or posturelab-80 or comtest-80, for --cycle-length s,
 default 20) or of a named sequence's bands (--bands peterka-2002-242: 17 bands of the 242-state
 sequence, cycle 60.5 s by default; posturelab.frequency.bands.SEQUENCE_BANDS).
 
+--torque-feedback-gain K and --torque-feedback-time-constant S add Peterka 2002's torque
+feedback: the active torque fed back positively through K/(S s + 1) (docs/design.md).
+
 A loop unstable about upright at its delay has no measurable FRF (a periodic-stimulus
 experiment on it would fall): frf-model refuses it (exit 2, the rightmost root named).
 
@@ -40,6 +45,7 @@ Example: posturelab frf-model --controller peterka-2002 --bands peterka --json
 def add_arguments(p: argparse.ArgumentParser) -> None:
     """The options of ``posturelab frf-model``."""
     add_muscle_arguments(p)
+    add_torque_feedback_arguments(p)
     p.add_argument("--input", choices=["tilt", "translation"], default="tilt",
                    help="tilt [rad] (default) or platform translation [m].")
     p.add_argument("--output", default="com_angle", metavar="NAME",
@@ -66,6 +72,7 @@ def run(args: argparse.Namespace) -> int:
     body = body_from_args(args)
     muscles = muscles_from_args(args, body)
     options = feedback_options_from_args(args)
+    torque_feedback = torque_feedback_options_from_args(args)
     if args.frequencies is not None:
         f = np.array(parse_float_list(args.frequencies, "--frequencies [Hz]"))
         if np.any(f <= 0) or np.any(f > 1e4) or f.size > 100_000:
@@ -79,14 +86,16 @@ def run(args: argparse.Namespace) -> int:
         f = band_frequencies(bands, cycle)
     from ..linear.verdict import upright_verdict
 
-    verdict = upright_verdict(body, muscles, options.get("feedback_delay", 0.0))
+    delay = options.get("feedback_delay", 0.0)
+    verdict = upright_verdict(body, muscles, delay, **torque_feedback)
     if not verdict.side(engaged=True).status == "stable":
         raise ParameterError(f"the loop is {verdict.describe()}: its FRF is not measurable "
-                             "(a periodic-stimulus experiment would fall); change the gains "
-                             "or --feedback-delay")
+                             "(a periodic-stimulus experiment would fall); change the gains, "
+                             "--feedback-delay or the torque feedback")
     H = model_frf(body, muscles, f, input=args.input, output=args.output.strip().lower(),
-                  feedback_delay=options.get("feedback_delay", 0.0),
-                  proprioceptive_weight=options.get("proprioceptive_weight", 1.0))
+                  feedback_delay=delay,
+                  proprioceptive_weight=options.get("proprioceptive_weight", 1.0),
+                  **torque_feedback)
     phase = np.degrees(np.unwrap(np.angle(H)))
     sign = ("−y/α (the literature's tilt sign: a body that follows the surface reads gain 1, "
             "phase 0)" if args.input == "tilt" else "y/x (as the output is, per metre)")

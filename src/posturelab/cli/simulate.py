@@ -24,6 +24,7 @@ from . import UsageError
 from ._common import (
     FIGURE_SUFFIXES,
     add_muscle_arguments,
+    add_torque_feedback_arguments,
     body_from_args,
     check_writable,
     feedback_from_args,
@@ -34,6 +35,7 @@ from ._common import (
     parse_limit_list,
     parse_tilt,
     print_json,
+    torque_feedback_options_from_args,
 )
 
 DESCRIPTION = """\
@@ -109,6 +111,7 @@ def add_experiment_arguments(p: argparse.ArgumentParser) -> None:
     src.add_argument("--builtin", metavar="NAME",
                      help="a built-in scenario: " + ", ".join(builtin_scenario_names()) + ".")
     add_muscle_arguments(p)
+    add_torque_feedback_arguments(p)
     src.add_argument("--disturbance", choices=["backward", "forward", "none"],
                      help="platform velocity step of --speed m/s at t = 0 (backward: the "
                      "platform moves back, the body sways forward).")
@@ -227,6 +230,7 @@ def run_options_from_args(args: argparse.Namespace, sc: Scenario,
                 _foot(args.foot) if args.foot != "none" else fall.base_of_support,
                 args.centre_of_pressure or fall.centre_of_pressure)
     feedback_delay, proprioceptive_weight = feedback_from_args(args)
+    torque_feedback = torque_feedback_options_from_args(args)
     description = base.description
     tilt = base.tilt
     if args.tilt is not None:
@@ -257,6 +261,10 @@ def run_options_from_args(args: argparse.Namespace, sc: Scenario,
             time_limit=_given(args.time_limit, base.time_limit),
             fall=fall, feedback_delay=_given(feedback_delay, base.feedback_delay),
             proprioceptive_weight=_given(proprioceptive_weight, base.proprioceptive_weight),
+            torque_feedback_gain=torque_feedback.get("torque_feedback_gain",
+                                                     base.torque_feedback_gain),
+            torque_feedback_time_constant=torque_feedback.get(
+                "torque_feedback_time_constant", base.torque_feedback_time_constant),
             tilt=tilt,
             tilt_axis_depth=_given(args.tilt_axis_depth, base.tilt_axis_depth),
             torque_limits=torque_limits,
@@ -401,7 +409,10 @@ def run(args: argparse.Namespace) -> int:
         animate(result, sc.body, args.animate)
     from ..linear.verdict import upright_verdict
 
-    verdict = upright_verdict(sc.body, sc.muscles, sc.options.feedback_delay)
+    verdict = upright_verdict(
+        sc.body, sc.muscles, sc.options.feedback_delay,
+        torque_feedback_gain=sc.options.torque_feedback_gain,
+        torque_feedback_time_constant=sc.options.torque_feedback_time_constant)
     outcome = result.outcome
     if args.json:
         print_json({**result.summary(), "engine": args.engine,

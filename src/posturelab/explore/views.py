@@ -8,7 +8,7 @@ cannot disagree. :func:`compute_views` turns checked parameters into the numbers
 figures of the page with the public API only: :func:`posturelab.analyse`,
 :func:`posturelab.rightmost_roots`, :func:`posturelab.delay_margin`,
 :func:`posturelab.frequency.model.model_frf` and :func:`posturelab.simulate` on the
-compiled engine.
+compiled engine (on the reference engine with torque feedback, which only it carries).
 """
 
 from __future__ import annotations
@@ -25,7 +25,13 @@ from ..model.controllers import CONTROLLERS
 from ..model.muscles import PAPER_PAIR_NAMES, STIFFNESS_CASES
 from ..model.platform import MAX_PLATFORM_SPEED
 from ..model.tilt import MAX_TILT
-from ..parameters import MAX_FEEDBACK_DELAY, MAX_PAIR_VISCOSITY, QUANTITIES, renamed
+from ..parameters import (
+    MAX_FEEDBACK_DELAY,
+    MAX_PAIR_VISCOSITY,
+    QUANTITIES,
+    TORQUE_FEEDBACK_TIME_CONSTANT,
+    renamed,
+)
 
 __all__ = ["Control", "CONTROLS", "PAIRS", "BODIES", "OWN_GAINS", "parse_parameters",
            "build_body", "build_model", "compute_views", "controller_presets"]
@@ -111,6 +117,10 @@ CONTROLS: tuple[Control, ...] = (
     _table("viscosity_ratio", "viscosity ratio L/K", 0.25, 1.0, 0.01, "pairs"),
     _table("feedback_delay", "feedback delay τ", 0.0, 0.3, 0.005, "neural"),
     _table("proprioceptive_weight", "proprioceptive weight W", 1.0, 1.0, 0.05, "neural"),
+    _table("torque_feedback_gain", "torque feedback gain K_t", 0.0, 3.0, 0.05, "neural"),
+    Control("torque_feedback_time_constant", "torque feedback time constant τ_t", "s",
+            TORQUE_FEEDBACK_TIME_CONSTANT, QUANTITIES["torque_feedback_time_constant"].low,
+            QUANTITIES["torque_feedback_time_constant"].high, 0.5, 100.0, 0.5, "neural"),
     Control("perturbation", "perturbation", "", "backward step", group="perturbation",
             choices=("backward step", "forward step", "tilt")),
     Control("step_speed", "step speed", "m/s", 0.3, 0.01, MAX_PLATFORM_SPEED, 0.01, 2.0, 0.01,
@@ -207,6 +217,12 @@ def parse_parameters(fields: dict) -> dict:
         for name in ("feedback_delay", "proprioceptive_weight"):
             if name not in fields:
                 out[name] = float(getattr(preset, name))
+    if out["torque_feedback_time_constant"] <= 0:  # the table's range is open at 0
+        raise _field_error("torque_feedback_time_constant", "torque feedback time constant "
+                           "τ_t [s] must be > 0, got 0")
+    if out["torque_feedback_gain"] > 0 and out["feedback_delay"] <= 0:
+        raise _field_error("torque_feedback_gain", "torque feedback filters the delayed "
+                           "active torque: give a feedback delay τ > 0 with K_t > 0")
     for name in PAIRS:  # a pair's viscosity is ratio × stiffness: its bound, on the stiffness
         viscosity = out["viscosity_ratio"] * out[f"stiffness:{name}"]
         if viscosity > MAX_PAIR_VISCOSITY:
@@ -328,6 +344,9 @@ def compute_views(p: dict) -> dict:
         when the loop is not stable at τ, else ``note`` None); ``run`` (outcome words,
         time [s], link angles [rad], CoG position [m] and velocity [m/s], joint positions
         [m] of the stick figure and the surface tilt [rad] at :data:`FRAME_RATE`).
+        With torque feedback (``torque_feedback_gain`` > 0) the verdict, ``poles`` and
+        ``roots`` are the linear system's with its filter states, ``delay_margin_note``
+        says the margin is not computed, and the run is on the reference engine.
     """
     import posturelab as pl
 
@@ -336,25 +355,38 @@ def compute_views(p: dict) -> dict:
 
     body, muscles, disturbance, tilt = build_model(p)
     delay, weight = p["feedback_delay"], p["proprioceptive_weight"]
+    torque_feedback = {"torque_feedback_gain": p["torque_feedback_gain"],
+                       "torque_feedback_time_constant": p["torque_feedback_time_constant"]}
     lin, margin = _linear(body, muscles)
     # the one verdict about upright (posturelab poles, simulate and the report give it too)
-    verdict = pl.upright_verdict(body, muscles, delay)
+    verdict = pl.upright_verdict(body, muscles, delay, **torque_feedback)
     engaged = verdict.side(engaged=True)  # the side the model FRF linearises
     roots = engaged.roots
-    if engaged.status == "stable":
+    status = engaged.status
+    poles = lin.poles
+    margin_note = None
+    if p["torque_feedback_gain"] > 0:  # the poles with the filter states
+        from ..linear.system import linear_system
+
+        poles = linear_system(body, muscles, delay=0.0, inputs=False,
+                              **torque_feedback).poles()[0]
+        margin_note = "not computed with torque feedback"
+    if status == "stable":
         frf = model_frf(body, muscles, FRF_FREQUENCIES, input="tilt", output="com_angle",
-                        feedback_delay=delay, proprioceptive_weight=weight)
+                        feedback_delay=delay, proprioceptive_weight=weight, **torque_feedback)
         frf_view = {"frequency": _rounded(FRF_FREQUENCIES, 9), "gain": _rounded(np.abs(frf), 9),
                     "phase": _rounded(np.degrees(np.unwrap(np.angle(frf))), 4), "note": None}
     else:  # no steady response to measure: say so rather than draw a formula's curve
-        word = "marginal (undamped)" if engaged.status == "marginal" else "unstable"
+        word = "marginal (undamped)" if status == "marginal" else "unstable"
         frf_view = {"frequency": [], "gain": [], "phase": [],
                     "note": f"the loop is {word} at this delay: an FRF cannot be measured "
                     "(the sway grows or never settles), so none is drawn"}
     rate = SAMPLE_RATE if tilt is None else max(SAMPLE_RATE, 40.0 * tilt.frequency)
-    run = pl.simulate(body, muscles, disturbance, p["duration"], engine="compiled",
+    # torque feedback runs on the reference engine (the compiled one does not carry it yet)
+    engine = "reference" if p["torque_feedback_gain"] > 0 else "compiled"
+    run = pl.simulate(body, muscles, disturbance, p["duration"], engine=engine,
                       feedback_delay=delay, proprioceptive_weight=weight, tilt=tilt,
-                      sample_rate=rate, time_limit=TIME_LIMIT)
+                      sample_rate=rate, time_limit=TIME_LIMIT, **torque_feedback)
     every = max(1, int(round(rate / FRAME_RATE)))
     frames = joint_positions(body, run.theta[::every])
     surface = (np.zeros(len(frames)) if tilt is None
@@ -367,11 +399,12 @@ def compute_views(p: dict) -> dict:
         "linear_stability": verdict.to_dict(),
         "body": body.name,
         "n_links": body.n_links,
-        "poles": _complex_list(lin.poles),
+        "poles": _complex_list(poles),
         "roots": _complex_list(roots),
         "delay_margin": (None if margin.delay_margin is None
                          or math.isinf(margin.delay_margin) else float(margin.delay_margin)),
         "stable_without_delay": bool(margin.stable_without_delay),
+        "delay_margin_note": margin_note,
         "delayed_part": "active" if muscles.has_active_feedback else "all",
         "frf": frf_view,
         "run": {"outcome": outcome.kind, "message": outcome.message,

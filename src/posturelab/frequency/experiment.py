@@ -111,7 +111,7 @@ def prts_experiment(body, muscles, *, tilt=None, cycles: int = 5, discard: int =
         (:func:`posturelab.frequency.bands.sequence_bands`).
     **run_options
         For :func:`posturelab.simulate` (``feedback_delay``, ``proprioceptive_weight``,
-        ``motor_noise``, …).
+        ``motor_noise``, ``engine`` (compiled by default), …).
     """
     from ..model.tilt import PRTSTilt
     from ..simulation.engines import simulate
@@ -133,8 +133,8 @@ def prts_experiment(body, muscles, *, tilt=None, cycles: int = 5, discard: int =
     if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0:
         raise ParameterError(f"seed must be an integer >= 0, got {seed!r}")
     total = tilt.cycle * (cycles + discard)
-    r = simulate(body, muscles, None, total, tilt=tilt, sample_rate=sample_rate,
-                 engine="compiled", **run_options)
+    run_options = {"engine": "compiled", **run_options}
+    r = simulate(body, muscles, None, total, tilt=tilt, sample_rate=sample_rate, **run_options)
     t = r.time[:-1] if r.time.size > 1 else r.time
     if output == "com_angle":
         angle = r.com_angle

@@ -8,6 +8,8 @@ one pair):
     active_stiffness:PAIR, active_viscosity:PAIR   active (delayed) gains [N·m/rad], [N·m·s/rad]
     feedback_delay                                 τ [s]
     proprioceptive_weight                          W [-]
+    torque_feedback_gain                           K_t [-] (Peterka 2002's torque feedback)
+    torque_feedback_time_constant                  τ_t [s]
 
 Every other parameter keeps the value of the starting ``muscles`` and options. With several
 conditions (for example tilts of different amplitudes) the ``free`` parameters are shared
@@ -75,7 +77,13 @@ from .._bounds import at_bound, clip_intervals
 from ..errors import ParameterError
 from ..model.body import Body
 from ..model.muscles import MuscleSet
-from ..parameters import MAX_FEEDBACK_DELAY, QUANTITIES, check_value, resolve
+from ..parameters import (
+    MAX_FEEDBACK_DELAY,
+    QUANTITIES,
+    TORQUE_FEEDBACK_TIME_CONSTANT,
+    check_value,
+    resolve,
+)
 from ..parameters import unit as parameter_unit
 from .estimate import FRFEstimate
 from .model import model_frf_batch
@@ -84,9 +92,14 @@ __all__ = ["FRFFit", "fit_frf", "check_fit_request", "PARAMETERS", "WEIGHTINGS",
            "MISMATCH_P"]
 
 PARAMETERS = ("stiffness", "viscosity", "active_stiffness", "active_viscosity",
-              "feedback_delay", "proprioceptive_weight")
-#: The default search interval of each parameter: the table's lower bound to its fit_high.
-_DEFAULT_BOUNDS = {name: (QUANTITIES[name].low, QUANTITIES[name].fit_high)
+              "feedback_delay", "proprioceptive_weight", "torque_feedback_gain",
+              "torque_feedback_time_constant")
+#: The lowest τ_t a fit searches by default (the table's range excludes 0). [s]
+_MIN_FIT_TIME_CONSTANT = 0.5
+#: The default search interval of each parameter: the table's lower bound to its fit_high
+#: (for a range open at its lower bound, from a positive value).
+_DEFAULT_BOUNDS = {name: (_MIN_FIT_TIME_CONSTANT if QUANTITIES[name].low_open
+                          else QUANTITIES[name].low, QUANTITIES[name].fit_high)
                    for name in PARAMETERS}
 #: The weightings (module notes).
 WEIGHTINGS = {
@@ -367,7 +380,8 @@ def check_fit_request(muscles: MuscleSet, free, per_condition=(), bounds=None) -
 def fit_frf(body: Body, muscles: MuscleSet, data, free, *, input: str = "tilt",
             output: str = "com_angle", feedback_delay: float = 0.0,
             proprioceptive_weight: float = 1.0, per_condition=(), bounds=None,
-            model_error: float | None = None) -> FRFFit:
+            model_error: float | None = None, torque_feedback_gain: float = 0.0,
+            torque_feedback_time_constant: float | None = None) -> FRFFit:
     """Fit controller parameters to one or several FRFs (module notes).
 
     Parameters
@@ -388,10 +402,14 @@ def fit_frf(body: Body, muscles: MuscleSet, data, free, *, input: str = "tilt",
         Parameters fitted separately for each condition.
     bounds : dict of name -> (low, high), optional
         Each within the parameter table's bounds (docs/parameters.md); defaults: the
-        table's search intervals (gains [0, 1e5], delay [0, 1] s, W [0, 1]).
+        table's search intervals (gains [0, 1e5], delay [0, 1] s, W [0, 1], K_t [0, 3],
+        τ_t [0.5, 200] s).
     model_error : float, optional
         A relative model error δ to allow from the start instead of the one a mismatch
         would choose (module notes; nested fits compared under one error model). [-]
+    torque_feedback_gain, torque_feedback_time_constant : float
+        Starting values of the torque feedback (K_t 0: none; τ_t by default the table's
+        17.4 s). [-], [s]
 
     Raises
     ------
@@ -418,6 +436,13 @@ def fit_frf(body: Body, muscles: MuscleSet, data, free, *, input: str = "tilt",
                                     MAX_FEEDBACK_DELAY, unit="s")
     proprioceptive_weight = float_in_range("proprioceptive_weight [-]", proprioceptive_weight,
                                            0.0, 1.0)
+    torque_feedback_gain = check_value("torque_feedback_gain", torque_feedback_gain)
+    torque_feedback_time_constant = check_value(
+        "torque_feedback_time_constant", TORQUE_FEEDBACK_TIME_CONSTANT
+        if torque_feedback_time_constant is None else torque_feedback_time_constant)
+    scalars = {"feedback_delay": feedback_delay, "proprioceptive_weight": proprioceptive_weight,
+               "torque_feedback_gain": torque_feedback_gain,
+               "torque_feedback_time_constant": torque_feedback_time_constant}
     targets = [_target(c, k) for k, c in enumerate(conditions)]
     base = np.stack([muscles.stiffnesses, muscles.viscosities, muscles.active_stiffnesses,
                      muscles.active_viscosities])
@@ -429,10 +454,8 @@ def fit_frf(body: Body, muscles: MuscleSet, data, free, *, input: str = "tilt",
 
     def start(spec) -> float:
         b, j = spec
-        if b == "feedback_delay":
-            return feedback_delay
-        if b == "proprioceptive_weight":
-            return proprioceptive_weight
+        if b in scalars:
+            return scalars[b]
         return float(base[rows[b], j])
 
     x0 = np.array([start(specs[i]) for i, _ in slots])
@@ -450,23 +473,25 @@ def fit_frf(body: Body, muscles: MuscleSet, data, free, *, input: str = "tilt",
         out = []
         for k, c in enumerate(conditions):
             gains = base.copy()
-            tau, w = feedback_delay, proprioceptive_weight
+            values = dict(scalars)
             for (i, cond), value in zip(slots, p, strict=True):
                 if cond is not None and cond != k:
                     continue
                 b, j = specs[i]
-                if b == "feedback_delay":
-                    tau = value
-                elif b == "proprioceptive_weight":
-                    w = value
+                if b in values:
+                    values[b] = value
                 else:
                     gains[rows[b], j] = value
 
-            def frf_at(f, gains=gains, tau=tau, w=w):
+            def frf_at(f, gains=gains, v=values):
                 return model_frf_batch(body, muscles, f, gains[0][None], gains[1][None],
                                        gains[2][None] if active else None,
-                                       gains[3][None] if active else None, tau, w,
-                                       input=input, output=output)[0]
+                                       gains[3][None] if active else None,
+                                       v["feedback_delay"], v["proprioceptive_weight"],
+                                       input=input, output=output,
+                                       torque_feedback_gain=v["torque_feedback_gain"],
+                                       torque_feedback_time_constant=v[
+                                           "torque_feedback_time_constant"])[0]
 
             if dense:
                 f = np.geomspace(c.frequency.min() / 1.5, c.frequency.max() * 1.5, 200)

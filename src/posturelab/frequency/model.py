@@ -19,6 +19,11 @@ Tilt FRFs are reported in the literature's sign, H = −y/α, so that a body tha
 surface (θ = −α: perpendicular to it) has H = 1; translation FRFs are H = y/x_d [rad/m].
 The gains split as :func:`posturelab.model.muscles.feedback_gains` states (without active
 gains the whole feedback is delayed, and W applies to it).
+
+With torque feedback (Peterka 2002; docs/design.md, "Torque feedback") the delayed part, in
+Δ(s) and in b(s), is multiplied by g(s) = (τ_t s + 1)/(τ_t s + 1 − K_t): the active torque
+fed back positively through K_t/(τ_t s + 1)
+(:meth:`posturelab.linear.system.LinearSystem.torque_feedback_factor`).
 """
 
 from __future__ import annotations
@@ -71,7 +76,8 @@ def output_vector(body: Body, output: str) -> np.ndarray:
 def model_frf_batch(body: Body, muscles: MuscleSet, frequencies, stiffness, viscosity,
                     active_stiffness=None, active_viscosity=None, feedback_delay=0.0,
                     proprioceptive_weight=1.0, *, input: str = "tilt",
-                    output: str = "com_angle") -> np.ndarray:
+                    output: str = "com_angle", torque_feedback_gain=0.0,
+                    torque_feedback_time_constant=None) -> np.ndarray:
     """Model FRFs of M parameter sets at F frequencies (module notes).
 
     Parameters
@@ -92,6 +98,10 @@ def model_frf_batch(body: Body, muscles: MuscleSet, frequencies, stiffness, visc
     input : {"tilt", "translation"}
     output : str
         :func:`output_names`.
+    torque_feedback_gain : float or array_like, shape (M,)
+        K_t (module notes; 0: none). [-]
+    torque_feedback_time_constant : float or array_like, shape (M,), optional
+        τ_t (default: the parameter table's 17.4 s). [s]
 
     Returns
     -------
@@ -124,7 +134,9 @@ def model_frf_batch(body: Body, muscles: MuscleSet, frequencies, stiffness, visc
             check_value(name, float(values[np.argmax(bad)]))
     system = linear_system(body, muscles, stiffness=k, viscosity=viscosity,
                            active_stiffness=active_stiffness, active_viscosity=active_viscosity,
-                           delay=tau, proprioceptive_weight=w)
+                           delay=tau, proprioceptive_weight=w,
+                           torque_feedback_gain=torque_feedback_gain,
+                           torque_feedback_time_constant=torque_feedback_time_constant)
     with np.errstate(all="ignore"):
         H = system.frequency_response(f, input, c)
     if input == "tilt":
@@ -150,7 +162,8 @@ def _gains(name: str, value, pairs: int, rows: int | None = None) -> np.ndarray:
 
 def model_frf(body: Body, muscles: MuscleSet, frequencies, *, input: str = "tilt",
               output: str = "com_angle", feedback_delay: float = 0.0,
-              proprioceptive_weight: float = 1.0) -> np.ndarray:
+              proprioceptive_weight: float = 1.0, torque_feedback_gain: float = 0.0,
+              torque_feedback_time_constant: float | None = None) -> np.ndarray:
     """The model FRF of one body and muscle set (its own intrinsic and active gains) at
     ``frequencies`` [Hz]; shape (F,). See :func:`model_frf_batch`."""
     check_value("feedback_delay", feedback_delay)
@@ -160,4 +173,6 @@ def model_frf(body: Body, muscles: MuscleSet, frequencies, *, input: str = "tilt
         body, muscles, frequencies, muscles.stiffnesses[None], muscles.viscosities[None],
         muscles.active_stiffnesses[None] if active else None,
         muscles.active_viscosities[None] if active else None, feedback_delay,
-        proprioceptive_weight, input=input, output=output)[0]
+        proprioceptive_weight, input=input, output=output,
+        torque_feedback_gain=torque_feedback_gain,
+        torque_feedback_time_constant=torque_feedback_time_constant)[0]

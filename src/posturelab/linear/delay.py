@@ -116,9 +116,17 @@ def _matrices(system: LinearSystem) -> tuple[np.ndarray, ...]:
 
 
 def _slope(system: LinearSystem, s: complex, delay: float) -> np.ndarray:
-    """dΔ/ds at ``s`` for delay τ. [N·m·s/rad]"""
+    """dΔ/ds at ``s`` for delay τ (with the torque feedback's factor g(s) and its
+    derivative g'(s) = −K_t τ_t/(τ_t s + 1 − K_t)² when the system has one). [N·m·s/rad]"""
     J0, _, Li, Ka, La = _matrices(system)
-    return 2 * s * J0 + Li + (La - delay * (Ka + s * La)) * np.exp(-s * delay)
+    delayed = np.exp(-s * delay)
+    slope = (La - delay * (Ka + s * La)) * delayed
+    if system.has_torque_feedback:
+        gain = float(system.torque_feedback_gain[0])
+        lag = float(system.torque_feedback_time_constant[0])
+        factor = (lag * s + 1.0) / (lag * s + 1.0 - gain)
+        slope = slope * factor - (Ka + s * La) * delayed * gain * lag / (lag * s + 1.0 - gain) ** 2
+    return 2 * s * J0 + Li + slope
 
 
 @dataclass(frozen=True)

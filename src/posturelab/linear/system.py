@@ -16,6 +16,14 @@ inputs are the surface tilt α [rad] (:func:`posturelab.model.tilt.tilt_pair_gai
 pairs that span the foot feel it, the active part weighted by the proprioceptive weight
 W) and the horizontal platform acceleration ẍ_d [m/s²] (h = −a, the linearised −H(Θ)).
 
+Torque feedback (Peterka 2002, J Neurophysiol 88:1097–1118; docs/design.md): the active
+(delayed) torque is fed back positively through the low-pass K_t/(τ_t s + 1), so that the
+active torque is g(s) = (τ_t s + 1)/(τ_t s + 1 − K_t) times the delayed PD's: in Δ(s) the
+delayed part (K_a + s L_a) e^{−sτ} and in the tilt input the delayed b2, b3 are multiplied
+by g(s). In the time domain a filter state Y per link coordinate (a generalised torque
+[N·m]) obeys τ_t Ẏ = (K_t − 1) Y + K_t (K_a Θ(t − τ) + L_a Θ̇(t − τ)) and enters the
+equation of motion beside the delayed part, so that the first-order form has 3N states.
+
 :class:`LinearSystem` holds these matrices for M sets (an axis of length 1 is shared by
 every set); :func:`linear_system` builds it once from a body and a muscle set (its own
 gains, or arrays of gains for a batch). Everything linear derives from it, as
@@ -186,6 +194,10 @@ class LinearSystem:
         inputs. [N·m/rad], [N·m·s/rad], [N·m/rad], [N·m·s/rad]
     translation_input : numpy.ndarray, shape (M or 1, N)
         h = −a, the moments per unit platform acceleration ẍ_d. [kg·m]
+    torque_feedback_gain : numpy.ndarray, shape (M or 1,), or None
+        K_t of the torque feedback (module notes); None for none. [-]
+    torque_feedback_time_constant : numpy.ndarray, shape (M or 1,), or None
+        τ_t, > 0 (with the gain). [s]
     """
 
     inertia: np.ndarray
@@ -196,6 +208,13 @@ class LinearSystem:
     delay: np.ndarray
     tilt_input: np.ndarray | None
     translation_input: np.ndarray
+    torque_feedback_gain: np.ndarray | None = None
+    torque_feedback_time_constant: np.ndarray | None = None
+
+    @property
+    def has_torque_feedback(self) -> bool:
+        """Whether any set has a torque feedback gain (its filter states then count)."""
+        return self.torque_feedback_gain is not None
 
     @property
     def n_links(self) -> int:
@@ -207,7 +226,8 @@ class LinearSystem:
         """M. [-]"""
         return _sets(self.inertia, self.stiffness, self.viscosity, self.delayed_stiffness,
                      self.delayed_viscosity, self.delay, self.tilt_input,
-                     self.translation_input)
+                     self.translation_input, self.torque_feedback_gain,
+                     self.torque_feedback_time_constant)
 
     def __len__(self) -> int:
         return self.n_sets
@@ -218,18 +238,33 @@ class LinearSystem:
             index = slice(int(index), int(index) + 1) if index != -1 else slice(-1, None)
         return LinearSystem(*(_pick(getattr(self, f), index) for f in (
             "inertia", "stiffness", "viscosity", "delayed_stiffness", "delayed_viscosity",
-            "delay", "tilt_input", "translation_input")))
+            "delay", "tilt_input", "translation_input", "torque_feedback_gain",
+            "torque_feedback_time_constant")))
 
     def without_delay(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The system at τ = 0, as the matrices of s² J0 + s L + K:
         (J0, L_i + L_a, S + K_a), each with its set axis (M or 1). [kg·m²], [N·m·s/rad],
-        [N·m/rad]"""
+        [N·m/rad]
+
+        Raises
+        ------
+        ParameterError
+            With torque feedback (its filter makes Δ(s) rational, not a matrix
+            polynomial; :meth:`first_order` carries it)."""
+        if self.has_torque_feedback:
+            raise ParameterError("this analysis does not take torque feedback yet (its "
+                                 "filter is not a matrix polynomial); poles, the FRFs and "
+                                 "the rightmost roots do")
         return (self.inertia, _add(self.viscosity, self.delayed_viscosity),
                 _add(self.stiffness, self.delayed_stiffness))
 
     def state_matrix(self) -> np.ndarray:
         """A of d[Θ, Θ̇]/dt = A [Θ, Θ̇] at τ = 0, shape (M, 2N, 2N): upper-right block
-        [-], lower-left [1/s²], lower-right [1/s]."""
+        [-], lower-left [1/s²], lower-right [1/s]; with torque feedback A0 + A1 of
+        :meth:`first_order`, (M, 3N, 3N) over [Θ, Θ̇, Y]."""
+        if self.has_torque_feedback:
+            A0, A1 = self.first_order()
+            return A0 + A1
         jac, damp, load = self.without_delay()
         m, n = self.n_sets, self.n_links
         A = np.zeros((m, 2 * n, 2 * n))
@@ -241,25 +276,62 @@ class LinearSystem:
         return A
 
     def first_order(self) -> tuple[np.ndarray, np.ndarray]:
-        """(A0, A1), each (M, 2N, 2N): d/dt [Θ, Θ̇] = A0 x(t) + A1 x(t − τ). [1/s², 1/s]"""
+        """(A0, A1), each (M, 2N, 2N): d/dt [Θ, Θ̇] = A0 x(t) + A1 x(t − τ). [1/s², 1/s]
+
+        With torque feedback each is (M, 3N, 3N) over x = [Θ, Θ̇, Y], Y the filter state
+        (module notes): J0 Θ̈ = −S Θ − L_i Θ̇ − Y − K_a Θ(t − τ) − L_a Θ̇(t − τ) and
+        τ_t Ẏ = (K_t − 1) Y + K_t (K_a Θ(t − τ) + L_a Θ̇(t − τ)). [N·m/s per state unit]"""
         m, n = self.n_sets, self.n_links
+        size = 3 * n if self.has_torque_feedback else 2 * n
         inv = np.broadcast_to(np.linalg.inv(self.inertia), (m, n, n))
-        A0 = np.zeros((m, 2 * n, 2 * n))
-        A0[:, :n, n:] = np.eye(n)
-        A0[:, n:, :n] = -inv @ self.stiffness
-        A0[:, n:, n:] = -inv @ self.viscosity
-        A1 = np.zeros((m, 2 * n, 2 * n))
-        A1[:, n:, :n] = -inv @ self.delayed_stiffness
-        A1[:, n:, n:] = -inv @ self.delayed_viscosity
+        A0 = np.zeros((m, size, size))
+        A0[:, :n, n:2 * n] = np.eye(n)
+        A0[:, n:2 * n, :n] = -inv @ self.stiffness
+        A0[:, n:2 * n, n:2 * n] = -inv @ self.viscosity
+        A1 = np.zeros((m, size, size))
+        A1[:, n:2 * n, :n] = -inv @ self.delayed_stiffness
+        A1[:, n:2 * n, n:2 * n] = -inv @ self.delayed_viscosity
+        if self.has_torque_feedback:
+            gain = np.broadcast_to(self.torque_feedback_gain, (m,))[:, None, None]
+            rate = 1.0 / np.broadcast_to(self.torque_feedback_time_constant, (m,))[:, None, None]
+            A0[:, n:2 * n, 2 * n:] = -inv
+            A0[:, 2 * n:, 2 * n:] = (gain - 1.0) * rate * np.eye(n)
+            A1[:, 2 * n:, :n] = gain * rate * np.broadcast_to(self.delayed_stiffness, (m, n, n))
+            A1[:, 2 * n:, n:2 * n] = gain * rate * np.broadcast_to(self.delayed_viscosity,
+                                                                    (m, n, n))
         return A0, A1
 
+    def torque_feedback_factor(self, s) -> np.ndarray:
+        """g(s) = (τ_t s + 1)/(τ_t s + 1 − K_t) of every set (1 without torque feedback):
+        the active torque over the delayed PD's (module notes).
+
+        Parameters
+        ----------
+        s : complex or array_like, shape (M or 1, ...)
+            Its first axis is the set axis. [1/s]
+
+        Returns
+        -------
+        numpy.ndarray, shape (M or 1, ...)
+            [-]
+        """
+        s = np.asarray(s, dtype=complex)
+        if not self.has_torque_feedback:
+            return np.ones_like(s)
+        extra = (None,) * (s.ndim - 1)
+        gain = self.torque_feedback_gain[(slice(None), *extra)]
+        lag = self.torque_feedback_time_constant[(slice(None), *extra)] * s + 1.0
+        return lag / (lag - gain)
+
     def poles(self) -> np.ndarray:
-        """The poles at τ = 0 of every set, shape (M, 2N), real part ascending (as
+        """The poles at τ = 0 of every set, shape (M, 2N) (M, 3N with torque feedback: the
+        eigenvalues of :meth:`state_matrix`), real part ascending (as
         :func:`posturelab.linear.sorted_poles`). [1/s]"""
         return sorted_poles(np.linalg.eigvals(self.state_matrix()))
 
     def characteristic_matrix(self, s, delay=None) -> np.ndarray:
-        """Δ(s) = s² J0 + s L_i + S + (K_a + s L_a) e^{−sτ} of every set.
+        """Δ(s) = s² J0 + s L_i + S + (K_a + s L_a) e^{−sτ} g(s) of every set (g the torque
+        feedback's factor, :meth:`torque_feedback_factor`; 1 without it).
 
         Parameters
         ----------
@@ -284,9 +356,12 @@ class LinearSystem:
             return x[(slice(None), *extra)]
 
         z = s[..., None, None]
+        delayed = np.exp(-s * tau)
+        if self.has_torque_feedback:
+            delayed = delayed * self.torque_feedback_factor(s)
         return (z * z * mat(self.inertia) + mat(self.stiffness) + z * mat(self.viscosity)
                 + (mat(self.delayed_stiffness) + z * mat(self.delayed_viscosity))
-                * np.exp(-s * tau)[..., None, None])
+                * delayed[..., None, None])
 
     def frequency_response(self, frequencies, input: str, output) -> np.ndarray:
         """y(s)/u(s) at s = 2πi f for every set, y = c·Θ.
@@ -324,7 +399,8 @@ class LinearSystem:
         s1 = s[..., None]                                                  # (1, F, 1)
         if input == "tilt":
             b = self.tilt_input[:, None]                                   # (M, 1, 4, N)
-            ex = np.exp(-s * self.delay[:, None])[..., None]               # (M, F, 1)
+            ex = np.exp(-s * self.delay[:, None])                          # (M, F)
+            ex = (ex * self.torque_feedback_factor(s))[..., None]          # (M, F, 1)
             rhs = b[..., 0, :] + s1 * b[..., 1, :] + (b[..., 2, :] + s1 * b[..., 3, :]) * ex
         else:
             rhs = s1 * s1 * self.translation_input[:, None, :]
@@ -424,10 +500,34 @@ def _gain_rows(name: str, value, pairs: int) -> np.ndarray:
     return arr
 
 
+def _torque_feedback(gain, time_constant) -> tuple[np.ndarray | None, np.ndarray | None]:
+    """K_t and τ_t as arrays of shape (M or 1,), checked against the parameter table, or
+    (None, None) when every gain is 0 (the system is then exactly the one without)."""
+    from ..parameters import QUANTITIES, TORQUE_FEEDBACK_TIME_CONSTANT, check_value
+
+    k = np.atleast_1d(finite_array("torque_feedback_gain [-]", gain))
+    t = np.atleast_1d(finite_array("torque_feedback_time_constant [s]",
+                                   TORQUE_FEEDBACK_TIME_CONSTANT if time_constant is None
+                                   else time_constant))
+    for name, values in (("torque_feedback_gain", k), ("torque_feedback_time_constant", t)):
+        q = QUANTITIES[name]
+        if values.ndim != 1:
+            raise ParameterError(f"{name} [{q.unit}] must be a scalar or shape (M,)")
+        low_ok = values > q.low if q.low_open else values >= q.low
+        bad = ~(low_ok & (values <= q.high))
+        if np.any(bad):
+            check_value(name, float(values[np.argmax(bad)]))
+    if not np.any(k):
+        return None, None
+    return k, t
+
+
 def linear_system(body: Body | BodyArrays, muscles: MuscleSet, *, stiffness=None,
                   viscosity=None, viscosity_ratio=None, active_stiffness=None,
                   active_viscosity=None, delay=0.0, proprioceptive_weight=1.0,
-                  one_sided: OneSided = "active", inputs: bool = True) -> LinearSystem:
+                  one_sided: OneSided = "active", inputs: bool = True,
+                  torque_feedback_gain=0.0,
+                  torque_feedback_time_constant=None) -> LinearSystem:
     """The chain linearised about upright (module notes), for one or M parameter sets.
 
     Parameters
@@ -454,6 +554,11 @@ def linear_system(body: Body | BodyArrays, muscles: MuscleSet, *, stiffness=None
         How a one-sided pair is linearised at upright (:func:`posturelab.analyse`).
     inputs : bool
         Also build the tilt input (a batched map without inputs leaves it out).
+    torque_feedback_gain : float or array_like, shape (M,)
+        K_t of the torque feedback (module notes), in the parameter table's range; 0 (every
+        set): none. [-]
+    torque_feedback_time_constant : float or array_like, shape (M,), optional
+        τ_t, > 0; by default the parameter table's 17.4 s (PMC5664365 Table 1). [s]
 
     Returns
     -------
@@ -518,10 +623,13 @@ def linear_system(body: Body | BodyArrays, muscles: MuscleSet, *, stiffness=None
                           for g in split], axis=-2)
         weight = np.atleast_1d(np.asarray(proprioceptive_weight, dtype=float))
         tilt = -tilt_pair_gains(gains, muscles.spans_foot, tau, weight) @ E
+    feedback_gain, time_constant = _torque_feedback(torque_feedback_gain,
+                                                    torque_feedback_time_constant)
     system = LinearSystem(
         inertia=jac, stiffness=stiff, viscosity=_joint_or_zero(split[1], E),
         delayed_stiffness=_joint_or_zero(split[2], E),
         delayed_viscosity=_joint_or_zero(split[3], E), delay=tau, tilt_input=tilt,
-        translation_input=-coefficients)
+        translation_input=-coefficients, torque_feedback_gain=feedback_gain,
+        torque_feedback_time_constant=time_constant)
     system.n_sets  # noqa: B018 (checks that the arrays agree on M)
     return system

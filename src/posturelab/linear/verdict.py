@@ -203,7 +203,8 @@ def _side_muscles(muscles: MuscleSet, engaged: frozenset[str]) -> MuscleSet:
 
 
 def upright_verdict(body: Body, muscles: MuscleSet, feedback_delay: float = 0.0, *,
-                    nodes: int = 40) -> UprightVerdict:
+                    nodes: int = 40, torque_feedback_gain: float = 0.0,
+                    torque_feedback_time_constant: float | None = None) -> UprightVerdict:
     """The one verdict about upright for this body, these gains and this delay.
 
     Parameters
@@ -217,6 +218,10 @@ def upright_verdict(body: Body, muscles: MuscleSet, feedback_delay: float = 0.0,
     nodes : int
         Chebyshev intervals of the root computation with a delay
         (:func:`posturelab.linear.delay.rightmost_roots`). [-]
+    torque_feedback_gain, torque_feedback_time_constant : float
+        Peterka 2002's torque feedback (:func:`posturelab.linear.system.linear_system`;
+        gain 0: none): the roots are then those of the first-order form with the filter
+        states. [-], [s]
 
     Returns
     -------
@@ -250,7 +255,9 @@ def upright_verdict(body: Body, muscles: MuscleSet, feedback_delay: float = 0.0,
     for flags in itertools.product((True, False), repeat=len(names)):
         engaged = tuple(n for n, f in zip(names, flags, strict=True) if f)
         slack = tuple(n for n, f in zip(names, flags, strict=True) if not f)
-        side = linear_system(body, _side_muscles(muscles, frozenset(engaged)), inputs=False)
+        side = linear_system(body, _side_muscles(muscles, frozenset(engaged)), inputs=False,
+                             torque_feedback_gain=torque_feedback_gain,
+                             torque_feedback_time_constant=torque_feedback_time_constant)
         roots = system_rightmost_roots(side, delay, count, nodes=nodes)
         top = complex(roots[0])
         sides.append(UprightSide(engaged, slack, _status(top), top,

@@ -47,6 +47,9 @@ __all__ = [
     "pull_value_formula",
     "saturated_moment_formula",
     "tilt_pair_torque_formula",
+    "torque_feedback_rate_formula",
+    "delayed_pair_torques",
+    "torque_feedback_rate",
     "model_response",
     "raw_moments",
     "saturated_moments",
@@ -94,6 +97,13 @@ def tilt_pair_torque_formula(gain_angle, gain_rate, gain_delayed_angle, gain_del
     """A pair's torque from the tilt: g₀ α(t) + g₁ α̇(t) + g₂ α(t − τ) + g₃ α̇(t − τ). [N·m]"""
     return (gain_angle * angle + gain_rate * rate) + (gain_delayed_angle * delayed_angle
                                                       + gain_delayed_rate * delayed_rate)
+
+
+def torque_feedback_rate_formula(filter_state, active_torque, gain, time_constant):
+    """Ẏ = (K_t A − Y)/τ_t of one pair's torque feedback filter (Peterka 2002; docs/design.md,
+    "Torque feedback"): Y [N·m] the filter state, A = P + Y the pair's active torque (P its
+    delayed PD part), K_t [-], τ_t [s]. [N·m/s]"""
+    return (gain * active_torque - filter_state) / time_constant
 
 
 # The event values (the physical part g of each event function; the offset of
@@ -197,6 +207,10 @@ class SwitchedModel:
         The row C of the knee constraint.
     knee : KneeModel
     fall : FallCriteria
+    torque_feedback_gain : float
+        K_t of the torque feedback (0: none; :func:`torque_feedback_rate_formula`). [-]
+    torque_feedback_time_constant : float
+        τ_t. [s]
     """
 
     body: Body
@@ -212,11 +226,19 @@ class SwitchedModel:
     knee_row: np.ndarray | None = None
     knee: KneeModel = KneeModel()
     fall: FallCriteria = FallCriteria()
+    torque_feedback_gain: float = 0.0
+    torque_feedback_time_constant: float = 17.4
 
     @property
     def n_links(self) -> int:
         """N. [-]"""
         return self.body.n_links
+
+    @property
+    def n_filter_states(self) -> int:
+        """Torque feedback filter states appended to [Θ, Θ̇]: one per pair with torque
+        feedback, else 0. [-]"""
+        return len(self.muscles.pairs) if self.torque_feedback_gain > 0 else 0
 
 
 def platform_acceleration(model: SwitchedModel, t) -> np.ndarray:
@@ -246,14 +268,45 @@ def tilt_pair_torques(tilt: Tilt, tilt_gains: np.ndarray, delay: float, t) -> np
     return k * a + v * ad
 
 
+def delayed_pair_torques(model: SwitchedModel, t: float, feedback: np.ndarray,
+                         active: np.ndarray) -> np.ndarray:
+    """P: each pair's delayed (active) torque at ``t`` [s], the delayed gains on
+    ``feedback`` (x(t − τ)) and the tilt's delayed part, what the torque feedback filters
+    (:func:`torque_feedback_rate_formula`). [N·m]"""
+    g = model.gains
+    E = model.muscles.selection_matrix
+    n = model.n_links
+    P = (g[DELAYED_STIFFNESS] * (E @ feedback[:n]) + g[DELAYED_VISCOSITY] * (E @ feedback[n:]))
+    P = P * np.asarray(active, dtype=float)
+    if model.tilt is not None and model.feedback_delay > 0:
+        a_d, ad_d = model.tilt.angle_and_rate(np.asarray(t - model.feedback_delay, float))
+        P = P + (model.tilt_gains[DELAYED_STIFFNESS] * a_d
+                 + model.tilt_gains[DELAYED_VISCOSITY] * ad_d)
+    return P
+
+
+def torque_feedback_rate(model: SwitchedModel, t: float, feedback: np.ndarray,
+                         active: np.ndarray, filter_state: np.ndarray) -> np.ndarray:
+    """Ẏ of the pairs' torque feedback filters at ``t`` [s]
+    (:func:`torque_feedback_rate_formula` with A = P + Y, the filter's part acting with its
+    pair). [N·m/s]"""
+    act = np.asarray(active, dtype=float)
+    A = delayed_pair_torques(model, t, feedback, active) + act * filter_state
+    return torque_feedback_rate_formula(filter_state, A, model.torque_feedback_gain,
+                                        model.torque_feedback_time_constant)
+
+
 def raw_moments(model: SwitchedModel, t: float, x: np.ndarray, feedback: np.ndarray,
-                active: np.ndarray) -> np.ndarray:
+                active: np.ndarray, filter_state: np.ndarray | None = None) -> np.ndarray:
     """Unsaturated net muscle moment per joint at time ``t`` [s]: the immediate part on the
-    state ``x``, the delayed part on ``feedback`` (x(t − τ)), the tilt's part and the motor
+    state ``x``, the delayed part on ``feedback`` (x(t − τ)), the tilt's part, the torque
+    feedback filters' ``filter_state`` (P,) (with their pairs' activity) and the motor
     noise. [N·m]"""
     M = feedback_pair_torques(model.muscles, model.gains, x, feedback, active)
     if model.tilt is not None:
         M = M + tilt_pair_torques(model.tilt, model.tilt_gains, model.feedback_delay, t)
+    if filter_state is not None and model.n_filter_states:
+        M = M + np.asarray(active, dtype=float) * filter_state
     tau = M @ model.muscles.crossing_matrix
     if model.motor_torque is not None:
         tau = tau + torque_at(model.motor_torque, t)
@@ -281,8 +334,8 @@ def _acceleration(model: SwitchedModel, x: np.ndarray, tau: np.ndarray, a: np.nd
 
 
 def model_response(model: SwitchedModel, t: float, x: np.ndarray, feedback: np.ndarray,
-                   active: np.ndarray, locked: bool, saturation: np.ndarray | None
-                   ) -> tuple[np.ndarray, np.ndarray]:
+                   active: np.ndarray, locked: bool, saturation: np.ndarray | None,
+                   filter_state: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """The model at one state with the run's switches applied.
 
     Parameters
@@ -300,6 +353,8 @@ def model_response(model: SwitchedModel, t: float, x: np.ndarray, feedback: np.n
         The knee constraint holds.
     saturation : numpy.ndarray, shape (N,), or None
         ±1 for a saturated joint (its moment is ±limit), 0 for a free one. [-]
+    filter_state : numpy.ndarray, shape (P,), or None
+        The torque feedback filters' states Y (:func:`torque_feedback_rate`). [N·m]
 
     Returns
     -------
@@ -308,18 +363,19 @@ def model_response(model: SwitchedModel, t: float, x: np.ndarray, feedback: np.n
     acceleration : numpy.ndarray, shape (N,)
         Θ̈ (on the knee constraint if locked). [rad/s²]
     """
-    tau = saturated_moments(raw_moments(model, t, x, feedback, active), saturation,
-                            model.torque_limits)
+    tau = saturated_moments(raw_moments(model, t, x, feedback, active, filter_state),
+                            saturation, model.torque_limits)
     return tau, _acceleration(model, x, tau, platform_acceleration(model, t), locked)
 
 
 def ankle_moment_and_load(model: SwitchedModel, t: float, x: np.ndarray, feedback: np.ndarray,
-                          active, locked, saturation) -> tuple[float, float]:
+                          active, locked, saturation, filter_state=None
+                          ) -> tuple[float, float]:
     """The net muscle moment at the ankle τ_ankle [N·m] and the vertical ground reaction F_y
     [N] at one state: x_p = τ_ankle / F_y. The centre-of-pressure events use them in moment
     form (:mod:`.events`), continuous where F_y passes 0."""
     n = model.n_links
-    tau, acc = model_response(model, t, x, feedback, active, locked, saturation)
+    tau, acc = model_response(model, t, x, feedback, active, locked, saturation, filter_state)
     fy = ground_reaction(model.body, x[:n], x[n:], acc, platform_acceleration(model, t))[1]
     return float(tau[0]), float(fy)
 
@@ -342,10 +398,12 @@ def pair_gains(model: SwitchedModel, j: int) -> tuple[float, float]:
 
 def event_value(model: SwitchedModel, kind: int, j: int, side: float, t: float, x: np.ndarray,
                 feedback: np.ndarray, active: np.ndarray, locked: bool,
-                saturation: np.ndarray | None) -> float:
+                saturation: np.ndarray | None, filter_state: np.ndarray | None = None
+                ) -> float:
     """The event function g(t, x) of event ``kind`` (index ``j``, side ``side``) with the
     segment's switches: :data:`EVENT_VALUES` on the quantities it names, plus the kind's
-    offset (:data:`.events.EVENT_OFFSET`)."""
+    offset (:data:`.events.EVENT_OFFSET`); ``filter_state`` the torque feedback filters'
+    (:func:`raw_moments`)."""
     n = model.n_links
     body, fall = model.body, model.fall
     bos = fall.base_of_support
@@ -365,11 +423,12 @@ def event_value(model: SwitchedModel, kind: int, j: int, side: float, t: float, 
         if name == "pair_viscosity":
             return pair_gains(model, j)[1]
         if name == "moment":
-            return raw_moments(model, t, x, feedback, active)[j]
+            return raw_moments(model, t, x, feedback, active, filter_state)[j]
         if name == "knee_angle":
             return x[1] - x[0]
         if name == "free_knee_acceleration":
-            acc = model_response(model, t, x, feedback, active, False, saturation)[1]
+            acc = model_response(model, t, x, feedback, active, False, saturation,
+                                 filter_state)[1]
             return acc[1] - acc[0]
         return {"max_link_angle": fall.max_link_angle, "side": side,
                 "toe": bos.toe if bos is not None else 0.0,
@@ -381,7 +440,7 @@ def event_value(model: SwitchedModel, kind: int, j: int, side: float, t: float, 
     values = {}
     if "ankle_moment" in names:
         values["ankle_moment"], values["vertical_reaction"] = ankle_moment_and_load(
-            model, t, x, feedback, active, locked, saturation)
+            model, t, x, feedback, active, locked, saturation, filter_state)
     for name in names:
         if name not in values:
             values[name] = quantity(name)

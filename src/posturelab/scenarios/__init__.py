@@ -32,6 +32,10 @@ Schema (every table optional except where noted; units in brackets)::
     active_viscosity = [5 values]        #   pairs = [...], per pair instead [N·m·s/rad]
     active_viscosity_ratio = 0.3         # or the active viscosity as a ratio [s]
     proprioceptive_weight = 1.0          # W of the active error, in [0, 1] [-]
+    torque_feedback_gain = 0.0           # K_t: the active torque fed back positively
+                                         #   through K_t/(τ_t s + 1) (Peterka 2002; needs
+                                         #   feedback_delay > 0 and --engine reference) [-]
+    torque_feedback_time_constant = 17.4 # τ_t [s] (PMC5664365 Table 1)
 
     [tilt]                               # support-surface tilt, positive toes-up
     type = "sine"                        # sine | raised-cosine | prts | profile

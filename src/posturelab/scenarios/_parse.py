@@ -61,7 +61,9 @@ OPTION_KEYS: dict[str, str] = {
     "duration": "duration", "initial_state": "initial", "rates_from": "initial.rates_from",
     "knee": "knee", "fall": "fall", "torque_limits": "limits.torque",
     "feedback_delay": "muscles.feedback_delay",
-    "proprioceptive_weight": "muscles.proprioceptive_weight", "tilt": "tilt",
+    "proprioceptive_weight": "muscles.proprioceptive_weight",
+    "torque_feedback_gain": "muscles.torque_feedback_gain",
+    "torque_feedback_time_constant": "muscles.torque_feedback_time_constant", "tilt": "tilt",
     "tilt_axis_depth": "tilt.axis_depth", "motor_noise": "motor_noise",
     "method": "solver.method", "rtol": "solver.rtol", "atol": "solver.atol",
     "sample_rate": "solver.sample_rate", "max_steps": "solver.max_steps",
@@ -95,7 +97,12 @@ def parse_tables(data: dict, base_dir: Path, origin: str) -> Scenario:
     delay = mt.pop("feedback_delay", 0.0 if preset is None else preset.feedback_delay)
     weight = mt.pop("proprioceptive_weight",
                     1.0 if preset is None else preset.proprioceptive_weight)
-    for key, value in (("feedback_delay", delay), ("proprioceptive_weight", weight)):
+    feedback_gain = mt.pop("torque_feedback_gain", DEFAULTS.torque_feedback_gain)
+    feedback_lag = mt.pop("torque_feedback_time_constant",
+                          DEFAULTS.torque_feedback_time_constant)
+    for key, value in (("feedback_delay", delay), ("proprioceptive_weight", weight),
+                       ("torque_feedback_gain", feedback_gain),
+                       ("torque_feedback_time_constant", feedback_lag)):
         try:  # the parameter table's bounds, before the muscles are built
             check_value(key, value, f"muscles.{key}")
         except ParameterError as exc:
@@ -135,6 +142,7 @@ def parse_tables(data: dict, base_dir: Path, origin: str) -> Scenario:
         origin, duration=duration, initial_state=initial,
         rates_from=it.get("rates_from", DEFAULTS.rates_from), knee=knee, fall=fall,
         torque_limits=torque_limits, feedback_delay=delay, proprioceptive_weight=weight,
+        torque_feedback_gain=feedback_gain, torque_feedback_time_constant=feedback_lag,
         tilt=tilt, tilt_axis_depth=tilt_table.get("axis_depth", 0.0), motor_noise=noise,
         method=st.get("method"), rtol=st.get("rtol", DEFAULTS.rtol),
         atol=st.get("atol", DEFAULTS.atol),

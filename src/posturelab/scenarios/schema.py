@@ -74,6 +74,8 @@ class MusclesTable(_Table):
     active_viscosity: list[float] | None = None
     active_viscosity_ratio: float | None = None
     proprioceptive_weight: float | None = None
+    torque_feedback_gain: float | None = None
+    torque_feedback_time_constant: float | None = None
     controller: str | None = None
 
 

@@ -26,7 +26,8 @@ __all__ = ["derived_series"]
 
 def derived_series(setup: RunSetup, time: np.ndarray, state: np.ndarray,
                    feedback_state: np.ndarray | None = None,
-                   locked: np.ndarray | None = None) -> DerivedSeries:
+                   locked: np.ndarray | None = None,
+                   filter_state: np.ndarray | None = None) -> DerivedSeries:
     """The derived series of a run.
 
     Parameters
@@ -42,6 +43,9 @@ def derived_series(setup: RunSetup, time: np.ndarray, state: np.ndarray,
         (x(t − τ)); ``state`` by default. [rad], [rad/s]
     locked : numpy.ndarray of bool, shape (T,), optional
         Samples at which the knee constraint held.
+    filter_state : numpy.ndarray, shape (T, P), optional
+        The torque feedback filters' states Y at the samples, added to their pairs'
+        torques (:func:`posturelab.model.switched.torque_feedback_rate`). [N·m]
 
     Returns
     -------
@@ -56,6 +60,8 @@ def derived_series(setup: RunSetup, time: np.ndarray, state: np.ndarray,
     theta, omega = state[:, :n], state[:, n:]
     fb = state if feedback_state is None else np.asarray(feedback_state, dtype=float)
     M = feedback_pair_torques(muscles, setup.gains, state, fb)
+    if filter_state is not None:
+        M = M + np.asarray(filter_state, dtype=float)
     if muscles.one_sided_mask.any():  # (such pairs are all-immediate or all-delayed)
         slack = muscles.one_sided_mask & (fb[:, :n] @ muscles.selection_matrix.T < 0.0)
         slack |= muscles.pull_only_mask & (M < 0.0)  # a pull-only pair does not push

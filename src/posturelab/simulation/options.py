@@ -29,7 +29,7 @@ from ..errors import ParameterError
 from ..model.noise import MotorNoise
 from ..model.options import FallCriteria, KneeModel
 from ..model.tilt import Tilt
-from ..parameters import QUANTITIES, RUN_SETTINGS, check_value
+from ..parameters import QUANTITIES, RUN_SETTINGS, TORQUE_FEEDBACK_TIME_CONSTANT, check_value
 from .tolerances import DEFAULT_ATOL, DEFAULT_RTOL
 
 __all__ = [
@@ -123,6 +123,13 @@ class RunOptions:
     proprioceptive_weight : float
         W in [0, 1]: the active part's error for pairs that span the foot is θ_hi + W·α
         (1: relative to the foot; 0: to the vertical). [-]
+    torque_feedback_gain : float
+        K_t of Peterka 2002's torque feedback: each pair's active torque fed back positively
+        through K_t/(τ_t s + 1) (docs/design.md; 0, the default: none). Needs a positive
+        ``feedback_delay`` and the reference engine (the compiled engine does not carry the
+        filter states yet). [-]
+    torque_feedback_time_constant : float
+        τ_t of its low-pass filter (default 17.4 s, PMC5664365 Table 1). [s]
     tilt : Tilt or None
         Support-surface tilt α(t), positive toes-up (:mod:`posturelab.model.tilt`). [rad]
     tilt_axis_depth : float
@@ -167,6 +174,10 @@ class RunOptions:
     feedback_delay: float = _option(0.0, QUANTITIES["feedback_delay"].meaning, "s")
     proprioceptive_weight: float = _option(1.0, QUANTITIES["proprioceptive_weight"].meaning,
                                            "-")
+    torque_feedback_gain: float = _option(0.0, QUANTITIES["torque_feedback_gain"].meaning,
+                                          "-")
+    torque_feedback_time_constant: float = _option(
+        TORQUE_FEEDBACK_TIME_CONSTANT, QUANTITIES["torque_feedback_time_constant"].meaning, "s")
     tilt: Tilt | None = _option(None, "support-surface tilt, positive toes-up", "rad")
     tilt_axis_depth: float = _option(0.0, RUN_SETTINGS["tilt_axis_depth"].meaning, "m")
     motor_noise: MotorNoise | None = _option(None, "seeded random joint torque", "N·m")
@@ -199,6 +210,10 @@ class RunOptions:
         put("feedback_delay", check_value("feedback_delay", self.feedback_delay))
         put("proprioceptive_weight", check_value("proprioceptive_weight",
                                                  self.proprioceptive_weight))
+        put("torque_feedback_gain", check_value("torque_feedback_gain",
+                                                self.torque_feedback_gain))
+        put("torque_feedback_time_constant", check_value("torque_feedback_time_constant",
+                                                         self.torque_feedback_time_constant))
         depth = _setting("tilt_axis_depth", self.tilt_axis_depth)
         put("tilt_axis_depth", depth)
         if self.tilt is not None:
@@ -212,6 +227,9 @@ class RunOptions:
         if self.motor_noise is not None:
             _expect("motor_noise", self.motor_noise, MotorNoise)
         put("engine", engine_name(self.engine))
+        if self.torque_feedback_gain > 0 and self.feedback_delay <= 0:
+            raise ParameterError("torque_feedback_gain > 0 filters the delayed active "
+                                 "torque: give a feedback_delay > 0")
         if self.method is not None and not isinstance(self.method, str):
             raise ParameterError(f"method must be the name of an integrator, got "
                                  f"{self.method!r:.60}")
@@ -236,6 +254,14 @@ class RunOptions:
             put("time_limit", _setting("time_limit", self.time_limit))
         if not isinstance(self.description, str):
             raise ParameterError(f"description must be a string, got {self.description!r:.60}")
+
+    def refuse_torque_feedback_on_compiled(self) -> None:
+        """Raise ParameterError when torque feedback is asked of the compiled engine (it does
+        not carry the filter states yet; the reference engine does)."""
+        if self.torque_feedback_gain > 0:
+            raise ParameterError("torque feedback (torque_feedback_gain > 0) runs on the "
+                                 "reference engine (engine='reference', --engine reference); "
+                                 "the compiled engine does not carry its filter states yet")
 
     def replace(self, **changes: Any) -> RunOptions:
         """A copy with some options changed (checked again); an unknown name is refused

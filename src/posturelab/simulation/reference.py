@@ -136,13 +136,20 @@ def integrate_reference(setup: RunSetup, method: str = "DOP853") -> SimulationRe
     budget = _Budget(setup.max_steps, setup.time_limit)
     solver = budget.solver(method)
 
+    m = 2 * n  # [Θ, Θ̇]; the torque feedback filters' states follow them in the state
+
     def feedback(t: float, x: np.ndarray) -> np.ndarray:
-        return x if history is None else history(t - delay)
+        return x[:m] if history is None else history(t - delay)[:m]
 
     model = switched_model(setup)
+    filters = model.n_filter_states
+
+    def filter_part(y: np.ndarray) -> np.ndarray | None:
+        return y[m:] if filters else None
+
     limits = setup.torque_limits
     limited = np.isfinite(limits).astype(np.int64) if limits is not None else np.zeros(n, int)
-    x = setup.x0.copy()
+    x = np.concatenate([setup.x0, np.zeros(filters)])  # the filters start at rest
     locked = setup.locked0
     active = setup.active0.copy()
     saturation = setup.saturation0.copy()
@@ -154,8 +161,8 @@ def integrate_reference(setup: RunSetup, method: str = "DOP853") -> SimulationRe
         """The event function g(t, x) of event kind k (index j, side sd) in this segment
         (:func:`posturelab.model.switched.event_value`); ``feedback(t, x)`` is the state the
         muscles respond to (by default the run's)."""
-        return lambda t, y: sw.event_value(model, k, j, sd, t, y, feedback(t, y), _active,
-                                           _locked, _sat)
+        return lambda t, y: sw.event_value(model, k, j, sd, t, y[:m], feedback(t, y), _active,
+                                           _locked, _sat, filter_part(y))
 
     if locked and knee.mode == "stop" and event_function(
             ev.KNEE_LEAVES_STOP, 1, 0.0, active, False, saturation)(0.0, x) < 0.0:
@@ -207,7 +214,7 @@ def integrate_reference(setup: RunSetup, method: str = "DOP853") -> SimulationRe
         if source is None:
             return None
         sat_now = saturation.copy() if limits is not None else None
-        left = history.left(source)
+        left = history.left(source)[:m]
         for e, (k, j, sd) in enumerate(listed):
             before_jump = event_function(k, j, sd, active, locked, sat_now,
                                          feedback=lambda tt, yy: left)(t, x)
@@ -232,9 +239,13 @@ def integrate_reference(setup: RunSetup, method: str = "DOP853") -> SimulationRe
             sat = saturation.copy() if limits is not None else None
 
             def rhs(tt, xx, _active=active, _locked=locked, _sat=sat):
-                acc = sw.model_response(model, tt, xx, feedback(tt, xx), _active, _locked,
-                                        _sat)[1]
-                return np.concatenate([xx[n:], acc])
+                fb = feedback(tt, xx)
+                acc = sw.model_response(model, tt, xx[:m], fb, _active, _locked, _sat,
+                                        filter_part(xx))[1]
+                if not filters:
+                    return np.concatenate([xx[n:], acc])
+                return np.concatenate([xx[n:m], acc,
+                                       sw.torque_feedback_rate(model, tt, fb, _active, xx[m:])])
 
             events = []
             for k, j, sd in listed:
@@ -305,8 +316,9 @@ def integrate_reference(setup: RunSetup, method: str = "DOP853") -> SimulationRe
             status = "failed"
             message = outcome_message("chattering", seg_end, setup)
             break
-        x, active, saturation, locked = sw.apply_switch(
-            model, kind, j, sd, x, feedback(seg_end, x), active, saturation, locked)
+        switched_state, active, saturation, locked = sw.apply_switch(
+            model, kind, j, sd, x[:m], feedback(seg_end, x), active, saturation, locked)
+        x = np.concatenate([switched_state, x[m:]])
         if kind == ev.KNEE_HITS_STOP and delay > 0:  # the muscles feel the impact τ later,
             rate_jumps.append(seg_end)  # its derivatives 2τ, … later
             feedback_jumps.extend(seg_end + k * delay
@@ -314,18 +326,20 @@ def integrate_reference(setup: RunSetup, method: str = "DOP853") -> SimulationRe
 
     if not times:  # the run ended before its first sample: the series is its initial state
         times.append(np.array([0.0]))
-        states.append(setup.x0[None, :].copy())
+        states.append(np.concatenate([setup.x0, np.zeros(filters)])[None, :])
         locked_flags.append(np.array([setup.locked0]))
     time = np.concatenate(times)
     state = np.concatenate(states, axis=0)
+    filter_states = state[:, m:] if filters else None
+    state = state[:, :m]
     feedback_states = None
     if history is not None:
-        feedback_states = np.array([history(tk - delay) for tk in time])
+        feedback_states = np.array([history(tk - delay)[:m] for tk in time])
     lock = np.concatenate(locked_flags)
     theta, omega = state[:, :n].copy(), state[:, n:].copy()
     for arr in (time, theta, omega):
         arr.setflags(write=False)
-    derived = derived_series(setup, time, state, feedback_states, lock)
+    derived = derived_series(setup, time, state, feedback_states, lock, filter_states)
     return SimulationResult(
         time=time, theta=theta, omega=omega, pair_names=tuple(muscles.names), status=status,
         message=message, fell=fell, fall_time=fall_time, fall_reason=fall_reason,

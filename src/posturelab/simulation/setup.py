@@ -460,7 +460,9 @@ def switched_model(setup: RunSetup) -> switched.SwitchedModel:
             disturbance=setup.disturbance, torque_limits=setup.torque_limits,
             feedback_delay=setup.feedback_delay, tilt=setup.tilt, tilt_gains=setup.tilt_gains,
             tilt_axis_depth=setup.tilt_axis_depth, motor_torque=setup.motor_torque,
-            knee_row=setup.knee_row, knee=setup.knee, fall=setup.fall)
+            knee_row=setup.knee_row, knee=setup.knee, fall=setup.fall,
+            torque_feedback_gain=setup.options.torque_feedback_gain,
+            torque_feedback_time_constant=setup.options.torque_feedback_time_constant)
         object.__setattr__(setup, "_switched_model", model)
     return model
 

@@ -71,7 +71,8 @@ class FitError(PostureLabError):
 VISCOSITY_RATIO = "viscosity_ratio"
 #: The quantities of the parameter table a time-domain fit can free.
 FIT_QUANTITIES = ("stiffness", "viscosity", "active_stiffness", "active_viscosity",
-                  "viscosity_ratio", "feedback_delay", "proprioceptive_weight")
+                  "viscosity_ratio", "feedback_delay", "proprioceptive_weight",
+                  "torque_feedback_gain", "torque_feedback_time_constant")
 #: How the uncertainty treats the residuals (:func:`fit_stiffness`).
 RESIDUAL_MODELS = ("ar1", "independent")
 #: The engines ``fit_stiffness`` can run the model on ("fast" is a former name of "compiled").
@@ -250,7 +251,9 @@ def fit_stiffness(
         ``"viscosity:PAIR"`` [N·m·s/rad] (else ratio × stiffness),
         ``"active_stiffness:PAIR"`` [N·m/rad], ``"active_viscosity:PAIR"`` [N·m·s/rad],
         ``"viscosity_ratio"`` [s], ``"feedback_delay"`` [s], ``"proprioceptive_weight"``
-        [-]; a former spelling (``"ankle"``, ``"active_ankle"``) is refused naming the new.
+        [-], ``"torque_feedback_gain"`` [-] and ``"torque_feedback_time_constant"`` [s]
+        (Peterka 2002's torque feedback; its runs need ``engine="reference"``); a former
+        spelling (``"ankle"``, ``"active_ankle"``) is refused naming the new.
     viscosity_ratio : float
         Viscosity / stiffness for every pair when the ratio is not fitted,
         and its starting value when it is. [s]
@@ -319,12 +322,16 @@ def fit_stiffness(
                   for p, v in zip(pairs, m0.active_viscosities, strict=True)}}
     special = {VISCOSITY_RATIO: viscosity_ratio,
                "feedback_delay": scenario.options.feedback_delay or 0.1,
-               "proprioceptive_weight": scenario.options.proprioceptive_weight}
+               "proprioceptive_weight": scenario.options.proprioceptive_weight,
+               "torque_feedback_gain": scenario.options.torque_feedback_gain,
+               "torque_feedback_time_constant": scenario.options.torque_feedback_time_constant}
     if initial_guess is None:
         x0 = [special[nm] if nm in special else (current[nm] or 500.0) for nm in names]
     else:
         x0 = list(finite_array("initial_guess", initial_guess, (len(names),)))
-    lower = np.array([QUANTITIES[nm.partition(":")[0]].low for nm in names])
+    # (a range open at its lower end, τ_t's, is searched from 0.5 s as fit-frf does)
+    lower = np.array([0.5 if QUANTITIES[nm.partition(":")[0]].low_open
+                      else QUANTITIES[nm.partition(":")[0]].low for nm in names])
     # the search box: the table's fit interval (pair gains: upper_bound, within the table's)
     upper = np.array([QUANTITIES[nm].fit_high if nm in special
                       else min(upper_bound, QUANTITIES[nm.partition(":")[0]].high)
@@ -352,7 +359,11 @@ def fit_stiffness(
             muscles=muscles,
             feedback_delay=value.get("feedback_delay", sc.options.feedback_delay),
             proprioceptive_weight=value.get("proprioceptive_weight",
-                                            sc.options.proprioceptive_weight))
+                                            sc.options.proprioceptive_weight),
+            torque_feedback_gain=value.get("torque_feedback_gain",
+                                           sc.options.torque_feedback_gain),
+            torque_feedback_time_constant=value.get("torque_feedback_time_constant",
+                                                    sc.options.torque_feedback_time_constant))
         result = trial.run(engine=engine)
         if result.status == "failed":  # never fit to a run that stopped short
             shown = ", ".join(f"{nm} = {v:.6g}" for nm, v in value.items())

@@ -203,8 +203,8 @@ function draw(d) {
   verdict.textContent = d.verdict;
   verdict.className = d.stable ? "stable" : d.verdict.startsWith("marginal") ? "marginal"
     : "unstable";
-  document.getElementById("delay-margin").textContent =
-    !d.stable_without_delay ? "none (unstable without delay)"
+  document.getElementById("delay-margin").textContent = d.delay_margin_note ? d.delay_margin_note
+    : !d.stable_without_delay ? "none (unstable without delay)"
       : d.delay_margin === null ? "∞ (no crossing)" : `${d.delay_margin.toPrecision(3)} s`;
   document.getElementById("delay-note").textContent =
     d.delayed_part === "active" ? "(of the active gains)" : "(of the whole pair feedback)";

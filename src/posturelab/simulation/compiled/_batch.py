@@ -286,6 +286,7 @@ def simulate_batch(
     """
     check_model(body, muscles)
     common = _shared_options(options, duration, initial_state, keywords)
+    common.refuse_torque_feedback_on_compiled()
     method = common.method
     if method is not None:
         check_method(method)

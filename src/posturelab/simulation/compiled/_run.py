@@ -154,6 +154,7 @@ def integrate_compiled(setup: RunSetup, method: str | None = None) -> Simulation
     SimulationResult
         Its derived series are computed when first read.
     """
+    setup.options.refuse_torque_feedback_on_compiled()
     method = default_method(setup.feedback_delay) if method is None else method
     check_method(method)
     a = packed(setup)
