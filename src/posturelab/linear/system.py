@@ -38,6 +38,12 @@ import numpy as np
 from .._validation import finite_array
 from ..errors import ParameterError
 from ..model.body import Body, upright_matrices
+from ..model.gains import (
+    DELAYED_STIFFNESS,
+    DELAYED_VISCOSITY,
+    IMMEDIATE_STIFFNESS,
+    IMMEDIATE_VISCOSITY,
+)
 from ..model.muscles import MuscleSet, feedback_gains
 from ..model.tilt import tilt_pair_gains
 
@@ -325,7 +331,8 @@ class LinearSystem:
         if input == "tilt":
             b = self.tilt_input[:, None]                                   # (M, 1, 4, N)
             ex = np.exp(-s * self.delay[:, None])[..., None]               # (M, F, 1)
-            rhs = b[..., 0, :] + s1 * b[..., 1, :] + (b[..., 2, :] + s1 * b[..., 3, :]) * ex
+            rhs = (b[..., IMMEDIATE_STIFFNESS, :] + s1 * b[..., IMMEDIATE_VISCOSITY, :]
+                   + (b[..., DELAYED_STIFFNESS, :] + s1 * b[..., DELAYED_VISCOSITY, :]) * ex)
         else:
             rhs = s1 * s1 * self.translation_input[:, None, :]
         rhs = np.broadcast_to(rhs, (m, f.size, n))
@@ -391,7 +398,8 @@ def _joint_or_zero(gains: np.ndarray | None, selection: np.ndarray) -> np.ndarra
 
 
 def _split(stiffness, viscosity, active_stiffness, active_viscosity) -> list:
-    """The gains by when they act for a positive delay, [k_i, l_i, k_a, l_a] (None: zero):
+    """The gains by when they act for a positive delay, indexed by the rows of
+    :mod:`posturelab.model.gains` (None: zero):
     :func:`posturelab.model.muscles.feedback_gains` applied as the linear map it is, its
     matrix read from unit gains (so that a block of many sets costs a few additions)."""
     unit = np.eye(4)
@@ -507,7 +515,7 @@ def linear_system(body: Body | BodyArrays, muscles: MuscleSet, *, stiffness=None
     split = _split(k, v, ka, va)
     E = muscles.selection_matrix
     n = E.shape[1]
-    stiff = _joint_or_zero(split[0], E)
+    stiff = _joint_or_zero(split[IMMEDIATE_STIFFNESS], E)
     index = np.arange(n)
     stiff = np.array(np.broadcast_to(stiff, (max(stiff.shape[0], jac.shape[0]), n, n)))
     stiff[:, index, index] -= gravity_torque
@@ -519,9 +527,9 @@ def linear_system(body: Body | BodyArrays, muscles: MuscleSet, *, stiffness=None
         weight = np.atleast_1d(np.asarray(proprioceptive_weight, dtype=float))
         tilt = -tilt_pair_gains(gains, muscles.spans_foot, tau, weight) @ E
     system = LinearSystem(
-        inertia=jac, stiffness=stiff, viscosity=_joint_or_zero(split[1], E),
-        delayed_stiffness=_joint_or_zero(split[2], E),
-        delayed_viscosity=_joint_or_zero(split[3], E), delay=tau, tilt_input=tilt,
+        inertia=jac, stiffness=stiff, viscosity=_joint_or_zero(split[IMMEDIATE_VISCOSITY], E),
+        delayed_stiffness=_joint_or_zero(split[DELAYED_STIFFNESS], E),
+        delayed_viscosity=_joint_or_zero(split[DELAYED_VISCOSITY], E), delay=tau, tilt_input=tilt,
         translation_input=-coefficients)
     system.n_sets  # noqa: B018 (checks that the arrays agree on M)
     return system
