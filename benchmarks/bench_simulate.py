@@ -22,7 +22,8 @@ Run it as a script (not a test): ``python benchmarks/bench_simulate.py``. It pri
    from an empty cache and from the cache;
 6. the targets, met or not.
 
-Environment: ``BENCH_QUICK=1`` shortens every part (for a smoke test).
+Environment: ``BENCH_QUICK=1`` shortens every part (for a smoke test). The PRTS experiment
+of 3b against jitcdde at equal accuracy is ``bench_prts.py``.
 """
 
 from __future__ import annotations

@@ -17,6 +17,7 @@ import pytest
 
 import posturelab as pl
 from posturelab.model.muscles import MusclePair, MuscleSet
+from posturelab.model.tilt import PRTSTilt, RaisedCosineTilt
 from posturelab.simulation import compiled
 from posturelab.simulation.compiled import simulate_batch
 
@@ -313,3 +314,25 @@ def test_codes_in_python_equal_those_in_the_c_header():
     for name in ("ALWAYS", "JOINT_FREE", "JOINT_SATURATED", "PAIR_ACTIVE", "PAIR_SLACK",
                  "KNEE_FREE", "KNEE_LOCKED"):
         assert c["COND_" + name] == getattr(ev, name), name
+
+
+def test_delayed_tilt_batch_equals_its_single_runs_bit_for_bit(rng):
+    """A tilt's corners and their delayed echoes: each row steps onto its own t_k + τ, as its
+    single run does (the batch hands the driver the corners; the driver adds each row's echoes)."""
+    m = 6
+    k = np.tile(np.asarray(pl.paper_muscles("1").stiffnesses), (m, 1))
+    k[:, 0] = rng.uniform(600.0, 1200.0, m)
+    delays = np.array([0.0, 0.01, 0.03, 0.05, 0.002, 0.03])
+    for tilt in (RaisedCosineTilt(amplitude=0.02, start=0.2, duration=0.5),
+                 PRTSTilt.named("posturelab-80", amplitude=0.02)):
+        _assert_tilt_batch_rows(k, delays, tilt)
+
+
+def _assert_tilt_batch_rows(k, delays, tilt):
+    m = len(delays)
+    out = simulate_batch(pl.paper_body(), k, 0.25 * k, None, 1.5, feedback_delay=delays,
+                         tilt=tilt)
+    for r in range(m):
+        one = _single(pl.paper_body(), k[r], None, 1.5, feedback_delay=float(delays[r]),
+                      tilt=tilt)
+        assert_row_is_run(out, r, one)

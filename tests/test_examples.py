@@ -69,3 +69,20 @@ def test_delay_stability_map_example_marks_a_stable_published_controller(tmp_pat
                                     active_viscosity=dmap.active_viscosity[iy]),), 1)
     assert pl.delay_margin(body, muscles).delay_margin > example.DELAY
     assert example.main(tmp_path).stat().st_size > 10_000
+
+
+def test_experiment_design_example_predicts_the_spread_of_simulated_fits(tmp_path):
+    """The design example's predicted error of the delay against the spread of its simulated
+    fits (20 seeds: the spread's own sampling error is 16 %), and its figure written."""
+    from posturelab.frequency.design import predict_errors
+    from posturelab.model.tilt import PRTSTilt
+
+    example = _load("plot_experiment_design")
+    body, muscles, options = example._model()
+    predicted = predict_errors(
+        body, muscles, example.FREE, tilt=PRTSTilt.named("posturelab-80", example.AMPLITUDE),
+        cycles=4, sensor_noise=example.SENSOR_NOISE,
+        motor_noise=example.MotorNoise(example.MOTOR_NOISE), **options).standard_errors
+    spread = np.std(example.spread_of_fits(4), axis=0, ddof=1)
+    assert np.all(np.abs(spread / predicted - 1) < 0.4), spread / predicted
+    assert example.main(tmp_path, seeds=3).stat().st_size > 10_000

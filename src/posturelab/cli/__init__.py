@@ -32,6 +32,7 @@ SUBCOMMANDS: dict[str, str] = {
     "likeness": "likeness",
     "likeness-reference": "likeness_reference",
     "cohort": "cohort",
+    "design": "design",
     "compare": "compare",
     "explore": "explore",
 }
@@ -60,6 +61,8 @@ SUBCOMMAND_HELP: dict[str, str] = {
     "likeness-reference": "build a human-likeness reference from one's own cohort of FRFs",
     "cohort": "fit the same model to every subject's FRF in parallel; a table per subject "
               "and parameter, a summary",
+    "design": "predict the standard errors of a PRTS experiment's fit before running it "
+              "(Fisher information), and optimise its design",
     "compare": "overlay saved runs (posturelab simulate --out) in one figure, and tabulate them",
     "explore": "explore the model interactively in the web browser (a local page)",
 }

@@ -20,6 +20,9 @@ from .estimate import FRFEstimate, estimate_frf
 
 __all__ = ["PRTSExperiment", "prts_experiment", "MAX_SENSOR_NOISE", "MAX_RECORD_RATE"]
 
+#: The spawn key of the sensor noise's random stream (see :func:`prts_experiment`).
+SENSOR_STREAM = 1
+
 #: Largest sensor noise (standard deviation) on a recorded angle. [rad]
 MAX_SENSOR_NOISE = 1.0
 #: Highest record rate of a PRTS experiment. [Hz]
@@ -140,7 +143,9 @@ def prts_experiment(body, muscles, *, tilt=None, cycles: int = 5, discard: int =
         angle = r.theta[:, int(output[5:]) - 1]
     else:
         check_output(output, body.n_links)
-    rng = np.random.default_rng(seed)
+    # the sensor's own stream, independent of a motor noise seeded with the same number
+    # (MotorNoise draws from default_rng(seed)): a child of the seed's SeedSequence
+    rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(SENSOR_STREAM,)))
     measured = angle[:t.size] + rng.normal(0.0, sensor_noise, t.size)
     stimulus = tilt.angle(t)
     if r.fell:

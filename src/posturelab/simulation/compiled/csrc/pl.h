@@ -36,6 +36,9 @@ typedef struct pl_history {
 int pl_history_init(pl_history *hist, int64_t m, int64_t cap);
 int pl_history_add(pl_history *hist, double t, double h, const double *x, const double *Q);
 void pl_history_at(const pl_history *hist, const double *before, double s, double *out);
+void pl_history_drop(pl_history *hist);  /* the last step out again (overlapping steps) */
+void pl_history_extrapolate(const pl_history *hist, double t, double h, const double *x,
+                            double *Q);
 void pl_history_free(pl_history *hist);
 
 /* dense output of a step: x + Q·(σ, σ², σ³, σ⁴) */
@@ -59,6 +62,9 @@ struct pl_method {
                    int locked, double *h_next, int64_t *evals);
     void (*commit)(pl_method *me);
     void (*release)(pl_method *me);
+    /* after a step onto a breakpoint: the first stage again, from the inputs just after it */
+    void (*refresh)(pl_method *me, const pl_model *md, const double *x, const double *inp,
+                    int locked, int64_t *evals);
 };
 int pl_explicit_init(pl_method *me, const pl_run *run, int64_t n);
 int pl_radau_init(pl_method *me, int64_t n);

@@ -5,8 +5,11 @@
  * event functions at the step's end, finds the earliest root on its dense output, and either
  * ends the run (a fall) or applies the switch and restarts the integrator, as the reference
  * engine does. With a feedback delay τ each kept step's dense output goes to the history,
- * the inputs of every stage include the delayed joint moments, steps are at most τ long and
- * land on kτ (k = 1 … delay_multiples). */
+ * the inputs of every stage include the delayed joint moments, steps are at most τ long (or,
+ * for a delay below OVERLAP_BELOW, overlap their own past) and land on kτ (k = 1 …
+ * delay_multiples). Steps also land on every breakpoint and on its echoes kτ later, and on
+ * the echoes of every switch: the inputs are taken just before a stop at a step's end and
+ * just after it at the next step's start. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -17,6 +20,14 @@
 #define EPS 2.220446049250313e-16
 #define SAMPLE_BLOCK 64  /* samples evaluated together */
 #define CLOCK_EVERY 256  /* attempted steps between looks at the clock (a time limit) */
+/* Overlapping steps: below this delay [s] a step may be longer than τ (otherwise it is at
+ * most τ, and the past it needs is computed before it starts). Its delayed states inside
+ * itself then come from its own dense output, first the last step's carried on, then its
+ * own, iterated until the end state moves by less than OVERLAP_TOL of the tolerance; a step
+ * that does not settle within OVERLAP_ITERATIONS tries is halved. */
+#define OVERLAP_BELOW 1e-4
+#define OVERLAP_TOL 1e-2
+#define OVERLAP_ITERATIONS 8
 
 /* Seconds on a clock that only moves forward (wall-clock seconds without one). [s] */
 static double wall_seconds(void)
@@ -31,7 +42,7 @@ static double wall_seconds(void)
 
 typedef struct {
     double *tm, *sat, *base, *work, *tau, *active, *x, *y, *Q, *inp, *g_old, *g_new, *sc_out,
-        *sc_inp, *sc_x, *ys, *ev_side, *block;
+        *sc_inp, *sc_x, *ys, *ev_side, *block, *Qg, *yp;
     int64_t *ev_kind, *ev_index;
 } buffers;
 
@@ -39,7 +50,7 @@ static void free_buffers(buffers *b)
 {
     double *d[] = {b->tm, b->sat, b->base, b->work, b->tau, b->active, b->x, b->y, b->Q,
                    b->inp, b->g_old, b->g_new, b->sc_out, b->sc_inp, b->sc_x, b->ys,
-                   b->ev_side, b->block};
+                   b->ev_side, b->block, b->Qg, b->yp};
     for (size_t k = 0; k < sizeof(d) / sizeof(d[0]); k++)
         free(d[k]);
     free(b->ev_kind);
@@ -70,9 +81,12 @@ static int alloc_buffers(buffers *b, int64_t n, int64_t p, int64_t n_nodes, int6
     b->sc_x = calloc(m, sizeof(double));
     b->ys = calloc(m, sizeof(double));
     b->block = calloc(m * SAMPLE_BLOCK, sizeof(double));
+    b->Qg = calloc(4 * m, sizeof(double));
+    b->yp = calloc(m, sizeof(double));
     return b->tm && b->sat && b->base && b->work && b->tau && b->active && b->x && b->y
            && b->Q && b->inp && b->g_old && b->g_new && b->ev_side && b->ev_kind
-           && b->ev_index && b->sc_out && b->sc_inp && b->sc_x && b->ys && b->block;
+           && b->ev_index && b->sc_out && b->sc_inp && b->sc_x && b->ys && b->block && b->Qg
+           && b->yp;
 }
 
 /* The events of a smooth segment: the slots (posturelab.model.events.event_slots) whose
@@ -103,9 +117,12 @@ static int64_t segment_events(const pl_run *run, const double *sat, const double
     return k;
 }
 
-/* Times at which the delayed feedback is not smooth after the start: kτ after each knee
- * impact, k = 1 … delay_multiples (the impact changes the rates at once, the muscles feel it
- * τ later, its derivatives 2τ, … later), sorted. Steps land on them as on the breakpoints. */
+/* Times at which the delayed feedback is not smooth after the start: kτ after each
+ * breakpoint and each knee impact, k = 1 … delay_multiples (a corner of the stimulus or an
+ * impact changes the rates or accelerations at once, the muscles feel it τ later, its
+ * derivatives 2τ, … later), sorted. Steps land on them as on the breakpoints: an integrator
+ * of order 5 that steps across a jump in a low derivative keeps an error its estimate does
+ * not see. */
 typedef struct {
     double *t;
     int64_t n, cap, next;
@@ -145,6 +162,29 @@ static double next_stop(const pl_run *run, int64_t bi, int64_t di, const jump_li
     return t_stop;
 }
 
+/* Whether breakpoint i is another's first echo (the set-up lists a tilt's corners t_k and
+ * t_k + τ): its own echoes are the other's. */
+static int is_echo(const pl_run *run, int64_t i)
+{
+    const double want = run->bps[i] - run->delay, tol = 1e-12 * fmax(1.0, run->bps[i]);
+    int64_t lo = 0, hi = i;  /* the first of bps[0 .. i) at or after want − tol */
+    while (lo < hi) {
+        const int64_t mid = (lo + hi) >> 1;
+        if (run->bps[mid] < want - tol)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo < i && run->bps[lo] <= want + tol;
+}
+
+/* How far inside a step its inputs are taken at a breakpoint it starts or ends on: far
+ * beyond the rounding of t ± τ, and a negligible part of the step. [s] */
+static double side_of(double t, double h)
+{
+    return fmin(1e-3 * h, 64.0 * EPS * (1.0 + fabs(t)));
+}
+
 int64_t pl_integrate(const pl_run *run, pl_out *out)
 {
     const int64_t n = run->n, m = 2 * n, T = run->n_grid, width = 2 + n;
@@ -153,7 +193,8 @@ int64_t pl_integrate(const pl_run *run, pl_out *out)
     const double settle_tol = fpar[F_SETTLE_TOL], stop_angle = fpar[F_STOP_ANGLE];
     const double delay = run->delay;
     double max_step = fpar[F_MAX_STEP];
-    if (delay > 0.0)
+    const int overlapping = delay > 0.0 && delay < OVERLAP_BELOW;
+    if (delay > 0.0 && !overlapping)
         max_step = fmin(max_step, delay);  /* the method of steps: the past is computed */
     const int64_t max_switches = run->ipar[I_MAX_SWITCHES];
     const int64_t max_steps = run->ipar[I_MAX_STEPS];
@@ -176,11 +217,19 @@ int64_t pl_integrate(const pl_run *run, pl_out *out)
                                          : pl_explicit_init(&me, run, n);
     ok = ok && alloc_buffers(&b, n, run->p, me.n_nodes, run->n_slots);
     ok = ok && pl_history_init(&hist, m, delay > 0.0 ? 256 : 1);
+    for (int64_t i = 0; delay > 0.0 && i < run->n_bps; i++)  /* the breakpoints' echoes */
+        for (int64_t k = 1; ok && k <= run->delay_multiples && !is_echo(run, i); k++) {
+            const double echo = run->bps[i] + k * delay;
+            if (echo >= duration)
+                break;
+            ok = jump_add(&jumps, echo);
+        }
     if (!ok) {
         if (me.release)
             me.release(&me);
         free_buffers(&b);
         pl_history_free(&hist);
+        free(jumps.t);
         res[R_STATUS] = PL_NO_MEMORY;
         return PL_NO_MEMORY;
     }
@@ -200,7 +249,7 @@ int64_t pl_integrate(const pl_run *run, pl_out *out)
     double t = 0.0, h = 0.0, fall_time = NAN, last_outside = NAN;
     int64_t status = PL_COMPLETED, fall_kind = -1, fall_index = -1, n_switches = 0;
     int64_t n_steps = 0, n_rejected = 0, n_evals = 0, gi = 0, bi = 0, di = 1, n_ev = 0;
-    int any_outside = 0, final_outside = 0, fall_sample = 0, restart = 1;
+    int any_outside = 0, final_outside = 0, fall_sample = 0, restart = 1, at_stop = 0;
 
     while (t < duration) {
         if (restart) {  /* a smooth segment starts (t = 0, or after a switch) */
@@ -219,10 +268,14 @@ int64_t pl_integrate(const pl_run *run, pl_out *out)
                 locked = 0;  /* at its stop, but the muscles pull the knee off it at once */
             n_ev = segment_events(run, b.sat, b.active, locked, b.ev_kind, b.ev_index,
                                   b.ev_side);
+            /* at a stop the inputs may jump: the events start from their values just
+             * before it (an event that the jump fires is found at the next step's start), the
+             * integrator from the inputs just after it */
+            const double side = at_stop ? side_of(t, INFINITY) : 0.0;
             for (int64_t e = 0; e < n_ev; e++)
-                b.g_old[e] = pl_event_value(&cx, b.ev_kind[e], b.ev_index[e], b.ev_side[e], t,
-                                            x, locked);
-            pl_inputs_at(&cx, t, inp);
+                b.g_old[e] = pl_event_value(&cx, b.ev_kind[e], b.ev_index[e], b.ev_side[e],
+                                            t - side, x, locked);
+            pl_inputs_at(&cx, t + side, inp);
             h = me.start(&me, &md, t, x, next_stop(run, bi, di, &jumps, duration), max_step,
                          rtol, atol, locked, inp, &n_evals);
             restart = 0;
@@ -248,28 +301,72 @@ int64_t pl_integrate(const pl_run *run, pl_out *out)
             break;
         }
         const double t_new = landing ? t_stop : t + h;
-        if (has_inputs)
-            for (int64_t k = 0; k < me.n_nodes; k++)
-                pl_inputs_at(&cx, me.nodes[k] == 1.0 ? t_new : t + me.nodes[k] * h,
-                             inp + k * width);
+        const int overlap = overlapping && h > delay;  /* its past reaches into itself */
+        if (overlap) {
+            pl_history_extrapolate(&hist, t, h, x, b.Qg);
+            if (!pl_history_add(&hist, t, h, x, b.Qg)) {
+                status = PL_NO_MEMORY;
+                break;
+            }
+            for (int64_t i = 0; i < m; i++)
+                b.yp[i] = x[i] + b.Qg[4 * i] + b.Qg[4 * i + 1] + b.Qg[4 * i + 2]
+                          + b.Qg[4 * i + 3];
+        }
         double h_next;
-        if (!me.attempt(&me, &md, t, h, x, y, Q, inp, rtol, atol, locked, &h_next, &n_evals)) {
+        int accepted = 0, settled = !overlap;
+        for (int64_t it = 0;; it++) {
+            if (has_inputs)
+                for (int64_t k = 0; k < me.n_nodes; k++) {
+                    /* the inputs may jump at a breakpoint: a step onto one takes them just
+                     * before it at its end, a step from one just after it at its start */
+                    double tk = me.nodes[k] == 1.0 ? t_new : t + me.nodes[k] * h;
+                    if (landing && me.nodes[k] == 1.0)
+                        tk = t_new - side_of(t_new, h);
+                    else if (at_stop && me.nodes[k] == 0.0)
+                        tk = t + side_of(t, h);
+                    pl_inputs_at(&cx, tk, inp + k * width);
+                }
+            accepted = me.attempt(&me, &md, t, h, x, y, Q, inp, rtol, atol, locked, &h_next,
+                                  &n_evals);
+            if (!accepted || !overlap)
+                break;
+            pl_history_drop(&hist);  /* the step's past inside itself: its own output */
+            pl_history_add(&hist, t, h, x, Q);  /* (the slot exists: cannot fail) */
+            double change = 0.0;
+            for (int64_t i = 0; i < m; i++) {
+                const double sc = atol + rtol * fmax(fabs(x[i]), fabs(y[i]));
+                const double d = (y[i] - b.yp[i]) / sc;
+                change += d * d;
+                b.yp[i] = y[i];
+            }
+            if (change / m <= OVERLAP_TOL * OVERLAP_TOL) {
+                settled = 1;
+                break;
+            }
+            if (it + 1 >= OVERLAP_ITERATIONS)
+                break;
+        }
+        if (!accepted || !settled) {
+            if (overlap)
+                pl_history_drop(&hist);
             n_rejected++;
-            h = h_next;
+            h = accepted ? 0.5 * h : h_next;  /* (not settled: a shorter step) */
             continue;
         }
         n_steps++;
-        if (delay > 0.0 && !pl_history_add(&hist, t, h, x, Q)) {
+        if (delay > 0.0 && !overlap && !pl_history_add(&hist, t, h, x, Q)) {
             status = PL_NO_MEMORY;
             break;
         }
 
-        /* events that fired in (t, t_new]: the earliest root on the interpolant */
+        /* events that fired in (t, t_new]: the earliest root on the interpolant (on a
+         * stop, their values just before it, as the step saw its inputs) */
         int64_t ev_hit = -1;
         double t_ev = t_new;
+        const double t_look = landing ? t_new - side_of(t_new, h) : t_new;
         for (int64_t e = 0; e < n_ev; e++) {
             const int64_t kind = b.ev_kind[e];
-            const double gn = pl_event_value(&cx, kind, b.ev_index[e], b.ev_side[e], t_new, y,
+            const double gn = pl_event_value(&cx, kind, b.ev_index[e], b.ev_side[e], t_look, y,
                                              locked);
             const double go = b.g_old[e];
             b.g_new[e] = gn;
@@ -286,6 +383,14 @@ int64_t pl_integrate(const pl_run *run, pl_out *out)
                 t_ev = root;  /* a tie within 1e-12 s: the earlier-listed event wins */
             }
         }
+        int ev_at_stop = 0;  /* an event on a stop happens there (a jump of the inputs) */
+        if (ev_hit >= 0 && at_stop && t_ev <= t + 1e-12 * fmax(1.0, fabs(t))) {
+            t_ev = t;
+            ev_at_stop = 1;
+        } else if (ev_hit >= 0 && landing && t_ev >= t_new - 1e-12 * fmax(1.0, fabs(t_new))) {
+            t_ev = t_new;
+            ev_at_stop = 1;
+        }
 
         /* output samples in [t, end of this piece], as the reference selects them */
         const double t_end = ev_hit >= 0 ? t_ev : t_new;
@@ -299,7 +404,18 @@ int64_t pl_integrate(const pl_run *run, pl_out *out)
          * component at a time (independent samples: the evaluations overlap), then the
          * outcomes sample by sample; the same code for a single run and a batch row */
         const int64_t comps = out->samples ? m : n;
-        for (int64_t g0 = gi; g0 < g_end; g0 += SAMPLE_BLOCK) {
+        /* a batch row keeps outcomes only: a step whose angles stay, by the bound |x| + Σ|q|
+         * of its interpolant on [t, t + h], within both the peaks so far and the settling
+         * band changes neither (its samples are not evaluated; the outcomes are the same) */
+        int quiet = !out->samples && !out->fb && !inclusive && g_end > gi;
+        for (int64_t i = 0; quiet && i < n; i++) {
+            const double *q = Q + 4 * i;
+            const double bound = fabs(x[i]) + fabs(q[0]) + fabs(q[1]) + fabs(q[2]) + fabs(q[3]);
+            quiet = bound <= out->peak[i] && bound <= settle_tol;
+        }
+        if (quiet)
+            final_outside = 0;
+        for (int64_t g0 = gi; !quiet && g0 < g_end; g0 += SAMPLE_BLOCK) {
             const int64_t g1 = g0 + SAMPLE_BLOCK < g_end ? g0 + SAMPLE_BLOCK : g_end;
             const int64_t len = g1 - g0;
             const double inv_h = 1.0 / h;
@@ -428,20 +544,20 @@ int64_t pl_integrate(const pl_run *run, pl_out *out)
                 x[1] = x[0] + stop_angle;
                 pl_project_velocity(x, run->bp, b.work, n);
                 locked = 1;
-                int stored = 1;
-                for (int64_t k = 1; delay > 0.0 && k <= run->delay_multiples; k++)
-                    if (t_ev + k * delay < duration)
-                        stored = stored && jump_add(&jumps, t_ev + k * delay);
-                if (!stored) {
-                    status = PL_NO_MEMORY;
-                    break;
-                }
             } else if (kind == EV_KNEE_LEAVES_STOP) {
                 locked = 0;
             } else if (kind == EV_SATURATES) {
                 b.sat[j] = b.ev_side[ev_hit];
             } else if (kind == EV_LETS_GO) {
                 b.sat[j] = 0.0;
+            }
+            int stored = 1;  /* the switch's echoes: the muscles feel it τ, 2τ, … later */
+            for (int64_t k = 1; delay > 0.0 && k <= run->delay_multiples; k++)
+                if (t_ev + k * delay < duration)
+                    stored = stored && jump_add(&jumps, t_ev + k * delay);
+            if (!stored) {
+                status = PL_NO_MEMORY;
+                break;
             }
             int finite = 1;
             for (int64_t i = 0; i < m; i++)
@@ -451,6 +567,7 @@ int64_t pl_integrate(const pl_run *run, pl_out *out)
                 break;
             }
             restart = 1;
+            at_stop = ev_at_stop;
             continue;
         }
 
@@ -466,12 +583,17 @@ int64_t pl_integrate(const pl_run *run, pl_out *out)
         me.commit(&me);
         memcpy(b.g_old, b.g_new, sizeof(double) * n_ev);
         pl_set_base(x, b.base, n);
+        at_stop = landing;
         if (landing) {
             while (bi < run->n_bps && run->bps[bi] <= t + 1e-12)
                 bi++;
             while (delay > 0.0 && di <= run->delay_multiples && di * delay <= t + 1e-12)
                 di++;
             jump_pass(&jumps, t);
+            if (has_inputs && t < duration) {  /* the first stage from just after it */
+                pl_inputs_at(&cx, t + side_of(t, h_next), inp);
+                me.refresh(&me, &md, x, inp, locked, &n_evals);
+            }
         }
         h = h_next;
     }

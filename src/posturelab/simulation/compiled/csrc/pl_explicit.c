@@ -140,6 +140,16 @@ static void rk_commit(pl_method *me)
         w->K[i] = w->K[(w->S - 1) * w->m + i];
 }
 
+/* after a step onto a breakpoint the last stage (the left limit there) is not the next
+ * step's first: evaluate it with the inputs just after the breakpoint */
+static void rk_refresh(pl_method *me, const pl_model *md, const double *x, const double *inp,
+                       int locked, int64_t *evals)
+{
+    rk_ws *w = me->ws;
+    pl_rhs(md, x, w->K, inp, locked);
+    *evals += 1;
+}
+
 static void rk_release(pl_method *me)
 {
     rk_ws *w = me->ws;
@@ -161,6 +171,7 @@ int pl_explicit_init(pl_method *me, const pl_run *run, int64_t n)
     me->attempt = rk_attempt;
     me->commit = rk_commit;
     me->release = rk_release;
+    me->refresh = rk_refresh;
     me->n_nodes = run->n_stages;
     me->nodes = run->tab_c;
     if (!w)

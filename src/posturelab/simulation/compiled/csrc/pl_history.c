@@ -2,7 +2,10 @@
  *
  * Before t = 0 the past is the state before the run; after it, the interpolant of the step
  * that covered that time. Steps are at most τ long, so the past a step needs is complete
- * when the step starts. Arrays double when full. */
+ * when the step starts, except with a very short delay (pl_driver.c: overlapping steps):
+ * there the step being tried is stored too, first as the last step's interpolant carried
+ * on (pl_history_extrapolate), then as its own, and taken out again if it is rejected.
+ * Arrays double when full. */
 #include <stdlib.h>
 #include <string.h>
 #include "pl.h"
@@ -91,4 +94,40 @@ void pl_history_free(pl_history *hist)
     free(hist->x);
     free(hist->q);
     hist->t = hist->h = hist->x = hist->q = NULL;
+}
+
+void pl_history_drop(pl_history *hist)
+{
+    if (hist->count > 0)
+        hist->count--;
+}
+
+/* Q of a step [t, t + h] from x that carries on the last stored step's interpolant: its
+ * derivatives re-expanded about t (σ' = a + b σ, a = (t − t_p)/h_p, b = h/h_p), its value
+ * replaced by x; zero (x held) when nothing is stored. */
+void pl_history_extrapolate(const pl_history *hist, double t, double h, const double *x,
+                            double *Q)
+{
+    const int64_t m = hist->m, last = hist->count - 1;
+    (void)x;
+    if (last < 0) {
+        for (int64_t i = 0; i < 4 * m; i++)
+            Q[i] = 0.0;
+        return;
+    }
+    const double a = (t - hist->t[last]) / hist->h[last], b = h / hist->h[last];
+    static const double binom[5][5] = {{1, 0, 0, 0, 0}, {1, 1, 0, 0, 0}, {1, 2, 1, 0, 0},
+                                       {1, 3, 3, 1, 0}, {1, 4, 6, 4, 1}};
+    double apow[5] = {1.0, a, a * a, a * a * a, a * a * a * a};
+    for (int64_t i = 0; i < m; i++) {
+        const double *q = hist->q + (last * m + i) * 4;
+        double bj = 1.0;
+        for (int64_t j = 1; j <= 4; j++) {
+            bj *= b;
+            double acc = 0.0;
+            for (int64_t k = j; k <= 4; k++)
+                acc += q[k - 1] * binom[k][j] * apow[k - j];
+            Q[4 * i + j - 1] = acc * bj;
+        }
+    }
 }

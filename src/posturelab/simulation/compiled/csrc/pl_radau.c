@@ -414,6 +414,15 @@ static void radau_commit(pl_method *me)
     memcpy(w->f0, w->fnew, sizeof(double) * w->m);
 }
 
+/* after a step onto a breakpoint: f at the step's start from the inputs just after it */
+static void radau_refresh(pl_method *me, const pl_model *md, const double *x,
+                          const double *inp, int locked, int64_t *evals)
+{
+    radau_ws *w = me->ws;
+    pl_rhs(md, x, w->f0, inp, locked);
+    *evals += 1;
+}
+
 static void radau_release(pl_method *me)
 {
     radau_ws *w = me->ws;
@@ -440,6 +449,7 @@ int pl_radau_init(pl_method *me, int64_t n)
     me->attempt = radau_attempt;
     me->commit = radau_commit;
     me->release = radau_release;
+    me->refresh = radau_refresh;
     me->n_nodes = 4;
     me->nodes = NODES;
     if (!w)
