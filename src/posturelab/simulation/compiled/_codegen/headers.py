@@ -104,8 +104,8 @@ def header() -> str:
     out = ["/* The interface of the generated model: GENERATED, do not edit.",
            " *",
            " * python -m posturelab.simulation.compiled._codegen writes this file from",
-           " * _codegen/headers.py (the structs' fields, which _layout.py carries for _binding.py)",
-           " * and sympy (the rotation's series), and the small-N helpers; pl.h includes it. */",
+           " * _codegen/headers.py (the structs' fields, which _layout.py carries for _binding.py,",
+           " * and the small-N helpers) and sympy (the rotation's series); pl.h includes it. */",
            "#ifndef PL_MODEL_H", "#define PL_MODEL_H", "",
            "/* One run: everything the integration needs (read only). */"]
     out += _struct("pl_run", RUN_FIELDS)
