@@ -179,7 +179,6 @@ class HalfSinePulse(_SinePulse):
     duration: float
     start: float = 0.0
     axis: Axis = "x"
-    _cycles = 0.5
 
     @property
     def velocity_gain(self) -> float:
