@@ -231,7 +231,7 @@ def test_batch_parameters_are_checked_as_single_runs_are():
 
 
 def test_generated_small_right_hand_sides_are_up_to_date():
-    """csrc/pl_rhs_small.c is what _codegen.py writes now (regenerate with
+    """csrc/pl_rhs_small.c is what _codegen/rhs_small.py writes now (regenerate with
     python -m posturelab.simulation.compiled._codegen)."""
     from posturelab.simulation.compiled import _codegen
 

@@ -46,6 +46,12 @@ import numpy as np
 from .._validation import finite_array
 from ..errors import ParameterError
 from ..model.body import Body
+from ..model.gains import (
+    DELAYED_STIFFNESS,
+    DELAYED_VISCOSITY,
+    IMMEDIATE_STIFFNESS,
+    IMMEDIATE_VISCOSITY,
+)
 from ..model.muscles import MuscleSet, feedback_gains
 from ..model.tilt import tilt_pair_gains
 from .body_arrays import BodyArrays
@@ -312,7 +318,8 @@ class LinearSystem:
             b = self.tilt_input[:, None]                                   # (M, 1, 4, N)
             ex = np.exp(-s * self.delay[:, None])                          # (M, F)
             ex = (ex * self.torque_feedback_factor(s))[..., None]          # (M, F, 1)
-            rhs = b[..., 0, :] + s1 * b[..., 1, :] + (b[..., 2, :] + s1 * b[..., 3, :]) * ex
+            rhs = (b[..., IMMEDIATE_STIFFNESS, :] + s1 * b[..., IMMEDIATE_VISCOSITY, :]
+                   + (b[..., DELAYED_STIFFNESS, :] + s1 * b[..., DELAYED_VISCOSITY, :]) * ex)
         else:
             rhs = s1 * s1 * self.translation_input[:, None, :]
         rhs = np.broadcast_to(rhs, (m, f.size, n))
@@ -378,7 +385,8 @@ def _joint_or_zero(gains: np.ndarray | None, selection: np.ndarray) -> np.ndarra
 
 
 def _split(stiffness, viscosity, active_stiffness, active_viscosity) -> list:
-    """The gains by when they act for a positive delay, [k_i, l_i, k_a, l_a] (None: zero):
+    """The gains by when they act for a positive delay, indexed by the rows of
+    :mod:`posturelab.model.gains` (None: zero):
     :func:`posturelab.model.muscles.feedback_gains` applied as the linear map it is, its
     matrix read from unit gains (so that a block of many sets costs a few additions)."""
     unit = np.eye(4)
@@ -523,7 +531,7 @@ def linear_system(body: Body | BodyArrays, muscles: MuscleSet, *, stiffness=None
     split = _split(k, v, ka, va)
     E = muscles.selection_matrix
     n = E.shape[1]
-    stiff = _joint_or_zero(split[0], E)
+    stiff = _joint_or_zero(split[IMMEDIATE_STIFFNESS], E)
     index = np.arange(n)
     stiff = np.array(np.broadcast_to(stiff, (max(stiff.shape[0], jac.shape[0]), n, n)))
     stiff[:, index, index] -= gravity_torque
@@ -537,10 +545,10 @@ def linear_system(body: Body | BodyArrays, muscles: MuscleSet, *, stiffness=None
     feedback_gain, time_constant = _torque_feedback(torque_feedback_gain,
                                                     torque_feedback_time_constant)
     system = LinearSystem(
-        inertia=jac, stiffness=stiff, viscosity=_joint_or_zero(split[1], E),
-        delayed_stiffness=_joint_or_zero(split[2], E),
-        delayed_viscosity=_joint_or_zero(split[3], E), delay=tau, tilt_input=tilt,
-        translation_input=-coefficients, torque_feedback_gain=feedback_gain,
+        inertia=jac, stiffness=stiff, viscosity=_joint_or_zero(split[IMMEDIATE_VISCOSITY], E),
+        delayed_stiffness=_joint_or_zero(split[DELAYED_STIFFNESS], E),
+        delayed_viscosity=_joint_or_zero(split[DELAYED_VISCOSITY], E), delay=tau,
+        tilt_input=tilt, translation_input=-coefficients, torque_feedback_gain=feedback_gain,
         torque_feedback_time_constant=time_constant)
     system.n_sets  # noqa: B018 (checks that the arrays agree on M)
     return system

@@ -164,8 +164,7 @@ def state_derivative(
     link_torques: np.ndarray | float = 0.0,
     platform_acceleration_x: np.ndarray | float = 0.0,
     platform_acceleration_y: np.ndarray | float = 0.0,
-    *,
-    joint_torques: np.ndarray | float | None = None,
+    **former_names: np.ndarray | float,
 ) -> np.ndarray:
     """Time derivative of the state ``[Θ, Θ̇]``.
 
@@ -173,9 +172,9 @@ def state_derivative(
     ----------
     state : array_like, shape (..., 2N)
         ``[θ1 … θN, θ̇1 … θ̇N]`` in [rad] and [rad/s].
-    link_torques, platform_acceleration_x, platform_acceleration_y
-        As in :func:`angular_acceleration` (``joint_torques``: the former name of
-        ``link_torques``). [N·m], [m/s²], [m/s²]
+    link_torques, platform_acceleration_x, platform_acceleration_y, **former_names
+        As in :func:`angular_acceleration`, which takes the former names
+        (``joint_torques`` for ``link_torques``). [N·m], [m/s²], [m/s²]
 
     Returns
     -------
@@ -185,10 +184,8 @@ def state_derivative(
     state = np.asarray(state, dtype=float)
     n = body.n_links
     theta, omega = state[..., :n], state[..., n:]
-    acc = angular_acceleration(
-        body, theta, omega, link_torques if joint_torques is None else joint_torques,
-        platform_acceleration_x, platform_acceleration_y
-    )
+    acc = angular_acceleration(body, theta, omega, link_torques, platform_acceleration_x,
+                               platform_acceleration_y, **former_names)
     return np.concatenate([omega, acc], axis=-1)
 
 

@@ -122,33 +122,36 @@ class EventKind:
     message: str
 
 
+def _fall(code: int, name: str, message: str) -> EventKind:
+    """A fall: its g falls through 0 (no hysteresis) and the run stops."""
+    return EventKind(code, name, True, -1, 0.0, message)
+
+
+def _switch(code: int, name: str, direction: int, hysteresis: float, message: str) -> EventKind:
+    """A switch: it fires once its g has passed 0 by ``hysteresis`` in ``direction`` (the
+    offset −direction × hysteresis), and the run restarts."""
+    return EventKind(code, name, False, direction, -direction * hysteresis, message)
+
+
 #: Every kind of event, indexed by its code.
 EVENT_KINDS: tuple[EventKind, ...] = (
-    EventKind(LINK_ANGLE, "link-angle", True, -1, 0.0,
-              "link {link} angle passed ±{limit:.3g} rad"),
-    EventKind(COG_TOE, "cog-toe", True, -1, 0.0, "centre of gravity passed the toe ({toe:.3f} m)"),
-    EventKind(COG_HEEL, "cog-heel", True, -1, 0.0,
-              "centre of gravity passed the heel ({heel:.3f} m)"),
-    EventKind(COP_TOE, "cop-toe", True, -1, 0.0,
-              "centre of pressure passed the toe ({toe:.3f} m): the foot tips"),
-    EventKind(COP_HEEL, "cop-heel", True, -1, 0.0,
-              "centre of pressure passed the heel ({heel:.3f} m): the foot tips"),
-    EventKind(SATURATES, "saturates", False, 1, -SWITCH_HYSTERESIS,
-              "the {joint} moment reached its limit"),
-    EventKind(LETS_GO, "lets-go", False, -1, SWITCH_HYSTERESIS,
-              "the {joint} moment came back inside its limit"),
-    EventKind(PAIR_SLACKENS, "pair-slackens", False, -1, SWITCH_HYSTERESIS,
-              "a one-sided pair went slack"),
-    EventKind(PAIR_ENGAGES, "pair-engages", False, 1, -SWITCH_HYSTERESIS,
-              "a one-sided pair engaged"),
-    EventKind(KNEE_HITS_STOP, "knee-hits-stop", False, 1, -SWITCH_HYSTERESIS,
-              "the knee reached its hyper-extension stop"),
-    EventKind(KNEE_LEAVES_STOP, "knee-leaves-stop", False, -1, RELEASE_HYSTERESIS,
-              "the knee left its stop"),
-    EventKind(PAIR_PUSHES, "pair-pushes", False, -1, TORQUE_HYSTERESIS,
-              "a pull-only pair would have pushed: it went slack"),
-    EventKind(PAIR_PULLS, "pair-pulls", False, 1, -TORQUE_HYSTERESIS,
-              "a slack pull-only pair pulls again"),
+    _fall(LINK_ANGLE, "link-angle", "link {link} angle passed ±{limit:.3g} rad"),
+    _fall(COG_TOE, "cog-toe", "centre of gravity passed the toe ({toe:.3f} m)"),
+    _fall(COG_HEEL, "cog-heel", "centre of gravity passed the heel ({heel:.3f} m)"),
+    _fall(COP_TOE, "cop-toe", "centre of pressure passed the toe ({toe:.3f} m): the foot tips"),
+    _fall(COP_HEEL, "cop-heel",
+          "centre of pressure passed the heel ({heel:.3f} m): the foot tips"),
+    _switch(SATURATES, "saturates", 1, SWITCH_HYSTERESIS, "the {joint} moment reached its limit"),
+    _switch(LETS_GO, "lets-go", -1, SWITCH_HYSTERESIS,
+            "the {joint} moment came back inside its limit"),
+    _switch(PAIR_SLACKENS, "pair-slackens", -1, SWITCH_HYSTERESIS, "a one-sided pair went slack"),
+    _switch(PAIR_ENGAGES, "pair-engages", 1, SWITCH_HYSTERESIS, "a one-sided pair engaged"),
+    _switch(KNEE_HITS_STOP, "knee-hits-stop", 1, SWITCH_HYSTERESIS,
+            "the knee reached its hyper-extension stop"),
+    _switch(KNEE_LEAVES_STOP, "knee-leaves-stop", -1, RELEASE_HYSTERESIS, "the knee left its stop"),
+    _switch(PAIR_PUSHES, "pair-pushes", -1, TORQUE_HYSTERESIS,
+            "a pull-only pair would have pushed: it went slack"),
+    _switch(PAIR_PULLS, "pair-pulls", 1, TORQUE_HYSTERESIS, "a slack pull-only pair pulls again"),
 )
 
 #: Direction of each kind, by code (+1 rising, −1 falling). [-]

@@ -121,31 +121,39 @@ class _SinePulse(Disturbance):
 
     #: Cycles of the sine within the pulse: ½ for a half-sine, 1 for ramp-and-hold. [-]
     _cycles: float = 0.5
+    #: The field that sets the pulse's size (what :meth:`scaled` scales), with its unit.
+    _size: tuple[str, str] = ("peak_acceleration", "peak_acceleration [m/s²]")
+    #: The peak acceleration's words in a message.
+    _peak_words = "peak_acceleration [m/s²]"
     start: float
     duration: float
     axis: str
+    #: Amplitude of the sine (a field, or a property of the size). [m/s²]
+    peak_acceleration: float
 
-    def _validate_window(self) -> None:
+    def __post_init__(self) -> None:
+        name, words = self._size
+        object.__setattr__(self, name, finite_float(words, getattr(self, name)))
         object.__setattr__(self, "duration", positive_float("duration [s]", self.duration))
         object.__setattr__(self, "start", nonnegative_float("start [s]", self.start))
         _axis(self.axis)
+        _check_acceleration(self._peak_words, self.peak_acceleration)
+
+    def scaled(self, factor: float) -> _SinePulse:
+        name = self._size[0]
+        return replace(self, **{name: getattr(self, name) * finite_float("factor [-]", factor)})
 
     @property
     def breakpoints(self) -> tuple[float, ...]:
         return (self.start, self.start + self.duration)
 
-    @property
-    def peak_acceleration_value(self) -> float:
-        """Amplitude of the sine. [m/s²]"""
-        raise NotImplementedError
-
     def primitives(self) -> tuple[Primitive, ...]:
-        return (Primitive("windowed-sine", _axis(self.axis), self.peak_acceleration_value,
+        return (Primitive("windowed-sine", _axis(self.axis), self.peak_acceleration,
                           duration=self.duration, start=self.start, cycles=self._cycles),)
 
     def acceleration(self, t):
         t = np.asarray(t, dtype=float)
-        a = windowed_sine_formula(t, self.peak_acceleration_value, self.duration, self.start,
+        a = windowed_sine_formula(t, self.peak_acceleration, self.duration, self.start,
                                   self._cycles)
         out = np.zeros(t.shape + (2,))
         out[..., _axis(self.axis)] = a
@@ -171,21 +179,6 @@ class HalfSinePulse(_SinePulse):
     duration: float
     start: float = 0.0
     axis: Axis = "x"
-    _cycles = 0.5
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "peak_acceleration",
-                           finite_float("peak_acceleration [m/s²]", self.peak_acceleration))
-        _check_acceleration("peak_acceleration [m/s²]", self.peak_acceleration)
-        self._validate_window()
-
-    @property
-    def peak_acceleration_value(self) -> float:
-        return self.peak_acceleration
-
-    def scaled(self, factor: float) -> HalfSinePulse:
-        return replace(self, peak_acceleration=self.peak_acceleration
-                       * finite_float("factor [-]", factor))
 
     @property
     def velocity_gain(self) -> float:
@@ -221,24 +214,13 @@ class RampAndHold(_SinePulse):
     start: float = 0.0
     axis: Axis = "x"
     _cycles = 1.0
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "displacement",
-                           finite_float("displacement [m]", self.displacement))
-        self._validate_window()
-        _check_acceleration("peak acceleration 2πD/T² [m/s²]", self.peak_acceleration)
-
-    def scaled(self, factor: float) -> RampAndHold:
-        return replace(self, displacement=self.displacement * finite_float("factor [-]", factor))
+    _size = ("displacement", "displacement [m]")
+    _peak_words = "peak acceleration 2πD/T² [m/s²]"
 
     @property
     def peak_acceleration(self) -> float:
         """2πD/T². [m/s²]"""
         return 2.0 * np.pi * self.displacement / self.duration**2
-
-    @property
-    def peak_acceleration_value(self) -> float:
-        return self.peak_acceleration
 
     def describe(self) -> str:
         return (f"ramp-and-hold: {self.displacement:g} m along {self.axis} over "

@@ -480,7 +480,7 @@ def pair_pulls_value(setup: RunSetup, j: int, feedback: np.ndarray) -> float:
     """min(M_j, k_j s_j) of a slack pull-only pair: positive once it is stretched and its
     torque pulls (k_j its stiffness, 1 N·m/rad if it has none). [N·m]"""
     n = setup.n_links
-    stiffness = switched.pair_gains(switched_model(setup), j)[0]
+    stiffness, _ = switched.pair_gains(switched_model(setup), j)
     stretch = setup.muscles.selection_matrix[j] @ feedback[:n]
     return float(switched.pull_value_formula(pair_torque_if_acting(setup, j, feedback),
                                              stiffness, stretch))

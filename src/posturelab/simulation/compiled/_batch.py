@@ -21,6 +21,7 @@ from ..._validation import finite_array, positive_float
 from ...errors import ParameterError
 from ...model.body import Body
 from ...model.checks import check_model
+from ...model.gains import GAIN_ROWS
 from ...model.muscles import MuscleSet, feedback_gains, paper_muscles
 from ...model.platform import Disturbance
 from ...model.tilt import tilt_pair_gains
@@ -381,7 +382,7 @@ def simulate_batch(
          for lv, row in zip(levels, values, strict=True)] or [packs[0]["active0"]]))
     # per run: the saturation at the start, from the moments a single run computes (the
     # tilt's gains follow each run's gains and delay)
-    tilt_gain_all = enc.readonly(np.zeros((M, 4, n)))
+    tilt_gain_all = enc.readonly(np.zeros((M, len(GAIN_ROWS), n)))
     pair_gains = None
     if base.tilt is not None:
         split = feedback_gains(kd_all, ld_all, ka_all, la_all, np.ones(M))

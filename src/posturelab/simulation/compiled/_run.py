@@ -10,6 +10,7 @@ import numpy as np
 
 from ...errors import ParameterError
 from ...model.events import fall_message
+from ...model.gains import GAIN_ROWS
 from ..derived import derived_series
 from ..messages import outcome_message
 from ..outcome import stimulus_timing
@@ -90,7 +91,7 @@ def packed(setup: RunSetup) -> dict:
         "dp": enc.encode_disturbance(setup.disturbance), "tp": enc.encode_tilt(setup.tilt),
         "tilt_gain": enc.readonly(np.ascontiguousarray(
             setup.tilt_gains @ muscles.crossing_matrix if setup.tilt_gains is not None
-            else np.zeros((4, n)))),
+            else np.zeros((len(GAIN_ROWS), n)))),
         "tilt_depth": float(setup.tilt_axis_depth),
         "mp": enc.encode_motor_noise(setup.motor_torque),
         "bps": enc.readonly(setup.breakpoints.astype(float)), "fpar": fpar, "ipar": ipar,

@@ -6,90 +6,65 @@ from :mod:`posturelab.model.gains`.
 
 from __future__ import annotations
 
+Row = tuple[str, str | None, int, str]
+
+
+def _counted(*rows: str | tuple[str, str], c_prefix: tuple[str, str] = ("", "")) -> list[Row]:
+    """Codes numbered 0, 1, … in the order given; a row is a name or (name, comment). C spells
+    a name the same, or with the prefix ``c_prefix[0]`` replaced by ``c_prefix[1]``."""
+    out = []
+    for value, row in enumerate(rows):
+        name, comment = (row, "") if isinstance(row, str) else row
+        out.append((name, name.replace(*c_prefix, 1) if c_prefix[0] else name, value, comment))
+    return out
+
+
+def _packed(prefix: str, row: int, *kinds: tuple[str, str]) -> list[Row]:
+    """A packed list of terms: ``{prefix}_ROW``, the numbers per term, then the term kinds
+    (name, its parameters) numbered from 1 as ``{prefix}_{name}``."""
+    return [(f"{prefix}_ROW", f"{prefix}_ROW", row, "numbers per term")] + [
+        (f"{prefix}_{name}", f"{prefix}_{name}", code, comment)
+        for code, (name, comment) in enumerate(kinds, start=1)]
+
+
 #: (heading, [(Python name, C name, value, comment)]) — the C name None when C has none.
-GROUPS: list[tuple[str, list[tuple[str, str | None, int, str]]]] = [
-    ("Outcome of a run (result vector, R_STATUS)", [
-        ("STATUS_COMPLETED", "PL_COMPLETED", 0, ""),
-        ("STATUS_FELL", "PL_FELL", 1, ""),
-        ("STATUS_STEP_TOO_SMALL", "PL_STEP_TOO_SMALL", 2, ""),
-        ("STATUS_NONFINITE", "PL_NONFINITE", 3, ""),
-        ("STATUS_CHATTERING", "PL_CHATTERING", 4, ""),
-        ("STATUS_NO_MEMORY", "PL_NO_MEMORY", 5, ""),
-        ("STATUS_STEP_BUDGET", "PL_STEP_BUDGET", 6, ""),
-        ("STATUS_TIME_BUDGET", "PL_TIME_BUDGET", 7, ""),
-    ]),
-    ("Integration methods", [
-        ("METHOD_RADAU", "METHOD_RADAU", 0, ""),
-        ("METHOD_EXPLICIT", "METHOD_EXPLICIT", 1, ""),
-    ]),
-    ("Knee models", [
-        ("KNEE_FREE", "KNEE_FREE", 0, ""),
-        ("KNEE_LOCKED", "KNEE_LOCKED", 1, ""),
-        ("KNEE_STOP", "KNEE_STOP", 2, ""),
-    ]),
+GROUPS: list[tuple[str, list[Row]]] = [
+    ("Outcome of a run (result vector, R_STATUS)", _counted(
+        "STATUS_COMPLETED", "STATUS_FELL", "STATUS_STEP_TOO_SMALL", "STATUS_NONFINITE",
+        "STATUS_CHATTERING", "STATUS_NO_MEMORY", "STATUS_STEP_BUDGET", "STATUS_TIME_BUDGET",
+        c_prefix=("STATUS_", "PL_"))),
+    ("Integration methods", _counted("METHOD_RADAU", "METHOD_EXPLICIT")),
+    ("Knee models", _counted("KNEE_FREE", "KNEE_LOCKED", "KNEE_STOP")),
     ("Packed disturbance ``dp``: dp[0] = number of terms Q, then Q rows of DIST_ROW numbers "
      "(kind, axis, p0, p1, p2, p3), then the sampled profiles (times, x and y "
-     "accelerations). The terms are posturelab.model.platform.Primitive.", [
-        ("DIST_ROW", "DIST_ROW", 6, "numbers per term"),
-        ("DIST_WINDOWED_SINE", "DIST_WINDOWED_SINE", 1,
-         "(amplitude [m/s²], duration [s], start [s], cycles [-])"),
-        ("DIST_SINE", "DIST_SINE", 2, "(amplitude [m/s²], frequency [Hz], phase [rad], 0)"),
-        ("DIST_SAMPLES", "DIST_SAMPLES", 3,
-         "linear interpolation, zero outside: (index of its times in dp, S, 0, 0)"),
-    ]),
+     "accelerations). The terms are posturelab.model.platform.Primitive.", _packed(
+        "DIST", 6, ("WINDOWED_SINE", "(amplitude [m/s²], duration [s], start [s], cycles [-])"),
+        ("SINE", "(amplitude [m/s²], frequency [Hz], phase [rad], 0)"),
+        ("SAMPLES", "linear interpolation, zero outside: (index of its times in dp, S, 0, 0)"))),
     ("Packed tilt ``tp``: tp[0] = number of terms, then rows of TILT_ROW numbers (kind, p0 … "
      "p5), then the piecewise-cubic data: K + 1 knots, then K rows of 4 coefficients in "
-     "ascending powers of t − knot (posturelab.model.tilt.TiltTerm).", [
-        ("TILT_ROW", "TILT_ROW", 7, "numbers per term"),
-        ("TILT_SINE", "TILT_SINE", 1, "(amplitude [rad], frequency [Hz], phase [rad])"),
-        ("TILT_RAISED_COSINE", "TILT_RAISED_COSINE", 2,
-         "(amplitude [rad], start [s], duration [s])"),
-        ("TILT_PPOLY", "TILT_PPOLY", 3, "(offset of the knots in tp, K intervals, period [s] "
-         "or 0)"),
-    ]),
-    ("Options, floats ``fpar``", [
-        ("F_MAX_ANGLE", "F_MAX_ANGLE", 0, "[rad]"),
-        ("F_HEEL", "F_HEEL", 1, "[m]"),
-        ("F_TOE", "F_TOE", 2, "[m]"),
-        ("F_STOP_ANGLE", "F_STOP_ANGLE", 3, "[rad]"),
-        ("F_RTOL", "F_RTOL", 4, "[-]"),
-        ("F_ATOL", "F_ATOL", 5, "[rad, rad/s]"),
-        ("F_MAX_STEP", "F_MAX_STEP", 6, "largest step resolving the profile, and at most the "
-         "duration [s]"),
-        ("F_DURATION", "F_DURATION", 7, "[s]"),
-        ("F_SETTLE_TOL", "F_SETTLE_TOL", 8, "[rad]"),
-        ("F_TIME_LIMIT", "F_TIME_LIMIT", 9, "wall-clock budget of the run, inf for none [s]"),
-        ("N_FPAR", "N_FPAR", 10, ""),
-    ]),
-    ("Options, integers ``ipar``", [
-        ("I_USE_BOS", "I_USE_BOS", 0, ""),
-        ("I_USE_COP", "I_USE_COP", 1, ""),
-        ("I_KNEE_MODE", "I_KNEE_MODE", 2, ""),
-        ("I_MAX_SWITCHES", "I_MAX_SWITCHES", 3, ""),
-        ("I_LOCKED0", "I_LOCKED0", 4, ""),
-        ("I_MAX_STEPS", "I_MAX_STEPS", 5, "the step budget: accepted steps [-]"),
-        ("N_IPAR", "N_IPAR", 6, ""),
-    ]),
-    ("Result vector of one run", [
-        ("R_STATUS", "R_STATUS", 0, ""),
-        ("R_N_SAMPLES", "R_N_SAMPLES", 1, "samples on the grid"),
-        ("R_FALL_KIND", "R_FALL_KIND", 2, "event code of the fall (posturelab.model.events), "
-         "−1 if none"),
-        ("R_FALL_INDEX", "R_FALL_INDEX", 3, "its link index"),
-        ("R_FALL_TIME", "R_FALL_TIME", 4, "[s], NaN if none"),
-        ("R_N_SWITCHES", "R_N_SWITCHES", 5, ""),
-        ("R_T_REACHED", "R_T_REACHED", 6, "[s]"),
-        ("R_N_STEPS", "R_N_STEPS", 7, ""),
-        ("R_N_REJECTED", "R_N_REJECTED", 8, ""),
-        ("R_N_EVALS", "R_N_EVALS", 9, ""),
-        ("R_LAST_OUTSIDE", "R_LAST_OUTSIDE", 10, "last sample time with some |θ_i| > settle "
-         "tolerance [s], NaN if none"),
-        ("R_ANY_OUTSIDE", "R_ANY_OUTSIDE", 11, "0/1"),
-        ("R_FINAL_OUTSIDE", "R_FINAL_OUTSIDE", 12, "0/1: the last sample is outside"),
-        ("R_FALL_SAMPLE", "R_FALL_SAMPLE", 13, "0/1: the state at the fall closes the series, "
-         "off the grid"),
-        ("N_RESULT", "N_RESULT", 14, ""),
-    ]),
+     "ascending powers of t − knot (posturelab.model.tilt.TiltTerm).", _packed(
+        "TILT", 7, ("SINE", "(amplitude [rad], frequency [Hz], phase [rad])"),
+        ("RAISED_COSINE", "(amplitude [rad], start [s], duration [s])"),
+        ("PPOLY", "(offset of the knots in tp, K intervals, period [s] or 0)"))),
+    ("Options, floats ``fpar``", _counted(
+        ("F_MAX_ANGLE", "[rad]"), ("F_HEEL", "[m]"), ("F_TOE", "[m]"),
+        ("F_STOP_ANGLE", "[rad]"), ("F_RTOL", "[-]"), ("F_ATOL", "[rad, rad/s]"),
+        ("F_MAX_STEP", "largest step resolving the profile, and at most the duration [s]"),
+        ("F_DURATION", "[s]"), ("F_SETTLE_TOL", "[rad]"),
+        ("F_TIME_LIMIT", "wall-clock budget of the run, inf for none [s]"), "N_FPAR")),
+    ("Options, integers ``ipar``", _counted(
+        "I_USE_BOS", "I_USE_COP", "I_KNEE_MODE", "I_MAX_SWITCHES", "I_LOCKED0",
+        ("I_MAX_STEPS", "the step budget: accepted steps [-]"), "N_IPAR")),
+    ("Result vector of one run", _counted(
+        "R_STATUS", ("R_N_SAMPLES", "samples on the grid"),
+        ("R_FALL_KIND", "event code of the fall (posturelab.model.events), −1 if none"),
+        ("R_FALL_INDEX", "its link index"), ("R_FALL_TIME", "[s], NaN if none"),
+        "R_N_SWITCHES", ("R_T_REACHED", "[s]"), "R_N_STEPS", "R_N_REJECTED", "R_N_EVALS",
+        ("R_LAST_OUTSIDE", "last sample time with some |θ_i| > settle tolerance [s], NaN if none"),
+        ("R_ANY_OUTSIDE", "0/1"), ("R_FINAL_OUTSIDE", "0/1: the last sample is outside"),
+        ("R_FALL_SAMPLE", "0/1: the state at the fall closes the series, off the grid"),
+        "N_RESULT")),
 ]
 
 #: The parameters of each analytic disturbance term (model.platform.Primitive), packed in

@@ -104,8 +104,8 @@ def header() -> str:
     out = ["/* The interface of the generated model: GENERATED, do not edit.",
            " *",
            " * python -m posturelab.simulation.compiled._codegen writes this file from",
-           " * _codegen/headers.py (the structs' fields, which _layout.py carries for _binding.py)",
-           " * and sympy (the rotation's series); pl.h includes it. */",
+           " * _codegen/headers.py (the structs' fields, which _layout.py carries for _binding.py,",
+           " * and the small-N helpers) and sympy (the rotation's series); pl.h includes it. */",
            "#ifndef PL_MODEL_H", "#define PL_MODEL_H", "",
            "/* One run: everything the integration needs (read only). */"]
     out += _struct("pl_run", RUN_FIELDS)
@@ -113,6 +113,7 @@ def header() -> str:
     out += _struct("pl_out", OUT_FIELDS)
     out.append(MODEL_STRUCTS)
     out.append(_rotation())
+    out.append(SMALL_N_HELPERS)
     out.append(PROTOTYPES)
     out.append("#endif")
     return "\n".join(out) + "\n"
@@ -145,6 +146,35 @@ typedef struct {
     int64_t p;
     double *sc_out, *sc_inp, *sc_x, *ys;   /* scratch (2n), (2 + n), (2n), (2n) */
 } pl_ctx;
+"""
+
+SMALL_N_HELPERS = """/* what the small-N right-hand sides (pl_rhs_small.c) read: θ_i, θ̇_i,
+ * sin θ_i and cos θ_i of each link (about the base, pl_rotate), ẍ_d and g + ÿ_d */
+static inline void pl_small_unpack(const pl_model *md, const double *x, const double *inp, int n,
+                                   double *th, double *w, double *s, double *c, double *ax,
+                                   double *ga)
+{
+    for (int i = 0; i < n; i++) {
+        th[i] = x[i];
+        w[i] = x[n + i];
+        pl_rotate(th[i], md->base[i], md->base[n + i], md->base[2 * n + i], &s[i], &c[i]);
+    }
+    *ax = inp[0];
+    *ga = md->bp[2 * n + n * n] + inp[1];
+}
+
+/* the small-N right-hand sides' stores (pl_rhs_small.c), all last: out and tau may not be
+ * read again, whatever they alias */
+static inline void pl_small_store(const pl_model *md, double *out, int n, const double *t,
+                                  const double *w, const double *a)
+{
+    for (int j = 0; j < n; j++)
+        md->tau[j] = t[j];
+    for (int i = 0; i < n; i++)
+        out[i] = w[i];
+    for (int i = 0; i < n; i++)
+        out[n + i] = a[i];
+}
 """
 
 PROTOTYPES = """/* the right-hand side (pl_model.c, pl_rhs_small.c) */

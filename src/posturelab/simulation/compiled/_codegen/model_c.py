@@ -371,23 +371,12 @@ void pl_project_velocity(double *x, const double *bp, double *work, int64_t n)
 # Event values
 # ---------------------------------------------------------------------------
 
-#: The C statements that compute what a quantity needs (in this order when several do).
+#: The C statements that compute what a quantity needs (in this order when several do); the
+#: ones several kinds share are helpers (:func:`_helpers`), written once.
 _STEPS = {
-    "feedback": """const double *fb = y;
-        if (cx->delay > 0.0) {
-            pl_history_at(cx->hist, cx->before, t - cx->delay, cx->sc_x);
-            fb = cx->sc_x;
-        }
-        double st = 0.0, sd = 0.0;
-        for (int64_t j = 0; j < n; j++) {
-            st += cx->E[idx * n + j] * fb[j];
-            sd += cx->E[idx * n + j] * fb[n + j];
-        }""",
-    "pair_gains": """const double *gn = cx->gains;
-        const double pk = gn[GAIN_IMMEDIATE_STIFFNESS * p + idx]
-                          + gn[GAIN_DELAYED_STIFFNESS * p + idx];
-        const double pv = gn[GAIN_IMMEDIATE_VISCOSITY * p + idx]
-                          + gn[GAIN_DELAYED_VISCOSITY * p + idx];""",
+    "feedback": "pair_stretch(cx, idx, t, y, &st, &sd);",
+    "pair_gains": "pair_gains(cx, idx, &pk, &pv);",
+    "cog": "xc = cog_x(md, y);",
     "inputs": "pl_inputs_at(cx, t, cx->sc_inp);",
     "moment": """const double *tk = md->tm, *tl = md->tm + n * n;
         double tau = cx->sc_inp[2 + idx];
@@ -395,23 +384,68 @@ _STEPS = {
             tau += tk[idx * n + k] * y[k] + tl[idx * n + k] * y[n + k];""",
     "free": "pl_rhs(md, y, cx->sc_out, cx->sc_inp, 0);",
     "response": "pl_rhs(md, y, cx->sc_out, cx->sc_inp, locked);",
+    "reaction": "fy = vertical_reaction(cx, y);",
 }
 
 
-def _cog_step() -> str:
-    term = dynamics.load_formula(symbols("bp[i]"), symbols("y[i]"), 1, 0, SYMPY)
-    return f"""double xc = 0.0;
-        for (int64_t i = 0; i < n; i++)
-            xc += {c(term)};
-        xc /= bp[2 * n + n * n + 1];"""
-
-
-def _reaction_step() -> str:
-    term = kinematics.cog_acceleration_terms_formula(
+def _helpers() -> str:
+    """The steps several event kinds share, as static C functions."""
+    cog = dynamics.load_formula(symbols("bp[i]"), symbols("y[i]"), 1, 0, SYMPY)
+    reaction = kinematics.cog_acceleration_terms_formula(
         *symbols("bp[i]", "y[i]", "y[n + i]", "cx->sc_out[n + i]"), SYMPY)[1]
-    return f"""double fy = bp[2 * n + n * n + 1] * (bp[2 * n + n * n] + cx->sc_inp[1]);
-        for (int64_t i = 0; i < n; i++)
-            fy += {c(term)};"""
+    return f"""
+/* The stretch of pair idx (its row of E times the angles) and its rate, on the state the
+ * feedback sees: x(t − τ) when it is delayed, y otherwise. */
+static void pair_stretch(const pl_ctx *cx, int64_t idx, double t, const double *y,
+                         double *stretch, double *stretch_rate)
+{{
+    const int64_t n = cx->md->n;
+    const double *fb = y;
+    if (cx->delay > 0.0) {{
+        pl_history_at(cx->hist, cx->before, t - cx->delay, cx->sc_x);
+        fb = cx->sc_x;
+    }}
+    double st = 0.0, sd = 0.0;
+    for (int64_t j = 0; j < n; j++) {{
+        st += cx->E[idx * n + j] * fb[j];
+        sd += cx->E[idx * n + j] * fb[n + j];
+    }}
+    *stretch = st;
+    *stretch_rate = sd;
+}}
+
+/* pair idx's stiffness and viscosity: its immediate and delayed gains together */
+static void pair_gains(const pl_ctx *cx, int64_t idx, double *stiffness, double *viscosity)
+{{
+    const double *gn = cx->gains;
+    const int64_t p = cx->p;
+    *stiffness = gn[GAIN_IMMEDIATE_STIFFNESS * p + idx] + gn[GAIN_DELAYED_STIFFNESS * p + idx];
+    *viscosity = gn[GAIN_IMMEDIATE_VISCOSITY * p + idx] + gn[GAIN_DELAYED_VISCOSITY * p + idx];
+}}
+
+/* the centre of gravity's x at the angles y [m] */
+static double cog_x(const pl_model *md, const double *y)
+{{
+    const int64_t n = md->n;
+    const double *bp = md->bp;
+    double xc = 0.0;
+    for (int64_t i = 0; i < n; i++)
+        xc += {c(cog)};
+    return xc / bp[2 * n + n * n + 1];
+}}
+
+/* the vertical ground reaction [N], once pl_rhs has left Θ̈ in cx->sc_out and the
+ * platform's vertical acceleration is in cx->sc_inp */
+static double vertical_reaction(const pl_ctx *cx, const double *y)
+{{
+    const int64_t n = cx->md->n;
+    const double *bp = cx->md->bp;
+    double fy = bp[2 * n + n * n + 1] * (bp[2 * n + n * n] + cx->sc_inp[1]);
+    for (int64_t i = 0; i < n; i++)
+        fy += {c(reaction)};
+    return fy;
+}}
+"""
 
 
 #: quantity -> (the steps it needs, its C expression)
@@ -438,7 +472,6 @@ _ORDER = ("feedback", "pair_gains", "cog", "inputs", "moment", "free", "response
 
 
 def _events() -> str:
-    steps = {**_STEPS, "cog": _cog_step(), "reaction": _reaction_step()}
     groups: dict = {}
     for kind in ev.EVENT_KINDS:
         groups.setdefault(switched.EVENT_VALUES[kind.code], []).append(kind)
@@ -449,24 +482,22 @@ def _events() -> str:
         args = [symbols(_QUANTITIES[name][1]) for name in names]
         lines = [f"    case EV_{k.name.upper().replace('-', '_')}:" for k in kinds]
         lines[-1] += " {"
-        lines += [f"        {steps[s]}" for s in _ORDER if s in needed]
+        lines += [f"        {_STEPS[s]}" for s in _ORDER if s in needed]
         lines += [f"        g = {c(formula(*args, xp=SYMPY))};", "        break;", "    }"]
         cases.append("\n".join(lines))
     body = "\n".join(cases)
-    return f"""
+    return _helpers() + f"""
 /* The value of an event function (model.switched.EVENT_VALUES, plus the kind's offset of
  * model.events) at (t, y) with the segment's switches. */
 double pl_event_value(const pl_ctx *cx, int64_t kind, int64_t idx, double side, double t,
                       const double *y, int locked)
 {{
     const pl_model *md = cx->md;
-    const int64_t n = md->n, p = cx->p;
-    const double *bp = md->bp, *fpar = cx->fpar;
-    (void)bp;
-    (void)p;
+    const int64_t n = md->n;
+    const double *fpar = cx->fpar;
     (void)locked;
     (void)side;
-    double g = 0.0;
+    double st = 0.0, sd = 0.0, pk = 0.0, pv = 0.0, xc = 0.0, fy = 0.0, g = 0.0;
     switch (kind) {{
 {body}
     default:

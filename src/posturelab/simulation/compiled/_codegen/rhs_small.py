@@ -68,19 +68,19 @@ def _adjugate_lines(n: int, printer) -> tuple[list[str], list[list[str]]]:
 
 
 def _entry(expr, *links: int) -> str:
-    """An entry formula on θ_i symbols printed with s_i, c_i for sin θ_i, cos θ_i."""
+    """An entry formula on θ_i symbols printed with s[i], c[i] for sin θ_i, cos θ_i."""
     from .model_c import _trig_symbols
     from .spec import c, symbols
 
-    return c(_trig_symbols(expr, {symbols(f"th{i}"): (f"s{i}", f"c{i}") for i in links}))
+    return c(_trig_symbols(expr, {symbols(f"th[{i}]"): (f"s[{i}]", f"c[{i}]") for i in links}))
 
 
 def _coupling(n: int, i: int, j: int) -> str:
     from ....model.dynamics import coupling_formula
     from .spec import SYMPY, symbols
 
-    return _entry(coupling_formula(symbols(f"bp[{2 * n + i * n + j}]"), symbols(f"th{i}"),
-                                   symbols(f"th{j}"), SYMPY), i, j)
+    return _entry(coupling_formula(symbols(f"bp[{2 * n + i * n + j}]"), symbols(f"th[{i}]"),
+                                   symbols(f"th[{j}]"), SYMPY), i, j)
 
 
 def _centripetal(n: int, i: int, j: int) -> str:
@@ -88,15 +88,15 @@ def _centripetal(n: int, i: int, j: int) -> str:
     from .spec import SYMPY, symbols
 
     return _entry(centripetal_formula(symbols(f"bp[{2 * n + min(i, j) * n + max(i, j)}]"),
-                                      symbols(f"th{i}"), symbols(f"th{j}"), symbols(f"w{j}"),
-                                      SYMPY), i, j)
+                                      symbols(f"th[{i}]"), symbols(f"th[{j}]"),
+                                      symbols(f"w[{j}]"), SYMPY), i, j)
 
 
 def _load(i: int) -> str:
     from ....model.dynamics import load_formula
     from .spec import SYMPY, symbols
 
-    return _entry(load_formula(symbols(f"bp[{i}]"), symbols(f"th{i}"), *symbols("ga", "ax"),
+    return _entry(load_formula(symbols(f"bp[{i}]"), symbols(f"th[{i}]"), *symbols("ga", "ax"),
                                SYMPY), i)
 
 
@@ -104,32 +104,25 @@ def _saturated(j: int) -> str:
     from ....model.switched import saturated_moment_formula
     from .spec import SYMPY, c, symbols
 
-    return c(saturated_moment_formula(*symbols(f"t{j}", f"md->sat[{j}]", f"md->lim[{j}]"),
+    return c(saturated_moment_formula(*symbols(f"t[{j}]", f"md->sat[{j}]", f"md->lim[{j}]"),
                                       SYMPY))
 
 
 def _rhs_function(n: int, printer) -> str:
-    L = [f"void pl_rhs{n}(const pl_model *md, const double *x, double *out, const double *inp,",
-         "             int locked)", "{",
+    L = [f"void pl_rhs{n}(const pl_model *md, const double *x, double *out, const double *inp, "
+         "int locked)", "{",
          "    const double *bp = md->bp, *tk = md->tm, *tl = md->tm + " + str(n * n) + ";",
-         "    const double *base = md->base;"]
+         f"    double th[{n}], w[{n}], s[{n}], c[{n}], t[{n}], a[{n}], ax, ga;"]
     if n == 1:
         L.append("    (void)locked;")
-    for i in range(n):
-        L.append(f"    const double th{i} = x[{i}], w{i} = x[{n + i}];")
-    for i in range(n):
-        L.append(f"    double s{i}, c{i};")
-        L.append(f"    pl_rotate(th{i}, base[{i}], base[{n + i}], base[{2 * n + i}], "
-                 f"&s{i}, &c{i});")
-    L.append("    const double ax = inp[0];")
-    L.append(f"    const double ga = bp[{2 * n + n * n}] + inp[1];")
+    L.append(f"    pl_small_unpack(md, x, inp, {n}, th, w, s, c, &ax, &ga);")
     for j in range(n):
-        k_terms = " + ".join(f"tk[{j * n + k}] * th{k}" for k in range(n))
-        l_terms = " + ".join(f"tl[{j * n + k}] * w{k}" for k in range(n))
-        L.append(f"    double t{j} = inp[{2 + j}] + ({k_terms}) + ({l_terms});")
-        L.append(f"    t{j} = {_saturated(j)};")
+        k_terms = " + ".join(f"tk[{j * n + k}] * th[{k}]" for k in range(n))
+        l_terms = " + ".join(f"tl[{j * n + k}] * w[{k}]" for k in range(n))
+        L.append(f"    t[{j}] = inp[{2 + j}] + ({k_terms}) + ({l_terms});")
+        L.append(f"    t[{j}] = {_saturated(j)};")
     for i in range(n):
-        rhs = f"t{i + 1} - t{i}" if i + 1 < n else f"-t{i}"
+        rhs = f"t[{i + 1}] - t[{i}]" if i + 1 < n else f"-t[{i}]"
         L.append(f"    const double u{i} = {rhs};")
     for i in range(n):
         terms = [_centripetal(n, i, j) for j in range(n) if j != i]
@@ -145,23 +138,17 @@ def _rhs_function(n: int, printer) -> str:
     L.append(f"    const double inv_det = 1.0 / ({det});")
     for i in range(n):
         terms = " + ".join(f"{names[i][k]} * r{k}" for k in range(n))
-        L.append(f"    double a{i} = ({terms}) * inv_det;")
+        L.append(f"    a[{i}] = ({terms}) * inv_det;")
     if n >= 2:
         L.append("    if (locked) {  /* knee constraint C = (−1, 1, 0): "
                  "Θ̈ −= J⁻¹C (C·Θ̈)/(C·J⁻¹C) */")
         for i in range(n):
             L.append(f"        const double y{i} = {names[i][1]} - {names[i][0]};")
-        L.append("        const double lam = (a1 - a0) / (y1 - y0);")
+        L.append("        const double lam = (a[1] - a[0]) / (y1 - y0);")
         for i in range(n):
-            L.append(f"        a{i} -= y{i} * lam;")
+            L.append(f"        a[{i}] -= y{i} * lam;")
         L.append("    }")
-    # every store last: out and tau may not be read again, whatever they alias
-    for j in range(n):
-        L.append(f"    md->tau[{j}] = t{j};")
-    for i in range(n):
-        L.append(f"    out[{i}] = w{i};")
-    for i in range(n):
-        L.append(f"    out[{n + i}] = a{i};")
+    L.append(f"    pl_small_store(md, out, {n}, t, w, a);")
     L.append("}")
     return "\n".join(L) + "\n"
 

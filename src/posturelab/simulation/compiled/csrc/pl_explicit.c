@@ -165,15 +165,9 @@ static void rk_release(pl_method *me)
 int pl_explicit_init(pl_method *me, const pl_run *run, int64_t n)
 {
     rk_ws *w = calloc(1, sizeof(rk_ws));
-    me->ws = w;
-    me->start = rk_start;
-    me->limit = rk_limit;
-    me->attempt = rk_attempt;
-    me->commit = rk_commit;
-    me->release = rk_release;
-    me->refresh = rk_refresh;
-    me->n_nodes = run->n_stages;
-    me->nodes = run->tab_c;
+    *me = (pl_method){.n_nodes = run->n_stages, .nodes = run->tab_c, .ws = w,
+                      .start = rk_start, .limit = rk_limit, .attempt = rk_attempt,
+                      .commit = rk_commit, .release = rk_release, .refresh = rk_refresh};
     if (!w)
         return 0;
     w->S = run->n_stages;

@@ -275,55 +275,95 @@ void pl_project_velocity(double *x, const double *bp, double *work, int64_t n)
         x[n + i] -= work[i * s + n] * lam;
 }
 
+/* The stretch of pair idx (its row of E times the angles) and its rate, on the state the
+ * feedback sees: x(t − τ) when it is delayed, y otherwise. */
+static void pair_stretch(const pl_ctx *cx, int64_t idx, double t, const double *y,
+                         double *stretch, double *stretch_rate)
+{
+    const int64_t n = cx->md->n;
+    const double *fb = y;
+    if (cx->delay > 0.0) {
+        pl_history_at(cx->hist, cx->before, t - cx->delay, cx->sc_x);
+        fb = cx->sc_x;
+    }
+    double st = 0.0, sd = 0.0;
+    for (int64_t j = 0; j < n; j++) {
+        st += cx->E[idx * n + j] * fb[j];
+        sd += cx->E[idx * n + j] * fb[n + j];
+    }
+    *stretch = st;
+    *stretch_rate = sd;
+}
+
+/* pair idx's stiffness and viscosity: its immediate and delayed gains together */
+static void pair_gains(const pl_ctx *cx, int64_t idx, double *stiffness, double *viscosity)
+{
+    const double *gn = cx->gains;
+    const int64_t p = cx->p;
+    *stiffness = gn[GAIN_IMMEDIATE_STIFFNESS * p + idx] + gn[GAIN_DELAYED_STIFFNESS * p + idx];
+    *viscosity = gn[GAIN_IMMEDIATE_VISCOSITY * p + idx] + gn[GAIN_DELAYED_VISCOSITY * p + idx];
+}
+
+/* the centre of gravity's x at the angles y [m] */
+static double cog_x(const pl_model *md, const double *y)
+{
+    const int64_t n = md->n;
+    const double *bp = md->bp;
+    double xc = 0.0;
+    for (int64_t i = 0; i < n; i++)
+        xc += bp[i]*sin(y[i]);
+    return xc / bp[2 * n + n * n + 1];
+}
+
+/* the vertical ground reaction [N], once pl_rhs has left Θ̈ in cx->sc_out and the
+ * platform's vertical acceleration is in cx->sc_inp */
+static double vertical_reaction(const pl_ctx *cx, const double *y)
+{
+    const int64_t n = cx->md->n;
+    const double *bp = cx->md->bp;
+    double fy = bp[2 * n + n * n + 1] * (bp[2 * n + n * n] + cx->sc_inp[1]);
+    for (int64_t i = 0; i < n; i++)
+        fy += -bp[i]*(cx->sc_out[n + i]*sin(y[i]) + (y[n + i] * y[n + i])*cos(y[i]));
+    return fy;
+}
+
 /* The value of an event function (model.switched.EVENT_VALUES, plus the kind's offset of
  * model.events) at (t, y) with the segment's switches. */
 double pl_event_value(const pl_ctx *cx, int64_t kind, int64_t idx, double side, double t,
                       const double *y, int locked)
 {
     const pl_model *md = cx->md;
-    const int64_t n = md->n, p = cx->p;
-    const double *bp = md->bp, *fpar = cx->fpar;
-    (void)bp;
-    (void)p;
+    const int64_t n = md->n;
+    const double *fpar = cx->fpar;
     (void)locked;
     (void)side;
-    double g = 0.0;
+    double st = 0.0, sd = 0.0, pk = 0.0, pv = 0.0, xc = 0.0, fy = 0.0, g = 0.0;
     switch (kind) {
     case EV_LINK_ANGLE: {
         g = fpar[F_MAX_ANGLE] - fabs(y[idx]);
         break;
     }
     case EV_COG_TOE: {
-        double xc = 0.0;
-        for (int64_t i = 0; i < n; i++)
-            xc += bp[i]*sin(y[i]);
-        xc /= bp[2 * n + n * n + 1];
+        xc = cog_x(md, y);
         g = fpar[F_TOE] - xc;
         break;
     }
     case EV_COG_HEEL: {
-        double xc = 0.0;
-        for (int64_t i = 0; i < n; i++)
-            xc += bp[i]*sin(y[i]);
-        xc /= bp[2 * n + n * n + 1];
+        xc = cog_x(md, y);
         g = -fpar[F_HEEL] + xc;
         break;
     }
     case EV_COP_TOE: {
         pl_inputs_at(cx, t, cx->sc_inp);
         pl_rhs(md, y, cx->sc_out, cx->sc_inp, locked);
-        double fy = bp[2 * n + n * n + 1] * (bp[2 * n + n * n] + cx->sc_inp[1]);
-        for (int64_t i = 0; i < n; i++)
-            fy += -bp[i]*(cx->sc_out[n + i]*sin(y[i]) + (y[n + i] * y[n + i])*cos(y[i]));
+        fy = vertical_reaction(cx, y);
         g = fpar[F_TOE]*fy - md->tau[0];
         break;
     }
     case EV_COP_HEEL: {
         pl_inputs_at(cx, t, cx->sc_inp);
         pl_rhs(md, y, cx->sc_out, cx->sc_inp, locked);
-        double fy = bp[2 * n + n * n + 1] * (bp[2 * n + n * n] + cx->sc_inp[1]);
-        for (int64_t i = 0; i < n; i++)
-            fy += -bp[i]*(cx->sc_out[n + i]*sin(y[i]) + (y[n + i] * y[n + i])*cos(y[i]));
+        fy = vertical_reaction(cx, y);
         g = -fpar[F_HEEL]*fy + md->tau[0];
         break;
     }
@@ -339,16 +379,7 @@ double pl_event_value(const pl_ctx *cx, int64_t kind, int64_t idx, double side, 
     }
     case EV_PAIR_SLACKENS:
     case EV_PAIR_ENGAGES: {
-        const double *fb = y;
-        if (cx->delay > 0.0) {
-            pl_history_at(cx->hist, cx->before, t - cx->delay, cx->sc_x);
-            fb = cx->sc_x;
-        }
-        double st = 0.0, sd = 0.0;
-        for (int64_t j = 0; j < n; j++) {
-            st += cx->E[idx * n + j] * fb[j];
-            sd += cx->E[idx * n + j] * fb[n + j];
-        }
+        pair_stretch(cx, idx, t, y, &st, &sd);
         g = st;
         break;
     }
@@ -363,40 +394,14 @@ double pl_event_value(const pl_ctx *cx, int64_t kind, int64_t idx, double side, 
         break;
     }
     case EV_PAIR_PUSHES: {
-        const double *fb = y;
-        if (cx->delay > 0.0) {
-            pl_history_at(cx->hist, cx->before, t - cx->delay, cx->sc_x);
-            fb = cx->sc_x;
-        }
-        double st = 0.0, sd = 0.0;
-        for (int64_t j = 0; j < n; j++) {
-            st += cx->E[idx * n + j] * fb[j];
-            sd += cx->E[idx * n + j] * fb[n + j];
-        }
-        const double *gn = cx->gains;
-        const double pk = gn[GAIN_IMMEDIATE_STIFFNESS * p + idx]
-                          + gn[GAIN_DELAYED_STIFFNESS * p + idx];
-        const double pv = gn[GAIN_IMMEDIATE_VISCOSITY * p + idx]
-                          + gn[GAIN_DELAYED_VISCOSITY * p + idx];
+        pair_stretch(cx, idx, t, y, &st, &sd);
+        pair_gains(cx, idx, &pk, &pv);
         g = pk*st + pv*sd;
         break;
     }
     case EV_PAIR_PULLS: {
-        const double *fb = y;
-        if (cx->delay > 0.0) {
-            pl_history_at(cx->hist, cx->before, t - cx->delay, cx->sc_x);
-            fb = cx->sc_x;
-        }
-        double st = 0.0, sd = 0.0;
-        for (int64_t j = 0; j < n; j++) {
-            st += cx->E[idx * n + j] * fb[j];
-            sd += cx->E[idx * n + j] * fb[n + j];
-        }
-        const double *gn = cx->gains;
-        const double pk = gn[GAIN_IMMEDIATE_STIFFNESS * p + idx]
-                          + gn[GAIN_DELAYED_STIFFNESS * p + idx];
-        const double pv = gn[GAIN_IMMEDIATE_VISCOSITY * p + idx]
-                          + gn[GAIN_DELAYED_VISCOSITY * p + idx];
+        pair_stretch(cx, idx, t, y, &st, &sd);
+        pair_gains(cx, idx, &pk, &pv);
         g = fmin(pk*st + pv*sd, st*((pk > 0.0) ? (pk) : (1.0)));
         break;
     }

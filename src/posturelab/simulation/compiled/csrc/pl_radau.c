@@ -443,15 +443,10 @@ int pl_radau_init(pl_method *me, int64_t n)
 {
     pl_radau_constants();
     radau_ws *w = calloc(1, sizeof(radau_ws));
-    me->ws = w;
-    me->start = radau_start;
-    me->limit = radau_limit;
-    me->attempt = radau_attempt;
-    me->commit = radau_commit;
-    me->release = radau_release;
-    me->refresh = radau_refresh;
-    me->n_nodes = 4;
-    me->nodes = NODES;
+    *me = (pl_method){.n_nodes = 4, .nodes = NODES, .ws = w,
+                      .start = radau_start, .limit = radau_limit, .attempt = radau_attempt,
+                      .commit = radau_commit, .release = radau_release,
+                      .refresh = radau_refresh};
     if (!w)
         return 0;
     const int64_t m = 2 * n;
