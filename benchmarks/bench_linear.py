@@ -175,14 +175,11 @@ t3 = time.perf_counter()
 with open(sys.argv[1] + ".csv", "w", encoding="utf-8", newline="") as stream:
     smap.write_csv(stream)
 t4 = time.perf_counter()
-try:
-    from posturelab.viz.plots import plot_stability_map
-except ImportError:
-    plot_stability_map = command.plot_stability_map
-import matplotlib.figure
+command._import_plotting()
+from posturelab.viz.maps import plot_stability_map
 t5 = time.perf_counter()
 with open(sys.argv[1] + ".png", "wb") as stream:
-    plot_stability_map(smap, stream, "png")
+    plot_stability_map(smap).savefig(stream, format="png", dpi=150)
 t6 = time.perf_counter()
 print(t1 - t0, t2 - t1, t3 - t2, t4 - t3, t5 - t4, t6 - t5)
 """
