@@ -20,7 +20,9 @@ Everything is measured in this one run on this machine:
 * the whole ``posturelab stability-map`` command at resolution 1000 (10⁶ sets:
   start-up, kernel, CSV and PNG), a fresh process each time with the numba cache
   warm, median of 3 after one warm-up run (``--skip-command`` leaves it out), against
-  numpy eigvals of the same number of sets; and where its time goes: a fresh process
+  numpy eigvals of the same number of sets (``--command-runs``; ``--compare-source SRC``
+  interleaves each run with one of another checkout's ``src`` and compares their outputs
+  byte for byte); and where its time goes: a fresh process
   that times each phase in turn (start-up, loading the kernels, the map, the CSV,
   matplotlib and the PNG; the command overlaps the map with matplotlib's import and
   the CSV with the PNG);
@@ -38,8 +40,10 @@ set to 0 (pairs switched off, as in Table I); viscosity ratio uniform in
 from __future__ import annotations
 
 import argparse
+import filecmp
 import os
 import platform
+import resource
 import statistics
 import subprocess
 import sys
@@ -145,19 +149,39 @@ COMMAND = ["stability-map", "--x", "stiffness:ankle:0:2000", "--y",
 COMMAND_SETS = 1000 * 1000
 
 
-def command_times(runs: int) -> list[float]:
-    """Wall time of ``posturelab stability-map`` (COMMAND) in fresh processes, after one
-    untimed warm-up run (which fills the numba cache if needed)."""
-    out = []
+def command_times(runs: int, other_source: str | None = None) -> tuple[list, list]:
+    """Wall and CPU time (user + system) of ``posturelab stability-map`` (COMMAND) in fresh
+    processes, after one untimed warm-up run (which fills the numba cache if needed). [s]
+
+    With ``other_source`` (the ``src`` folder of another checkout), each run is followed by
+    one of that checkout's command, and each list holds pairs (this, other)."""
+    sources = [None] if other_source is None else [None, other_source]
+    wall, cpu = [], []
     with tempfile.TemporaryDirectory(prefix="posturelab-map-") as folder:
-        argv = [sys.executable, "-m", "posturelab", *COMMAND, "--out",
-                os.path.join(folder, "map.png")]
         for i in range(runs + 1):
-            t = time.perf_counter()
-            subprocess.run(argv, capture_output=True, text=True, check=True)
+            pair_wall, pair_cpu = [], []
+            for k, source in enumerate(sources):
+                env = dict(os.environ)
+                if source is not None:
+                    env["PYTHONPATH"] = source
+                argv = [sys.executable, "-m", "posturelab", *COMMAND, "--out",
+                        os.path.join(folder, f"map{k}.png")]
+                used = resource.getrusage(resource.RUSAGE_CHILDREN)
+                t = time.perf_counter()
+                subprocess.run(argv, capture_output=True, text=True, check=True, env=env)
+                pair_wall.append(time.perf_counter() - t)
+                now = resource.getrusage(resource.RUSAGE_CHILDREN)
+                pair_cpu.append(now.ru_utime + now.ru_stime - used.ru_utime - used.ru_stime)
             if i:
-                out.append(time.perf_counter() - t)
-    return out
+                wall.append(pair_wall if other_source else pair_wall[0])
+                cpu.append(pair_cpu if other_source else pair_cpu[0])
+        if other_source is not None:
+            for suffix in (".png", ".csv"):
+                same = filecmp.cmp(os.path.join(folder, "map0" + suffix),
+                                   os.path.join(folder, "map1" + suffix), shallow=False)
+                print(f"  {suffix[1:].upper()} of this checkout and of {other_source}: "
+                      f"{'identical' if same else 'DIFFERENT'} bytes")
+    return wall, cpu
 
 
 #: A fresh process timing each phase of the stability-map command in turn. [s]
@@ -175,14 +199,11 @@ t3 = time.perf_counter()
 with open(sys.argv[1] + ".csv", "w", encoding="utf-8", newline="") as stream:
     smap.write_csv(stream)
 t4 = time.perf_counter()
-try:
-    from posturelab.viz.plots import plot_stability_map
-except ImportError:
-    plot_stability_map = command.plot_stability_map
-import matplotlib.figure
+command._import_plotting()
+from posturelab.viz.maps import plot_stability_map
 t5 = time.perf_counter()
 with open(sys.argv[1] + ".png", "wb") as stream:
-    plot_stability_map(smap, stream, "png")
+    plot_stability_map(smap).savefig(stream, format="png", dpi=150)
 t6 = time.perf_counter()
 print(t1 - t0, t2 - t1, t3 - t2, t4 - t3, t5 - t4, t6 - t5)
 """
@@ -287,6 +308,12 @@ def main() -> None:
     parser.add_argument("--skip-margins", action="store_true",
                         help="skip the batched delay margins")
     parser.add_argument("--margin-baseline-sets", type=int, default=40)
+    parser.add_argument("--command-runs", type=int, default=3,
+                        help="timed runs of the whole stability-map command (default 3)")
+    parser.add_argument("--compare-source", metavar="SRC",
+                        help="the src folder of another checkout (e.g. `git archive REV src | "
+                        "tar -x -C DIR`, then DIR/src): its stability-map command is timed "
+                        "interleaved with this one's, and their outputs compared")
     args = parser.parse_args()
 
     print(f"machine: {machine()}")
@@ -347,11 +374,24 @@ def main() -> None:
     print(f"{f'stability_map {map_resolution}², roots warm-started':<56}{t_map:>11.3f}"
           f"{1e6 * t_map / map_sets:>14.3f}{t_base * map_sets / args.sets / t_map:>9.1f}×")
     if not args.skip_command:
-        t_cmd = statistics.median(command_times(3))
+        if args.compare_source:
+            walls, cpus = command_times(args.command_runs, args.compare_source)
+            this = [w[0] for w in walls]
+            note = (f"  interleaved with {args.compare_source}, {args.command_runs} pairs: "
+                    f"wall {statistics.median(this):.3f} s against "
+                    f"{statistics.median(w[1] for w in walls):.3f} s (median ratio "
+                    f"{statistics.median(w[0] / w[1] for w in walls):.2f}), CPU "
+                    f"{statistics.median(c[0] for c in cpus):.3f} s against "
+                    f"{statistics.median(c[1] for c in cpus):.3f} s")
+        else:
+            this, cpus = command_times(args.command_runs)
+            note = f"  CPU (user + system) median {statistics.median(cpus):.3f} s"
+        t_cmd = statistics.median(this)
         base_cmd = t_base * COMMAND_SETS / args.sets  # the baseline for as many sets
         print(f"{'stability-map command, resolution 1000 (warm, whole)':<56}{t_cmd:>11.3f}"
               f"{1e6 * t_cmd / COMMAND_SETS:>14.3f}{base_cmd / t_cmd:>9.1f}×"
               f"   (goal 1.5 s: {'ok' if t_cmd <= 1.5 else 'MISSED'})")
+        print(note)
         phases = np.median(np.array(phase_times(3)), axis=0)
         print(f"  where it goes (each phase in turn, fresh processes, median of 3; "
               f"python -c 'import posturelab.cli' alone: {startup_time(3):.2f} s):")

@@ -24,6 +24,7 @@ def plot_stability_map(smap) -> Figure:
     -------
     Figure
     """
+    from matplotlib.cm import ScalarMappable
     from matplotlib.colors import TwoSlopeNorm
     from matplotlib.lines import Line2D
 
@@ -40,9 +41,12 @@ def plot_stability_map(smap) -> Figure:
     extent = (xs[0] - dx / 2, xs[-1] + dx / 2, ys[0] - dy / 2, ys[-1] + dy / 2)
 
     fig, ax = new_figure(figsize=(7.5, 5.8))
-    image = ax.imshow(values, origin="lower", extent=extent, aspect="auto",
-                      interpolation="nearest", cmap="RdBu_r", norm=norm)
-    fig.colorbar(image, ax=ax, label="largest real part of the poles [1/s]")
+    # Coloured once here, as RGBA bytes: matplotlib would map the float array through the
+    # norm (masked arrays) at every draw; with nearest interpolation the pixels are the same.
+    colours = ScalarMappable(norm=norm, cmap="RdBu_r")
+    ax.imshow(colours.to_rgba(values, bytes=True), origin="lower", extent=extent,
+              aspect="auto", interpolation="nearest")
+    fig.colorbar(colours, ax=ax, label="largest real part of the poles [1/s]")
     handles = []
     if smap.stable.any() and not smap.stable.all():
         ax.contour(xs, ys, smap.stable.astype(float), levels=[0.5], colors="k", linewidths=1.5)
