@@ -8,9 +8,7 @@ from ..errors import ParameterError
 from ..parameters import MAX_FEEDBACK_DELAY
 from ._common import (
     add_muscle_arguments,
-    body_from_args,
-    feedback_options_from_args,
-    muscles_from_args,
+    model_from_args,
     print_json,
 )
 
@@ -172,9 +170,8 @@ def run(args: argparse.Namespace) -> int:
                                                    "--compare-plot": args.compare_plot})
     check_plot_path(args.plot)
     compare = _compare_request(args)
-    body = body_from_args(args)
-    muscles = muscles_from_args(args, body)
-    options = feedback_options_from_args(args)
+    model = model_from_args(args)
+    body, muscles, options = model.body, model.muscles, model.options
     free, per = _names(args.free), _names(args.per_condition)
     checked = check_fit_request(muscles, free, per, None)  # the names first, before any data
     if compare is not None:
@@ -185,8 +182,8 @@ def run(args: argparse.Namespace) -> int:
         check_fit_request(muscles, free, per, _bounds(args.bounds))
     conditions = [_condition(path, args) for path in args.data]
     fit_options = dict(input=args.input, output=args.output.strip().lower(),
-                       feedback_delay=options.get("feedback_delay", 0.0),
-                       proprioceptive_weight=options.get("proprioceptive_weight", 1.0),
+                       feedback_delay=options.feedback_delay,
+                       proprioceptive_weight=options.proprioceptive_weight,
                        bounds=_bounds(args.bounds))
     comparison = None
     if compare is not None:
