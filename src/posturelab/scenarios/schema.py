@@ -39,11 +39,14 @@ class SegmentTable(_Table):
 
 
 class BodyTable(_Table):
-    """``[body]``: a preset or the segments, lowest first; gravity [m/s²]."""
+    """``[body]``: a preset, the segments (lowest first), or a height [m] and mass [kg]
+    (Winter's anthropometric table); gravity [m/s²]."""
 
     preset: str | None = None
     segments: list[SegmentTable] | None = None
     gravity: float | None = None
+    height: float | None = None
+    mass: float | None = None
 
 
 class PairTable(_Table):
@@ -66,6 +69,7 @@ class MusclesTable(_Table):
 
     case: str | None = None
     stiffness: list[float] | None = None
+    viscosity: list[float] | None = None
     pairs: list[PairTable] | None = None
     viscosity_ratio: float | None = None
     gastrocnemius: Literal["two-sided", "one-sided", "pull-only"] | None = None
