@@ -207,9 +207,10 @@ def largest_recoverable_batch(
     def falls(rows: np.ndarray, scale: np.ndarray) -> np.ndarray:
         out = simulate_batch(body, stiffness[rows], viscosity[rows], disturbance, duration,
                              initial_state, muscles=muscles, options=shared,
-                             feedback_delay=_open_rows(feedback_delay, rows, 1),
-                             proprioceptive_weight=_open_rows(proprioceptive_weight, rows, 1),
-                             torque_limits=_open_rows(torque_limits, rows, 2),
+                             feedback_delay=_open_rows(feedback_delay, rows, PER_SET),
+                             proprioceptive_weight=_open_rows(proprioceptive_weight, rows,
+                                                              PER_SET),
+                             torque_limits=_open_rows(torque_limits, rows, PER_SET + 1),
                              disturbance_scale=scale, parallel=parallel)
         return out.fell
 
@@ -231,6 +232,11 @@ def largest_recoverable_batch(
         hi[rows[f]] = mid[f]
         lo[rows[~f]] = mid[~f]
     return BatchRecoveryBoundaries(lo, hi, count)
+
+
+#: The dimensions of a number given per gain set (one value per set); a per-joint one has one
+#: more.
+PER_SET = 1
 
 
 def _open_rows(values, rows: np.ndarray, per_set_ndim: int):
