@@ -95,17 +95,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 def add_fit_arguments(p: argparse.ArgumentParser, *, per_condition: bool) -> None:
     """How a trial CSV is read and what is fitted (``fit-frf`` and ``cohort`` share them)."""
-    p.add_argument("--stimulus", metavar="COLUMN", help="stimulus column of a trial CSV.")
-    p.add_argument("--response", metavar="COLUMN", help="response column of a trial CSV.")
-    p.add_argument("--cycle-length", type=float, metavar="SECONDS", help="of a trial CSV [s].")
-    p.add_argument("--discard-cycles", type=int, default=0, metavar="N",
-                   help="leading cycles of a trial CSV to drop (the transient; default 0).")
-    p.add_argument("--response-sign", choices=["-1", "+1", "1"], default="-1",
-                   help="multiply a trial's response by this (default -1: posturelab's tilt "
-                   "convention, as posturelab frf).")
-    p.add_argument("--input", choices=["tilt", "translation"], default="tilt",
-                   help="what the stimulus is: tilt [rad] (default) or platform "
-                   "translation [m].")
+    from .compare_frf import add_trial_arguments
+
+    add_trial_arguments(p, input_help="what the stimulus is: tilt [rad] (default) or "
+                        "platform translation [m].")
     p.add_argument("--output", default="com_angle", metavar="NAME",
                    help="the model output the response is (default com_angle).")
     p.add_argument("--free", required=True, metavar="NAMES",
