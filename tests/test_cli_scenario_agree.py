@@ -33,8 +33,23 @@ def from_file(text: str, tmp_path) -> pl.Scenario:
     return pl.load_scenario(path)
 
 
+def segments_table(body) -> str:
+    """A file's [body] table of ``body``'s segments (a file has no height and mass)."""
+    rows = ", ".join(f'{{name = "{s.name}", mass = {s.mass!r}, length = {s.length!r}, '
+                     f'com_distance = {s.com_distance!r}, inertia = {s.inertia!r}}}'
+                     for s in body.segments)
+    return f"[body]\nsegments = [{rows}]\n"
+
+
+def lumped(height: float, mass: float) -> str:
+    """The [body] table of the one-link body a controller has on --height/--mass."""
+    from posturelab.model.anthropometry import body_from_anthropometry, one_link
+
+    return segments_table(one_link(body_from_anthropometry(height, mass)))
+
+
 def assert_same_experiment(a: pl.Scenario, b: pl.Scenario) -> None:
-    assert a.body == b.body
+    assert (a.body.segments, a.body.gravity) == (b.body.segments, b.body.gravity)
     assert a.muscles == b.muscles
     assert a.disturbance == b.disturbance
     assert a.case == b.case
@@ -65,11 +80,7 @@ posture = {FLEXED}
     "a controller on a body from height and mass, its delay replaced, a PRTS tilt": (
         ["--controller", "peterka-2002", "--height", "1.8", "--mass", "82",
          "--feedback-delay", "0.15", "--tilt", "prts:0.035"],
-        """duration = 5.0
-[body]
-height = 1.8
-mass = 82.0
-[muscles]
+        "duration = 5.0\n" + lumped(1.8, 82.0) + """[muscles]
 controller = "peterka-2002"
 feedback_delay = 0.15
 [tilt]
@@ -197,9 +208,9 @@ def test_every_model_command_builds_the_model_a_file_does(tmp_path, command, cap
     extra = ["--data", "x.csv", "--free", "feedback_delay"] if command == "fit-frf" else []
     model = model_from_args(build_parser(command).parse_args([command, *flags, *extra]))
     assert "one-link controller" in capsys.readouterr().err
-    sc = from_file('duration = 5.0\n[body]\nheight = 1.7\nmass = 70.0\n[muscles]\n'
+    sc = from_file("duration = 5.0\n" + lumped(1.7, 70.0) + '[muscles]\n'
                    'controller = "peterka-2002"\nproprioceptive_weight = 0.6\n', tmp_path)
-    assert (model.body, model.muscles) == (sc.body, sc.muscles)
+    assert (model.body.segments, model.muscles) == (sc.body.segments, sc.muscles)
     assert (model.options.feedback_delay, model.options.proprioceptive_weight) == (
         sc.options.feedback_delay, sc.options.proprioceptive_weight)
 

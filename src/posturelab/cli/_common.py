@@ -32,27 +32,6 @@ def parse_float_list(text: str, field: str, n: int | None = None) -> list[float]
     return number_list(str(text), field, n)
 
 
-def parse_limit_list(text: str, field: str, n: int) -> list[float]:
-    """Parse ``"120,inf,80"``: n positive numbers, ``inf``/``none`` meaning no limit."""
-    parts = [p.strip().lower() for p in str(text).split(",")]
-    if len(parts) != n:
-        raise ParameterError(f"{field} must have {n} comma-separated values, got {len(parts)}")
-    out = []
-    for p in parts:
-        if p in ("inf", "none"):
-            out.append(math.inf)
-            continue
-        try:
-            v = float(p)
-        except ValueError:
-            raise ParameterError(f"{field} must be numbers or 'inf', got {p!r}") from None
-        if not (math.isfinite(v) and v > 0):
-            raise ParameterError(f"{field} must each be in (0, inf] (a number > 0, or 'inf' "
-                                 f"for no limit), got {p!r}")
-        out.append(v)
-    return out
-
-
 def add_muscle_arguments(p: argparse.ArgumentParser, *, require: bool = False,
                          own_case: bool = False) -> None:
     """The body and its feedback: --body / --height --mass, --case / --stiffness /
@@ -134,6 +113,8 @@ EXPERIMENT_FLAGS: dict[str, str] = {
     "motor_noise": "motor_noise.standard_deviation",
     "motor_noise_cutoff": "motor_noise.cutoff", "seed": "motor_noise.seed",
     "speed": "disturbance.speed", "platform_profile": "disturbance.file",
+    "foot": "fall.base_of_support", "max_link_angle": "fall.max_link_angle",
+    "torque_limits": "limits.torque",
 }
 
 

@@ -8,7 +8,7 @@ import sys
 from typing import TypeVar
 
 from ..errors import DataFileError, ParameterError
-from ..model.options import FOOT_FROM_LITERATURE, BaseOfSupport, FallCriteria, KneeModel
+from ..model.options import KneeModel
 from ..model.platform import MAX_PLATFORM_SPEED, VelocityStep
 from ..paper.printed import BACKWARD_INITIAL_STATE
 from ..parameters import RUN_SETTINGS, check_value
@@ -19,6 +19,7 @@ from ..scenarios import (
     builtin_scenario_names,
     load_scenario,
 )
+from ..scenarios._parse import fall_from_table, torque_limits_from_table
 from ..simulation.options import RunOptions
 from . import UsageError
 from ._common import (
@@ -29,8 +30,6 @@ from ._common import (
     model_from_args,
     naming_given_options,
     naming_option,
-    parse_float_list,
-    parse_limit_list,
     parse_tilt,
     print_json,
 )
@@ -217,14 +216,14 @@ def run_options_from_args(args: argparse.Namespace, sc: Scenario,
     base = sc.options
     n = sc.body.n_links
     fall = base.fall
-    if args.max_link_angle is not None or args.foot != "none" or args.centre_of_pressure:
+    fall_table = {"max_link_angle": args.max_link_angle,
+                  "base_of_support": None if args.foot == "none" else args.foot,
+                  "centre_of_pressure": args.centre_of_pressure or None}
+    fall_table = {k: v for k, v in fall_table.items() if v is not None}
+    if fall_table:
         with naming_option("--max-link-angle" if args.max_link_angle is not None
                            else "--foot"):
-            fall = FallCriteria(
-                args.max_link_angle if args.max_link_angle is not None
-                else fall.max_link_angle,
-                _foot(args.foot) if args.foot != "none" else fall.base_of_support,
-                args.centre_of_pressure or fall.centre_of_pressure)
+            fall = fall_from_table(fall_table, "", FLAG_NAMES, base=fall)
     feedback = {attribute: check_value(attribute, getattr(args, attribute),
                                        FLAG_NAMES[f"muscles.{attribute}"])
                 for attribute in ("feedback_delay", "proprioceptive_weight")
@@ -240,7 +239,7 @@ def run_options_from_args(args: argparse.Namespace, sc: Scenario,
         description = f"{description}, {tilt.describe()}"
     torque_limits = base.torque_limits
     if args.torque_limits:
-        torque_limits = tuple(parse_limit_list(args.torque_limits, "--torque-limits [N·m]", n))
+        torque_limits = torque_limits_from_table(args.torque_limits, n, "", FLAG_NAMES)
     with naming_option("--motor-noise"):
         motor_noise = motor_noise_from_args(args, n)
     if motor_noise is not None:
@@ -286,13 +285,6 @@ def motor_noise_from_args(args: argparse.Namespace, n_joints: int):
     table = {"standard_deviation": args.motor_noise, "cutoff": args.motor_noise_cutoff,
              "seed": args.seed or 0}
     return motor_noise_from_table(table, n_joints, "", FLAG_NAMES)
-
-
-def _foot(text: str) -> BaseOfSupport:
-    if text == "literature":
-        return FOOT_FROM_LITERATURE
-    heel, toe = parse_float_list(text, "--foot HEEL,TOE [m]", 2)
-    return BaseOfSupport(heel, toe, source="--foot")
 
 
 def _scenario_from_options(args: argparse.Namespace, command: str) -> Scenario:

@@ -14,8 +14,6 @@ Schema (every table optional except where noted; units in brackets)::
     [body]
     preset = "paper"                     # or: segments = [{name, mass, length,
                                          #                  com_distance, inertia}, ...]
-                                         # or: height = 1.8 [m] and mass = 82.0 [kg]
-                                         #   (Winter's table; one link with a controller)
     gravity = 9.81                       # [m/s²]
 
     [muscles]

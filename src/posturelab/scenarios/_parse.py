@@ -47,7 +47,8 @@ from ._scenario import Scenario
 
 __all__ = ["OPTION_KEYS", "parse_tables", "run_options", "body_from_table",
            "muscles_from_table", "tilt_from_table", "disturbance_from_tables",
-           "motor_noise_from_table", "number_list"]
+           "motor_noise_from_table", "fall_from_table", "torque_limits_from_table",
+           "number_list"]
 
 
 def _reject(d: dict, allowed, where: str, origin: str) -> None:
@@ -120,19 +121,11 @@ def parse_tables(data: dict, base_dir: Path, origin: str,
         initial = np.concatenate([posture, rates])
     kt = data.get("knee", {})
     knee = KneeModel(kt.get("mode", "free"), kt.get("stop_angle", 0.0))
-    ft = data.get("fall", {})
-    bos_spec = ft.get("base_of_support", "none")
-    bos = (None if bos_spec == "none" else FOOT_FROM_LITERATURE if bos_spec == "literature"
-           else BaseOfSupport(bos_spec["heel"], bos_spec["toe"], source=origin))
-    fall = FallCriteria(ft.get("max_link_angle", math.pi / 3), bos,
-                        bool(ft.get("centre_of_pressure", False)))
+    fall = fall_from_table(data.get("fall", {}), origin, names)
     torque_limits = None
     if "torque" in data.get("limits", {}):
-        values = [math.inf if v in ("inf", "none") else v for v in data["limits"]["torque"]]
-        torque_limits = tuple(finite_or_inf("limits.torque [N·m]", v) for v in values)
-        if len(torque_limits) != body.n_links:
-            raise _error(origin, f"limits.torque needs {body.n_links} values "
-                                 f"(one per joint), got {len(torque_limits)}")
+        torque_limits = torque_limits_from_table(data["limits"]["torque"], body.n_links,
+                                                 origin, names)
     st = data.get("solver", {})
     options = run_options(
         origin, duration=duration, initial_state=initial,
@@ -235,22 +228,61 @@ def tilt_from_table(tt: dict, base_dir: Path, origin: str = "",
         raise _error(origin, f"{where}: {exc}") from None
 
 
-def finite_or_inf(name: str, value) -> float:
-    """A number > 0, or +inf (no limit)."""
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise ScenarioError(f"{name} must be numbers or \"inf\", got {value!r}") from None
-    if math.isnan(v) or v <= 0:
-        raise ScenarioError(f"{name} must be > 0 (or \"inf\"), got {value!r}")
-    return v
+def fall_from_table(ft: dict, origin: str = "", names: Mapping[str, str] | None = None,
+                    base: FallCriteria | None = None) -> FallCriteria:
+    """The [fall] table: max_link_angle [rad], base_of_support ("none", "literature", a
+    table {heel, toe} [m] or its text "HEEL,TOE"), centre_of_pressure; a key not given keeps
+    ``base``'s (default: the paper's criteria)."""
+    base = FallCriteria() if base is None else base
+    spec = ft.get("base_of_support")
+    if spec is None:
+        bos = base.base_of_support
+    elif spec == "none":
+        bos = None
+    elif spec == "literature":
+        bos = FOOT_FROM_LITERATURE
+    else:
+        where = _name(names, "fall.base_of_support")
+        if isinstance(spec, str):
+            heel, toe = number_list(spec, f"{where} HEEL,TOE [m]", 2)
+            spec = {"heel": heel, "toe": toe}
+        bos = BaseOfSupport(spec["heel"], spec["toe"], source=origin or where)
+    return FallCriteria(ft.get("max_link_angle", base.max_link_angle), bos,
+                        bool(ft.get("centre_of_pressure", base.centre_of_pressure)))
+
+
+def torque_limits_from_table(values, n_joints: int, origin: str = "",
+                             names: Mapping[str, str] | None = None) -> tuple[float, ...]:
+    """limits.torque: one largest net moment per joint [N·m], each > 0, or "inf" / "none"
+    for no limit; a list, or its text ``"120,inf,80"``."""
+    where = f"{_name(names, 'limits.torque')} [N·m]"
+    if isinstance(values, str):
+        values = [v.strip().lower() for v in values.split(",")]
+    if len(values) != n_joints:
+        raise _error(origin, f"{where} needs {n_joints} values (one per joint), got "
+                     f"{len(values)}")
+    out = []
+    for value in values:
+        if value in ("inf", "none"):
+            out.append(math.inf)
+            continue
+        try:
+            v = float(value)
+        except (TypeError, ValueError):
+            raise _error(origin, f"{where} must be numbers or 'inf', got {value!r}") from None
+        if isinstance(value, bool) or not (math.isfinite(v) and v > 0):
+            raise _error(origin, f"{where} must each be in (0, inf] (a number > 0, or 'inf' "
+                         f"for no limit), got {value!r}")
+        out.append(v)
+    return tuple(out)
 
 
 def body_from_table(bt: dict, origin: str = "", names: Mapping[str, str] | None = None, *,
                     one_link: bool = False) -> Body:
-    """The [body] table: a preset, the segments, or a height [m] and mass [kg] (Winter's
-    anthropometric table); ``one_link`` (a one-link controller): by default the paper's body
-    as one link, and a body from height and mass lumped to one link."""
+    """The [body] table: a preset or the segments, or (from the command line's --height and
+    --mass, not a file's keys) a height [m] and mass [kg] (Winter's anthropometric table);
+    ``one_link`` (a one-link controller): by default the paper's body as one link, and a body
+    from height and mass lumped to one link."""
     def name(key: str) -> str:
         return _name(names, f"body.{key}")
 

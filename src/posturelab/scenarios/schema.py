@@ -39,14 +39,11 @@ class SegmentTable(_Table):
 
 
 class BodyTable(_Table):
-    """``[body]``: a preset, the segments (lowest first), or a height [m] and mass [kg]
-    (Winter's anthropometric table); gravity [m/s²]."""
+    """``[body]``: a preset or the segments, lowest first; gravity [m/s²]."""
 
     preset: str | None = None
     segments: list[SegmentTable] | None = None
     gravity: float | None = None
-    height: float | None = None
-    mass: float | None = None
 
 
 class PairTable(_Table):
