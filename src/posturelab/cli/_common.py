@@ -91,6 +91,23 @@ def add_muscle_arguments(p: argparse.ArgumentParser, *, require: bool = False,
                     "vertical).")
 
 
+def add_trial_arguments(p: argparse.ArgumentParser, *,
+                        input_help: str = "what a trial's stimulus is: tilt [rad] (default) "
+                        "or translation [m].") -> None:
+    """How a trial CSV among the inputs is estimated (``fit-frf``, ``cohort``, ``likeness``
+    and this command share them)."""
+    p.add_argument("--stimulus", metavar="COLUMN", help="stimulus column of a trial CSV.")
+    p.add_argument("--response", metavar="COLUMN", help="response column of a trial CSV.")
+    p.add_argument("--cycle-length", type=float, metavar="SECONDS", help="of a trial CSV [s].")
+    p.add_argument("--discard-cycles", type=int, default=0, metavar="N",
+                   help="leading cycles of a trial CSV to drop (the transient; default 0).")
+    p.add_argument("--response-sign", choices=["-1", "+1", "1"], default="-1",
+                   help="multiply a trial's response by this (default -1: posturelab's tilt "
+                   "convention, as posturelab frf).")
+    p.add_argument("--input", choices=["tilt", "translation"], default="tilt",
+                   help=input_help)
+
+
 #: The scenario-file key each model flag sets: the command line states its body, muscles and
 #: feedback as a scenario file's [body] and [muscles] tables, which the scenario parser
 #: (:func:`posturelab.scenarios._parse.parse_tables`) builds, as it builds a file's.

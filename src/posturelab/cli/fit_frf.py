@@ -8,6 +8,7 @@ from ..errors import ParameterError
 from ..parameters import MAX_FEEDBACK_DELAY
 from ._common import (
     add_muscle_arguments,
+    add_trial_arguments,
     model_from_args,
     print_json,
 )
@@ -95,8 +96,6 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 def add_fit_arguments(p: argparse.ArgumentParser, *, per_condition: bool) -> None:
     """How a trial CSV is read and what is fitted (``fit-frf`` and ``cohort`` share them)."""
-    from .compare_frf import add_trial_arguments
-
     add_trial_arguments(p, input_help="what the stimulus is: tilt [rad] (default) or "
                         "platform translation [m].")
     p.add_argument("--output", default="com_angle", metavar="NAME",
