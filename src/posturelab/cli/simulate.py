@@ -19,7 +19,6 @@ from ..scenarios import (
     builtin_scenario_names,
     load_scenario,
 )
-from ..scenarios._parse import fall_from_table, torque_limits_from_table
 from ..simulation.options import RunOptions
 from . import UsageError
 from ._common import (
@@ -213,6 +212,8 @@ def run_options_from_args(args: argparse.Namespace, sc: Scenario,
     """The scenario's run options with those the command line gives: each option's flag read
     here once, then checked by :class:`~posturelab.simulation.options.RunOptions` (a bad
     value names the flag)."""
+    from ..scenarios._parse import fall_from_table, torque_limits_from_table
+
     base = sc.options
     n = sc.body.n_links
     fall = base.fall
