@@ -10,7 +10,6 @@ from typing import TypeVar
 from ..errors import DataFileError, ParameterError
 from ..model.options import KneeModel
 from ..model.platform import MAX_PLATFORM_SPEED, VelocityStep
-from ..paper.printed import BACKWARD_INITIAL_STATE
 from ..parameters import RUN_SETTINGS, check_value
 from ..scenarios import (
     SCENARIO_DEFAULTS,
@@ -295,6 +294,8 @@ def _scenario_from_options(args: argparse.Namespace, command: str) -> Scenario:
     if args.case is None and args.stiffness is None and args.controller is None:
         raise UsageError(f"{command}: give --case, --stiffness or --controller (or "
                          "--scenario / --builtin)")
+    from ..paper.printed import BACKWARD_INITIAL_STATE
+
     tables = experiment_tables(args, command)
     try:
         sc = model_from_args(args, tables)
