@@ -25,41 +25,11 @@ GASTROCNEMIUS_CHOICES = ("two-sided", "one-sided", "pull-only")
 
 
 def parse_float_list(text: str, field: str, n: int | None = None) -> list[float]:
-    """Parse ``"a,b,c"`` into floats, checking count and finiteness; errors name ``field``."""
-    parts = [p.strip() for p in str(text).split(",")]
-    try:
-        values = [float(p) for p in parts]
-    except ValueError:
-        raise ParameterError(
-            f"{field} must be comma-separated numbers, got {text!r}"
-        ) from None
-    if n is not None and len(values) != n:
-        raise ParameterError(f"{field} must have {n} comma-separated values, got {len(values)}")
-    for v in values:
-        if not math.isfinite(v):
-            raise ParameterError(f"{field} must contain finite numbers, got {v}")
-    return values
+    """Parse ``"a,b,c"`` into floats, checking count and finiteness; errors name ``field``
+    (:func:`posturelab.scenarios._parse.number_list`, which reads a list given as text)."""
+    from ..scenarios._parse import number_list
 
-
-def parse_limit_list(text: str, field: str, n: int) -> list[float]:
-    """Parse ``"120,inf,80"``: n positive numbers, ``inf``/``none`` meaning no limit."""
-    parts = [p.strip().lower() for p in str(text).split(",")]
-    if len(parts) != n:
-        raise ParameterError(f"{field} must have {n} comma-separated values, got {len(parts)}")
-    out = []
-    for p in parts:
-        if p in ("inf", "none"):
-            out.append(math.inf)
-            continue
-        try:
-            v = float(p)
-        except ValueError:
-            raise ParameterError(f"{field} must be numbers or 'inf', got {p!r}") from None
-        if not (math.isfinite(v) and v > 0):
-            raise ParameterError(f"{field} must each be in (0, inf] (a number > 0, or 'inf' "
-                                 f"for no limit), got {p!r}")
-        out.append(v)
-    return out
+    return number_list(str(text), field, n)
 
 
 def add_muscle_arguments(p: argparse.ArgumentParser, *, require: bool = False,
@@ -121,141 +91,134 @@ def add_muscle_arguments(p: argparse.ArgumentParser, *, require: bool = False,
                     "vertical).")
 
 
-def _naming_model_options(function):
-    """Decorate ``function(args, ...)`` so that a bad body or gain it builds is named by the
-    option the user typed (:data:`MODEL_FIELD_OPTIONS`)."""
-    import functools
+def add_trial_arguments(p: argparse.ArgumentParser, *,
+                        input_help: str = "what a trial's stimulus is: tilt [rad] (default) "
+                        "or translation [m].") -> None:
+    """How a trial CSV among the inputs is estimated (``fit-frf``, ``cohort``, ``likeness``
+    and this command share them)."""
+    p.add_argument("--stimulus", metavar="COLUMN", help="stimulus column of a trial CSV.")
+    p.add_argument("--response", metavar="COLUMN", help="response column of a trial CSV.")
+    p.add_argument("--cycle-length", type=float, metavar="SECONDS", help="of a trial CSV [s].")
+    p.add_argument("--discard-cycles", type=int, default=0, metavar="N",
+                   help="leading cycles of a trial CSV to drop (the transient; default 0).")
+    p.add_argument("--response-sign", choices=["-1", "+1", "1"], default="-1",
+                   help="multiply a trial's response by this (default -1: posturelab's tilt "
+                   "convention, as posturelab frf).")
+    p.add_argument("--input", choices=["tilt", "translation"], default="tilt",
+                   help=input_help)
 
-    @functools.wraps(function)
-    def wrapper(args, *rest, **options):
-        with naming_given_options(args, MODEL_FIELD_OPTIONS):
-            return function(args, *rest, **options)
 
-    return wrapper
+#: The scenario-file key each model flag sets: the command line states its body, muscles and
+#: feedback as a scenario file's [body] and [muscles] tables, which the scenario parser
+#: (:func:`posturelab.scenarios._parse.parse_tables`) builds, as it builds a file's.
+MODEL_FLAGS: dict[str, str] = {
+    "body": "body.preset", "height": "body.height", "mass": "body.mass",
+    "case": "muscles.case", "stiffness": "muscles.stiffness",
+    "controller": "muscles.controller", "viscosity": "muscles.viscosity",
+    "viscosity_ratio": "muscles.viscosity_ratio", "gastrocnemius": "muscles.gastrocnemius",
+    "active_stiffness": "muscles.active_stiffness",
+    "active_viscosity": "muscles.active_viscosity",
+    "active_viscosity_ratio": "muscles.active_viscosity_ratio",
+    "feedback_delay": "muscles.feedback_delay",
+    "proprioceptive_weight": "muscles.proprioceptive_weight",
+    "torque_feedback_gain": "muscles.torque_feedback_gain",
+    "torque_feedback_time_constant": "muscles.torque_feedback_time_constant",
+}
+#: The experiment flags read into a scenario table by ``simulate`` and the commands that
+#: share its options (their values are parsed first: a --tilt spec, a noise list).
+EXPERIMENT_FLAGS: dict[str, str] = {
+    "tilt": "tilt", "tilt_axis_depth": "tilt.axis_depth",
+    "initial_posture": "initial.posture", "initial_rates": "initial.rates",
+    "motor_noise": "motor_noise.standard_deviation",
+    "motor_noise_cutoff": "motor_noise.cutoff", "seed": "motor_noise.seed",
+    "speed": "disturbance.speed", "platform_profile": "disturbance.file",
+    "foot": "fall.base_of_support", "max_link_angle": "fall.max_link_angle",
+    "torque_limits": "limits.torque",
+}
 
 
-@_naming_model_options
+def flag(attribute: str) -> str:
+    """The flag of an ``args`` attribute: ``feedback_delay`` → ``--feedback-delay``."""
+    return "--" + attribute.replace("_", "-")
+
+
+#: How a message names a scenario key the command line set: its flag.
+FLAG_NAMES: dict[str, str] = {key: flag(attribute) for attribute, key in
+                              (MODEL_FLAGS | EXPERIMENT_FLAGS).items()}
+
+
+def model_tables(args: argparse.Namespace) -> dict[str, dict]:
+    """The [body] and [muscles] tables of the model flags given (:data:`MODEL_FLAGS`)."""
+    tables: dict[str, dict] = {"body": {}, "muscles": {}}
+    for attribute, key in MODEL_FLAGS.items():
+        value = getattr(args, attribute, None)
+        if value is None or (attribute == "gastrocnemius" and value == "two-sided"):
+            continue
+        section, field = key.split(".")
+        tables[section][field] = value
+    return tables
+
+
+def model_from_args(args: argparse.Namespace, tables: dict | None = None):
+    """The :class:`~posturelab.Scenario` of the model flags (body, muscles, feedback delay
+    and proprioceptive weight in its options) and of ``tables`` (a scenario file's other
+    tables), built by the scenario parser; a bad value names the flag the user typed."""
+    from pathlib import Path
+
+    from ..scenarios import SCENARIO_DEFAULTS
+    from ..scenarios._parse import parse_tables
+
+    data = {"duration": SCENARIO_DEFAULTS.duration, **model_tables(args), **(tables or {})}
+    with naming_given_options(args, MODEL_FIELD_OPTIONS):
+        scenario = parse_tables(data, Path("."), "", FLAG_NAMES)
+    _note_one_link(args, scenario.body)
+    return scenario
+
+
+def _note_one_link(args: argparse.Namespace, body) -> None:
+    """Say that a one-link controller lumps a body from height and mass to one link."""
+    if getattr(args, "controller", None) is not None and getattr(args, "height", None):
+        print(f"posturelab: note: --controller {args.controller} is a one-link controller: "
+              f"the body is {body.name}", file=sys.stderr)
+
+
 def body_from_args(args: argparse.Namespace):
-    """The body of --body / --height --mass (the paper's by default)."""
-    from ..model.anthropometry import body_from_anthropometry
-    from ..model.body import get_body, paper_body
+    """The body of --body / --height --mass (the paper's by default; with --controller, a
+    one-link body), built by the scenario parser from the [body] table of the flags."""
+    from ..scenarios._parse import body_from_table
 
-    given = [getattr(args, "height", None), getattr(args, "mass", None)]
-    if any(v is not None for v in given):
-        if None in given:
-            raise ParameterError("--height [m] and --mass [kg] go together")
-        if args.body is not None:
-            raise ParameterError("give --body or --height/--mass, not both")
-        height = parse_float_list(args.height, "--height [m]", 1)[0]
-        mass = parse_float_list(args.mass, "--mass [kg]", 1)[0]
-        body = body_from_anthropometry(height, mass)
-        if getattr(args, "controller", None) is not None:
-            from ..model.anthropometry import one_link
-
-            body = one_link(body)
-            print(f"posturelab: note: --controller {args.controller} is a one-link controller: "
-                  f"the body is {body.name}", file=sys.stderr)
-        return body
-    if getattr(args, "body", None) is not None:
-        return get_body(args.body)
-    if getattr(args, "controller", None) is not None:
-        return get_body("paper-1link")
-    return paper_body()
+    with naming_given_options(args, MODEL_FIELD_OPTIONS):
+        body = body_from_table(model_tables(args)["body"], "", FLAG_NAMES,
+                               one_link=getattr(args, "controller", None) is not None)
+    _note_one_link(args, body)
+    return body
 
 
-def _pairs(body) -> int:
-    from ..model.muscles import joint_pair_names
-
-    return 5 if body.n_links == 3 else len(joint_pair_names(body.n_links))
-
-
-@_naming_model_options
 def muscles_from_args(args: argparse.Namespace, body=None):
-    """The MuscleSet of --case / --stiffness / --controller and the gain options."""
-    from ..model.controllers import get_controller
-    from ..model.muscles import muscles_for, paper_muscles
+    """The MuscleSet of --case / --stiffness / --controller and the gain options on ``body``
+    (default :func:`body_from_args`), built by the scenario parser from the [muscles] table
+    of the flags."""
+    return muscles_and_delay_from_args(args, body)[0]
+
+
+def muscles_and_delay_from_args(args: argparse.Namespace, body=None):
+    """(:func:`muscles_from_args`, the feedback delay [s]: --feedback-delay, a
+    --controller's, or 0)."""
+    from ..scenarios._parse import muscles_from_table
 
     body = body_from_args(args) if body is None else body
-    if getattr(args, "controller", None) is not None:
-        clash = [f for f in ("viscosity", "viscosity_ratio", "active_stiffness",
-                             "active_viscosity", "active_viscosity_ratio")
-                 if getattr(args, f, None) is not None]
-        if clash:
-            raise ParameterError(f"--controller sets every gain; it cannot be combined with "
-                                 f"--{clash[0].replace('_', '-')}")
-        controller = get_controller(args.controller)
-        if body.n_links != 1:
-            raise ParameterError(
-                f"--controller {controller.name} is a one-link controller (an inverted pendulum "
-                f"about the ankle); --body {args.body} has {body.n_links} links: give a one-link "
-                "--body (paper-1link), --height/--mass (lumped to one link), or no body")
-        return controller.muscles(body)
-    if args.case is None and args.stiffness is None:
-        raise ParameterError("give --case (Table I), --stiffness LIST or --controller NAME")
-    if args.viscosity is not None and args.viscosity_ratio is not None:
-        raise ParameterError("give --viscosity or --viscosity-ratio, not both")
-    if args.active_viscosity is not None and args.active_viscosity_ratio is not None:
-        raise ParameterError("give --active-viscosity or --active-viscosity-ratio, not both")
-    P = _pairs(body)
-    ratio = 0.25 if args.viscosity_ratio is None else args.viscosity_ratio
-    if not (math.isfinite(ratio) and ratio >= 0):
-        raise ParameterError(f"--viscosity-ratio [s] must be a finite number >= 0, got {ratio:g}")
-    lists = {}
-    for flag in ("viscosity", "active_stiffness", "active_viscosity"):
-        text = getattr(args, flag, None)
-        unit = "[N·m/rad]" if flag == "active_stiffness" else "[N·m·s/rad]"
-        lists[flag] = (None if text is None
-                       else parse_float_list(text, f"--{flag.replace('_', '-')} {unit}", P))
-    active_ratio = args.active_viscosity_ratio
-    if active_ratio is not None and not (math.isfinite(active_ratio) and active_ratio >= 0):
-        raise ParameterError(f"--active-viscosity-ratio [s] must be a finite number >= 0, "
-                             f"got {active_ratio:g}")
-    if args.case is not None:
-        if body.n_links != 3:
-            raise ParameterError(f"--case is a Table I set for the three-link body; this body "
-                                 f"has {body.n_links} links: give --stiffness ({P} values)")
-        return paper_muscles(args.case, viscosity_ratio=ratio, viscosity=lists["viscosity"],
-                             gastrocnemius=args.gastrocnemius,
-                             active_stiffness=lists["active_stiffness"],
-                             active_viscosity=lists["active_viscosity"],
-                             active_viscosity_ratio=active_ratio)
-    stiffness = parse_float_list(args.stiffness, "--stiffness [N·m/rad]", P)
-    return muscles_for(body.n_links, stiffness, lists["viscosity"], viscosity_ratio=ratio,
-                       active_stiffness=lists["active_stiffness"],
-                       active_viscosity=lists["active_viscosity"],
-                       active_viscosity_ratio=active_ratio, gastrocnemius=args.gastrocnemius)
+    tables = model_tables(args)
+    with naming_given_options(args, MODEL_FIELD_OPTIONS):
+        muscles, _, delay, _ = muscles_from_table(tables["muscles"], body, "", FLAG_NAMES,
+                                                  tables["body"])
+    return muscles, delay
 
 
-def feedback_from_args(args: argparse.Namespace) -> tuple[float | None, float | None]:
-    """(feedback_delay [s], proprioceptive_weight [-]) given on the command line (or by
-    --controller), each checked against the parameter table and named by its flag; None
-    where not given."""
-    from ..model.controllers import get_controller
-    from ..parameters import check_value
-
-    delay: float | None = None
-    weight: float | None = None
-    if getattr(args, "controller", None) is not None:
-        controller = get_controller(args.controller)
-        delay, weight = controller.feedback_delay, controller.proprioceptive_weight
-    if getattr(args, "feedback_delay", None) is not None:
-        delay = check_value("feedback_delay", args.feedback_delay, "--feedback-delay")
-    if getattr(args, "proprioceptive_weight", None) is not None:
-        weight = check_value("proprioceptive_weight", args.proprioceptive_weight,
-                             "--proprioceptive-weight")
-    return delay, weight
-
-
-def feedback_options_from_args(args: argparse.Namespace) -> dict:
-    """:func:`feedback_from_args` as keywords: ``feedback_delay`` [s] and
-    ``proprioceptive_weight`` [-], each absent when not given."""
-    delay, weight = feedback_from_args(args)
-    out = {}
-    if delay is not None:
-        out["feedback_delay"] = delay
-    if weight is not None:
-        out["proprioceptive_weight"] = weight
-    return out
+def feedback_given(args: argparse.Namespace) -> bool:
+    """Whether the command line gives a feedback delay (--feedback-delay, or a
+    --controller's)."""
+    return (getattr(args, "feedback_delay", None) is not None
+            or getattr(args, "controller", None) is not None)
 
 
 def add_torque_feedback_arguments(p: argparse.ArgumentParser) -> None:
@@ -288,39 +251,48 @@ def torque_feedback_options_from_args(args: argparse.Namespace) -> dict:
     return out
 
 
-def parse_tilt(text: str):
-    """``--tilt``: ``sine:AMPLITUDE_RAD:FREQUENCY_HZ[:PHASE_RAD]``,
+def tilt_table(text: str) -> dict:
+    """``--tilt`` as a scenario file's [tilt] table:
+    ``sine:AMPLITUDE_RAD:FREQUENCY_HZ[:PHASE_RAD]``,
     ``raised-cosine:AMPLITUDE_RAD:DURATION_S[:START_S]`` or
     ``prts:AMPLITUDE_RAD[:STATE_DURATION_S][:SEQUENCE]`` (peak to peak; SEQUENCE one of
     :data:`posturelab.model.tilt.PRTS_SEQUENCES`, posturelab-80 by default)."""
-    from ..model.tilt import DEFAULT_PRTS, PRTSTilt, RaisedCosineTilt, SineTilt, get_prts_sequence
+    from ..model.tilt import DEFAULT_PRTS, get_prts_sequence
 
     forms = ("sine:AMPLITUDE_RAD:FREQUENCY_HZ[:PHASE_RAD], "
              "raised-cosine:AMPLITUDE_RAD:DURATION_S[:START_S] or "
              "prts:AMPLITUDE_RAD[:STATE_DURATION_S][:SEQUENCE]")
     kind, _, rest = str(text).partition(":")
     kind = kind.strip().lower()
-    counts = {"sine": (2, 3), "raised-cosine": (2, 3), "prts": (1, 2)}
-    if kind not in counts or not rest:
+    fields = {"sine": ("amplitude", "frequency", "phase"),
+              "raised-cosine": ("amplitude", "duration", "start"),
+              "prts": ("amplitude", "state_duration")}
+    if kind not in fields or not rest:
         raise ParameterError(f"--tilt must be {forms}, got {text!r}")
-    sequence = None
+    sequence = DEFAULT_PRTS
     if kind == "prts":
         head, _, last = rest.rpartition(":")
         if head and last.strip() and not last.strip()[0].isdigit() \
                 and last.strip()[0] not in "+-.":
-            sequence = get_prts_sequence(last)  # an unknown name lists the known ones
+            get_prts_sequence(last)  # an unknown name lists the known ones
+            sequence = last.strip().lower()
             rest = head
     values = parse_float_list(rest.replace(":", ","), f"--tilt {kind}", None)
-    lo, hi = counts[kind]
-    if not lo <= len(values) <= hi:
+    if not 2 - (kind == "prts") <= len(values) <= len(fields[kind]):
         raise ParameterError(f"--tilt must be {forms}, got {text!r}")
-    if kind == "sine":
-        return SineTilt(*values)
-    if kind == "raised-cosine":
-        return RaisedCosineTilt(*values)
-    sequence = sequence or get_prts_sequence(DEFAULT_PRTS)
-    state = values[1] if len(values) == 2 else sequence.state_duration
-    return PRTSTilt(values[0], state, sequence.registers, sequence.taps, sequence.seed)
+    table = {"type": kind, **dict(zip(fields[kind], values, strict=False))}
+    if kind == "prts":
+        table["sequence"] = sequence
+    return table
+
+
+def parse_tilt(text: str):
+    """The Tilt of ``--tilt`` (:func:`tilt_table`), built by the scenario parser."""
+    from pathlib import Path
+
+    from ..scenarios._parse import tilt_from_table
+
+    return tilt_from_table(tilt_table(text), Path("."), "", FLAG_NAMES)
 
 
 @contextlib.contextmanager

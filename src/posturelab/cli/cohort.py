@@ -8,9 +8,7 @@ import argparse
 from ..errors import ParameterError
 from ._common import (
     add_muscle_arguments,
-    body_from_args,
-    feedback_options_from_args,
-    muscles_from_args,
+    model_from_args,
     print_json,
 )
 from .fit_frf import _bounds, _names, add_fit_arguments, reader_options
@@ -82,9 +80,8 @@ def run(args: argparse.Namespace) -> int:
     if args.workers is not None and not 1 <= args.workers <= limit:
         raise ParameterError(f"--workers must be an integer in 1 … {limit} (4 × the CPUs), "
                              f"got {args.workers}")
-    body = body_from_args(args)
-    muscles = muscles_from_args(args, body)
-    options = feedback_options_from_args(args)
+    model = model_from_args(args)
+    body, muscles, options = model.body, model.muscles, model.options
     free = _names(args.free)
     check_fit_request(muscles, free, (), _bounds(args.bounds))  # before any file is read
     bar = (Progress(len(args.data), label="cohort", unit="subjects")
@@ -93,8 +90,8 @@ def run(args: argparse.Namespace) -> int:
         cohort = fit_cohort(body, muscles, args.data, free, workers=args.workers,
                             progress=bar, reader=reader_options(args), input=args.input,
                             output=args.output.strip().lower(),
-                            feedback_delay=options.get("feedback_delay", 0.0),
-                            proprioceptive_weight=options.get("proprioceptive_weight", 1.0),
+                            feedback_delay=options.feedback_delay,
+                            proprioceptive_weight=options.proprioceptive_weight,
                             bounds=_bounds(args.bounds))
     finally:
         if bar is not None:

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import argparse
 
+from ._common import add_trial_arguments  # (likeness and likeness-reference import it here)
+
 DESCRIPTION = """\
 Compare two groups of FRFs (patients and controls, eyes open and closed, two amplitudes):
 each --a and --b FILE is one subject's FRF, a trial CSV (then --stimulus, --response,
@@ -49,20 +51,6 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="coverage of the per-band intervals (default 0.95).")
     add_trial_arguments(p)
     p.add_argument("--json", action="store_true", help="print one JSON object.")
-
-
-def add_trial_arguments(p: argparse.ArgumentParser) -> None:
-    """How a trial CSV among the inputs is estimated (as ``posturelab fit-frf``)."""
-    p.add_argument("--stimulus", metavar="COLUMN", help="stimulus column of a trial CSV.")
-    p.add_argument("--response", metavar="COLUMN", help="response column of a trial CSV.")
-    p.add_argument("--cycle-length", type=float, metavar="SECONDS", help="of a trial CSV [s].")
-    p.add_argument("--discard-cycles", type=int, default=0, metavar="N",
-                   help="leading cycles of a trial CSV to drop (default 0).")
-    p.add_argument("--response-sign", choices=["-1", "+1", "1"], default="-1",
-                   help="multiply a trial's response by this (default -1: posturelab's tilt "
-                   "convention, as posturelab frf).")
-    p.add_argument("--input", choices=["tilt", "translation"], default="tilt",
-                   help="what a trial's stimulus is: tilt [rad] (default) or translation [m].")
 
 
 def read_frfs(paths: list[str], args: argparse.Namespace) -> list:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import math
 
-from ._common import add_muscle_arguments, body_from_args, muscles_from_args, print_json
+from ._common import add_muscle_arguments, feedback_given, model_from_args, print_json
 
 DESCRIPTION = """\
 The delay margin of the chain linearised about upright: the smallest feedback delay τ at
@@ -47,11 +47,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     from ..linear.delay import delay_margin
     from ..linear.verdict import upright_verdict
-    from ._common import feedback_options_from_args
 
-    body = body_from_args(args)
-    muscles = muscles_from_args(args, body)
-    delay = feedback_options_from_args(args).get("feedback_delay")
+    model = model_from_args(args)
+    body, muscles = model.body, model.muscles
+    delay = model.options.feedback_delay if feedback_given(args) else None
     result = delay_margin(body, muscles)
     unstable = _unstable_sides(body, muscles) if muscles.one_sided_mask.any() else []
     if args.json:

@@ -7,9 +7,7 @@ import argparse
 from ..errors import ParameterError
 from ._common import (
     add_muscle_arguments,
-    body_from_args,
-    feedback_options_from_args,
-    muscles_from_args,
+    model_from_args,
     parse_float_list,
     print_json,
 )
@@ -132,9 +130,8 @@ def run(args: argparse.Namespace) -> int:
     from ._common import naming_option, parse_tilt
     from .simulate import motor_noise_from_args
 
-    body = body_from_args(args)
-    muscles = muscles_from_args(args, body)
-    options = feedback_options_from_args(args)
+    model = model_from_args(args)
+    body, muscles, options = model.body, model.muscles, model.options
     with naming_option("--tilt"):
         tilt = parse_tilt(args.tilt)
     with naming_option("--motor-noise"):
@@ -143,8 +140,8 @@ def run(args: argparse.Namespace) -> int:
     _check_numbers(args)
     common = dict(discard=args.discard, sensor_noise=args.sensor_noise, motor_noise=noise,
                   sample_rate=args.sample_rate, output=args.output.strip().lower(),
-                  feedback_delay=options.get("feedback_delay", 0.0),
-                  proprioceptive_weight=options.get("proprioceptive_weight", 1.0))
+                  feedback_delay=options.feedback_delay,
+                  proprioceptive_weight=options.proprioceptive_weight)
     if args.optimise:
         if args.budget is None:
             raise ParameterError("--optimise needs --budget SECONDS")

@@ -9,11 +9,9 @@ from ..parameters import MAX_FEEDBACK_DELAY
 from ._common import (
     add_muscle_arguments,
     add_torque_feedback_arguments,
-    body_from_args,
-    feedback_options_from_args,
-    muscles_from_args,
+    add_trial_arguments,
+    model_from_args,
     print_json,
-    torque_feedback_options_from_args,
 )
 
 DESCRIPTION = f"""\
@@ -102,17 +100,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 def add_fit_arguments(p: argparse.ArgumentParser, *, per_condition: bool) -> None:
     """How a trial CSV is read and what is fitted (``fit-frf`` and ``cohort`` share them)."""
-    p.add_argument("--stimulus", metavar="COLUMN", help="stimulus column of a trial CSV.")
-    p.add_argument("--response", metavar="COLUMN", help="response column of a trial CSV.")
-    p.add_argument("--cycle-length", type=float, metavar="SECONDS", help="of a trial CSV [s].")
-    p.add_argument("--discard-cycles", type=int, default=0, metavar="N",
-                   help="leading cycles of a trial CSV to drop (the transient; default 0).")
-    p.add_argument("--response-sign", choices=["-1", "+1", "1"], default="-1",
-                   help="multiply a trial's response by this (default -1: posturelab's tilt "
-                   "convention, as posturelab frf).")
-    p.add_argument("--input", choices=["tilt", "translation"], default="tilt",
-                   help="what the stimulus is: tilt [rad] (default) or platform "
-                   "translation [m].")
+    add_trial_arguments(p, input_help="what the stimulus is: tilt [rad] (default) or "
+                        "platform translation [m].")
     p.add_argument("--output", default="com_angle", metavar="NAME",
                    help="the model output the response is (default com_angle).")
     p.add_argument("--free", required=True, metavar="NAMES",
@@ -178,9 +167,8 @@ def run(args: argparse.Namespace) -> int:
                                                    "--compare-plot": args.compare_plot})
     check_plot_path(args.plot)
     compare = _compare_request(args)
-    body = body_from_args(args)
-    muscles = muscles_from_args(args, body)
-    options = feedback_options_from_args(args)
+    model = model_from_args(args)
+    body, muscles, options = model.body, model.muscles, model.options
     free, per = _names(args.free), _names(args.per_condition)
     checked = check_fit_request(muscles, free, per, None)  # the names first, before any data
     if compare is not None:
@@ -191,10 +179,11 @@ def run(args: argparse.Namespace) -> int:
         check_fit_request(muscles, free, per, _bounds(args.bounds))
     conditions = [_condition(path, args) for path in args.data]
     fit_options = dict(input=args.input, output=args.output.strip().lower(),
-                       feedback_delay=options.get("feedback_delay", 0.0),
-                       proprioceptive_weight=options.get("proprioceptive_weight", 1.0),
-                       bounds=_bounds(args.bounds),
-                       **torque_feedback_options_from_args(args))
+                       feedback_delay=options.feedback_delay,
+                       proprioceptive_weight=options.proprioceptive_weight,
+                       torque_feedback_gain=options.torque_feedback_gain,
+                       torque_feedback_time_constant=options.torque_feedback_time_constant,
+                       bounds=_bounds(args.bounds))
     comparison = None
     if compare is not None:
         from pathlib import Path

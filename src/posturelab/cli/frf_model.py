@@ -8,12 +8,9 @@ from ..errors import ParameterError
 from ._common import (
     add_muscle_arguments,
     add_torque_feedback_arguments,
-    body_from_args,
-    feedback_options_from_args,
-    muscles_from_args,
+    model_from_args,
     parse_float_list,
     print_json,
-    torque_feedback_options_from_args,
 )
 from .frf import BAND_CHOICES
 
@@ -69,10 +66,10 @@ def run(args: argparse.Namespace) -> int:
     from ..frequency.bands import PETERKA_BAND_HARMONICS, SEQUENCE_BANDS, band_frequencies
     from ..frequency.model import model_frf
 
-    body = body_from_args(args)
-    muscles = muscles_from_args(args, body)
-    options = feedback_options_from_args(args)
-    torque_feedback = torque_feedback_options_from_args(args)
+    model = model_from_args(args)
+    body, muscles, options = model.body, model.muscles, model.options
+    torque_feedback = dict(torque_feedback_gain=options.torque_feedback_gain,
+                           torque_feedback_time_constant=options.torque_feedback_time_constant)
     if args.frequencies is not None:
         f = np.array(parse_float_list(args.frequencies, "--frequencies [Hz]"))
         if np.any(f <= 0) or np.any(f > 1e4) or f.size > 100_000:
@@ -86,16 +83,14 @@ def run(args: argparse.Namespace) -> int:
         f = band_frequencies(bands, cycle)
     from ..linear.verdict import upright_verdict
 
-    delay = options.get("feedback_delay", 0.0)
-    verdict = upright_verdict(body, muscles, delay, **torque_feedback)
+    verdict = upright_verdict(body, muscles, options.feedback_delay, **torque_feedback)
     if not verdict.side(engaged=True).status == "stable":
         raise ParameterError(f"the loop is {verdict.describe()}: its FRF is not measurable "
                              "(a periodic-stimulus experiment would fall); change the gains, "
                              "--feedback-delay or the torque feedback")
     H = model_frf(body, muscles, f, input=args.input, output=args.output.strip().lower(),
-                  feedback_delay=delay,
-                  proprioceptive_weight=options.get("proprioceptive_weight", 1.0),
-                  **torque_feedback)
+                  feedback_delay=options.feedback_delay,
+                  proprioceptive_weight=options.proprioceptive_weight, **torque_feedback)
     phase = np.degrees(np.unwrap(np.angle(H)))
     sign = ("−y/α (the literature's tilt sign: a body that follows the surface reads gain 1, "
             "phase 0)" if args.input == "tilt" else "y/x (as the output is, per metre)")

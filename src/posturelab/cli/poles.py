@@ -6,9 +6,8 @@ import argparse
 
 from ._common import (
     add_muscle_arguments,
-    body_from_args,
-    feedback_options_from_args,
-    muscles_from_args,
+    feedback_given,
+    model_from_args,
     print_json,
 )
 
@@ -67,11 +66,11 @@ def run(args: argparse.Namespace) -> int:
     from ..linear.analysis import analyse_both_sides
     from ..linear.verdict import upright_verdict
 
-    body = body_from_args(args)
-    muscles = muscles_from_args(args, body)
+    model = model_from_args(args)
+    body, muscles = model.body, model.muscles
     active, inactive = analyse_both_sides(body, muscles)
     one_sided = muscles.one_sided_mask.any()
-    delay = feedback_options_from_args(args).get("feedback_delay")
+    delay = model.options.feedback_delay if feedback_given(args) else None
     verdict = upright_verdict(body, muscles, delay or 0.0)
     if args.json:
         out = {

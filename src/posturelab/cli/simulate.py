@@ -7,11 +7,10 @@ import math
 import sys
 from typing import TypeVar
 
-from ..errors import ParameterError
-from ..model.options import FOOT_FROM_LITERATURE, BaseOfSupport, FallCriteria, KneeModel
-from ..model.platform import MAX_PLATFORM_SPEED, NoDisturbance, VelocityStep, read_profile_csv
-from ..paper.printed import BACKWARD_INITIAL_STATE
-from ..parameters import RUN_SETTINGS
+from ..errors import DataFileError, ParameterError
+from ..model.options import KneeModel
+from ..model.platform import MAX_PLATFORM_SPEED, VelocityStep
+from ..parameters import RUN_SETTINGS, check_value
 from ..scenarios import (
     SCENARIO_DEFAULTS,
     Scenario,
@@ -23,19 +22,15 @@ from ..simulation.options import RunOptions
 from . import UsageError
 from ._common import (
     FIGURE_SUFFIXES,
+    FLAG_NAMES,
     add_muscle_arguments,
     add_torque_feedback_arguments,
-    body_from_args,
     check_writable,
-    feedback_from_args,
-    muscles_from_args,
+    model_from_args,
     naming_given_options,
     naming_option,
-    parse_float_list,
-    parse_limit_list,
     parse_tilt,
     print_json,
-    torque_feedback_options_from_args,
 )
 
 DESCRIPTION = """\
@@ -218,19 +213,24 @@ def run_options_from_args(args: argparse.Namespace, sc: Scenario,
     """The scenario's run options with those the command line gives: each option's flag read
     here once, then checked by :class:`~posturelab.simulation.options.RunOptions` (a bad
     value names the flag)."""
+    from ..scenarios._parse import fall_from_table, torque_limits_from_table
+
     base = sc.options
     n = sc.body.n_links
     fall = base.fall
-    if args.max_link_angle is not None or args.foot != "none" or args.centre_of_pressure:
+    fall_table = {"max_link_angle": args.max_link_angle,
+                  "base_of_support": None if args.foot == "none" else args.foot,
+                  "centre_of_pressure": args.centre_of_pressure or None}
+    fall_table = {k: v for k, v in fall_table.items() if v is not None}
+    if fall_table:
         with naming_option("--max-link-angle" if args.max_link_angle is not None
                            else "--foot"):
-            fall = FallCriteria(
-                args.max_link_angle if args.max_link_angle is not None
-                else fall.max_link_angle,
-                _foot(args.foot) if args.foot != "none" else fall.base_of_support,
-                args.centre_of_pressure or fall.centre_of_pressure)
-    feedback_delay, proprioceptive_weight = feedback_from_args(args)
-    torque_feedback = torque_feedback_options_from_args(args)
+            fall = fall_from_table(fall_table, "", FLAG_NAMES, base=fall)
+    feedback = {attribute: check_value(attribute, getattr(args, attribute),
+                                       FLAG_NAMES[f"muscles.{attribute}"])
+                for attribute in ("feedback_delay", "proprioceptive_weight",
+                                  "torque_feedback_gain", "torque_feedback_time_constant")
+                if getattr(args, attribute, None) is not None}
     description = base.description
     tilt = base.tilt
     if args.tilt is not None:
@@ -242,7 +242,7 @@ def run_options_from_args(args: argparse.Namespace, sc: Scenario,
         description = f"{description}, {tilt.describe()}"
     torque_limits = base.torque_limits
     if args.torque_limits:
-        torque_limits = tuple(parse_limit_list(args.torque_limits, "--torque-limits [N·m]", n))
+        torque_limits = torque_limits_from_table(args.torque_limits, n, "", FLAG_NAMES)
     with naming_option("--motor-noise"):
         motor_noise = motor_noise_from_args(args, n)
     if motor_noise is not None:
@@ -259,13 +259,7 @@ def run_options_from_args(args: argparse.Namespace, sc: Scenario,
             sample_rate=_given(args.sample_rate, base.sample_rate),
             max_steps=_given(args.max_steps, base.max_steps),
             time_limit=_given(args.time_limit, base.time_limit),
-            fall=fall, feedback_delay=_given(feedback_delay, base.feedback_delay),
-            proprioceptive_weight=_given(proprioceptive_weight, base.proprioceptive_weight),
-            torque_feedback_gain=torque_feedback.get("torque_feedback_gain",
-                                                     base.torque_feedback_gain),
-            torque_feedback_time_constant=torque_feedback.get(
-                "torque_feedback_time_constant", base.torque_feedback_time_constant),
-            tilt=tilt,
+            fall=fall, **feedback, tilt=tilt,
             tilt_axis_depth=_given(args.tilt_axis_depth, base.tilt_axis_depth),
             torque_limits=torque_limits,
             motor_noise=motor_noise, description=description,
@@ -281,7 +275,7 @@ def _given(value: T | None, default: T) -> T:
 def motor_noise_from_args(args: argparse.Namespace, n_joints: int):
     """The MotorNoise of --motor-noise, --motor-noise-cutoff and --seed (None without
     --motor-noise; the other two need it)."""
-    from ..model.noise import MotorNoise
+    from ..scenarios._parse import motor_noise_from_table
 
     if args.motor_noise is None:
         # (sweep --experiment prts seeds its measurement noise with --seed too)
@@ -291,89 +285,85 @@ def motor_noise_from_args(args: argparse.Namespace, n_joints: int):
             if getattr(args, flag) is not None:
                 raise UsageError(f"--{flag.replace('_', '-')} needs --motor-noise")
         return None
-    sigma = parse_float_list(args.motor_noise, "--motor-noise [N·m]")
-    if len(sigma) > n_joints:
-        raise ParameterError(f"--motor-noise [N·m] takes at most {n_joints} values (one per "
-                             f"joint), got {len(sigma)}")
-    return MotorNoise(tuple(sigma), args.motor_noise_cutoff, seed=args.seed or 0)
-
-
-def _foot(text: str) -> BaseOfSupport:
-    if text == "literature":
-        return FOOT_FROM_LITERATURE
-    heel, toe = parse_float_list(text, "--foot HEEL,TOE [m]", 2)
-    return BaseOfSupport(heel, toe, source="--foot")
+    table = {"standard_deviation": args.motor_noise, "cutoff": args.motor_noise_cutoff,
+             "seed": args.seed or 0}
+    return motor_noise_from_table(table, n_joints, "", FLAG_NAMES)
 
 
 def _scenario_from_options(args: argparse.Namespace, command: str) -> Scenario:
+    """The scenario of the model and experiment flags: their scenario tables
+    (:func:`experiment_tables`, :func:`~posturelab.cli._common.model_tables`), built by the
+    scenario parser as a file's are."""
     if args.case is None and args.stiffness is None and args.controller is None:
         raise UsageError(f"{command}: give --case, --stiffness or --controller (or "
                          "--scenario / --builtin)")
-    if args.disturbance not in (None, "none") and args.platform_profile:
-        raise UsageError(f"{command}: give --disturbance or --platform-profile, not both")
-    body = body_from_args(args)
-    muscles = muscles_from_args(args, body)
-    n = body.n_links
-    tilt = None
-    if args.platform_profile:
-        disturbance, tilt = _read_platform_file(args.platform_profile)
-        default_posture = [0.0] * n
-    elif args.disturbance in ("backward", "forward"):
-        step = VelocityStep.backward if args.disturbance == "backward" else VelocityStep.forward
-        speed = 1.0 if args.speed is None else args.speed
-        if not (math.isfinite(speed) and 0 < speed <= MAX_PLATFORM_SPEED):
-            raise ParameterError(f"--speed [m/s] must be in (0, {MAX_PLATFORM_SPEED:g}] (the "
-                                 f"step's size; --disturbance gives its direction), got "
-                                 f"{speed:g}")
-        disturbance = step(speed)
-        default_posture = list(BACKWARD_INITIAL_STATE[:n]) if n == 3 else [0.0] * n
-    else:
-        disturbance = NoDisturbance()
-        default_posture = [0.0] * n
-    if args.speed is not None and not isinstance(disturbance, VelocityStep):
-        raise UsageError(f"{command}: --speed is the size of a velocity step; it needs "
-                         "--disturbance backward or forward")
-    posture = (parse_float_list(args.initial_posture, "--initial-posture [rad]", n)
-               if args.initial_posture else default_posture)
-    rates = (parse_float_list(args.initial_rates, "--initial-rates [rad/s]", n)
-             if args.initial_rates else [0.0] * n)
+    from ..paper.printed import BACKWARD_INITIAL_STATE
+
+    tables = experiment_tables(args, command)
+    try:
+        sc = model_from_args(args, tables)
+    except DataFileError as exc:
+        if "tilt" in tables or "lacks column" not in str(exc):  # (a bad value: it is there)
+            raise
+        raise DataFileError(f"{exc} (or a tilt [rad] column)") from None
+    n = sc.body.n_links
+    initial = sc.options.initial_state
+    if isinstance(sc.disturbance, VelocityStep) and args.initial_posture is None and n == 3:
+        # the paper's flexed posture before a step, unless told otherwise
+        rates = [0.0] * n if initial is None else list(initial[n:])
+        initial = tuple(BACKWARD_INITIAL_STATE[:n]) + tuple(rates)
     label = (f"case {args.case}" if args.case else f"controller {args.controller}"
              if args.controller else "custom stiffness")
     if args.gastrocnemius != "two-sided":
         label += f", {args.gastrocnemius} gastrocnemius"
     if args.body is not None or args.height is not None:
-        label += f", body {body.name}"
-    what = disturbance.describe() + (f", {tilt.describe()}" if tilt is not None else "")
-    return Scenario(
-        name="cli", source="command line", body=body, muscles=muscles,
-        disturbance=disturbance, case=args.case,
-        options=SCENARIO_DEFAULTS.replace(initial_state=tuple(posture + rates), tilt=tilt,
-                                          description=f"{label}, {what}"),
-    )
+        label += f", body {sc.body.name}"
+    tilt = sc.options.tilt
+    what = sc.disturbance.describe() + (f", {tilt.describe()}" if tilt is not None else "")
+    return sc.replace(name="cli", source="command line", options=sc.options.replace(
+        initial_state=initial, description=f"{label}, {what}"))
 
 
-def _read_platform_file(path: str):
-    """A measured profile: the translation (x_acceleration, y_acceleration) and the tilt
-    (tilt [rad]) columns it has, at least one."""
+def experiment_tables(args: argparse.Namespace, command: str) -> dict[str, dict]:
+    """The scenario tables of the experiment flags: [disturbance] (--disturbance and
+    --speed, or a --platform-profile's translation), [tilt] (a --platform-profile's tilt
+    column) and [initial] (--initial-posture, --initial-rates)."""
+    if args.disturbance not in (None, "none") and args.platform_profile:
+        raise UsageError(f"{command}: give --disturbance or --platform-profile, not both")
+    tables: dict[str, dict] = {}
+    if args.platform_profile:
+        tables.update(_platform_tables(args.platform_profile))
+    elif args.disturbance in ("backward", "forward"):
+        speed = 1.0 if args.speed is None else args.speed
+        if not (math.isfinite(speed) and 0 < speed <= MAX_PLATFORM_SPEED):
+            raise ParameterError(f"--speed [m/s] must be in (0, {MAX_PLATFORM_SPEED:g}] (the "
+                                 f"step's size; --disturbance gives its direction), got "
+                                 f"{speed:g}")
+        tables["disturbance"] = {"type": "velocity-step", "direction": args.disturbance,
+                                 "speed": speed}
+    if args.speed is not None and "speed" not in tables.get("disturbance", {}):
+        raise UsageError(f"{command}: --speed is the size of a velocity step; it needs "
+                         "--disturbance backward or forward")
+    initial = {"posture": args.initial_posture, "rates": args.initial_rates}
+    tables["initial"] = {k: v for k, v in initial.items() if v is not None}
+    return tables
 
+
+def _platform_tables(path: str) -> dict[str, dict]:
+    """A measured profile as the scenario tables of the columns it has: [disturbance] of
+    type profile (x_acceleration, y_acceleration) and [tilt] of type profile (tilt [rad]);
+    a file with neither is read as a translation profile (whose error says so)."""
     from .._files import csv_rows, read_text
-    from ..errors import DataFileError
-    from ..model.tilt import read_tilt_csv
 
     first = next(csv_rows(read_text(path, "platform profile"), repr(path)), None)
     header = first[1] if first is not None else []
     names = {h.split("[")[0].strip().lower() for h in header}
-    translation = names & {"x_acceleration", "ax", "xdd"}
-    if "tilt" in names and not translation:
-        return NoDisturbance(), read_tilt_csv(path)
+    tables: dict[str, dict] = {}
+    if names & {"x_acceleration", "ax", "xdd"} or "tilt" not in names:
+        tables["disturbance"] = {"type": "profile", "file": path}
     if "tilt" in names:
-        return read_profile_csv(path), read_tilt_csv(path)
-    try:
-        return read_profile_csv(path), None
-    except DataFileError as exc:
-        if "lacks column" not in str(exc):  # (a bad value: the column is there)
-            raise
-        raise DataFileError(f"{exc} (or a tilt [rad] column)") from None
+        tables["tilt"] = {"type": "profile", "file": path}
+    return tables
 
 
 def experiment_inputs(args: argparse.Namespace) -> dict[str, str | None]:

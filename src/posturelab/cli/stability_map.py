@@ -207,11 +207,10 @@ def _base_muscles(args: argparse.Namespace, body):
                 f"--stiffness ({len(names)} value{'s' if len(names) > 1 else ''}: "
                 f"{', '.join(names)}), the pairs not on an axis keep theirs")
         return None
-    from ..model.muscles import muscles_for
-    from ._common import _pairs, parse_float_list
+    from ..scenarios._parse import muscles_from_table
+    from ._common import FLAG_NAMES
 
-    stiffness = parse_float_list(args.stiffness, "--stiffness [N·m/rad]", _pairs(body))
-    return muscles_for(body.n_links, stiffness)
+    return muscles_from_table({"stiffness": args.stiffness}, body, "", FLAG_NAMES)[0]
 
 
 def _import_plotting() -> None:
@@ -367,12 +366,18 @@ def _run_delayed_map(args: argparse.Namespace) -> int:
     from .._progress import Progress, shown
     from ..linear.delay_batch import MAX_DELAY_MAP_RESOLUTION, delay_stability_map
     from ..viz.maps import plot_delay_stability_map
-    from ._common import body_from_args, feedback_options_from_args, muscles_from_args
+    from ._common import body_from_args, feedback_given, muscles_and_delay_from_args
 
     if args.pair is not None:
         raise ParameterError(f"--pair is now part of the axis names: --x active_stiffness:"
                              f"{args.pair}:LO:HI --y active_viscosity:{args.pair}:LO:HI")
+    if args.stiffness is not None or args.controller is not None:
+        args.case = None  # (--case has a default: the paper's Table I case 1)
+    args.viscosity_ratio = parse_viscosity_ratio(args.viscosity_ratio)
     body = body_from_args(args)
+    if args.case is not None and body.n_links != 3:
+        raise ParameterError("give --stiffness (the intrinsic gains) or --controller for "
+                             "this body")
     pairs = _gain_pair_names(body)
     parsed = [_delayed_axis(a, f, pairs) for a, f in ((args.x, "--x"), (args.y, "--y"))]
     axes = {name: (low, high) for name, _, low, high in parsed}
@@ -385,18 +390,10 @@ def _run_delayed_map(args: argparse.Namespace) -> int:
     pair = parsed[0][1]
     resolution = parse_resolution(args.resolution, MAX_DELAY_MAP_RESOLUTION,
                                   "with a feedback delay")
-    delay = feedback_options_from_args(args).get("feedback_delay")
-    if delay is None:
+    if not feedback_given(args):
         raise ParameterError("a map over active gains needs --feedback-delay S [s]")
     figure_path, csv_path, fmt = output_paths(args.out)
-    if args.stiffness is None and args.controller is None:
-        if body.n_links != 3:
-            raise ParameterError("give --stiffness (the intrinsic gains) or --controller for "
-                                 "this body")
-    else:
-        args.case = None  # (--case has a default: the paper's Table I case 1)
-    args.viscosity_ratio = parse_viscosity_ratio(args.viscosity_ratio)
-    muscles = muscles_from_args(args, body)
+    muscles, delay = muscles_and_delay_from_args(args, body)
     bar = Progress(resolution**2, label="stability-map", unit="sets") \
         if shown(args.progress) else None
     try:

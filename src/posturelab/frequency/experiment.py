@@ -12,10 +12,12 @@ stimulus does not explain, is a run option: ``motor_noise=MotorNoise(...)``
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from ..errors import ParameterError
+from ..simulation.options import RunOptions
 from .estimate import FRFEstimate, estimate_frf
 
 __all__ = ["PRTSExperiment", "prts_experiment", "MAX_SENSOR_NOISE", "MAX_RECORD_RATE"]
@@ -85,8 +87,8 @@ def check_length(cycles: int, discard: int, cycle: float) -> None:
 
 def prts_experiment(body, muscles, *, tilt=None, cycles: int = 5, discard: int = 1,
                     sensor_noise: float = 0.0, seed: int = 0, sample_rate: float = 100.0,
-                    output: str = "com_angle", bands=None, **run_options
-                    ) -> PRTSExperiment:
+                    output: str = "com_angle", bands=None, options: RunOptions | None = None,
+                    **run_options: Any) -> PRTSExperiment:
     """Run one seeded PRTS experiment (module notes).
 
     Parameters
@@ -109,9 +111,15 @@ def prts_experiment(body, muscles, *, tilt=None, cycles: int = 5, discard: int =
     bands
         As for :func:`posturelab.frequency.estimate_frf`; default: the tilt's sequence's
         (:func:`posturelab.frequency.bands.sequence_bands`).
+    options : RunOptions, optional
+        The run's other options (``feedback_delay`` [s], ``proprioceptive_weight`` [-],
+        ``motor_noise``, ``knee``, ``fall``, ``torque_limits`` [N·m], …); the experiment sets
+        the duration, the tilt and the sample rate. Default: ``RunOptions()``.
     **run_options
-        For :func:`posturelab.simulate` (``feedback_delay``, ``proprioceptive_weight``,
-        ``motor_noise``, ``engine`` (compiled by default), …).
+        Fields of :class:`~posturelab.simulation.options.RunOptions` by name, replacing
+        those of ``options`` (``feedback_delay=0.1``); ``engine`` is the compiled one unless
+        given (``engine="reference"`` for what only the reference engine runs, such as
+        torque feedback).
     """
     from ..model.tilt import PRTSTilt
     from ..simulation.engines import simulate
@@ -133,8 +141,11 @@ def prts_experiment(body, muscles, *, tilt=None, cycles: int = 5, discard: int =
     if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0:
         raise ParameterError(f"seed must be an integer >= 0, got {seed!r}")
     total = tilt.cycle * (cycles + discard)
-    run_options = {"engine": "compiled", **run_options}
-    r = simulate(body, muscles, None, total, tilt=tilt, sample_rate=sample_rate, **run_options)
+    engine = run_options.pop("engine", "compiled")
+    run = RunOptions.from_keywords("prts_experiment", **run_options) if options is None \
+        else options.replace(**run_options)
+    r = simulate(body, muscles, None, options=run.replace(
+        duration=total, tilt=tilt, sample_rate=sample_rate, engine=engine))
     t = r.time[:-1] if r.time.size > 1 else r.time
     if output == "com_angle":
         angle = r.com_angle

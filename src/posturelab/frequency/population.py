@@ -32,6 +32,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..scenarios import Scenario
+from ..simulation.options import RunOptions
 from .experiment import MAX_RECORD_RATE, MAX_SENSOR_NOISE  # (the one experiment's bounds)
 
 __all__ = ["PRTSProtocol", "PRTSSweepResult", "prts_sweep", "MAX_EXPERIMENTS"]
@@ -114,20 +115,20 @@ class _ExperimentTask:
         out = []
         for r in range(lo, hi):
             muscles = _run_muscles(base, grid, r)
-            options = {"feedback_delay": float(grid.feedback_delay[r]),
-                       "proprioceptive_weight": float(
-                           sc.proprioceptive_weight if grid.proprioceptive_weight is None
-                           else grid.proprioceptive_weight[r]),
-                       "knee": sc.knee, "fall": sc.fall,
-                       "torque_limits": (None if grid.torque_limits is None
-                                         else grid.torque_limits[r])}
-            if sc.motor_noise is not None:
-                options["motor_noise"] = replace(sc.motor_noise,
-                                                 seed=_row_seed(sc.motor_noise.seed, r))
+            options = RunOptions(
+                feedback_delay=float(grid.feedback_delay[r]),
+                proprioceptive_weight=float(
+                    sc.proprioceptive_weight if grid.proprioceptive_weight is None
+                    else grid.proprioceptive_weight[r]),
+                knee=sc.knee, fall=sc.fall,
+                torque_limits=(None if grid.torque_limits is None
+                               else tuple(grid.torque_limits[r])),
+                motor_noise=(None if sc.motor_noise is None else replace(
+                    sc.motor_noise, seed=_row_seed(sc.motor_noise.seed, r))))
             exp = prts_experiment(sc.body, muscles, tilt=sc.tilt, cycles=pr.cycles,
                                   discard=pr.discard, sensor_noise=pr.sensor_noise,
                                   seed=_row_seed(pr.seed, r), sample_rate=pr.sample_rate,
-                                  output=pr.output, bands=pr.bands, **options)
+                                  output=pr.output, bands=pr.bands, options=options)
             fit = None
             if exp.estimate is not None and pr.fit:
                 fit = fit_frf(sc.body, base, exp.estimate, pr.fit, output=pr.output,

@@ -25,7 +25,7 @@ Schema (every table optional except where noted; units in brackets)::
                                          # pairs = [{name, lo, hi, stiffness, viscosity,
                                          #   one_sided}] (lo, hi: the links the pair spans,
                                          #   0 the foot: the ankle pair is lo = 0, hi = 1)
-    viscosity_ratio = 0.25               # [s]
+    viscosity_ratio = 0.25               # [s]; or viscosity = [one value per pair]
     gastrocnemius = "two-sided"          # or "one-sided" (θ2 ≥ 0), "pull-only"
     feedback_delay = 0.0                 # neural delay of the muscle feedback [s]
     active_stiffness = [5 values]        # active (neural, delayed) gains [N·m/rad]; with

@@ -9,6 +9,7 @@ objects built.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from pathlib import Path
 
 import numpy as np
@@ -44,7 +45,10 @@ from ..simulation.options import RunOptions
 from ._scenario import SCENARIO_DEFAULTS as DEFAULTS
 from ._scenario import Scenario
 
-__all__ = ["OPTION_KEYS", "parse_tables", "run_options"]
+__all__ = ["OPTION_KEYS", "parse_tables", "run_options", "body_from_table",
+           "muscles_from_table", "tilt_from_table", "disturbance_from_tables",
+           "motor_noise_from_table", "fall_from_table", "torque_limits_from_table",
+           "number_list"]
 
 
 def _reject(d: dict, allowed, where: str, origin: str) -> None:
@@ -86,57 +90,53 @@ def run_options(origin: str, **fields) -> RunOptions:
         raise ScenarioError(f"{origin}: {text}") from None
 
 
-def parse_tables(data: dict, base_dir: Path, origin: str) -> Scenario:
+def parse_tables(data: dict, base_dir: Path, origin: str,
+                 names: Mapping[str, str] | None = None) -> Scenario:
     """A scenario from its tables (types already checked by
-    :func:`posturelab.scenarios.schema.check_types`)."""
+    :func:`posturelab.scenarios.schema.check_types`, or built by the command line).
 
+    ``origin`` starts each message (the file; empty for the command line, whose messages are
+    then ParameterErrors); ``names`` says how the user wrote a key when not as in a scenario
+    file (the command line's flags: ``{"muscles.feedback_delay": "--feedback-delay"}``).
+    """
     duration = finite_float("duration [s]", data["duration"])
-    body = _parse_body(data.get("body", {}), origin)
     mt = dict(data.get("muscles", {}))
-    preset = _controller(mt, body, origin)
-    delay = mt.pop("feedback_delay", 0.0 if preset is None else preset.feedback_delay)
-    weight = mt.pop("proprioceptive_weight",
-                    1.0 if preset is None else preset.proprioceptive_weight)
     feedback_gain = mt.pop("torque_feedback_gain", DEFAULTS.torque_feedback_gain)
     feedback_lag = mt.pop("torque_feedback_time_constant",
                           DEFAULTS.torque_feedback_time_constant)
-    for key, value in (("feedback_delay", delay), ("proprioceptive_weight", weight),
-                       ("torque_feedback_gain", feedback_gain),
+    for key, value in (("torque_feedback_gain", feedback_gain),
                        ("torque_feedback_time_constant", feedback_lag)):
         try:  # the parameter table's bounds, before the muscles are built
-            check_value(key, value, f"muscles.{key}")
+            check_value(key, value, _name(names, f"muscles.{key}"))
         except ParameterError as exc:
-            raise ScenarioError(f"{origin}: {exc}") from None
-    muscles, case = (_parse_muscles(mt, body, origin) if preset is None
-                     else (preset.muscles(body), None))
+            raise _error(origin, str(exc)) from None
+    body = body_from_table(data.get("body", {}), origin, names,
+                           one_link="controller" in mt)
+    muscles, case, delay, weight = muscles_from_table(mt, body, origin, names,
+                                                      data.get("body", {}))
     tilt_table = data.get("tilt", {})
-    tilt = _parse_tilt(tilt_table, base_dir, origin)
-    disturbance = _parse_disturbances(data.get("disturbance"), base_dir, origin)
-    nt = data.get("motor_noise", {})
-    noise = None if not nt else MotorNoise(nt["standard_deviation"], nt.get("cutoff"),
-                                           nt.get("sample_rate", 100.0), nt.get("seed", 0))
+    tilt = tilt_from_table(tilt_table, base_dir, origin, names)
+    disturbance = disturbance_from_tables(data.get("disturbance"), base_dir, origin, names)
+    noise = motor_noise_from_table(data.get("motor_noise", {}), body.n_links, origin, names)
     it = data.get("initial", {})
     n = body.n_links
     initial = None
     if "posture" in it or "rates" in it:
-        posture = finite_array("initial.posture [rad]", it.get("posture", [0.0] * n), (n,))
-        rates = finite_array("initial.rates [rad/s]", it.get("rates", [0.0] * n), (n,))
+        posture = finite_array(f"{_name(names, 'initial.posture')} [rad]",
+                               number_list(it.get("posture", [0.0] * n),
+                                           f"{_name(names, 'initial.posture')} [rad]", n),
+                               (n,))
+        rates = finite_array(f"{_name(names, 'initial.rates')} [rad/s]",
+                             number_list(it.get("rates", [0.0] * n),
+                                         f"{_name(names, 'initial.rates')} [rad/s]", n), (n,))
         initial = np.concatenate([posture, rates])
     kt = data.get("knee", {})
     knee = KneeModel(kt.get("mode", "free"), kt.get("stop_angle", 0.0))
-    ft = data.get("fall", {})
-    bos_spec = ft.get("base_of_support", "none")
-    bos = (None if bos_spec == "none" else FOOT_FROM_LITERATURE if bos_spec == "literature"
-           else BaseOfSupport(bos_spec["heel"], bos_spec["toe"], source=origin))
-    fall = FallCriteria(ft.get("max_link_angle", math.pi / 3), bos,
-                        bool(ft.get("centre_of_pressure", False)))
+    fall = fall_from_table(data.get("fall", {}), origin, names)
     torque_limits = None
     if "torque" in data.get("limits", {}):
-        values = [math.inf if v in ("inf", "none") else v for v in data["limits"]["torque"]]
-        torque_limits = tuple(finite_or_inf("limits.torque [N·m]", v) for v in values)
-        if len(torque_limits) != body.n_links:
-            raise ScenarioError(f"{origin}: limits.torque needs {body.n_links} values "
-                                f"(one per joint), got {len(torque_limits)}")
+        torque_limits = torque_limits_from_table(data["limits"]["torque"], body.n_links,
+                                                 origin, names)
     st = data.get("solver", {})
     options = run_options(
         origin, duration=duration, initial_state=initial,
@@ -150,19 +150,56 @@ def parse_tables(data: dict, base_dir: Path, origin: str) -> Scenario:
         max_switches=st.get("max_switches", DEFAULTS.max_switches),
         max_steps=st.get("max_steps"), time_limit=st.get("time_limit"),
         description=str(data.get("description", "")))
-    return Scenario(name=str(data.get("name", Path(origin).stem)),
+    return Scenario(name=str(data.get("name", Path(origin).stem if origin else "")),
                     source=str(data.get("source", "")), body=body, muscles=muscles,
                     disturbance=disturbance, options=options, case=case)
+
+
+def _name(names: Mapping[str, str] | None, key: str) -> str:
+    """How the user wrote ``key`` (a scenario file's key, or the flag in ``names``)."""
+    return key if names is None else names.get(key, key)
+
+
+def _error(origin: str, text: str) -> PostureLabError:
+    """A ScenarioError naming the file ``origin``; a ParameterError without one (the
+    command line, which names its flags)."""
+    return ScenarioError(f"{origin}: {text}") if origin else ParameterError(text)
+
+
+def number_list(value, field: str, n: int | None = None) -> list[float]:
+    """Numbers given as a list, or as text ``"a,b,c"`` (the command line's spelling),
+    checking their count and finiteness; errors name ``field``."""
+    if not isinstance(value, str):
+        return list(value)
+    parts = [p.strip() for p in value.split(",")]
+    try:
+        values = [float(p) for p in parts]
+    except ValueError:
+        raise ParameterError(f"{field} must be comma-separated numbers, got {value!r}") from None
+    if n is not None and len(values) != n:
+        raise ParameterError(f"{field} must have {n} comma-separated values, got {len(values)}")
+    for v in values:
+        if not math.isfinite(v):
+            raise ParameterError(f"{field} must contain finite numbers, got {v}")
+    return values
+
+
+def _one_number(value, field: str) -> float:
+    """One number, or its text."""
+    return number_list(value, field, 1)[0] if isinstance(value, str) else value
 
 
 TILT_KEYS = ("type", "amplitude", "frequency", "phase", "duration", "start", "state_duration",
              "registers", "taps", "seed", "sequence", "file", "axis_depth")
 
 
-def _parse_tilt(tt: dict, base_dir: Path, origin: str) -> Tilt | None:
-    """The [tilt] table (module docstring), or None when there is none."""
+def tilt_from_table(tt: dict, base_dir: Path, origin: str = "",
+                    names: Mapping[str, str] | None = None) -> Tilt | None:
+    """The [tilt] table (module docstring), or None when there is none; the command line's
+    ``--tilt`` as this table too."""
     if not tt:
         return None
+    where = _name(names, "tilt")
     kind = tt.get("type")
     allowed = {"sine": ("amplitude", "frequency", "phase"),
                "raised-cosine": ("amplitude", "duration", "start"),
@@ -170,8 +207,7 @@ def _parse_tilt(tt: dict, base_dir: Path, origin: str) -> Tilt | None:
                         "sequence"),
                "profile": ("file",)}
     if kind not in allowed:
-        raise ScenarioError(f"{origin}: tilt.type must be one of {', '.join(allowed)}; "
-                            f"got {kind!r}")
+        raise _error(origin, f"tilt.type must be one of {', '.join(allowed)}; got {kind!r}")
     _reject(tt, ("type", "axis_depth", *allowed[kind]), f"tilt (type {kind})", origin)
     try:
         if kind == "sine":
@@ -186,6 +222,8 @@ def _parse_tilt(tt: dict, base_dir: Path, origin: str) -> Tilt | None:
                 try:
                     seq = get_prts_sequence(str(tt["sequence"]))
                 except UnknownNameError as exc:
+                    if not origin:
+                        raise
                     raise ScenarioError(f"{origin}: tilt.sequence: {exc}") from None
                 return PRTSTilt(tt.get("amplitude"),
                                 tt.get("state_duration", seq.state_duration), seq.registers,
@@ -199,92 +237,196 @@ def _parse_tilt(tt: dict, base_dir: Path, origin: str) -> Tilt | None:
             raise ScenarioError(f"{origin}: tilt (type profile) needs file")
         return read_tilt_csv(base_dir / str(tt["file"]))
     except TypeError as exc:
-        raise ScenarioError(f"{origin}: tilt: {exc}") from None
+        raise _error(origin, f"{where}: {exc}") from None
 
 
-def finite_or_inf(name: str, value) -> float:
-    """A number > 0, or +inf (no limit)."""
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise ScenarioError(f"{name} must be numbers or \"inf\", got {value!r}") from None
-    if math.isnan(v) or v <= 0:
-        raise ScenarioError(f"{name} must be > 0 (or \"inf\"), got {value!r}")
-    return v
+def fall_from_table(ft: dict, origin: str = "", names: Mapping[str, str] | None = None,
+                    base: FallCriteria | None = None) -> FallCriteria:
+    """The [fall] table: max_link_angle [rad], base_of_support ("none", "literature", a
+    table {heel, toe} [m] or its text "HEEL,TOE"), centre_of_pressure; a key not given keeps
+    ``base``'s (default: the paper's criteria)."""
+    base = FallCriteria() if base is None else base
+    spec = ft.get("base_of_support")
+    if spec is None:
+        bos = base.base_of_support
+    elif spec == "none":
+        bos = None
+    elif spec == "literature":
+        bos = FOOT_FROM_LITERATURE
+    else:
+        where = _name(names, "fall.base_of_support")
+        if isinstance(spec, str):
+            heel, toe = number_list(spec, f"{where} HEEL,TOE [m]", 2)
+            spec = {"heel": heel, "toe": toe}
+        bos = BaseOfSupport(spec["heel"], spec["toe"], source=origin or where)
+    return FallCriteria(ft.get("max_link_angle", base.max_link_angle), bos,
+                        bool(ft.get("centre_of_pressure", base.centre_of_pressure)))
 
 
-def _parse_body(bt: dict, origin: str) -> Body:
-    if "preset" in bt and "segments" in bt:
-        raise ScenarioError(f"{origin}: [body] takes preset or segments, not both")
+def torque_limits_from_table(values, n_joints: int, origin: str = "",
+                             names: Mapping[str, str] | None = None) -> tuple[float, ...]:
+    """limits.torque: one largest net moment per joint [N·m], each > 0, or "inf" / "none"
+    for no limit; a list, or its text ``"120,inf,80"``."""
+    where = f"{_name(names, 'limits.torque')} [N·m]"
+    if isinstance(values, str):
+        values = [v.strip().lower() for v in values.split(",")]
+    if len(values) != n_joints:
+        raise _error(origin, f"{where} needs {n_joints} values (one per joint), got "
+                     f"{len(values)}")
+    out = []
+    for value in values:
+        if value in ("inf", "none"):
+            out.append(math.inf)
+            continue
+        try:
+            v = float(value)
+        except (TypeError, ValueError):
+            raise _error(origin, f"{where} must be numbers or 'inf', got {value!r}") from None
+        if isinstance(value, bool) or not (math.isfinite(v) and v > 0):
+            raise _error(origin, f"{where} must each be in (0, inf] (a number > 0, or 'inf' "
+                         f"for no limit), got {value!r}")
+        out.append(v)
+    return tuple(out)
+
+
+def body_from_table(bt: dict, origin: str = "", names: Mapping[str, str] | None = None, *,
+                    one_link: bool = False) -> Body:
+    """The [body] table: a preset or the segments, or (from the command line's --height and
+    --mass, not a file's keys) a height [m] and mass [kg] (Winter's anthropometric table);
+    ``one_link`` (a one-link controller): by default the paper's body as one link, and a body
+    from height and mass lumped to one link."""
+    def name(key: str) -> str:
+        return _name(names, f"body.{key}")
+
+    if ("height" in bt) != ("mass" in bt):
+        raise _error(origin, f"{name('height')} [m] and {name('mass')} [kg] go together")
+    given = [k for k in ("preset", "segments", "height") if k in bt]
+    if len(given) > 1:
+        raise _error(origin, f"give {name(given[0])} or {name(given[1])}, not both")
     gravity = bt.get("gravity")
     if "segments" in bt:
         segs = bt["segments"]
         if not isinstance(segs, list) or not segs:
-            raise ScenarioError(f"{origin}: body.segments must be a non-empty array of tables")
+            raise _error(origin, "body.segments must be a non-empty array of tables")
         out = []
         for i, s in enumerate(segs):
             if not isinstance(s, dict):
-                raise ScenarioError(f"{origin}: body.segments[{i}] must be a table")
+                raise _error(origin, f"body.segments[{i}] must be a table")
             keys = ("name", "mass", "length", "com_distance", "inertia")
             _reject(s, keys, f"body.segments[{i}]", origin)
             missing = [k for k in keys[1:] if k not in s]
             if missing:
-                raise ScenarioError(f"{origin}: body.segments[{i}] lacks {missing[0]!r}")
+                raise _error(origin, f"body.segments[{i}] lacks {missing[0]!r}")
             out.append(Segment(str(s.get("name", f"link{i + 1}")), s["mass"], s["length"],
                                s["com_distance"], s["inertia"]))
         body = Body(tuple(out), name="scenario")
+    elif "height" in bt:
+        from ..model.anthropometry import body_from_anthropometry
+        from ..model.anthropometry import one_link as lumped
+
+        body = body_from_anthropometry(_one_number(bt["height"], f"{name('height')} [m]"),
+                                       _one_number(bt["mass"], f"{name('mass')} [kg]"))
+        if one_link:
+            body = lumped(body)
     else:
-        body = get_body(str(bt.get("preset", "paper")))
+        body = get_body(str(bt.get("preset", "paper-1link" if one_link else "paper")))
     if gravity is not None:
         body = body.with_gravity(gravity)
     return body
 
 
-def _controller(mt: dict, body: Body, origin: str):
+#: The keys of [muscles] that set a gain (none may be given with a controller preset).
+GAIN_KEYS = ("case", "stiffness", "pairs", "viscosity", "viscosity_ratio", "gastrocnemius",
+             "active_stiffness", "active_viscosity", "active_viscosity_ratio")
+
+
+def muscles_from_table(mt: dict, body: Body, origin: str = "",
+                       names: Mapping[str, str] | None = None, bt: dict | None = None
+                       ) -> tuple[MuscleSet, str | None, float, float]:
+    """The [muscles] table on ``body`` (``bt``: its [body] table, for messages): the muscle
+    pairs, the Table I case (or None), the feedback delay [s] and the proprioceptive weight
+    [-] (a controller preset's unless the table gives them), each checked against the
+    parameter table."""
+    mt = dict(mt)
+    preset = _controller(mt, body, origin, names, bt or {})
+    delay = mt.pop("feedback_delay", 0.0 if preset is None else preset.feedback_delay)
+    weight = mt.pop("proprioceptive_weight",
+                    1.0 if preset is None else preset.proprioceptive_weight)
+    for key, value in (("feedback_delay", delay), ("proprioceptive_weight", weight)):
+        try:  # the parameter table's bounds, before the muscles are built
+            value = check_value(key, value, _name(names, f"muscles.{key}"))
+        except ParameterError as exc:
+            raise _error(origin, str(exc)) from None
+        delay, weight = (value, weight) if key == "feedback_delay" else (delay, value)
+    muscles, case = (_muscles(mt, body, origin, names) if preset is None
+                     else (preset.muscles(body), None))
+    return muscles, case, delay, weight
+
+
+def _controller(mt: dict, body: Body, origin: str, names: Mapping[str, str] | None,
+                bt: dict):
     """``[muscles] controller = NAME``: the preset (its gains on this one-link body, its delay
     and weight unless the table gives them), or None."""
     if "controller" not in mt:
         return None
     from ..model.controllers import get_controller
 
+    ctl = _name(names, "muscles.controller")
     name = str(mt.pop("controller"))
     try:
         preset = get_controller(name)
     except PostureLabError as exc:
-        raise ScenarioError(f"{origin}: muscles.controller: {exc}") from None
-    others = [k for k in ("case", "stiffness", "pairs", "viscosity_ratio", "gastrocnemius",
-                          "active_stiffness", "active_viscosity", "active_viscosity_ratio")
-              if k in mt]
+        raise _error(origin, f"{ctl}: {exc}") from None
+    others = [k for k in GAIN_KEYS if k in mt]
     if others:
-        raise ScenarioError(f"{origin}: muscles.{others[0]} cannot be given with "
-                            f"muscles.controller {name!r}, which sets every gain")
+        raise _error(origin, f"{ctl} sets every gain ({name}); "
+                     f"{_name(names, 'muscles.' + others[0])} cannot be given with {ctl}")
     if body.n_links != 1:
-        raise ScenarioError(f"{origin}: muscles.controller {name!r} is a one-link controller; "
-                            f"this body has {body.n_links} links (preset = \"paper-1link\", or "
-                            "one segment)")
+        which = (f"{_name(names, 'body.preset')} {bt['preset']}" if "preset" in bt
+                 else "this body")
+        raise _error(origin, f"{ctl} {name} is a one-link controller (an inverted pendulum "
+                     f"about the ankle); {which} has {body.n_links} links: give a one-link "
+                     f"body ({_name(names, 'body.preset')} paper-1link), "
+                     f"{_name(names, 'body.height')} and {_name(names, 'body.mass')} "
+                     "(lumped to one link), or no body")
     return preset
 
 
-def _parse_muscles(mt: dict, body: Body, origin: str) -> tuple[MuscleSet, str | None]:
+def _muscles(mt: dict, body: Body, origin: str, names: Mapping[str, str] | None
+             ) -> tuple[MuscleSet, str | None]:
+    def name(key: str) -> str:
+        return _name(names, f"muscles.{key}")
+
     given = [k for k in ("case", "stiffness", "pairs") if k in mt]
     if len(given) != 1:
-        raise ScenarioError(f"{origin}: [muscles] needs exactly one of case, stiffness, pairs")
+        choices = ", ".join(name(k) for k in ("case", "stiffness", "pairs", "controller")
+                            if names is None or f"muscles.{k}" in names)
+        raise _error(origin, f"[muscles] needs exactly one of {choices}")
+    for a, b in (("viscosity", "viscosity_ratio"),
+                 ("active_viscosity", "active_viscosity_ratio")):
+        if a in mt and b in mt:
+            raise _error(origin, f"give {name(a)} or {name(b)}, not both")
+    for key in ("viscosity_ratio", "active_viscosity_ratio"):
+        ratio = mt.get(key)
+        if ratio is not None and not (isinstance(ratio, int | float)
+                                      and math.isfinite(ratio) and ratio >= 0):
+            raise _error(origin, f"{name(key)} [s] must be a finite number >= 0, got {ratio!r}")
     if "pairs" in mt:
-        stray = [k for k in ("active_stiffness", "active_viscosity", "active_viscosity_ratio")
-                 if k in mt]
+        stray = [k for k in ("viscosity", "active_stiffness", "active_viscosity",
+                             "active_viscosity_ratio") if k in mt]
         if stray:
-            raise ScenarioError(f"{origin}: muscles.{stray[0]} is for case / stiffness; with "
-                                "pairs give active_stiffness and active_viscosity per pair")
+            raise _error(origin, f"muscles.{stray[0]} is for case / stiffness; with "
+                         "pairs give active_stiffness and active_viscosity per pair")
         pairs = []
         for i, p in enumerate(mt["pairs"]):
             if not isinstance(p, dict):
-                raise ScenarioError(f"{origin}: muscles.pairs[{i}] must be a table")
+                raise _error(origin, f"muscles.pairs[{i}] must be a table")
             keys = ("name", "lo", "hi", "stiffness", "viscosity", "one_sided",
                     "active_stiffness", "active_viscosity", "pull_only")
             _reject(p, keys, f"muscles.pairs[{i}]", origin)
             for k in ("lo", "hi", "stiffness"):
                 if k not in p:
-                    raise ScenarioError(f"{origin}: muscles.pairs[{i}] lacks {k!r}")
+                    raise _error(origin, f"muscles.pairs[{i}] lacks {k!r}")
             ratio = finite_float("muscles.viscosity_ratio [s]", mt.get("viscosity_ratio", 0.25))
             visc = p.get("viscosity", ratio * finite_float("stiffness", p["stiffness"]))
             pairs.append(MusclePair(str(p.get("name", f"pair{i + 1}")), p["lo"], p["hi"],
@@ -292,36 +434,57 @@ def _parse_muscles(mt: dict, body: Body, origin: str) -> tuple[MuscleSet, str | 
                                     p.get("active_stiffness"), p.get("active_viscosity"),
                                     bool(p.get("pull_only", False))))
         return MuscleSet(tuple(pairs), body.n_links), None
+    from ..model.muscles import joint_pair_names, muscles_for
+
+    count = 5 if body.n_links == 3 else len(joint_pair_names(body.n_links))
+    units = {"stiffness": "[N·m/rad]", "viscosity": "[N·m·s/rad]",
+             "active_stiffness": "[N·m/rad]", "active_viscosity": "[N·m·s/rad]"}
+    lists = {key: None if mt.get(key) is None
+             else number_list(mt[key], f"{name(key)} {units[key]}", count) for key in units}
+    ratio = mt.get("viscosity_ratio", 0.25)
     if body.n_links != 3:
         if "case" in mt:
-            raise ScenarioError(f"{origin}: muscles.case is one of the paper's Table I sets of "
-                                f"five pairs on 3 links; this body has {body.n_links}: give "
-                                "muscles.stiffness (one value per pair, as on the command line) "
-                                "or muscles.pairs")
+            raise _error(origin, f"{name('case')} is one of the paper's Table I sets of "
+                         f"five pairs on 3 links; this body has {body.n_links}: give "
+                         f"{name('stiffness')} (one value per pair) or {name('pairs')}")
         if mt.get("gastrocnemius", "two-sided") != "two-sided":
-            raise ScenarioError(f"{origin}: muscles.gastrocnemius is a pair of the paper's "
-                                f"three-link body; this body has {body.n_links} links")
-        from ..model.muscles import joint_pair_names, muscles_for
-
-        names = joint_pair_names(body.n_links)
-        stiffness = mt["stiffness"]
-        if not isinstance(stiffness, list) or len(stiffness) != len(names):
-            raise ScenarioError(f"{origin}: muscles.stiffness must have one value per pair of "
-                                f"this {body.n_links}-link body ({', '.join(names)}), got "
-                                f"{stiffness!r}")
+            raise _error(origin, f"{name('gastrocnemius')} is a pair of the paper's "
+                         f"three-link body; this body has {body.n_links} links")
+        pair_names = joint_pair_names(body.n_links)
+        stiffness = lists["stiffness"]
+        if not isinstance(stiffness, list) or len(stiffness) != len(pair_names):
+            raise _error(origin, f"{name('stiffness')} must have one value per pair of this "
+                         f"{body.n_links}-link body ({', '.join(pair_names)}), got "
+                         f"{stiffness!r}")
         return muscles_for(
-            body.n_links, stiffness, viscosity_ratio=mt.get("viscosity_ratio", 0.25),
-            active_stiffness=mt.get("active_stiffness"),
-            active_viscosity=mt.get("active_viscosity"),
+            body.n_links, stiffness, lists["viscosity"], viscosity_ratio=ratio,
+            active_stiffness=lists["active_stiffness"],
+            active_viscosity=lists["active_viscosity"],
             active_viscosity_ratio=mt.get("active_viscosity_ratio")), None
     case = mt.get("case")
     return paper_muscles(
-        None if case is None else str(case), stiffness=mt.get("stiffness"),
-        viscosity_ratio=mt.get("viscosity_ratio", 0.25),
+        None if case is None else str(case), stiffness=lists["stiffness"],
+        viscosity_ratio=ratio, viscosity=lists["viscosity"],
         gastrocnemius=mt.get("gastrocnemius", "two-sided"),
-        active_stiffness=mt.get("active_stiffness"), active_viscosity=mt.get("active_viscosity"),
+        active_stiffness=lists["active_stiffness"], active_viscosity=lists["active_viscosity"],
         active_viscosity_ratio=mt.get("active_viscosity_ratio"),
     ), (None if case is None else str(case))
+
+
+def motor_noise_from_table(nt: dict, n_joints: int, origin: str = "",
+                           names: Mapping[str, str] | None = None) -> MotorNoise | None:
+    """The [motor_noise] table (None when there is none): standard deviation per joint
+    [N·m], ankle first, at most one per joint; cutoff [Hz]; sample rate [Hz]; seed."""
+    if not nt:
+        return None
+    where = _name(names, "motor_noise.standard_deviation")
+    sigma = nt["standard_deviation"]
+    if isinstance(sigma, str | list | tuple):
+        sigma = tuple(number_list(sigma, f"{where} [N·m]"))
+        if len(sigma) > n_joints:
+            raise _error(origin, f"{where} [N·m] takes at most {n_joints} values (one per "
+                         f"joint), got {len(sigma)}")
+    return MotorNoise(sigma, nt.get("cutoff"), nt.get("sample_rate", 100.0), nt.get("seed", 0))
 
 
 DISTURBANCE_KEYS = {
@@ -334,14 +497,16 @@ DISTURBANCE_KEYS = {
 }
 
 
-def _parse_disturbances(spec, base_dir: Path, origin: str) -> Disturbance:
+def disturbance_from_tables(spec, base_dir: Path, origin: str = "",
+                            names: Mapping[str, str] | None = None) -> Disturbance:
+    """The [disturbance] table, or an array of them (their sum); none when absent."""
     if spec is None:
         return NoDisturbance()
     specs = spec if isinstance(spec, list) else [spec]
-    return combine(*[_parse_disturbance(s, base_dir, origin, i) for i, s in enumerate(specs)])
+    return combine(*[_disturbance(s, base_dir, origin, i) for i, s in enumerate(specs)])
 
 
-def _parse_disturbance(d, base_dir: Path, origin: str, i: int) -> Disturbance:
+def _disturbance(d, base_dir: Path, origin: str, i: int) -> Disturbance:
     if not isinstance(d, dict):
         raise ScenarioError(f"{origin}: [disturbance] must be a table")
     kind = d.get("type")
@@ -379,6 +544,8 @@ def _parse_disturbance(d, base_dir: Path, origin: str, i: int) -> Disturbance:
         file = Path(str(_need(d, "file", origin)))
         return read_profile_csv(file if file.is_absolute() else base_dir / file)
     except ParameterError as exc:
+        if not origin:
+            raise
         raise ScenarioError(f"{origin}: disturbance: {exc}") from None
 
 

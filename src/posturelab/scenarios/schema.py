@@ -66,6 +66,7 @@ class MusclesTable(_Table):
 
     case: str | None = None
     stiffness: list[float] | None = None
+    viscosity: list[float] | None = None
     pairs: list[PairTable] | None = None
     viscosity_ratio: float | None = None
     gastrocnemius: Literal["two-sided", "one-sided", "pull-only"] | None = None

@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .._files import atomic_write_bytes, atomic_write_text
 from ..errors import ParameterError, PostureLabError
 from ..model.muscles import DEFAULT_VISCOSITY_RATIO
 from ..model.platform import NoDisturbance
@@ -25,7 +26,6 @@ from ..parameters import resolve as resolve_name
 from ..parameters import unit as parameter_unit
 from ..scenarios import Scenario
 from ..simulation.outcome import UPRIGHT_BAND
-from ..simulation.results import atomic_write_bytes, atomic_write_text
 
 if TYPE_CHECKING:  # (the engine loads when a sweep runs: posturelab --help stays light)
     from ..simulation.compiled import BatchResult

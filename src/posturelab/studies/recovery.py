@@ -10,12 +10,17 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from .._validation import positive_float
 from ..errors import ParameterError
+from ..simulation.options import RunOptions
 from ..simulation.results import SimulationResult
+
+if TYPE_CHECKING:
+    from ..model.muscles import MuscleSet
 
 __all__ = ["RecoveryBoundary", "largest_recoverable", "BatchRecoveryBoundaries",
            "largest_recoverable_batch"]
@@ -136,7 +141,14 @@ def largest_recoverable_batch(
     *,
     tolerance: float = 1e-3,
     max_rounds: int = 60,
-    **batch_options,
+    options: RunOptions | None = None,
+    muscles: MuscleSet | None = None,
+    initial_state: np.ndarray | None = None,
+    feedback_delay: float | np.ndarray | None = None,
+    proprioceptive_weight: float | np.ndarray | None = None,
+    torque_limits: np.ndarray | tuple[float, ...] | None = None,
+    parallel: bool = True,
+    **run_options: Any,
 ) -> BatchRecoveryBoundaries:
     """Bisect, for every gain set at once, for the largest factor on ``disturbance`` that
     does not fall (the compiled simulator, :func:`posturelab.simulation.compiled.simulate_batch`).
@@ -163,9 +175,15 @@ def largest_recoverable_batch(
         Width of the final brackets. [-]
     max_rounds : int
         Most bisection rounds. [-]
-    **batch_options
-        Passed to :func:`posturelab.simulation.compiled.simulate_batch` (``initial_state``,
-        ``muscles``, ``knee``, ``fall``, ``rtol``, …).
+    initial_state, muscles, feedback_delay, proprioceptive_weight, torque_limits, parallel
+        As for :func:`posturelab.simulation.compiled.simulate_batch` (the state before the
+        motion [rad, rad/s]; the pair layout; per gain set or shared [s], [-], [N·m]).
+    options : RunOptions, optional
+        The options every run shares (:class:`~posturelab.simulation.options.RunOptions`:
+        knee, fall criteria, tolerances, …).
+    **run_options
+        Fields of :class:`~posturelab.simulation.options.RunOptions` by name (``fall=...``,
+        ``rtol=...``), replacing those of ``options``.
 
     Returns
     -------
@@ -176,8 +194,10 @@ def largest_recoverable_batch(
     positive_float("tolerance", tolerance)
     if not low < high:
         raise ParameterError(f"low must be < high, got {low:g} and {high:g}")
-    if "disturbance_scale" in batch_options:
+    if "disturbance_scale" in run_options:
         raise ParameterError("largest_recoverable_batch sets disturbance_scale itself")
+    shared = (RunOptions.from_keywords("largest_recoverable_batch", **run_options)
+              if options is None else options.replace(**run_options))
     stiffness = np.asarray(stiffness, dtype=float)
     viscosity = np.asarray(viscosity, dtype=float)
     m = stiffness.shape[0] if stiffness.ndim == 2 else 1
@@ -186,7 +206,12 @@ def largest_recoverable_batch(
 
     def falls(rows: np.ndarray, scale: np.ndarray) -> np.ndarray:
         out = simulate_batch(body, stiffness[rows], viscosity[rows], disturbance, duration,
-                             disturbance_scale=scale, **batch_options)
+                             initial_state, muscles=muscles, options=shared,
+                             feedback_delay=_open_rows(feedback_delay, rows, PER_SET),
+                             proprioceptive_weight=_open_rows(proprioceptive_weight, rows,
+                                                              PER_SET),
+                             torque_limits=_open_rows(torque_limits, rows, PER_SET + 1),
+                             disturbance_scale=scale, parallel=parallel)
         return out.fell
 
     every = np.arange(m)
@@ -207,3 +232,16 @@ def largest_recoverable_batch(
         hi[rows[f]] = mid[f]
         lo[rows[~f]] = mid[~f]
     return BatchRecoveryBoundaries(lo, hi, count)
+
+
+#: The dimensions of a number given per gain set (one value per set); a per-joint one has one
+#: more.
+PER_SET = 1
+
+
+def _open_rows(values, rows: np.ndarray, per_set_ndim: int):
+    """``values`` for the gain sets ``rows`` when it is given per gain set (``per_set_ndim``
+    dimensions), else as it is (shared by every run)."""
+    if values is None or np.ndim(values) != per_set_ndim:
+        return values
+    return np.asarray(values, dtype=float)[rows]
