@@ -22,19 +22,20 @@ N·m/rad and K_D = 313.5 N·m·s/rad, divided by that table's m·g·h = 75 × 9.
 (1.55 mgh and 0.51 mgh·s, scaled here to the paper body's mgh), τ = 0.097 s, W = 0.8, and
 its intrinsic stiffness and damping (40.5 N·m/rad, 68.8 N·m·s/rad, likewise per mgh) for
 every subject. **Spreads: assumptions of this page, not a source's**: a coefficient of
-variation of 15 % on K_P and K_D (log-normal), 0.015 s on τ and 0.08 on W (normal); the
-searched sources (Peterka 2002; PMC5664365; van der Kooij and Peterka 2011, J Comput
-Neurosci 30:759) were not found, in the time this page was written, to print per-subject
-standard deviations in a form that could be checked. **W at the larger amplitude**: Peterka
-2002 reports that the proprioceptive weight falls as the surface-tilt amplitude grows
-(eyes closed); the size of the fall here (0.2 on average from 1° to 4°, standard deviation
-0.05 between subjects) is this page's assumption, not a number read from that paper.
+variation of 15 % on K_P and K_D (log-normal), 0.015 s on τ and 0.08 on W (normal). The
+searches made for this page (Peterka 2002; PMC5664365; van der Kooij and Peterka 2011, J
+Comput Neurosci 30:759) found no between-subject standard deviations of these parameters in
+a form that could be checked, so none is attributed to a source. **W at the larger
+amplitude**: Peterka 2002 reports that the proprioceptive weight falls as the surface-tilt
+amplitude grows (eyes closed); the size of the fall here (0.2 on average from 1° to 4°,
+standard deviation 0.05 between subjects) is this page's assumption, not a number read from
+that paper.
 
 **Torque feedback is omitted.** The issue asks for the slow positive torque feedback among
 the spreads (PMC5664365 Table 1 gives K_F = 0.0018 rad/N·m and τ_F = 17.4 s); posturelab
 models it (``torque_feedback_gain``, ``torque_feedback_time_constant``) on the reference
-engine only: the compiled engine refuses it, and 240 reference-engine trials (80 per seed) do not
-fit this page's time. The virtual subjects therefore have none (gain 0), and the fitted
+engine only: the compiled engine refuses it, and 240 reference-engine trials (80 per
+seed) do not fit this page's time. The virtual subjects therefore have none (gain 0), and the fitted
 model has none either.
 
 **Spread over seeds.** The whole study (new subjects, new noise) is run for ``SEEDS`` seeds;
