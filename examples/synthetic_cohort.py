@@ -34,9 +34,9 @@ that paper.
 **Torque feedback is omitted.** The issue asks for the slow positive torque feedback among
 the spreads (PMC5664365 Table 1 gives K_F = 0.0018 rad/N·m and τ_F = 17.4 s); posturelab
 models it (``torque_feedback_gain``, ``torque_feedback_time_constant``) on the reference
-engine only: the compiled engine refuses it, and 240 reference-engine trials (80 per
-seed) do not fit this page's time. The virtual subjects therefore have none (gain 0), and the fitted
-model has none either.
+engine only: the compiled engine refuses it, and 240 reference-engine trials (80 per seed)
+do not fit this page's time. The virtual subjects therefore have none (gain 0), and the
+fitted model has none either.
 
 **Spread over seeds.** The whole study (new subjects, new noise) is run for ``SEEDS`` seeds;
 every number printed is the mean over the seeds ± their standard deviation. The figure
