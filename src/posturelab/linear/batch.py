@@ -95,7 +95,6 @@ __all__ = [
     "STABILITY_MARGIN",
     "GRID_PARAMETERS",
     "GRID_PARAMETER_UNITS",
-    "BodyArrays",
     "BatchLinearAnalysis",
     "ParameterRange",
     "ParameterGrid",

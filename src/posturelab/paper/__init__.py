@@ -1,7 +1,8 @@
 """The ankle-strategy paper: its printed numbers, captions and errata (:mod:`.printed`), the
 comparison of printed and computed values (:mod:`.compare`) and the reproduction report,
 imported on first use: its runs (:mod:`.runs`), checks and findings as data
-(:mod:`.checks`, :mod:`.findings`), figures (:mod:`.figures`) and the page rendered from
+(:mod:`posturelab.paper.checks`, :mod:`.findings`), figures (:mod:`.figures`) and the page
+rendered from
 ``templates/report.html.j2`` (:mod:`.report`)."""
 
 from .._lazy import submodule_getattr  # noqa: E402

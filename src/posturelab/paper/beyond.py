@@ -5,7 +5,8 @@ experiment fitted back.
 
 The two searches, :func:`recovery_finding` and :func:`delay_finding`, take their simulation
 runner as one parameter (:func:`ramp_and_hold_run`, :func:`delayed_run`), so that the engine
-they run on is changed in one place. :mod:`.checks` gathers these with the figure verdicts.
+they run on is changed in one place. :mod:`posturelab.paper.checks` gathers these with the
+figure verdicts.
 """
 
 from __future__ import annotations

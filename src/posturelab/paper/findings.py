@@ -1,7 +1,7 @@
 """The findings beyond the paper, as data: each finding holds its numbers and says
 itself in words (``text``), as the reproduction report prints it.
 
-The findings are computed in :mod:`.checks`; this module only holds them.
+The findings are computed in :mod:`posturelab.paper.checks`; this module only holds them.
 """
 
 from __future__ import annotations

@@ -5,7 +5,7 @@ One call computes Table II (printed beside computed, disagreements flagged
 with their erratum), the disturbance-severity vector J⁻¹H (at upright and at
 the flexed initial posture), runs the four built-in paper scenarios
 (Figs. 3–10) and the real one-sided gastrocnemius in the forward case
-(:mod:`.runs`), computes the verdicts and the findings (:mod:`.checks`), draws
+(:mod:`.runs`), computes the verdicts and the findings (:mod:`posturelab.paper.checks`), draws
 Figs. 3–10 (:mod:`.figures`), and writes into a directory:
 
 * ``index.html`` — self-contained (figures embedded as base64 PNG), rendered

@@ -2,7 +2,7 @@
 (Figs. 3–10) and the runs added beyond the paper.
 
 :func:`run_paper` runs them once; :class:`PaperRuns` holds the results, which
-:mod:`.checks` turns into verdicts and findings and :mod:`.figures` draws.
+:mod:`posturelab.paper.checks` turns into verdicts and findings and :mod:`.figures` draws.
 """
 
 from __future__ import annotations
