@@ -54,15 +54,20 @@ RTOL = 1e-6
 REF_RTOL, REF_ATOL = 1e-10, 1e-12
 
 
-def median_time(fn, repeats: int) -> float:
-    """Median wall time of ``fn()`` over ``repeats`` calls after one warm-up call. [s]"""
+def wall_times(fn, repeats: int) -> list[float]:
+    """Wall times of ``repeats`` calls of ``fn()`` after one warm-up call. [s]"""
     fn()
     times = []
     for _ in range(repeats):
         t0 = time.perf_counter()
         fn()
         times.append(time.perf_counter() - t0)
-    return statistics.median(times)
+    return times
+
+
+def median_time(fn, repeats: int) -> float:
+    """Median wall time of ``fn()`` over ``repeats`` calls after one warm-up call. [s]"""
+    return statistics.median(wall_times(fn, repeats))
 
 
 def numpy_rhs(body, muscles):
