@@ -401,7 +401,11 @@ def _muscles(mt: dict, body: Body, origin: str, names: Mapping[str, str] | None
     if len(given) != 1:
         choices = ", ".join(name(k) for k in ("case", "stiffness", "pairs", "controller")
                             if names is None or f"muscles.{k}" in names)
-        raise _error(origin, f"[muscles] needs exactly one of {choices}")
+        where = "[muscles]" if names is None else "the muscles"
+        given_words = f" (given: {', '.join(name(k) for k in given)})" if given else ""
+        raise _error(origin, f"{where} need exactly one of {choices}{given_words}"
+                     if names is not None else f"{where} needs exactly one of {choices}"
+                     f"{given_words}")
     for a, b in (("viscosity", "viscosity_ratio"),
                  ("active_viscosity", "active_viscosity_ratio")):
         if a in mt and b in mt:
