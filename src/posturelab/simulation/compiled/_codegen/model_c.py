@@ -1,7 +1,8 @@
 """Writes ``csrc/pl_model.c``: the switched model in C for any N — the inputs (platform
 acceleration, tilt, axis translation, delayed moments, motor noise), the right-hand side
-(``pl_rhs_general``, the knee impact ``pl_project_velocity``, the dispatch to the small-N code)
-and each event's value (``pl_event_value``).
+(``pl_rhs_general``, the knee impact ``pl_project_velocity``, the dispatch to the small-N code),
+each event's value (``pl_event_value``), what a switch does (``pl_apply_switch``,
+``pl_switch_needs_feedback``) and which slots a segment lists (``pl_slot_on``).
 
 The loops and the packing are written here; every formula is evaluated from its one statement
 in :mod:`posturelab.model` on sympy symbols named as C expressions (:mod:`.spec`) and printed.
