@@ -194,6 +194,11 @@ SLOT_CONDITIONS = {
 }
 
 
+#: The kinds whose side is the joint's saturation at the segment's start (a joint lets go
+#: from the side it is saturated at); every other kind keeps its slot's side.
+SIDE_IS_SATURATION = frozenset({LETS_GO})
+
+
 def slot_on(condition: int, index: int, saturation, active, locked) -> bool:
     """Whether a slot with ``condition`` (at joint or pair ``index``) is part of a segment
     that starts with joint ``saturation`` (N,), pairs ``active`` (P,) and the knee
@@ -297,7 +302,7 @@ def segment_events(slots: EventSlots, saturation: np.ndarray, active: np.ndarray
     for k, i, sd, c in zip(slots.kind.tolist(), slots.index.tolist(), slots.side.tolist(),
                            slots.condition.tolist(), strict=True):
         if slot_on(c, i, saturation, active, locked):
-            out.append((k, i, float(saturation[i]) if k == LETS_GO else sd))
+            out.append((k, i, float(saturation[i]) if k in SIDE_IS_SATURATION else sd))
     return out
 
 

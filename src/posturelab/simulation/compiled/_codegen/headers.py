@@ -203,4 +203,5 @@ void pl_apply_switch(const pl_run *run, int64_t kind, int64_t j, double side,
                      const double *feedback, double *x, double *active, double *sat,
                      int *locked, double *work);
 int pl_slot_on(int64_t cond, int64_t i, const double *sat, const double *active, int locked);
+double pl_slot_side(int64_t kind, int64_t i, double side, const double *sat);
 """

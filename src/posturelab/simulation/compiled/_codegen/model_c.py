@@ -2,7 +2,8 @@
 acceleration, tilt, axis translation, delayed moments, motor noise), the right-hand side
 (``pl_rhs_general``, the knee impact ``pl_project_velocity``, the dispatch to the small-N code),
 each event's value (``pl_event_value``), what a switch does (``pl_apply_switch``,
-``pl_switch_needs_feedback``) and which slots a segment lists (``pl_slot_on``).
+``pl_switch_needs_feedback``) and which slots a segment lists, with which side
+(``pl_slot_on``, ``pl_slot_side``).
 
 The loops and the packing are written here; every formula is evaluated from its one statement
 in :mod:`posturelab.model` on sympy symbols named as C expressions (:mod:`.spec`) and printed.
@@ -521,8 +522,9 @@ def _kind_case(code: int) -> str:
 
 
 def _switch_effects() -> str:
-    """pl_switch_needs_feedback, pl_apply_switch and pl_slot_on, from
-    model.switched.SWITCH_EFFECTS and its functions, and model.events.SLOT_CONDITIONS."""
+    """pl_slot_side, pl_switch_needs_feedback, pl_apply_switch and pl_slot_on, from
+    model.switched.SWITCH_EFFECTS and its functions, and model.events.SIDE_IS_SATURATION and
+    SLOT_CONDITIONS."""
     stretch_rate, side = symbols("sd", "side")
     x0, stop_angle = symbols("x[0]", "stop_angle")
     groups: dict = {}
@@ -559,7 +561,21 @@ def _switch_effects() -> str:
         if negated:
             test = f"!({test})" if compare is not None else f"!{test}"
         conds.append(f"    case COND_{ev.CONDITION_NAMES[code]}: return {test};")
+    from_saturation = [_kind_case(k) for k in sorted(ev.SIDE_IS_SATURATION)]
     return f"""
+/* The side of an event slot of kind `kind` at joint or pair i in a segment that starts with
+ * joint saturation `sat` (model.events.SIDE_IS_SATURATION: a joint lets go from the side it
+ * is saturated at), else the slot's `side`. */
+double pl_slot_side(int64_t kind, int64_t i, double side, const double *sat)
+{{
+    switch (kind) {{
+{chr(10).join(from_saturation)}
+        return sat[i];
+    default:
+        return side;
+    }}
+}}
+
 /* Whether switch `kind` reads the state the muscles respond to (model.switched.SWITCH_EFFECTS:
  * a pair's activity follows its fed-back stretch rate). */
 int pl_switch_needs_feedback(int64_t kind)

@@ -90,7 +90,7 @@ static int alloc_buffers(buffers *b, int64_t n, int64_t p, int64_t n_nodes, int6
 }
 
 /* The events of a smooth segment: the slots (posturelab.model.events.event_slots) whose
- * condition holds now (pl_slot_on, generated), in slot order. */
+ * condition holds now (pl_slot_on, with pl_slot_side: generated), in slot order. */
 static int64_t segment_events(const pl_run *run, const double *sat, const double *active,
                               int locked, int64_t *kind, int64_t *index, double *side)
 {
@@ -101,7 +101,7 @@ static int64_t segment_events(const pl_run *run, const double *sat, const double
             continue;
         kind[k] = run->slot_kind[s];
         index[k] = i;
-        side[k] = run->slot_kind[s] == EV_LETS_GO ? sat[i] : run->slot_side[s];
+        side[k] = pl_slot_side(run->slot_kind[s], i, run->slot_side[s], sat);
         k++;
     }
     return k;

@@ -411,6 +411,19 @@ double pl_event_value(const pl_ctx *cx, int64_t kind, int64_t idx, double side, 
     return g + cx->ev_offset[kind];
 }
 
+/* The side of an event slot of kind `kind` at joint or pair i in a segment that starts with
+ * joint saturation `sat` (model.events.SIDE_IS_SATURATION: a joint lets go from the side it
+ * is saturated at), else the slot's `side`. */
+double pl_slot_side(int64_t kind, int64_t i, double side, const double *sat)
+{
+    switch (kind) {
+    case EV_LETS_GO:
+        return sat[i];
+    default:
+        return side;
+    }
+}
+
 /* Whether switch `kind` reads the state the muscles respond to (model.switched.SWITCH_EFFECTS:
  * a pair's activity follows its fed-back stretch rate). */
 int pl_switch_needs_feedback(int64_t kind)
