@@ -77,3 +77,26 @@ def test_a_formula_means_the_same_on_numpy_and_on_sympy(name, formula, params, t
         numeric = numeric if isinstance(numeric, tuple) else (numeric,)
         np.testing.assert_allclose(np.array(evaluate(*values), dtype=float),
                                    np.array(numeric, dtype=float), rtol=1e-12, atol=1e-12)
+
+
+def test_a_switch_means_the_same_on_numpy_and_on_sympy():
+    """What each switch sets (the generated pl_apply_switch prints these on sympy symbols)
+    equals what the reference engine sets, including a stretch rate of exactly zero."""
+    import sympy as sp
+
+    from posturelab.model import switched
+    from posturelab.simulation.compiled._codegen.spec import SYMPY
+
+    rate, side, shank, stop = sp.symbols("rate side shank stop", real=True)
+    for kind, effect in switched.SWITCH_EFFECTS.items():
+        for r, s in [(-0.3, 1.0), (0.0, -1.0), (0.7, 1.0)]:
+            if effect == "active":
+                symbolic = switched.pair_activity_after(kind, rate, SYMPY.where)
+                assert float(sp.sympify(symbolic).subs(rate, r)) == \
+                    switched.pair_activity_after(kind, r)
+            elif effect == "saturation":
+                symbolic = switched.saturation_after(kind, side)
+                assert float(sp.sympify(symbolic).subs(side, s)) == \
+                    switched.saturation_after(kind, s)
+    assert float(switched.knee_angle_at_stop(shank, stop).subs({shank: 0.1, stop: -0.2})) \
+        == switched.knee_angle_at_stop(0.1, -0.2)

@@ -46,6 +46,7 @@ the constant added to the physical part.
 
 from __future__ import annotations
 
+import operator
 from dataclasses import dataclass
 
 import numpy as np
@@ -175,6 +176,39 @@ PAIR_ACTIVE = 3
 PAIR_SLACK = 4
 KNEE_FREE = 5
 KNEE_LOCKED = 6
+#: The conditions' names, by code.
+CONDITION_NAMES = ("ALWAYS", "JOINT_FREE", "JOINT_SATURATED", "PAIR_ACTIVE", "PAIR_SLACK",
+                   "KNEE_FREE", "KNEE_LOCKED")
+
+#: When each condition holds, stated once for both engines (the C is generated from it):
+#: condition -> (the segment's switch it reads, at the slot's index unless "locked";
+#: the comparison; the value compared with; whether the comparison is negated). [-]
+SLOT_CONDITIONS = {
+    ALWAYS: (None, None, None, False),
+    JOINT_FREE: ("saturation", operator.eq, 0.0, False),
+    JOINT_SATURATED: ("saturation", operator.ne, 0.0, False),
+    PAIR_ACTIVE: ("active", operator.gt, 0.0, False),
+    PAIR_SLACK: ("active", operator.gt, 0.0, True),
+    KNEE_FREE: ("locked", None, None, True),
+    KNEE_LOCKED: ("locked", None, None, False),
+}
+
+
+#: The kinds whose side is the joint's saturation at the segment's start (a joint lets go
+#: from the side it is saturated at); every other kind keeps its slot's side.
+SIDE_IS_SATURATION = frozenset({LETS_GO})
+
+
+def slot_on(condition: int, index: int, saturation, active, locked) -> bool:
+    """Whether a slot with ``condition`` (at joint or pair ``index``) is part of a segment
+    that starts with joint ``saturation`` (N,), pairs ``active`` (P,) and the knee
+    ``locked`` (:data:`SLOT_CONDITIONS`)."""
+    switch, compare, value, negated = SLOT_CONDITIONS[condition]
+    if switch is None:
+        return True
+    held = {"saturation": saturation, "active": active}.get(switch)
+    on = bool(locked) if held is None else bool(compare(held[index], value))
+    return on != negated
 
 
 @dataclass(frozen=True)
@@ -264,15 +298,11 @@ def segment_events(slots: EventSlots, saturation: np.ndarray, active: np.ndarray
                    locked: bool) -> list[tuple[int, int, float]]:
     """The (kind, index, side) of each event of a smooth segment that starts with joint
     saturation ``saturation`` (N,), pairs ``active`` (P,) and the knee ``locked``."""
-    on = {ALWAYS: lambda i: True, JOINT_FREE: lambda i: saturation[i] == 0.0,
-          JOINT_SATURATED: lambda i: saturation[i] != 0.0,
-          PAIR_ACTIVE: lambda i: active[i] > 0.0, PAIR_SLACK: lambda i: not active[i] > 0.0,
-          KNEE_FREE: lambda i: not locked, KNEE_LOCKED: lambda i: bool(locked)}
     out = []
     for k, i, sd, c in zip(slots.kind.tolist(), slots.index.tolist(), slots.side.tolist(),
                            slots.condition.tolist(), strict=True):
-        if on[c](i):
-            out.append((k, i, float(saturation[i]) if k == LETS_GO else sd))
+        if slot_on(c, i, saturation, active, locked):
+            out.append((k, i, float(saturation[i]) if k in SIDE_IS_SATURATION else sd))
     return out
 
 

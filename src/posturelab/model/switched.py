@@ -452,30 +452,52 @@ def event_value(model: SwitchedModel, kind: int, j: int, side: float, t: float, 
 # ---------------------------------------------------------------------------
 
 
-def pair_activity_after(kind: int, stretch_rate: float) -> float:
+#: What each switch changes, stated once for both engines (the C of ``pl_apply_switch`` is
+#: generated from it): "active" (pair j, :func:`pair_activity_after`), "saturation" (joint j,
+#: :func:`saturation_after`), "knee impact" (:func:`knee_impact`, the knee locks) or
+#: "knee free" (the knee lets go). Falls change nothing.
+SWITCH_EFFECTS = {
+    ev.PAIR_SLACKENS: "active", ev.PAIR_ENGAGES: "active",
+    ev.PAIR_PUSHES: "active", ev.PAIR_PULLS: "active",
+    ev.SATURATES: "saturation", ev.LETS_GO: "saturation",
+    ev.KNEE_HITS_STOP: "knee impact", ev.KNEE_LEAVES_STOP: "knee free",
+}
+
+
+def _where(condition, if_true, if_false):
+    return if_true if condition else if_false
+
+
+def pair_activity_after(kind: int, stretch_rate, where=_where):
     """Whether a pair acts after its event ``kind`` fired: after a stretch event if its
     (fed-back) stretch is growing, ``stretch_rate`` [rad/s] >= 0; slack after PAIR_PUSHES;
-    acting after PAIR_PULLS (stretched, and pulling). [-]"""
+    acting after PAIR_PULLS (stretched, and pulling). ``where(condition, a, b)`` chooses
+    (the generator passes a symbolic one). [-]"""
     if kind == ev.PAIR_PUSHES:
         return 0.0
     if kind == ev.PAIR_PULLS:
         return 1.0
-    return 1.0 if stretch_rate >= 0 else 0.0
+    return where(stretch_rate >= 0, 1.0, 0.0)
 
 
-def saturation_after(kind: int, side: float) -> float:
+def saturation_after(kind: int, side):
     """A joint's saturation after SATURATES (its side, ±1) or LETS_GO (0). [-]"""
     return side if kind == ev.SATURATES else 0.0
 
 
+def knee_angle_at_stop(shank_angle, stop_angle):
+    """Link 2's angle when the knee reaches its stop, from link 1's. [rad]"""
+    return shank_angle + stop_angle
+
+
 def knee_impact(body: Body, x: np.ndarray, stop_angle: float, knee_row: np.ndarray
                 ) -> np.ndarray:
-    """The state after the knee reaches its stop: the knee angle at the stop, the rates
-    after a plastic impact onto the constraint (:func:`.dynamics.constrained_velocity`).
-    [rad], [rad/s]"""
+    """The state after the knee reaches its stop: the knee angle at the stop
+    (:func:`knee_angle_at_stop`), the rates after a plastic impact onto the constraint
+    (:func:`.dynamics.constrained_velocity`). [rad], [rad/s]"""
     n = body.n_links
     x = np.array(x, dtype=float)
-    x[1] = x[0] + stop_angle
+    x[1] = knee_angle_at_stop(x[0], stop_angle)
     x[n:] = constrained_velocity(body, x[:n], x[n:], knee_row)
     return x
 
@@ -485,18 +507,20 @@ def apply_switch(model: SwitchedModel, kind: int, j: int, side: float, x: np.nda
                  locked: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray, bool]:
     """What switch ``kind`` (index ``j``, side ``side``) does at state ``x`` (2N,), the muscles
     responding to ``feedback`` (2N,): the new (state, active, saturation, locked), new arrays
-    where they change. A stretch event sets pair j's activity (:func:`pair_activity_after`),
-    the knee stop locks the knee after a plastic impact (:func:`knee_impact`) or lets it go, a
-    joint saturates or lets go (:func:`saturation_after`). [rad, rad/s], [-], [-]"""
-    if kind in (ev.PAIR_SLACKENS, ev.PAIR_ENGAGES, ev.PAIR_PUSHES, ev.PAIR_PULLS):
+    where they change (:data:`SWITCH_EFFECTS`). A stretch event sets pair j's activity
+    (:func:`pair_activity_after`), the knee stop locks the knee after a plastic impact
+    (:func:`knee_impact`) or lets it go, a joint saturates or lets go
+    (:func:`saturation_after`). [rad, rad/s], [-], [-]"""
+    effect = SWITCH_EFFECTS.get(kind)
+    if effect == "active":
         n = model.n_links
         active = active.copy()
         active[j] = pair_activity_after(kind, model.muscles.selection_matrix[j] @ feedback[n:])
-    elif kind == ev.KNEE_HITS_STOP:
+    elif effect == "knee impact":
         x, locked = knee_impact(model.body, x, model.knee.stop_angle, model.knee_row), True
-    elif kind == ev.KNEE_LEAVES_STOP:
+    elif effect == "knee free":
         locked = False
-    elif kind in (ev.SATURATES, ev.LETS_GO):
+    elif effect == "saturation":
         saturation = saturation.copy()
         saturation[j] = saturation_after(kind, side)
     return x, active, saturation, locked

@@ -96,8 +96,7 @@ def _model_groups():
     kinds = [(None, "EV_" + k.name.upper().replace("-", "_"), k.code, k.name)
              for k in ev.EVENT_KINDS]
     conditions = [(None, "COND_" + name, getattr(ev, name), "")
-                  for name in ("ALWAYS", "JOINT_FREE", "JOINT_SATURATED", "PAIR_ACTIVE",
-                               "PAIR_SLACK", "KNEE_FREE", "KNEE_LOCKED")]
+                  for name in ev.CONDITION_NAMES]
     rows = [(None, "GAIN_" + name.upper(), getattr(gains, name.upper()), "")
             for name in gains.GAIN_ROWS]
     return [("Event kinds (posturelab.model.events)", kinds),

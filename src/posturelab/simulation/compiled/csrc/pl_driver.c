@@ -90,28 +90,18 @@ static int alloc_buffers(buffers *b, int64_t n, int64_t p, int64_t n_nodes, int6
 }
 
 /* The events of a smooth segment: the slots (posturelab.model.events.event_slots) whose
- * condition holds now, in slot order. */
+ * condition holds now (pl_slot_on, with pl_slot_side: generated), in slot order. */
 static int64_t segment_events(const pl_run *run, const double *sat, const double *active,
                               int locked, int64_t *kind, int64_t *index, double *side)
 {
     int64_t k = 0;
     for (int64_t s = 0; s < run->n_slots; s++) {
         const int64_t i = run->slot_index[s];
-        int on;
-        switch (run->slot_cond[s]) {
-        case COND_JOINT_FREE: on = sat[i] == 0.0; break;
-        case COND_JOINT_SATURATED: on = sat[i] != 0.0; break;
-        case COND_PAIR_ACTIVE: on = active[i] > 0.0; break;
-        case COND_PAIR_SLACK: on = !(active[i] > 0.0); break;
-        case COND_KNEE_FREE: on = !locked; break;
-        case COND_KNEE_LOCKED: on = locked; break;
-        default: on = 1;
-        }
-        if (!on)
+        if (!pl_slot_on(run->slot_cond[s], i, sat, active, locked))
             continue;
         kind[k] = run->slot_kind[s];
         index[k] = i;
-        side[k] = run->slot_kind[s] == EV_LETS_GO ? sat[i] : run->slot_side[s];
+        side[k] = pl_slot_side(run->slot_kind[s], i, run->slot_side[s], sat);
         k++;
     }
     return k;
@@ -190,7 +180,7 @@ int64_t pl_integrate(const pl_run *run, pl_out *out)
     const int64_t n = run->n, m = 2 * n, T = run->n_grid, width = 2 + n;
     const double *fpar = run->fpar, *grid = run->grid;
     const double rtol = fpar[F_RTOL], atol = fpar[F_ATOL], duration = fpar[F_DURATION];
-    const double settle_tol = fpar[F_SETTLE_TOL], stop_angle = fpar[F_STOP_ANGLE];
+    const double settle_tol = fpar[F_SETTLE_TOL];
     const double delay = run->delay;
     double max_step = fpar[F_MAX_STEP];
     const int overlapping = delay > 0.0 && delay < OVERLAP_BELOW;
@@ -519,38 +509,15 @@ int64_t pl_integrate(const pl_run *run, pl_out *out)
                 status = PL_CHATTERING;
                 break;
             }
-            if (kind == EV_PAIR_SLACKENS || kind == EV_PAIR_ENGAGES || kind == EV_PAIR_PUSHES
-                || kind == EV_PAIR_PULLS) {
-                /* stretch events: the pair acts if its (fed-back) stretch is now growing; a
-                 * pull-only pair goes slack when it would push, and acts again when it pulls
-                 * while stretched */
-                const double *s = x;
-                if (delay > 0.0) {
-                    pl_history_at(&hist, run->before, t_ev - delay, b.sc_x);
-                    s = b.sc_x;
-                }
-                double st = 0.0, sd = 0.0;
-                for (int64_t k = 0; k < n; k++) {
-                    st += run->E[j * n + k] * s[k];
-                    sd += run->E[j * n + k] * s[n + k];
-                }
-                if (kind == EV_PAIR_PUSHES)
-                    b.active[j] = 0.0;
-                else if (kind == EV_PAIR_PULLS)
-                    b.active[j] = 1.0;
-                else
-                    b.active[j] = sd >= 0.0 ? 1.0 : 0.0;
-            } else if (kind == EV_KNEE_HITS_STOP) {
-                x[1] = x[0] + stop_angle;
-                pl_project_velocity(x, run->bp, b.work, n);
-                locked = 1;
-            } else if (kind == EV_KNEE_LEAVES_STOP) {
-                locked = 0;
-            } else if (kind == EV_SATURATES) {
-                b.sat[j] = b.ev_side[ev_hit];
-            } else if (kind == EV_LETS_GO) {
-                b.sat[j] = 0.0;
+            /* what the switch does (pl_apply_switch, generated from model.switched); a
+             * pair's activity follows the state the muscles respond to */
+            const double *feedback = x;
+            if (delay > 0.0 && pl_switch_needs_feedback(kind)) {
+                pl_history_at(&hist, run->before, t_ev - delay, b.sc_x);
+                feedback = b.sc_x;
             }
+            pl_apply_switch(run, kind, j, b.ev_side[ev_hit], feedback, x, b.active, b.sat,
+                            &locked, b.work);
             int stored = 1;  /* the switch's echoes: the muscles feel it τ, 2τ, … later */
             for (int64_t k = 1; delay > 0.0 && k <= run->delay_multiples; k++)
                 if (t_ev + k * delay < duration)

@@ -410,3 +410,98 @@ double pl_event_value(const pl_ctx *cx, int64_t kind, int64_t idx, double side, 
     }
     return g + cx->ev_offset[kind];
 }
+
+/* The side of an event slot of kind `kind` at joint or pair i in a segment that starts with
+ * joint saturation `sat` (model.events.SIDE_IS_SATURATION: a joint lets go from the side it
+ * is saturated at), else the slot's `side`. */
+double pl_slot_side(int64_t kind, int64_t i, double side, const double *sat)
+{
+    switch (kind) {
+    case EV_LETS_GO:
+        return sat[i];
+    default:
+        return side;
+    }
+}
+
+/* Whether switch `kind` reads the state the muscles respond to (model.switched.SWITCH_EFFECTS:
+ * a pair's activity follows its fed-back stretch rate). */
+int pl_switch_needs_feedback(int64_t kind)
+{
+    switch (kind) {
+    case EV_PAIR_SLACKENS:
+    case EV_PAIR_ENGAGES:
+    case EV_PAIR_PUSHES:
+    case EV_PAIR_PULLS:
+        return 1;
+    default:
+        return 0;
+    }
+}
+
+/* What switch `kind` (index j, side `side`) does (model.switched.apply_switch): x, active,
+ * sat and *locked updated in place, `feedback` the state the muscles respond to (x, or the
+ * delayed state), `work` pl_project_velocity's scratch. */
+void pl_apply_switch(const pl_run *run, int64_t kind, int64_t j, double side,
+                     const double *feedback, double *x, double *active, double *sat,
+                     int *locked, double *work)
+{
+    const int64_t n = run->n;
+    const double stop_angle = run->fpar[F_STOP_ANGLE];
+    (void)side;
+    (void)feedback;
+    (void)stop_angle;
+    switch (kind) {
+    case EV_PAIR_SLACKENS:
+    case EV_PAIR_ENGAGES: {
+        double sd = 0.0;
+        for (int64_t k = 0; k < n; k++)
+            sd += run->E[j * n + k] * feedback[n + k];
+        active[j] = ((sd >= 0.0) ? (1.0) : (0.0));
+        break;
+    }
+    case EV_PAIR_PUSHES: {
+        active[j] = 0.0;
+        break;
+    }
+    case EV_PAIR_PULLS: {
+        active[j] = 1.0;
+        break;
+    }
+    case EV_SATURATES: {
+        sat[j] = side;
+        break;
+    }
+    case EV_LETS_GO: {
+        sat[j] = 0.0;
+        break;
+    }
+    case EV_KNEE_HITS_STOP: {
+        x[1] = stop_angle + x[0];
+        pl_project_velocity(x, run->bp, work, n);
+        *locked = 1;
+        break;
+    }
+    case EV_KNEE_LEAVES_STOP: {
+        *locked = 0;
+        break;
+    }
+    default:
+        break;
+    }
+}
+
+/* Whether an event slot with condition `cond` (at joint or pair i) is part of a segment that
+ * starts with these switches (model.events.SLOT_CONDITIONS). */
+int pl_slot_on(int64_t cond, int64_t i, const double *sat, const double *active, int locked)
+{
+    switch (cond) {
+    case COND_JOINT_FREE: return sat[i] == 0.0;
+    case COND_JOINT_SATURATED: return sat[i] != 0.0;
+    case COND_PAIR_ACTIVE: return active[i] > 0.0;
+    case COND_PAIR_SLACK: return !(active[i] > 0.0);
+    case COND_KNEE_FREE: return !locked;
+    case COND_KNEE_LOCKED: return locked;
+    default: return 1;
+    }
+}

@@ -158,4 +158,12 @@ void pl_inputs_at(const pl_ctx *cx, double t, double *out);
 double pl_event_value(const pl_ctx *cx, int64_t kind, int64_t idx, double side, double t,
                       const double *y, int locked);
 
+/* what a switch does, which slots a segment lists (pl_model.c) */
+int pl_switch_needs_feedback(int64_t kind);
+void pl_apply_switch(const pl_run *run, int64_t kind, int64_t j, double side,
+                     const double *feedback, double *x, double *active, double *sat,
+                     int *locked, double *work);
+int pl_slot_on(int64_t cond, int64_t i, const double *sat, const double *active, int locked);
+double pl_slot_side(int64_t kind, int64_t i, double side, const double *sat);
+
 #endif
