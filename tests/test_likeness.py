@@ -177,3 +177,16 @@ def test_the_likeness_commands(tmp_path, rng):
 def json_frf(path):
     obj = json.loads(open(path).read())
     return np.array([z["re"] + 1j * z["im"] for z in obj["frf"]])
+
+
+def test_a_negative_or_zero_scale_is_refused_in_one_line():
+    """The scale is a peak-to-peak amplitude: a negative one would flip the FRF's sign
+    silently (the sign belongs to the response sign)."""
+    from posturelab.frequency.likeness import likeness, likeness_reference
+
+    ref = likeness_reference("comtest-eyes-closed")
+    frf = np.asarray(ref.mean)
+    assert likeness(frf, ref, scale=1.0).score == pytest.approx(0.0, abs=1e-9)
+    for bad in (-1.0, 0.0):
+        with pytest.raises(ParameterError, match="scale"):
+            likeness(frf, ref, scale=bad)

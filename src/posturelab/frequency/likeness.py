@@ -194,9 +194,10 @@ def likeness(frf, reference: LikenessReference, *, scale: float = 1.0) -> Likene
     """
     from .._validation import float_in_range
 
-    k = float_in_range("scale", scale, -1e9, 1e9)
-    if k == 0:
-        raise ParameterError("scale must not be 0")
+    k = float_in_range("scale", scale, 0.0, 1e9)
+    if k == 0:  # a peak-to-peak amplitude; the FRF's sign is the response sign's, not this
+        raise ParameterError("scale must be > 0 (the stimulus's peak-to-peak amplitude; the "
+                             "sign is set by the response sign), got 0")
     if hasattr(frf, "frf") and hasattr(frf, "frequency"):
         f = np.asarray(frf.frequency, dtype=float)
         if f.shape != reference.frequency.shape or not np.allclose(
