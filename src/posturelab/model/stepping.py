@@ -43,6 +43,7 @@ def pendulum_frequency(com_height, gravity=9.81) -> np.ndarray:
 
     Examples
     --------
+    >>> from posturelab.model.stepping import pendulum_frequency
     >>> round(float(pendulum_frequency(0.981)), 4)  # l = 0.981 m: ω0 = √10 [1/s]
     3.1623
     """
@@ -72,6 +73,7 @@ def xcom(position, velocity, omega0) -> np.ndarray:
 
     Examples
     --------
+    >>> from posturelab.model.stepping import xcom
     >>> float(xcom(0.02, 0.1, 4.0))  # 0.02 m + (0.1 m/s)/(4 1/s) [m]
     0.045
     """
@@ -80,12 +82,12 @@ def xcom(position, velocity, omega0) -> np.ndarray:
     return x + v / np.asarray(omega0, dtype=float)
 
 
-def margin_of_stability(xcom_position, heel, toe) -> np.ndarray:
+def margin_of_stability(xcom_position, heel, toe, side: str = "nearer") -> np.ndarray:
     """Hof's margin of stability toward the nearer edge of the base of support. [m]
 
-    b = min(toe − ξ, ξ − heel): positive while the extrapolated centre of mass is over the
-    foot (the distance the centre of pressure can still move to catch it), negative by how
-    far it is beyond the toe (forward) or the heel (backward).
+    b = min(toe − ξ, ξ − heel) (or one side of it): positive while the extrapolated centre of
+    mass is over the foot (the distance the centre of pressure can still move to catch it),
+    negative by how far it is beyond the toe (forward) or the heel (backward).
 
     Parameters
     ----------
@@ -93,18 +95,28 @@ def margin_of_stability(xcom_position, heel, toe) -> np.ndarray:
         ξ (:func:`xcom`). [m]
     heel, toe : float
         The base of support along x, from the ankle: heel < toe. [m]
+    side : {"nearer", "toe", "heel"}
+        ``"toe"``: Hof's b = toe − ξ for forward motion; ``"heel"``: ξ − heel for backward
+        motion; ``"nearer"`` (default): the smaller of the two.
 
     Examples
     --------
-    >>> float(margin_of_stability(0.15, -0.06, 0.19))  # 4 cm in front of ξ is the toe [m]
+    >>> from posturelab.model.stepping import margin_of_stability
+    >>> round(float(margin_of_stability(0.15, -0.06, 0.19)), 6)  # 4 cm in front of ξ is the toe [m]
     0.04
-    >>> float(margin_of_stability(-0.08, -0.06, 0.19))  # 2 cm behind the heel [m]
+    >>> round(float(margin_of_stability(-0.08, -0.06, 0.19)), 6)  # 2 cm behind the heel [m]
     -0.02
     """
     if not float(heel) < float(toe):
         raise ParameterError(f"heel [m] must be behind toe [m], got heel = {heel!r}, "
                              f"toe = {toe!r}")
     xi = np.asarray(xcom_position, dtype=float)
+    if side == "toe":
+        return float(toe) - xi
+    if side == "heel":
+        return xi - float(heel)
+    if side != "nearer":
+        raise ParameterError(f"side must be 'nearer', 'toe' or 'heel', got {side!r}")
     return np.minimum(float(toe) - xi, xi - float(heel))
 
 
@@ -127,6 +139,7 @@ def ankle_moment_cap(strength: float, weight: float, toe: float) -> float:
 
     Examples
     --------
+    >>> from posturelab.model.stepping import ankle_moment_cap
     >>> ankle_moment_cap(264.0, 700.0, 0.2)  # the toe binds [N·m]
     140.0
     >>> ankle_moment_cap(100.0, 700.0, 0.2)  # the muscles bind [N·m]

@@ -102,6 +102,7 @@ def step_verdict(time, xcom_position, heel: float, toe: float, fell: bool = Fals
 
     Examples
     --------
+    >>> from posturelab.studies.stepping import step_verdict
     >>> v = step_verdict([0.0, 0.1, 0.2], [0.0, 0.12, 0.21], heel=-0.06, toe=0.2)
     >>> v.needs_step, round(v.minimum_margin, 3), v.time  # [-], [m], [s]
     (True, -0.01, 0.2)
