@@ -205,6 +205,20 @@ def test_a_threshold_says_what_happened(thresholds):
     assert d["largest_translation"] == r.largest_translation and d["within_two_sd"] is True
 
 
+def test_the_guide_prints_the_thresholds_computed(thresholds):
+    """docs/guide/stepping.rst's table of thresholds is what the study computes (to its
+    printed 0.1 cm)."""
+    from pathlib import Path
+
+    text = (Path(__file__).resolve().parents[1] / "docs" / "guide" / "stepping.rst"
+            ).read_text(encoding="utf-8")
+    for name in ("young", "older"):
+        row = next(line for line in text.splitlines()
+                   if line.startswith(f"{name} ") and "±" in line)
+        printed = float(row.split()[1]) / 100.0
+        assert thresholds[name].largest_translation == pytest.approx(printed, abs=5e-4)
+
+
 def test_threshold_falls_with_the_delay():
     values = [step_threshold(HEIGHT, MASS, "young", feedback_delay=d).largest_translation
               for d in (0.0, 0.05, 0.097, 0.15, 0.2)]

@@ -35,22 +35,35 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--ankle-strength", type=float, default=None, metavar="NM",
                    help="plantarflexion strength of both ankles [N·m] in place of the "
                    "population's.")
+    p.add_argument("--move-duration", type=float, default=None, metavar="S",
+                   help="duration T [s] of each platform move in place of the protocol's 0.5 s "
+                   "(posturelab's assumption).")
+    p.add_argument("--cop-criterion", action="store_true",
+                   help="also count a step when the centre of pressure leaves the foot (the "
+                   "heel would rise or the toes lift).")
     p.add_argument("--sources", action="store_true",
                    help="also print where each number of the population comes from.")
     p.add_argument("--json", action="store_true", help="print one JSON object instead of text.")
 
 
 def run(args: argparse.Namespace) -> int:
+    from dataclasses import replace
+
+    from .._validation import float_in_range
     from ..studies.stepping import PROTOCOL, UNITS, get_population, step_threshold
 
     population = get_population(args.population)
+    protocol = PROTOCOL if args.move_duration is None else replace(
+        PROTOCOL, move_duration=float_in_range("--move-duration [s]", args.move_duration,
+                                               0.05, 10.0, unit="s"))
     result = step_threshold(args.height, args.mass, population, args.direction,
-                            feedback_delay=args.feedback_delay,
-                            ankle_strength=args.ankle_strength)
+                            protocol=protocol, feedback_delay=args.feedback_delay,
+                            ankle_strength=args.ankle_strength,
+                            cop_criterion=args.cop_criterion)
     out = result.to_dict()
     if args.json:
         out["units"] = UNITS
-        out["protocol"] = PROTOCOL.citation
+        out["protocol"] = protocol.citation
         if args.sources:
             out["sources"] = population.provenance_text()
         print_json(out)
@@ -65,6 +78,9 @@ def run(args: argparse.Namespace) -> int:
     print(f"  τ = {result.feedback_delay * 1000:.0f} ms, ankle strength "
           f"{result.ankle_strength:.0f} N·m (cap {result.ankle_moment_cap:.0f} N·m), foot "
           f"{result.heel * cm:.1f} … {result.toe * cm:.1f} cm, ω0 = {result.omega0:.2f} 1/s")
+    if result.cop_overrun > 0.0:
+        print(f"  the centre of pressure went {result.cop_overrun * cm:.1f} cm beyond the foot "
+              "at the threshold (the moment cap is the same both ways; see the guide)")
     if result.published_mean is not None:
         verdict = "within" if result.within_two_sd else "outside"
         print(f"published: {result.published_mean * cm:.1f} ± {result.published_sd * cm:.1f} "

@@ -208,7 +208,17 @@ PROTOCOL = PlatformProtocol(
 
 @dataclass(frozen=True)
 class PublishedThreshold:
-    """A published largest translation without a step: mean ± SD. [m]"""
+    """A published largest translation without a step.
+
+    Attributes
+    ----------
+    mean, sd : float
+        Group mean and standard deviation as printed. [m]
+    n : int
+        Subjects in the group. [-]
+    source : str
+        The citation and where in it.
+    """
 
     mean: float
     sd: float

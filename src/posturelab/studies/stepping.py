@@ -60,6 +60,9 @@ __all__ = ["StepThreshold", "RunVerdict", "step_threshold", "step_verdict", "DIR
 DIRECTIONS = ("backward", "forward")
 #: Output samples per second of each run (the XCoM is judged at these samples). [Hz]
 SAMPLE_RATE = 500.0
+#: How far the centre of pressure may pass an end of the foot before ``cop_criterion`` counts
+#: a step (the cap m g × toe is static; the vertical force varies a little). [m]
+COP_TOLERANCE = 0.001
 
 
 @dataclass(frozen=True)
@@ -162,6 +165,10 @@ class StepThreshold:
         Smallest margin of stability in the run at ``largest_translation``. [m]
     xcom_at_response_onset : float
         ξ at t = τ (when the neural response starts) in that run, from the ankle. [m]
+    cop_overrun : float
+        How far the centre of pressure went beyond the foot (either end) in that run, 0 if
+        it stayed on it: the engine's moment cap is the same both ways, so the dorsiflexors
+        may pull it behind the heel, where a real foot's toes would lift. [m]
     n_simulations : int
         Runs made. [-]
     published_mean, published_sd : float or None
@@ -189,6 +196,7 @@ class StepThreshold:
     omega0: float
     minimum_margin: float
     xcom_at_response_onset: float
+    cop_overrun: float
     n_simulations: int
     published_mean: float | None
     published_sd: float | None
@@ -215,13 +223,14 @@ UNITS = {"largest_translation": "m", "smallest_stepping": "m", "height": "m", "m
          "move_duration": "s", "peak_velocity": "m/s", "peak_acceleration": "m/s²",
          "feedback_delay": "s", "ankle_strength": "N·m", "ankle_moment_cap": "N·m",
          "heel": "m", "toe": "m", "com_height": "m", "omega0": "1/s", "minimum_margin": "m",
-         "xcom_at_response_onset": "m", "published_mean": "m", "published_sd": "m"}
+         "xcom_at_response_onset": "m", "cop_overrun": "m", "published_mean": "m",
+         "published_sd": "m"}
 
 
 def step_threshold(height: float, mass: float, population: str | Population = "young",
                    direction: str = "backward", *, protocol: PlatformProtocol = PROTOCOL,
                    feedback_delay: float | None = None, ankle_strength: float | None = None,
-                   engine: str = "compiled") -> StepThreshold:
+                   cop_criterion: bool = False, engine: str = "compiled") -> StepThreshold:
     """The largest platform translation a subject withstands without stepping.
 
     Parameters
@@ -238,6 +247,10 @@ def step_threshold(height: float, mass: float, population: str | Population = "y
         τ in place of the population's. [s]
     ankle_strength : float, optional
         Plantarflexion strength of both ankles in place of the population's. [N·m]
+    cop_criterion : bool
+        Also count a step when the centre of pressure leaves the foot by more than
+        :data:`COP_TOLERANCE` (the heel would rise or the toes lift): stricter than Hof's
+        criterion, and a check on the both-ways moment cap (see ``cop_overrun``).
     engine : {"compiled", "reference"}
         The simulator.
 
@@ -252,11 +265,10 @@ def step_threshold(height: float, mass: float, population: str | Population = "y
     UnknownNameError
         An unknown population (listing the known ones).
     """
-    import posturelab as pl
-
-    from ..model.anthropometry import one_link
+    from ..model.anthropometry import body_from_anthropometry, one_link
     from ..model.options import FallCriteria, base_of_support_for_height
     from ..model.stepping import ankle_moment_cap, pendulum_frequency, xcom
+    from ..simulation.engines import simulate
 
     h = float_in_range("height [m]", height, *HEIGHT_RANGE, unit="m")
     m = float_in_range("mass [kg]", mass, *MASS_RANGE, unit="kg")
@@ -268,7 +280,7 @@ def step_threshold(height: float, mass: float, population: str | Population = "y
         "feedback_delay [s]", feedback_delay, 0.0, 1.0, unit="s")
     strength = pop.ankle_strength if ankle_strength is None else positive_float(
         "ankle_strength [N·m]", ankle_strength)
-    body = one_link(pl.body_from_anthropometry(h, m))
+    body = one_link(body_from_anthropometry(h, m))
     foot = base_of_support_for_height(h)
     weight = body.total_mass * body.gravity
     cap = ankle_moment_cap(strength, weight, foot.toe)
@@ -281,7 +293,7 @@ def step_threshold(height: float, mass: float, population: str | Population = "y
     def trial(size: float):
         nonlocal count
         count += 1
-        run = pl.simulate(body, muscles, protocol.disturbance(sign * size),
+        run = simulate(body, muscles, protocol.disturbance(sign * size),
                           duration=protocol.move_duration + protocol.settle_time,
                           feedback_delay=delay, proprioceptive_weight=pop.proprioceptive_weight,
                           torque_limits=(cap,), fall=FallCriteria(base_of_support=foot),
@@ -289,8 +301,18 @@ def step_threshold(height: float, mass: float, population: str | Population = "y
         if run.status == "failed":
             raise PostureLabError(f"the run at a {size:g} m translation failed: {run.message}")
         xi = xcom(run.cog_position[:, 0], run.cog_velocity[:, 0], omega0)
-        return run, xi, step_verdict(run.time, xi, foot.heel, foot.toe, run.fell,
-                                     run.fall_reason, run.fall_time)
+        verdict = step_verdict(run.time, xi, foot.heel, foot.toe, run.fell, run.fall_reason,
+                               run.fall_time)
+        if cop_criterion and not verdict.needs_step:
+            cop = run.centre_of_pressure
+            off = np.flatnonzero((cop > foot.toe + COP_TOLERANCE)
+                                 | (cop < foot.heel - COP_TOLERANCE))
+            if off.size:
+                i = int(off[0])
+                verdict = RunVerdict(True, f"the centre of pressure reached {cop[i]:.3f} m, off "
+                                     f"the foot, at t = {run.time[i]:.3f} s",
+                                     float(run.time[i]), verdict.minimum_margin)
+        return run, xi, verdict
 
     low, high, reason = 0.0, math.inf, ""
     size = protocol.increment
@@ -311,8 +333,10 @@ def step_threshold(height: float, mass: float, population: str | Population = "y
         run, xi, verdict = trial(low)
         onset = float(np.interp(delay, run.time, xi))
         margin = verdict.minimum_margin
+        cop = run.centre_of_pressure
+        overrun = float(max(0.0, np.nanmax(cop) - foot.toe, foot.heel - np.nanmin(cop)))
     else:
-        onset, margin = 0.0, min(foot.toe, -foot.heel)
+        onset, margin, overrun = 0.0, min(foot.toe, -foot.heel), 0.0
     published = PUBLISHED.get((pop.name, direction))
     duration = protocol.move_duration
     return StepThreshold(
@@ -322,7 +346,7 @@ def step_threshold(height: float, mass: float, population: str | Population = "y
         peak_acceleration=2 * math.pi * low / duration**2, feedback_delay=delay,
         ankle_strength=strength, ankle_moment_cap=cap, heel=foot.heel, toe=foot.toe,
         com_height=com_height, omega0=omega0, minimum_margin=margin,
-        xcom_at_response_onset=onset, n_simulations=count,
+        xcom_at_response_onset=onset, cop_overrun=overrun, n_simulations=count,
         published_mean=None if published is None else published.mean,
         published_sd=None if published is None else published.sd,
         published_source="" if published is None else published.source,
