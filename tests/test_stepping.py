@@ -219,6 +219,44 @@ def test_the_guide_prints_the_thresholds_computed(thresholds):
         assert thresholds[name].largest_translation == pytest.approx(printed, abs=5e-4)
 
 
+@pytest.mark.parametrize("duration", [0.4, 0.7, 1.0])
+def test_the_comparison_holds_for_other_move_durations(duration):
+    """The protocol's T = 0.5 s is posturelab's assumption: at other durations of the move
+    the thresholds stay within two published SD, older below young."""
+    from dataclasses import replace
+
+    from posturelab.studies.stepping import PROTOCOL
+
+    protocol = replace(PROTOCOL, move_duration=duration)
+    young, older = (step_threshold(HEIGHT, MASS, p, protocol=protocol).largest_translation
+                    for p in ("young", "older"))
+    assert abs(young - KOUSHYAR_YOUNG[0]) <= 2 * KOUSHYAR_YOUNG[1]
+    assert abs(older - KOUSHYAR_OLDER[0]) <= 2 * KOUSHYAR_OLDER[1]
+    assert older < young
+
+
+def test_reference_engine_finds_the_same_threshold(thresholds):
+    """A feature of both engines: the reference engine (numpy model, scipy) brackets the
+    same threshold to the search's 1 mm."""
+    ref = step_threshold(HEIGHT, MASS, "young", engine="reference")
+    assert ref.largest_translation == pytest.approx(
+        thresholds["young"].largest_translation, abs=1e-3)
+
+
+def test_gallery_example_draws_both_populations(tmp_path):
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[1] / "examples" / "step_threshold_vs_duration.py"
+    spec = importlib.util.spec_from_file_location("step_threshold_vs_duration", path)
+    example = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(example)
+    values = example.thresholds(np.array([0.5]))
+    assert set(values) == {"young", "older"} and values["older"][0] < values["young"][0]
+    figure = example.main(tmp_path)
+    assert figure.exists() and figure.stat().st_size > 10_000
+
+
 def test_threshold_falls_with_the_delay():
     values = [step_threshold(HEIGHT, MASS, "young", feedback_delay=d).largest_translation
               for d in (0.0, 0.05, 0.097, 0.15, 0.2)]
