@@ -271,6 +271,16 @@ def test_threshold_rises_with_ankle_strength():
     assert values[-1] > values[0]
 
 
+def test_no_step_up_to_the_largest_translation_is_said():
+    from dataclasses import replace
+
+    from posturelab.studies.stepping import PROTOCOL
+
+    r = step_threshold(HEIGHT, MASS, "young", protocol=replace(PROTOCOL, largest=0.02))
+    assert r.largest_translation == pytest.approx(0.02) and math.isinf(r.smallest_stepping)
+    assert r.reason == "" and r.to_dict()["smallest_stepping"] is None
+
+
 def test_forward_has_no_published_figure():
     r = step_threshold(HEIGHT, MASS, "young", "forward")
     assert r.published_mean is None and r.within_two_sd is None

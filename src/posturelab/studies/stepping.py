@@ -38,9 +38,9 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from .._validation import float_in_range, positive_float
+from .._validation import positive_float
 from ..errors import PostureLabError, UnknownNameError
-from ..parameters import HEIGHT_RANGE, MASS_RANGE
+from ..parameters import check_value
 from ._stepping_presets import (
     POPULATIONS,
     PROTOCOL,
@@ -270,14 +270,14 @@ def step_threshold(height: float, mass: float, population: str | Population = "y
     from ..model.stepping import ankle_moment_cap, pendulum_frequency, xcom
     from ..simulation.engines import simulate
 
-    h = float_in_range("height [m]", height, *HEIGHT_RANGE, unit="m")
-    m = float_in_range("mass [kg]", mass, *MASS_RANGE, unit="kg")
+    h = check_value("height", height)
+    m = check_value("mass", mass)
     if direction not in DIRECTIONS:
         raise UnknownNameError(f"unknown direction {direction!r}; known: "
                                f"{', '.join(DIRECTIONS)}")
     pop = population if isinstance(population, Population) else get_population(population)
-    delay = pop.feedback_delay if feedback_delay is None else float_in_range(
-        "feedback_delay [s]", feedback_delay, 0.0, 1.0, unit="s")
+    delay = pop.feedback_delay if feedback_delay is None else check_value(
+        "feedback_delay", feedback_delay)
     strength = pop.ankle_strength if ankle_strength is None else positive_float(
         "ankle_strength [N·m]", ankle_strength)
     body = one_link(body_from_anthropometry(h, m))
@@ -322,7 +322,7 @@ def step_threshold(height: float, mass: float, population: str | Population = "y
             high, reason = size, verdict.reason
             break
         low, size = size, size + protocol.increment
-    while high - low > protocol.tolerance:  # bisection between withstood and stepped
+    while high - low > protocol.tolerance and math.isfinite(high):  # bisection
         mid = 0.5 * (low + high)
         verdict = trial(mid)[2]
         if verdict.needs_step:
