@@ -120,7 +120,8 @@ def test_step_verdict_names_the_side_and_the_time():
 
 def test_young_preset_numbers_are_their_sources():
     young = get_population("young")
-    # Simoneau, Martin & Van Hoecke 2005 (J Gerontol A 60:439), young men: 132 N·m
+    # 'Muscular performances at the ankle joint in young and elderly men', HAL
+    # inserm-00080421 abstract: plantarflexion 132 N·m (young men)
     assert young.plantarflexion_strength == 132.0
     assert young.ankle_strength == 264.0  # two ankles (posturelab's choice)
     # PMC5664365 Table 1: τ_D = 0.097 s; K_P = 943.9 N·m/rad, K_D = 313.5 N·m·s/rad,
@@ -137,7 +138,7 @@ def test_young_preset_numbers_are_their_sources():
 
 def test_older_preset_numbers_are_their_sources_or_labelled_assumptions():
     older = get_population("older")
-    # Simoneau et al. 2005, elderly men: 80 N·m
+    # HAL inserm-00080421 abstract: 80 N·m (elderly men)
     assert older.plantarflexion_strength == 80.0
     assert older.provenance_of("plantarflexion_strength").from_source
     # the older delay is posturelab's assumption (young + 20 ms), and says so

@@ -25,15 +25,16 @@ KOUSHYAR_2019 = ("Koushyar H, Bieryla KA, Nussbaum MA, Madigan ML (2019) Age-rel
                  "loss affects non-stepping balance recovery. PLoS ONE 14(1):e0210049, "
                  "doi:10.1371/journal.pone.0210049, PMC6338353")
 #: Isometric plantarflexion strength, young and elderly men.
-SIMONEAU_2005 = ("Simoneau E, Martin A, Van Hoecke J (2005) Muscular performances at the "
-                 "ankle joint in young and elderly men. J Gerontol A Biol Sci Med Sci "
-                 "60:439–447 (HAL inserm-00080421): maximal isometric plantarflexion 132 N·m "
-                 "(11 men, mean 24 y) vs 80 N·m (12 men, mean 77 y)")
+SIMONEAU_2005 = ("Muscular performances at the ankle joint in young and elderly men, HAL "
+                 "inserm-00080421 (abstract): maximal isometric plantarflexion 132 N·m (11 "
+                 "men, mean 24 y) vs 80 N·m (12 men, mean 77 y); Simoneau, Martin & Van "
+                 "Hoecke, J Gerontol A 2005 (authors and journal as posturelab recalls them, "
+                 "not checked against the stored record)")
 #: Postural response latencies with age (a direction, not a number).
-LIN_WOOLLACOTT_2002 = ("Lin S-I, Woollacott MH (2002) Postural muscle responses following "
-                       "changing balance threats in young, stable older, and unstable older "
-                       "adults. J Mot Behav 34:37–44 (PMID 11880248): longer onset latencies "
-                       "in the older groups")
+LIN_WOOLLACOTT_2002 = ("Postural muscle responses following changing balance threats in "
+                       "young, stable older, and unstable older adults. J Mot Behav 2002 "
+                       "34(1):37–44, PMID 11880248 (abstract): longer onset latencies in the "
+                       "older groups; Lin & Woollacott (authors as posturelab recalls them)")
 #: The model's ankle is both legs together: strengths measured on one leg are doubled. [-]
 LEGS = 2
 
@@ -114,7 +115,7 @@ _YOUNG = Population(
         *((k, _icm(k)) for k in _ICM_NUMBERS),
         ("feedback_delay", _ICM.provenance_of("feedback_delay")),
         ("plantarflexion_strength", Provenance(
-            "Simoneau et al. 2005 (J Gerontol A 60:439), young men", 132.0, "N·m",
+            "HAL inserm-00080421 abstract (Simoneau et al. 2005), young men", 132.0, "N·m",
             f"one ankle's maximal isometric plantarflexion; doubled for the two ankles of the "
             f"model's one link ({LEGS} legs: posturelab's choice)")),
     ),
@@ -132,9 +133,9 @@ _OLDER = replace(
         ("feedback_delay", Provenance(None, note=(
             f"the young delay (PMC5664365 Table 1, τ_D = 0.097 s) plus "
             f"{OLDER_EXTRA_DELAY * 1000:g} ms; older adults' postural responses start later "
-            "(Lin & Woollacott 2002, J Mot Behav 34:37), but the 20 ms is posturelab's"))),
+            "(J Mot Behav 2002 34:37, PMID 11880248), but the 20 ms is posturelab's"))),
         ("plantarflexion_strength", Provenance(
-            "Simoneau et al. 2005 (J Gerontol A 60:439), elderly men", 80.0, "N·m",
+            "HAL inserm-00080421 abstract (Simoneau et al. 2005), elderly men", 80.0, "N·m",
             f"one ankle's maximal isometric plantarflexion; doubled for the two ankles "
             f"({LEGS} legs: posturelab's choice)")),
     ),
