@@ -1,0 +1,92 @@
+"""``posturelab step-threshold``: the largest platform translation withstood without a step."""
+
+from __future__ import annotations
+
+import argparse
+
+from ._common import print_json
+
+DESCRIPTION = """\
+The largest platform translation a subject withstands with the feet in place: a one-link
+body scaled from --height and --mass (Winter's table), an ankle controller with the
+population's gains, feedback delay and ankle strength, on a foot of 0.152 × height. A run
+needs a step when the extrapolated centre of mass x + v/ω0 (Hof, Gazendam & Sinke 2005,
+J Biomech 38:1–8; ω0 = √(g/l), l the centre of mass's height) leaves the foot, or when
+the body falls. The platform moves are ramp-and-holds over 0.5 s (posturelab's assumption),
+increased in 1 cm steps and then bisected to 1 mm. Compared with Koushyar et al. 2019
+(PLoS ONE 14:e0210049, PMC6338353): backward, 16.2 ± 2.6 cm (young), 11.8 ± 2.1 cm (older).
+Where each number of a population comes from: --sources.
+"""
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    """The options of ``posturelab step-threshold``."""
+    p.add_argument("--height", type=float, required=True, metavar="M",
+                   help="standing height [m] (0.5–2.5).")
+    p.add_argument("--mass", type=float, required=True, metavar="KG",
+                   help="body mass [kg] (10–300).")
+    p.add_argument("--population", default="young", metavar="NAME",
+                   help="young or older (default young): the controller, delay and ankle "
+                   "strength.")
+    p.add_argument("--direction", default="backward", metavar="WAY",
+                   help="backward (default; the body sways forward) or forward.")
+    p.add_argument("--feedback-delay", type=float, default=None, metavar="S",
+                   help="feedback delay τ [s] in place of the population's.")
+    p.add_argument("--ankle-strength", type=float, default=None, metavar="NM",
+                   help="plantarflexion strength of both ankles [N·m] in place of the "
+                   "population's.")
+    p.add_argument("--move-duration", type=float, default=None, metavar="S",
+                   help="duration T [s] of each platform move in place of the protocol's 0.5 s "
+                   "(posturelab's assumption).")
+    p.add_argument("--cop-criterion", action="store_true",
+                   help="also count a step when the centre of pressure leaves the foot (the "
+                   "heel would rise or the toes lift).")
+    p.add_argument("--sources", action="store_true",
+                   help="also print where each number of the population comes from.")
+    p.add_argument("--json", action="store_true", help="print one JSON object instead of text.")
+
+
+def run(args: argparse.Namespace) -> int:
+    from dataclasses import replace
+
+    from .._validation import float_in_range
+    from ..studies.stepping import PROTOCOL, UNITS, get_population, step_threshold
+
+    population = get_population(args.population)
+    protocol = PROTOCOL if args.move_duration is None else replace(
+        PROTOCOL, move_duration=float_in_range("--move-duration [s]", args.move_duration,
+                                               0.05, 10.0, unit="s"))
+    result = step_threshold(args.height, args.mass, population, args.direction,
+                            protocol=protocol, feedback_delay=args.feedback_delay,
+                            ankle_strength=args.ankle_strength,
+                            cop_criterion=args.cop_criterion)
+    out = result.to_dict()
+    if args.json:
+        out["units"] = UNITS
+        out["protocol"] = protocol.citation
+        if args.sources:
+            out["sources"] = population.provenance_text()
+        print_json(out)
+        return 0
+    cm = 100.0
+    print(f"{result.population}, {result.direction}, H = {result.height:g} m, "
+          f"M = {result.mass:g} kg")
+    print(f"largest translation without a step: {result.largest_translation * cm:.1f} cm "
+          f"(a step at {result.smallest_stepping * cm:.1f} cm: {result.reason or 'none'})")
+    print(f"  platform move over {result.move_duration:g} s: peak {result.peak_velocity:.2f} "
+          f"m/s, {result.peak_acceleration:.2f} m/s² at the threshold")
+    print(f"  τ = {result.feedback_delay * 1000:.0f} ms, ankle strength "
+          f"{result.ankle_strength:.0f} N·m (cap {result.ankle_moment_cap:.0f} N·m), foot "
+          f"{result.heel * cm:.1f} … {result.toe * cm:.1f} cm, ω0 = {result.omega0:.2f} 1/s")
+    if result.cop_overrun > 0.0:
+        print(f"  the centre of pressure went {result.cop_overrun * cm:.1f} cm beyond the foot "
+              "at the threshold (the moment cap is the same both ways; see the guide)")
+    if result.published_mean is not None:
+        verdict = "within" if result.within_two_sd else "outside"
+        print(f"published: {result.published_mean * cm:.1f} ± {result.published_sd * cm:.1f} "
+              f"cm ({verdict} two SD); {result.published_source}")
+    else:
+        print("published: no figure for this population and direction")
+    if args.sources:
+        print(f"sources: {population.provenance_text()}")
+    return 0
