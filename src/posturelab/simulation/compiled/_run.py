@@ -189,7 +189,7 @@ def integrate_compiled(setup: RunSetup, method: str | None = None) -> Simulation
         sat0 = enc.readonly(setup.saturation0)
         run = run_struct(a, method, g, lim, setup.feedback_delay, sat0)
         samples = np.empty((m, T + 1))
-        fb = np.empty((m, T + 1)) if delayed else None
+        fb = np.empty((2 * n, T + 1)) if delayed else None
         locked_u8 = np.zeros(T + 1, np.uint8)
         switches = np.empty(setup.max_switches + 1)
         peak, final, res = np.empty(n), np.empty(2 * n), np.empty(N_RESULT)
@@ -226,7 +226,7 @@ def integrate_compiled(setup: RunSetup, method: str | None = None) -> Simulation
                                       method=method)
     # the engine keeps time last; the result holds time-first views of the same memory
     theta = samples[:n, :count].T
-    omega = samples[n:, :count].T
+    omega = samples[n:2 * n, :count].T
     locked = locked[:count]
     for arr in (time, theta, omega):
         arr.setflags(write=False)
