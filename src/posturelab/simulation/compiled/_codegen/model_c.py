@@ -376,7 +376,8 @@ _STEPS = {
     "moment": """const double *tk = md->tm, *tl = md->tm + n * n;
         double tau = cx->sc_inp[2 + idx];
         for (int64_t k = 0; k < n; k++)
-            tau += tk[idx * n + k] * y[k] + tl[idx * n + k] * y[n + k];""" + filters_c.moment_step(),
+            tau += tk[idx * n + k] * y[k] + tl[idx * n + k] * y[n + k];"""
+    + filters_c.moment_step(),
     "free": "pl_rhs(md, y, cx->sc_out, cx->sc_inp, 0);",
     "response": "pl_rhs(md, y, cx->sc_out, cx->sc_inp, locked);",
     "reaction": "fy = vertical_reaction(cx, y);",
