@@ -268,3 +268,35 @@ def test_the_filters_start_at_rest_and_are_kept_through_a_switch():
     assert fast.pair_torques[0, 0] == pytest.approx(ref.pair_torques[0, 0], abs=1e-9)
     np.testing.assert_allclose(fast.pair_torques, ref.pair_torques, rtol=0,
                                atol=1e-6 * np.abs(ref.pair_torques).max())
+
+
+def test_delayed_stability_map_takes_torque_feedback(tmp_path, capsys):
+    """stability-map's D-subdivision map with --torque-feedback-gain: at the controller's own
+    active gains its rightmost root is the upright verdict's with the same filter (the
+    linear system with the filter states); the map without delay refuses it in one line."""
+    from posturelab.cli import main
+    from posturelab.linear.delay_batch import delay_stability_map
+    from posturelab.linear.verdict import upright_verdict
+
+    ka, va = PRESET_MUSCLES.active_stiffnesses[0], PRESET_MUSCLES.active_viscosities[0]
+    feedback = {"torque_feedback_gain": 0.5, "torque_feedback_time_constant": 5.0}
+    delay = PRESET.feedback_delay
+    dmap = delay_stability_map(ONE_LINK, PRESET_MUSCLES, delay, (ka, 2 * ka), (va, 2 * va), 2,
+                               **feedback)
+    verdict = upright_verdict(ONE_LINK, PRESET_MUSCLES, delay, **feedback)
+    assert dmap.max_real_part[0, 0] == pytest.approx(verdict.rightmost_root.real, abs=1e-6)
+    plain = delay_stability_map(ONE_LINK, PRESET_MUSCLES, delay, (ka, 2 * ka), (va, 2 * va), 2)
+    assert abs(plain.max_real_part[0, 0] - dmap.max_real_part[0, 0]) > 1e-3  # it matters
+    code = main(["stability-map", "--body", "paper-1link", "--controller", "icm-pmc5664365",
+                 "--x", f"active_stiffness:{ka}:{2 * ka}", "--y", f"active_viscosity:{va}:{2 * va}",
+                 "--resolution", "2", "--torque-feedback-gain", "0.5",
+                 "--torque-feedback-time-constant", "5", "--out", str(tmp_path / "d.png")])
+    assert code == 0
+    table = np.genfromtxt(tmp_path / "d.csv", delimiter=",", names=True)
+    assert table["max_real_part"][0] == pytest.approx(dmap.max_real_part[0, 0], abs=1e-12)
+    capsys.readouterr()
+    code = main(["stability-map", "--x", "stiffness:ankle:0:2000", "--y",
+                 "stiffness:gastrocnemius:0:1000", "--torque-feedback-gain", "0.5",
+                 "--out", str(tmp_path / "m.png")])
+    assert code == 2
+    assert "--torque-feedback-gain is for the delayed map" in capsys.readouterr().err
