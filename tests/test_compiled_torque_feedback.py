@@ -90,7 +90,9 @@ def assert_engines_agree(run_with, theta_tol: float = THETA_TOL) -> pl.Simulatio
 def test_engines_agree_over_the_covering_array(seed, run):
     """The paper's body under a 0.25 m/s backward platform step (a translation), τ = 10 ms,
     1 s, at rtol 1e-9: each run of the covering array with its own K_t and τ_t. Measured
-    largest |Δθ| 3e-8 rad. The runs whose knee hits its stop amplify every difference
+    largest |Δθ| 3.7e-7 rad (whole feedback delayed, one-sided gastrocnemius, knee stop), the
+    others 6e-8 rad or less; switch times within 3e-10 s. The runs whose knee hits its stop
+    amplify every difference
     (tests/test_engine_parity.py: the reference itself moves by 2e-5 rad between rtol 1e-9
     and 1e-11): 1e-4 rad there."""
     feedback, limit, knee_stop, tilt, cop = run
@@ -118,7 +120,7 @@ def test_one_link_prts_tilt_agrees(seed, limit, method):
     and without an ankle limit that the tilt saturates (40 N·m: it lets go again; 25 N·m: the
     body falls while saturated); the compiled engine's RK45
     and its Radau (whose Newton systems include the filter states) against the reference at
-    rtol 1e-9. Measured largest |Δθ| 2e-9 rad."""
+    rtol 1e-9. Measured largest |Δθ| 7e-9 rad (the falls), 1.3e-9 rad otherwise."""
     def run_with(engine):
         return pl.simulate(ONE_LINK, PRESET_MUSCLES, pl.NoDisturbance(), 6.0,
                            tilt=PRTSTilt(0.1), torque_limits=None if limit is None else [limit],
@@ -140,7 +142,8 @@ def test_one_link_prts_tilt_agrees(seed, limit, method):
 def test_three_link_prts_tilt_agrees(seed):
     """The paper's body, case 1 split 60 % intrinsic / 40 % active, a PRTS tilt of 0.02 rad,
     τ = 10 ms, 3 s, with the ankle limited to 60 N·m: the two engines at rtol 1e-9, and the
-    derived joint moments (which add the filter states) with them."""
+    derived joint moments (which add the filter states) with them (measured |Δθ| 1.3e-11
+    rad, moments 2.7e-8 of their peak)."""
     def run_with(engine):
         return pl.simulate(pl.paper_body(), paper_muscles("split/two-sided"), pl.NoDisturbance(),
                            3.0, tilt=PRTSTilt(0.02), feedback_delay=DELAY,
@@ -329,3 +332,17 @@ def test_radau_solves_a_stiff_filter_implicitly():
     assert steps["Radau"] < steps["RK45"] / 4
     for peak in peaks.values():
         assert peak == pytest.approx(np.abs(ref.theta).max(), abs=1e-7)
+
+
+def test_overlapping_steps_carry_the_filters():
+    """With τ = 0.05 ms (below pl_driver.c's OVERLAP_BELOW) a compiled step reaches into its
+    own past; the filters ride along in the state while the history keeps [Θ, Θ̇]: the paper's
+    body after a 0.25 m/s step, K_t = 0.5, τ_t = 10 ms, 50 ms, agrees with the reference
+    within 1e-9 rad (measured 1.5e-12) and differs from the run without the filter by 1e-3."""
+    def run_with(engine, gain=0.5):
+        return pl.simulate(pl.paper_body(), pl.paper_muscles("1"), pl.VelocityStep.backward(0.25),
+                           0.05, feedback_delay=5e-5, torque_feedback_gain=gain,
+                           torque_feedback_time_constant=0.01, engine=engine, **TOLERANCES)
+
+    fast = assert_engines_agree(run_with, 1e-9)
+    assert np.abs(fast.theta - run_with("compiled", 0.0).theta).max() > 1e-4
