@@ -45,8 +45,10 @@ Example: posturelab stability-map --x stiffness:ankle:0:2000 \\
 With a feedback delay, the D-subdivision map: --x active_stiffness:PAIR:LO:HI --y
 active_viscosity:PAIR:LO:HI [N·m/rad, N·m·s/rad] of one pair (:PAIR may be left out on a
 one-pair body) at --feedback-delay S, for any body and gains (--body, --height/--mass,
---stiffness, --controller, ...: the other gains as in posturelab simulate). Colour is the
-real part of the rightmost characteristic root; the CSV has active_stiffness:PAIR,
+--stiffness, --controller, ...: the other gains as in posturelab simulate; with
+--torque-feedback-gain K the filter states of Peterka 2002's torque feedback join the
+model). Colour is the real part of the rightmost characteristic root; the CSV has
+active_stiffness:PAIR,
 active_viscosity:PAIR, max_real_part [1/s], stable [1 or 0].
 
 Example: posturelab stability-map --body paper-1link --stiffness 28 --viscosity 11 \\
@@ -82,9 +84,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--pair", metavar="NAME",
                    help="former option: the pair is now part of the axis names "
                    "(active_stiffness:PAIR:LO:HI).")
-    from ._common import add_muscle_arguments
+    from ._common import add_muscle_arguments, add_torque_feedback_arguments
 
     add_muscle_arguments(p, own_case=True)
+    add_torque_feedback_arguments(p)
 
 
 # ---- argument parsing -------------------------------------------------------
@@ -252,7 +255,7 @@ def _run_pair_map(args: argparse.Namespace) -> int:
 
     model = [f for f in ("controller", "viscosity", "active_stiffness", "active_viscosity",
                          "active_viscosity_ratio", "feedback_delay", "proprioceptive_weight",
-                         "pair")
+                         "pair", "torque_feedback_gain", "torque_feedback_time_constant")
              if getattr(args, f, None) is not None]
     if model:
         raise ParameterError(
@@ -366,7 +369,12 @@ def _run_delayed_map(args: argparse.Namespace) -> int:
     from .._progress import Progress, shown
     from ..linear.delay_batch import MAX_DELAY_MAP_RESOLUTION, delay_stability_map
     from ..viz.maps import plot_delay_stability_map
-    from ._common import body_from_args, feedback_given, muscles_and_delay_from_args
+    from ._common import (
+        body_from_args,
+        feedback_given,
+        muscles_and_delay_from_args,
+        torque_feedback_options_from_args,
+    )
 
     if args.pair is not None:
         raise ParameterError(f"--pair is now part of the axis names: --x active_stiffness:"
@@ -394,13 +402,15 @@ def _run_delayed_map(args: argparse.Namespace) -> int:
         raise ParameterError("a map over active gains needs --feedback-delay S [s]")
     figure_path, csv_path, fmt = output_paths(args.out)
     muscles, delay = muscles_and_delay_from_args(args, body)
+    torque_feedback = torque_feedback_options_from_args(args)
     bar = Progress(resolution**2, label="stability-map", unit="sets") \
         if shown(args.progress) else None
     try:
         dmap = delay_stability_map(body, muscles, delay, axes["active_stiffness"],
                                    axes["active_viscosity"], resolution, pair=pair,
                                    progress=bar or ExpectedTime("stability-map", "sets",
-                                                                min_total=2500))
+                                                                min_total=2500),
+                                   **torque_feedback)
     finally:
         if bar is not None:
             bar.close()

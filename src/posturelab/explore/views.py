@@ -8,7 +8,7 @@ cannot disagree. :func:`compute_views` turns checked parameters into the numbers
 figures of the page with the public API only: :func:`posturelab.analyse`,
 :func:`posturelab.rightmost_roots`, :func:`posturelab.delay_margin`,
 :func:`posturelab.frequency.model.model_frf` and :func:`posturelab.simulate` on the
-compiled engine (on the reference engine with torque feedback, which only it carries).
+compiled engine.
 """
 
 from __future__ import annotations
@@ -346,7 +346,7 @@ def compute_views(p: dict) -> dict:
         [m] of the stick figure and the surface tilt [rad] at :data:`FRAME_RATE`).
         With torque feedback (``torque_feedback_gain`` > 0) the verdict, ``poles`` and
         ``roots`` are the linear system's with its filter states, ``delay_margin_note``
-        says the margin is not computed, and the run is on the reference engine.
+        says the margin is not computed; the run is on the compiled engine as always.
     """
     import posturelab as pl
 
@@ -382,9 +382,7 @@ def compute_views(p: dict) -> dict:
                     "note": f"the loop is {word} at this delay: an FRF cannot be measured "
                     "(the sway grows or never settles), so none is drawn"}
     rate = SAMPLE_RATE if tilt is None else max(SAMPLE_RATE, 40.0 * tilt.frequency)
-    # torque feedback runs on the reference engine (the compiled one does not carry it yet)
-    engine = "reference" if p["torque_feedback_gain"] > 0 else "compiled"
-    run = pl.simulate(body, muscles, disturbance, p["duration"], engine=engine,
+    run = pl.simulate(body, muscles, disturbance, p["duration"],
                       feedback_delay=delay, proprioceptive_weight=weight, tilt=tilt,
                       sample_rate=rate, time_limit=TIME_LIMIT, **torque_feedback)
     every = max(1, int(round(rate / FRAME_RATE)))

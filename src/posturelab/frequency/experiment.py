@@ -118,8 +118,7 @@ def prts_experiment(body, muscles, *, tilt=None, cycles: int = 5, discard: int =
     **run_options
         Fields of :class:`~posturelab.simulation.options.RunOptions` by name, replacing
         those of ``options`` (``feedback_delay=0.1``); ``engine`` is the compiled one unless
-        given (``engine="reference"`` for what only the reference engine runs, such as
-        torque feedback).
+        given (``engine="reference"``).
     """
     from ..model.tilt import PRTSTilt
     from ..simulation.engines import simulate

@@ -43,7 +43,9 @@ _CHUNK = 1024
 def batch_rightmost_root(body: Body, muscles: MuscleSet, stiffness, viscosity,
                          active_stiffness=None, active_viscosity=None, delay: float = 0.0, *,
                          nodes: int = 12,
-                         progress: Callable[[int, int], None] | None = None) -> np.ndarray:
+                         progress: Callable[[int, int], None] | None = None,
+                         torque_feedback_gain: float = 0.0,
+                         torque_feedback_time_constant: float | None = None) -> np.ndarray:
     """The rightmost characteristic root of each of M gain sets at delay ``delay``.
 
     Parameters
@@ -62,6 +64,9 @@ def batch_rightmost_root(body: Body, muscles: MuscleSet, stiffness, viscosity,
         Chebyshev intervals, 4 … 64. [-]
     progress : callable, optional
         Called as ``progress(done, M)`` on this thread as blocks of sets finish. [-]
+    torque_feedback_gain, torque_feedback_time_constant : float
+        K_t [-] and τ_t [s] of Peterka 2002's torque feedback (the filter states join the
+        first-order form; :func:`posturelab.linear.system.linear_system`). 0: none.
 
     Returns
     -------
@@ -74,7 +79,9 @@ def batch_rightmost_root(body: Body, muscles: MuscleSet, stiffness, viscosity,
         raise ParameterError(f"nodes must be an integer in [4, 64], got {nodes!r}")
     system = linear_system(body, muscles, stiffness=stiffness, viscosity=viscosity,
                            active_stiffness=active_stiffness,
-                           active_viscosity=active_viscosity, delay=delay, inputs=False)
+                           active_viscosity=active_viscosity, delay=delay, inputs=False,
+                           torque_feedback_gain=torque_feedback_gain,
+                           torque_feedback_time_constant=torque_feedback_time_constant)
     A0, A1 = system.first_order()
     M, m = A0.shape[0], A0.shape[1]
     roots = np.empty(M, dtype=complex)
@@ -191,7 +198,9 @@ def delay_stability_map(body: Body, muscles: MuscleSet, delay: float,
                         stiffness_range: tuple[float, float],
                         viscosity_range: tuple[float, float], resolution: int = 200, *,
                         pair: str | None = None, nodes: int = 12,
-                        progress: Callable[[int, int], None] | None = None
+                        progress: Callable[[int, int], None] | None = None,
+                        torque_feedback_gain: float = 0.0,
+                        torque_feedback_time_constant: float | None = None
                         ) -> DelayStabilityMap:
     """Rightmost root over a grid of one pair's active stiffness × active viscosity at a
     fixed delay (the D-subdivision figure); every other gain is ``muscles``' own.
@@ -212,6 +221,8 @@ def delay_stability_map(body: Body, muscles: MuscleSet, delay: float,
     progress : callable, optional
         Called as ``progress(done, total)`` as sets finish (see
         :func:`batch_rightmost_root`). [-]
+    torque_feedback_gain, torque_feedback_time_constant : float
+        K_t [-] and τ_t [s] of the torque feedback (:func:`batch_rightmost_root`).
     """
     if isinstance(resolution, bool) or not isinstance(resolution, int | np.integer) \
             or not 2 <= resolution <= MAX_DELAY_MAP_RESOLUTION:
@@ -238,7 +249,8 @@ def delay_stability_map(body: Body, muscles: MuscleSet, delay: float,
     k = np.tile(muscles.stiffnesses, (count, 1))
     v = np.tile(muscles.viscosities, (count, 1))
     root = batch_rightmost_root(body, muscles.as_two_sided(), k, v, ka, va, delay, nodes=nodes,
-                                progress=progress)
+                                progress=progress, torque_feedback_gain=torque_feedback_gain,
+                                torque_feedback_time_constant=torque_feedback_time_constant)
     real = root.real.reshape(kx.shape)
     stable = real < -1e-9 * np.maximum(1.0, np.abs(root)).reshape(kx.shape)
     for arr in (real, stable, axes[0], axes[1]):

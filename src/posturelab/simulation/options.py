@@ -126,8 +126,7 @@ class RunOptions:
     torque_feedback_gain : float
         K_t of Peterka 2002's torque feedback: each pair's active torque fed back positively
         through K_t/(τ_t s + 1) (docs/design.md; 0, the default: none). Needs a positive
-        ``feedback_delay`` and the reference engine (the compiled engine does not carry the
-        filter states yet). [-]
+        ``feedback_delay``; both engines carry the filter states. [-]
     torque_feedback_time_constant : float
         τ_t of its low-pass filter (default 17.4 s, PMC5664365 Table 1). [s]
     tilt : Tilt or None
@@ -254,14 +253,6 @@ class RunOptions:
             put("time_limit", _setting("time_limit", self.time_limit))
         if not isinstance(self.description, str):
             raise ParameterError(f"description must be a string, got {self.description!r:.60}")
-
-    def refuse_torque_feedback_on_compiled(self) -> None:
-        """Raise ParameterError when torque feedback is asked of the compiled engine (it does
-        not carry the filter states yet; the reference engine does)."""
-        if self.torque_feedback_gain > 0:
-            raise ParameterError("torque feedback (torque_feedback_gain > 0) runs on the "
-                                 "reference engine (engine='reference', --engine reference); "
-                                 "the compiled engine does not carry its filter states yet")
 
     def replace(self, **changes: Any) -> RunOptions:
         """A copy with some options changed (checked again); an unknown name is refused

@@ -252,7 +252,7 @@ def fit_stiffness(
         ``"active_stiffness:PAIR"`` [N·m/rad], ``"active_viscosity:PAIR"`` [N·m·s/rad],
         ``"viscosity_ratio"`` [s], ``"feedback_delay"`` [s], ``"proprioceptive_weight"``
         [-], ``"torque_feedback_gain"`` [-] and ``"torque_feedback_time_constant"`` [s]
-        (Peterka 2002's torque feedback; its runs need ``engine="reference"``); a former
+        (Peterka 2002's torque feedback, on either engine); a former
         spelling (``"ankle"``, ``"active_ankle"``) is refused naming the new.
     viscosity_ratio : float
         Viscosity / stiffness for every pair when the ratio is not fitted,

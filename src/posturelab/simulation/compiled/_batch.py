@@ -287,7 +287,6 @@ def simulate_batch(
     """
     check_model(body, muscles)
     common = _shared_options(options, duration, initial_state, keywords)
-    common.refuse_torque_feedback_on_compiled()
     method = common.method
     if method is not None:
         check_method(method)
@@ -350,8 +349,9 @@ def simulate_batch(
     for d in np.unique(delays):
         level_setup(1.0, float(d), None)
     any_limit = bool(np.isfinite(lims).any())
+    some_delay = 1.0 if common.torque_feedback_gain > 0 else 0.0  # (it needs one)
     for row in (np.unique(lims, axis=0) if M and any_limit else []):
-        level_setup(1.0, 0.0, None if np.all(np.isinf(row)) else row)
+        level_setup(1.0, some_delay, None if np.all(np.isinf(row)) else row)
     # one level per distinct (scale, delayed or not, pairs acting at the start): start
     # state, disturbance, knee, pairs (a pull-only pair's start depends on the run's gains)
     delayed = delays > 0
@@ -370,7 +370,7 @@ def simulate_batch(
     values, which = np.unique(keys, axis=0, return_inverse=True) if M else (keys, [])
     which = np.ascontiguousarray(np.asarray(which).ravel(), dtype=np.int64)
     levels = [level_setup(float(row[0]), 1.0 if row[1] else 0.0, slot_limits) for row in values]
-    base = levels[0] if levels else level_setup(1.0, 0.0, slot_limits)
+    base = levels[0] if levels else level_setup(1.0, some_delay, slot_limits)
     packs = [packed(lv) for lv in levels] or [packed(base)]
     stack = lambda key: enc.readonly(np.stack([p[key] for p in packs]))  # noqa: E731
     x0_all, before_all, ipar_all = stack("x0"), stack("before"), stack("ipar")
@@ -383,11 +383,13 @@ def simulate_batch(
     # per run: the saturation at the start, from the moments a single run computes (the
     # tilt's gains follow each run's gains and delay)
     tilt_gain_all = enc.readonly(np.zeros((M, len(GAIN_ROWS), n)))
+    tilt_pair_gain_all = enc.readonly(np.zeros((M, len(GAIN_ROWS), P)))
     pair_gains = None
     if base.tilt is not None:
         split = feedback_gains(kd_all, ld_all, ka_all, la_all, np.ones(M))
         pair_gains = tilt_pair_gains(split, muscles.spans_foot, delays, weights)
         tilt_gain_all = enc.readonly(np.ascontiguousarray(pair_gains @ muscles.crossing_matrix))
+        tilt_pair_gain_all = enc.readonly(np.ascontiguousarray(pair_gains))
     moments0 = np.empty((M, n))
     for d in np.unique(delays):
         rows = delays == d
@@ -433,7 +435,8 @@ def simulate_batch(
                       sat0_all=pointer(sat0_all), method_all=pointer(method_all, ctypes_int64),
                       results=pointer(results),
                       peaks=pointer(peaks), finals=pointer(finals),
-                      tilt_gain_all=pointer(tilt_gain_all))
+                      tilt_gain_all=pointer(tilt_gain_all),
+                      tilt_pair_gain_all=pointer(tilt_pair_gain_all))
         _run_rows(batch, todo, parallel, int(chunk))
     if at_start.any():
         results[at_start] = 0.0

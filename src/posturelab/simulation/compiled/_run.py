@@ -15,7 +15,7 @@ from ..derived import derived_series
 from ..messages import outcome_message
 from ..outcome import stimulus_timing
 from ..results import SimulationResult
-from ..setup import DELAY_BREAKPOINT_MULTIPLES, RunSetup
+from ..setup import DELAY_BREAKPOINT_MULTIPLES, RunSetup, switched_model
 from . import _encode as enc
 from ._binding import Out, Run, library, pointer
 from ._layout import (
@@ -92,7 +92,13 @@ def packed(setup: RunSetup) -> dict:
         "tilt_gain": enc.readonly(np.ascontiguousarray(
             setup.tilt_gains @ muscles.crossing_matrix if setup.tilt_gains is not None
             else np.zeros((len(GAIN_ROWS), n)))),
+        "tilt_pair_gain": enc.readonly(np.ascontiguousarray(
+            setup.tilt_gains if setup.tilt_gains is not None
+            else np.zeros((len(GAIN_ROWS), len(muscles.pairs))))),
         "tilt_depth": float(setup.tilt_axis_depth),
+        "n_filters": switched_model(setup).n_filter_states,
+        "filter_gain": float(setup.options.torque_feedback_gain),
+        "filter_time": float(setup.options.torque_feedback_time_constant),
         "mp": enc.encode_motor_noise(setup.motor_torque),
         "bps": enc.readonly(setup.breakpoints.astype(float)), "fpar": fpar, "ipar": ipar,
         "active0": enc.readonly(setup.active0), "slots": slots,
@@ -119,9 +125,11 @@ def base_run_struct(a: dict, method: str) -> Run:
     n = a["n"]
     run = Run(n=n, p=a["E"].shape[0], n_grid=a["grid"].size, n_bps=a["bps"].size,
               n_slots=len(a["slots"]), method=METHOD_RADAU if tab is None else METHOD_EXPLICIT,
-              delay_multiples=DELAY_BREAKPOINT_MULTIPLES, tilt_depth=a["tilt_depth"])
+              delay_multiples=DELAY_BREAKPOINT_MULTIPLES, tilt_depth=a["tilt_depth"],
+              n_filters=a["n_filters"], filter_gain=a["filter_gain"],
+              filter_time=a["filter_time"])
     for name in ("x0", "before", "grid", "bp", "E", "C", "dp", "bps", "fpar", "active0",
-                 "ev_offset", "tp", "tilt_gain", "mp"):
+                 "ev_offset", "tp", "tilt_gain", "tilt_pair_gain", "mp"):
         setattr(run, name, pointer(a[name]))
     for name in ("one_sided", "ipar", "ev_direction", "ev_ends"):
         setattr(run, name, pointer(a[name], ctypes_int64))
@@ -155,12 +163,11 @@ def integrate_compiled(setup: RunSetup, method: str | None = None) -> Simulation
     SimulationResult
         Its derived series are computed when first read.
     """
-    setup.options.refuse_torque_feedback_on_compiled()
     method = default_method(setup.feedback_delay) if method is None else method
     check_method(method)
     a = packed(setup)
     n = a["n"]
-    m = 2 * n
+    m = 2 * n + a["n_filters"]  # [Θ, Θ̇] and the torque feedback filters' Y
     muscles = setup.muscles
     delayed = setup.feedback_delay > 0
     switches = np.zeros(0)
@@ -169,7 +176,7 @@ def integrate_compiled(setup: RunSetup, method: str | None = None) -> Simulation
     if setup.fall_at_start is not None:
         status, t_reached = STATUS_FELL, 0.0
         time = np.zeros(1)
-        samples = np.array(setup.x0[:, None])
+        samples = np.concatenate([setup.x0, np.zeros(m - 2 * n)])[:, None]
         locked = np.array([setup.locked0])
         count = 1
         fall_time, fall_reason = 0.0, setup.fall_at_start
@@ -182,10 +189,10 @@ def integrate_compiled(setup: RunSetup, method: str | None = None) -> Simulation
         sat0 = enc.readonly(setup.saturation0)
         run = run_struct(a, method, g, lim, setup.feedback_delay, sat0)
         samples = np.empty((m, T + 1))
-        fb = np.empty((m, T + 1)) if delayed else None
+        fb = np.empty((2 * n, T + 1)) if delayed else None
         locked_u8 = np.zeros(T + 1, np.uint8)
         switches = np.empty(setup.max_switches + 1)
-        peak, final, res = np.empty(n), np.empty(m), np.empty(N_RESULT)
+        peak, final, res = np.empty(n), np.empty(2 * n), np.empty(N_RESULT)
         out = Out(samples=pointer(samples), fb=pointer(fb),
                   locked=pointer(locked_u8, ctypes_uint8), switches=pointer(switches),
                   switch_cap=switches.size, peak=pointer(peak), final=pointer(final),
@@ -201,7 +208,8 @@ def integrate_compiled(setup: RunSetup, method: str | None = None) -> Simulation
             time = np.append(time, t_reached)
         if count == 0:  # the run ended before its first sample: the series is its initial state
             time, count = np.zeros(1), 1
-            samples[:, 0] = setup.x0
+            samples[:, 0] = 0.0  # (the filters start at rest)
+            samples[:2 * n, 0] = setup.x0
             locked[0] = setup.locked0
             if delayed:
                 fb[:, 0] = setup.before
@@ -218,12 +226,13 @@ def integrate_compiled(setup: RunSetup, method: str | None = None) -> Simulation
                                       method=method)
     # the engine keeps time last; the result holds time-first views of the same memory
     theta = samples[:n, :count].T
-    omega = samples[n:, :count].T
+    omega = samples[n:2 * n, :count].T
     locked = locked[:count]
     for arr in (time, theta, omega):
         arr.setflags(write=False)
-    state = samples[:m, :count].T
-    derive = functools.partial(derived_series, setup, time, state, feedback, locked)
+    state = samples[:2 * n, :count].T
+    filters = samples[2 * n:, :count].T if m > 2 * n else None
+    derive = functools.partial(derived_series, setup, time, state, feedback, locked, filters)
     return SimulationResult(
         time=time, theta=theta, omega=omega, pair_names=tuple(muscles.names),
         status=STATUS_NAMES[status], message=message, fell=status == STATUS_FELL,

@@ -8,7 +8,7 @@ sympy. Each says so in its first lines.
 
 ========================  =====================================================================
 ``csrc/pl_model.c``       inputs, right-hand side for any N, knee impact, event values
-                          (:mod:`.model_c`)
+                          (:mod:`.model_c`), torque feedback filters (:mod:`.filters_c`)
 ``csrc/pl_rhs_small.c``   straight-line right-hand sides for N = 1, 2, 3 (:mod:`.rhs_small`)
 ``csrc/pl_model.h``       the structs of a run and of the model, the rotation series,
                           the prototypes (:mod:`.headers`)

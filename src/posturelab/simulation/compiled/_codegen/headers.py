@@ -37,10 +37,14 @@ RUN_FIELDS = [
     ("tilt_gain", "*f64", "(4, n) joint moments per α(t), α̇(t), α(t−τ), α̇(t−τ)"),
     ("tilt_depth", "f64", "tilt axis below the ankle [m] (0: the ankle's)"),
     ("mp", "*f64", "packed motor noise (mp[0] = 0: none)"),
+    ("n_filters", "i64", "torque feedback filter states after [Θ, Θ̇]: p, or 0"),
+    ("filter_gain", "f64", "K_t of the torque feedback [-]"),
+    ("filter_time", "f64", "τ_t of its filter [s]"),
+    ("tilt_pair_gain", "*f64", "(4, p) pair torques per α(t), α̇(t), α(t−τ), α̇(t−τ)"),
 ]
 #: ``pl_out``: where one run's outputs go (any pointer may be NULL where noted).
 OUT_FIELDS = [
-    ("samples", "w*f64", "(2n, n_grid + 1) or NULL"),
+    ("samples", "w*f64", "(2n + n_filters, n_grid + 1) or NULL"),
     ("fb", "w*f64", "(2n, n_grid + 1) states the muscles responded to, or NULL"),
     ("locked", "w*u8", "(n_grid + 1) or NULL"),
     ("switches", "w*f64", "(switch_cap) or NULL"), ("switch_cap", "i64", ""),
@@ -129,6 +133,12 @@ typedef struct {
     double *base;        /* (3n) θ, sin θ, cos θ at the step's start */
     double *work;        /* (n, n + 4) */
     double *tau;         /* (n) receives the joint moments */
+    int64_t nf;          /* torque feedback filter states after [Θ, Θ̇] (0: none) */
+    double tf_gain;      /* K_t [-] */
+    double tf_time;      /* τ_t [s] */
+    const double *C;     /* (p, n) joint-crossing rows */
+    const double *active;  /* (p) which pairs act */
+    double *fscr;        /* (2 + n + nf) the inputs with the filters' moments, their rates */
 } pl_model;
 
 struct pl_history;
@@ -144,7 +154,8 @@ typedef struct {
     const double *mp;                      /* packed motor noise */
     const double *gains;                   /* (4, p) the run's pair gains */
     int64_t p;
-    double *sc_out, *sc_inp, *sc_x, *ys;   /* scratch (2n), (2 + n), (2n), (2n) */
+    double *sc_out, *sc_inp, *sc_x, *ys;   /* scratch (m), (2 + n + nf), (m), (m) */
+    const double *tilt_pair_gain;          /* (4, p) pair gains on the tilt */
 } pl_ctx;
 """
 

@@ -18,6 +18,7 @@ import sympy as sp
 from ....model import dynamics, kinematics, platform, switched, tilt
 from ....model import events as ev
 from ....model.gains import GAIN_ROWS
+from . import filters_c
 from .codes import DIST_TERM_FIELDS, TILT_TERM_FIELDS
 from .spec import SYMPY, c, symbols
 from .switch_c import switch_effects
@@ -32,7 +33,8 @@ HEADER = """/* The switched model for any N links: GENERATED, do not edit.
  *
  * τ the net muscle moments at the joints: τ = T_K Θ + T_L Θ̇ + inp[2 + j] (T_K = Cᵀ
  * diag(k·active) E, pl_moment_gains), or ±limit_j while joint j saturates;
- * inp = (ẍ_d, ÿ_d, delayed, tilt and noise moments), from pl_inputs_at. */
+ * inp = (ẍ_d, ÿ_d, delayed, tilt and noise moments, then each torque feedback filter's
+ * input), from pl_inputs_at; with torque feedback the state is [Θ, Θ̇, Y] (filters_c.py). */
 #include <math.h>
 #include "pl.h"
 #include "pl_events.h"
@@ -230,7 +232,7 @@ void pl_inputs_at(const pl_ctx *cx, double t, double *out)
                      + tm[3 * n * n + j * n + k] * cx->sc_x[n + k];
             out[2 + j] = s;
         }}
-    }} else {{
+{filters_c.inputs_pairs()}    }} else {{
         for (int64_t j = 0; j < n; j++)
             out[2 + j] = 0.0;
     }}
@@ -241,7 +243,7 @@ void pl_inputs_at(const pl_ctx *cx, double t, double *out)
             pl_tilt(t - cx->delay, cx->tp, &a_d, &ad_d, &add_d);
         for (int64_t j = 0; j < n; j++)
             out[2 + j] += {c(tilt_moment)};
-    }}
+{filters_c.inputs_tilt()}    }}
     if (cx->mp[0] > 0.0)  /* the motor noise, on the motor command */
         pl_motor_noise_add(t, cx->mp, n, out + 2);
 }}
@@ -323,17 +325,7 @@ void pl_rhs_general(const pl_model *md, const double *x, double *out, const doub
         out[n + i] = work[i * w + n];
     }}
 }}
-
-void pl_rhs(const pl_model *md, const double *x, double *out, const double *inp, int locked)
-{{
-    switch (md->n) {{
-    case 3: pl_rhs3(md, x, out, inp, locked); break;
-    case 2: pl_rhs2(md, x, out, inp, locked); break;
-    case 1: pl_rhs1(md, x, out, inp, locked); break;
-    default: pl_rhs_general(md, x, out, inp, locked);
-    }}
-}}
-
+{filters_c.rhs()}
 void pl_moment_gains(const double *E, const double *C, const double *kd, const double *ld,
                      const double *active, int64_t p, int64_t n, double *tk, double *tl)
 {{
@@ -384,7 +376,8 @@ _STEPS = {
     "moment": """const double *tk = md->tm, *tl = md->tm + n * n;
         double tau = cx->sc_inp[2 + idx];
         for (int64_t k = 0; k < n; k++)
-            tau += tk[idx * n + k] * y[k] + tl[idx * n + k] * y[n + k];""",
+            tau += tk[idx * n + k] * y[k] + tl[idx * n + k] * y[n + k];"""
+    + filters_c.moment_step(),
     "free": "pl_rhs(md, y, cx->sc_out, cx->sc_inp, 0);",
     "response": "pl_rhs(md, y, cx->sc_out, cx->sc_inp, locked);",
     "reaction": "fy = vertical_reaction(cx, y);",

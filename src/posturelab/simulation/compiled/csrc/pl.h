@@ -30,7 +30,7 @@ void pl_inverse3_complex(const double *ar, const double *ai, double *outr, doubl
 
 /* history of a delayed run (pl_history.c) */
 typedef struct pl_history {
-    int64_t m, count, cap;
+    int64_t m, count, cap;  /* m: the first m components of a state ([Θ, Θ̇]) */
     double *t, *h, *x, *q;   /* (cap), (cap), (cap, m), (cap, m, 4) */
 } pl_history;
 int pl_history_init(pl_history *hist, int64_t m, int64_t cap);
@@ -67,7 +67,7 @@ struct pl_method {
                     int locked, int64_t *evals);
 };
 int pl_explicit_init(pl_method *me, const pl_run *run, int64_t n);
-int pl_radau_init(pl_method *me, int64_t n);
+int pl_radau_init(pl_method *me, int64_t n, int64_t m);
 void pl_radau_constants(void);  /* once, at import */
 double pl_initial_step(const pl_model *md, double t0, const double *y0, const double *f0,
                        double t_bound, double max_step, double rtol, double atol, int locked,

@@ -9,7 +9,9 @@
  * for a delay below OVERLAP_BELOW, overlap their own past) and land on kτ (k = 1 …
  * delay_multiples). Steps also land on every breakpoint and on its echoes kτ later, and on
  * the echoes of every switch: the inputs are taken just before a stop at a step's end and
- * just after it at the next step's start. */
+ * just after it at the next step's start. The state is [Θ, Θ̇] or, with torque feedback,
+ * [Θ, Θ̇, Y] (m = 2N + P): the filters start at rest and a switch leaves them as they are, the
+ * history keeps [Θ, Θ̇] and the samples all m components. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -42,7 +44,7 @@ static double wall_seconds(void)
 
 typedef struct {
     double *tm, *sat, *base, *work, *tau, *active, *x, *y, *Q, *inp, *g_old, *g_new, *sc_out,
-        *sc_inp, *sc_x, *ys, *ev_side, *block, *Qg, *yp;
+        *sc_inp, *sc_x, *ys, *ev_side, *block, *Qg, *yp, *fscr;
     int64_t *ev_kind, *ev_index;
 } buffers;
 
@@ -50,16 +52,17 @@ static void free_buffers(buffers *b)
 {
     double *d[] = {b->tm, b->sat, b->base, b->work, b->tau, b->active, b->x, b->y, b->Q,
                    b->inp, b->g_old, b->g_new, b->sc_out, b->sc_inp, b->sc_x, b->ys,
-                   b->ev_side, b->block, b->Qg, b->yp};
+                   b->ev_side, b->block, b->Qg, b->yp, b->fscr};
     for (size_t k = 0; k < sizeof(d) / sizeof(d[0]); k++)
         free(d[k]);
     free(b->ev_kind);
     free(b->ev_index);
 }
 
-static int alloc_buffers(buffers *b, int64_t n, int64_t p, int64_t n_nodes, int64_t n_slots)
+static int alloc_buffers(buffers *b, int64_t n, int64_t nf, int64_t p, int64_t n_nodes,
+                         int64_t n_slots)
 {
-    const int64_t m = 2 * n, cap = n_slots > 0 ? n_slots : 1;
+    const int64_t m = 2 * n + nf, cap = n_slots > 0 ? n_slots : 1, width = 2 + n + nf;
     memset(b, 0, sizeof(*b));
     b->tm = calloc(4 * n * n, sizeof(double));
     b->sat = calloc(n, sizeof(double));
@@ -70,23 +73,24 @@ static int alloc_buffers(buffers *b, int64_t n, int64_t p, int64_t n_nodes, int6
     b->x = calloc(m, sizeof(double));
     b->y = calloc(m, sizeof(double));
     b->Q = calloc(4 * m, sizeof(double));
-    b->inp = calloc(n_nodes * (2 + n), sizeof(double));
+    b->inp = calloc(n_nodes * width, sizeof(double));
     b->g_old = calloc(cap, sizeof(double));
     b->g_new = calloc(cap, sizeof(double));
     b->ev_side = calloc(cap, sizeof(double));
     b->ev_kind = calloc(cap, sizeof(int64_t));
     b->ev_index = calloc(cap, sizeof(int64_t));
     b->sc_out = calloc(m, sizeof(double));
-    b->sc_inp = calloc(2 + n, sizeof(double));
+    b->sc_inp = calloc(width, sizeof(double));
     b->sc_x = calloc(m, sizeof(double));
     b->ys = calloc(m, sizeof(double));
     b->block = calloc(m * SAMPLE_BLOCK, sizeof(double));
     b->Qg = calloc(4 * m, sizeof(double));
     b->yp = calloc(m, sizeof(double));
+    b->fscr = calloc(width, sizeof(double));
     return b->tm && b->sat && b->base && b->work && b->tau && b->active && b->x && b->y
            && b->Q && b->inp && b->g_old && b->g_new && b->ev_side && b->ev_kind
            && b->ev_index && b->sc_out && b->sc_inp && b->sc_x && b->ys && b->block && b->Qg
-           && b->yp;
+           && b->yp && b->fscr;
 }
 
 /* The events of a smooth segment: the slots (posturelab.model.events.event_slots) whose
@@ -177,7 +181,8 @@ static double side_of(double t, double h)
 
 int64_t pl_integrate(const pl_run *run, pl_out *out)
 {
-    const int64_t n = run->n, m = 2 * n, T = run->n_grid, width = 2 + n;
+    const int64_t n = run->n, nf = run->n_filters, m = 2 * n + nf, T = run->n_grid;
+    const int64_t width = 2 + n + nf;
     const double *fpar = run->fpar, *grid = run->grid;
     const double rtol = fpar[F_RTOL], atol = fpar[F_ATOL], duration = fpar[F_DURATION];
     const double settle_tol = fpar[F_SETTLE_TOL];
@@ -203,10 +208,10 @@ int64_t pl_integrate(const pl_run *run, pl_out *out)
     pl_history hist = {0};
     jump_list jumps = {0};
     memset(&b, 0, sizeof(b));
-    int ok = run->method == METHOD_RADAU ? pl_radau_init(&me, n)
+    int ok = run->method == METHOD_RADAU ? pl_radau_init(&me, n, m)
                                          : pl_explicit_init(&me, run, n);
-    ok = ok && alloc_buffers(&b, n, run->p, me.n_nodes, run->n_slots);
-    ok = ok && pl_history_init(&hist, m, delay > 0.0 ? 256 : 1);
+    ok = ok && alloc_buffers(&b, n, nf, run->p, me.n_nodes, run->n_slots);
+    ok = ok && pl_history_init(&hist, 2 * n, delay > 0.0 ? 256 : 1);
     for (int64_t i = 0; delay > 0.0 && i < run->n_bps; i++)  /* the breakpoints' echoes */
         for (int64_t k = 1; ok && k <= run->delay_multiples && !is_echo(run, i); k++) {
             const double echo = run->bps[i] + k * delay;
@@ -225,15 +230,16 @@ int64_t pl_integrate(const pl_run *run, pl_out *out)
     }
     memcpy(b.sat, run->sat0, sizeof(double) * n);
     memcpy(b.active, run->active0, sizeof(double) * run->p);
-    memcpy(b.x, run->x0, sizeof(double) * m);
-    pl_model md = {n, run->bp, b.tm, run->lim, b.sat, b.base, b.work, b.tau};
+    memcpy(b.x, run->x0, sizeof(double) * 2 * n);
+    pl_model md = {n, run->bp, b.tm, run->lim, b.sat, b.base, b.work, b.tau, nf,
+                   run->filter_gain, run->filter_time, run->C, b.active, b.fscr};
     pl_ctx cx = {&md, run->E, run->dp, fpar, run->before, run->ev_offset, &hist, delay,
                  run->tp, run->tilt_gain, run->tilt_depth, run->mp, run->gains, run->p,
-                 b.sc_out, b.sc_inp, b.sc_x, b.ys};
+                 b.sc_out, b.sc_inp, b.sc_x, b.ys, run->tilt_pair_gain};
     double *x = b.x, *y = b.y, *Q = b.Q, *inp = b.inp;
     for (int64_t i = 0; i < n; i++)
         out->peak[i] = 0.0;
-    for (int64_t i = 0; i < m; i++)
+    for (int64_t i = 0; i < 2 * n; i++)
         out->final[i] = NAN;
 
     double t = 0.0, h = 0.0, fall_time = NAN, last_outside = NAN;
@@ -448,7 +454,7 @@ int64_t pl_integrate(const pl_run *run, pl_out *out)
             if (out->fb)
                 for (int64_t g = g0; g < g1; g++) {
                     pl_history_at(&hist, run->before, grid[g] - delay, b.sc_x);
-                    for (int64_t i = 0; i < m; i++)
+                    for (int64_t i = 0; i < 2 * n; i++)
                         out->fb[i * (T + 1) + g] = b.sc_x[i];
                 }
         }
@@ -456,7 +462,7 @@ int64_t pl_integrate(const pl_run *run, pl_out *out)
         if (gi > first_gi) {
             /* the expression of the samples above (a batch row keeps no samples) */
             const double s = (grid[gi - 1] - t) * (1.0 / h);
-            for (int64_t i = 0; i < m; i++) {
+            for (int64_t i = 0; i < 2 * n; i++) {
                 const double *q = Q + 4 * i;
                 out->final[i] = x[i] + s * (q[0] + s * (q[1] + s * (q[2] + s * q[3])));
             }
@@ -488,7 +494,7 @@ int64_t pl_integrate(const pl_run *run, pl_out *out)
                         any_outside = 1;
                     }
                     final_outside = outside;
-                    memcpy(out->final, x, sizeof(double) * m);
+                    memcpy(out->final, x, sizeof(double) * 2 * n);
                     if (out->samples) {
                         for (int64_t i = 0; i < m; i++)
                             out->samples[i * (T + 1) + gi] = x[i];
@@ -496,7 +502,7 @@ int64_t pl_integrate(const pl_run *run, pl_out *out)
                     }
                     if (out->fb) {
                         pl_history_at(&hist, run->before, t_ev - delay, b.sc_x);
-                        for (int64_t i = 0; i < m; i++)
+                        for (int64_t i = 0; i < 2 * n; i++)
                             out->fb[i * (T + 1) + gi] = b.sc_x[i];
                     }
                 }

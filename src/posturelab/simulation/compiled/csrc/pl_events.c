@@ -27,7 +27,7 @@ double pl_event_root(const pl_ctx *cx, int64_t kind, int64_t idx, double side, d
         double tc = (ta * gb - tb * ga) / (gb - ga);
         if (!(tc > fmin(ta, tb) && tc < fmax(ta, tb)))
             tc = 0.5 * (ta + tb);
-        pl_dense_at(x, Q, 2 * cx->md->n, t0, h, tc, cx->ys);
+        pl_dense_at(x, Q, 2 * cx->md->n + cx->md->nf, t0, h, tc, cx->ys);
         const double gc = pl_event_value(cx, kind, idx, side, tc, cx->ys, locked);
         if (gc == 0.0)
             return tc;

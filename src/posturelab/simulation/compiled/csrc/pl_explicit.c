@@ -80,7 +80,7 @@ static int rk_attempt(pl_method *me, const pl_model *md, double t, double h,
                       int locked, double *h_next, int64_t *evals)
 {
     rk_ws *w = me->ws;
-    const int64_t S = w->S, m = w->m, width = 2 + md->n;
+    const int64_t S = w->S, m = w->m, width = 2 + md->n + md->nf;
     double *restrict K = w->K;
     const double *restrict A = w->A, *restrict ew = w->e, *restrict P = w->P;
     (void)t;
@@ -171,7 +171,7 @@ int pl_explicit_init(pl_method *me, const pl_run *run, int64_t n)
     if (!w)
         return 0;
     w->S = run->n_stages;
-    w->m = 2 * n;
+    w->m = 2 * n + run->n_filters;
     w->order = run->tab_error_order;
     w->A = run->tab_A;
     w->e = run->tab_e;

@@ -8,7 +8,8 @@
  *
  * τ the net muscle moments at the joints: τ = T_K Θ + T_L Θ̇ + inp[2 + j] (T_K = Cᵀ
  * diag(k·active) E, pl_moment_gains), or ±limit_j while joint j saturates;
- * inp = (ẍ_d, ÿ_d, delayed, tilt and noise moments), from pl_inputs_at. */
+ * inp = (ẍ_d, ÿ_d, delayed, tilt and noise moments, then each torque feedback filter's
+ * input), from pl_inputs_at; with torque feedback the state is [Θ, Θ̇, Y] (filters_c.py). */
 #include <math.h>
 #include "pl.h"
 #include "pl_events.h"
@@ -156,6 +157,14 @@ void pl_inputs_at(const pl_ctx *cx, double t, double *out)
                      + tm[3 * n * n + j * n + k] * cx->sc_x[n + k];
             out[2 + j] = s;
         }
+        for (int64_t q = 0; q < cx->md->nf; q++) {  /* the filters' inputs */
+            double st = 0.0, sd = 0.0;
+            for (int64_t k = 0; k < n; k++) {
+                st += cx->E[q * n + k] * cx->sc_x[k];
+                sd += cx->E[q * n + k] * cx->sc_x[n + k];
+            }
+            out[2 + n + q] = cx->md->active[q]*(cx->gains[GAIN_DELAYED_STIFFNESS * cx->p + q]*st + cx->gains[GAIN_DELAYED_VISCOSITY * cx->p + q]*sd);
+        }
     } else {
         for (int64_t j = 0; j < n; j++)
             out[2 + j] = 0.0;
@@ -167,6 +176,8 @@ void pl_inputs_at(const pl_ctx *cx, double t, double *out)
             pl_tilt(t - cx->delay, cx->tp, &a_d, &ad_d, &add_d);
         for (int64_t j = 0; j < n; j++)
             out[2 + j] += a*g[GAIN_IMMEDIATE_STIFFNESS * n + j] + a_d*g[GAIN_DELAYED_STIFFNESS * n + j] + ad*g[GAIN_IMMEDIATE_VISCOSITY * n + j] + ad_d*g[GAIN_DELAYED_VISCOSITY * n + j];
+        for (int64_t q = 0; q < cx->md->nf; q++)
+            out[2 + n + q] += a_d*cx->tilt_pair_gain[GAIN_DELAYED_STIFFNESS * cx->p + q] + ad_d*cx->tilt_pair_gain[GAIN_DELAYED_VISCOSITY * cx->p + q];
     }
     if (cx->mp[0] > 0.0)  /* the motor noise, on the motor command */
         pl_motor_noise_add(t, cx->mp, n, out + 2);
@@ -231,14 +242,31 @@ void pl_rhs_general(const pl_model *md, const double *x, double *out, const doub
     }
 }
 
+/* [Θ̇, Θ̈, Ẏ] at x = [Θ, Θ̇, Y]: the N-link right-hand side, with the torque feedback filters'
+ * moments added to the inputs' and their rates after it (model.switched.raw_moments,
+ * torque_feedback_rate) */
 void pl_rhs(const pl_model *md, const double *x, double *out, const double *inp, int locked)
 {
-    switch (md->n) {
+    const int64_t n = md->n, nf = md->nf;
+    double *fs = md->fscr;
+    if (nf > 0) {
+        for (int64_t k = 0; k < 2 + n; k++)
+            fs[k] = inp[k];
+        for (int64_t q = 0; q < nf; q++) {
+            for (int64_t j = 0; j < n; j++)
+                fs[2 + j] += md->C[q * n + j] * (md->active[q]*x[2 * n + q]);
+            fs[2 + n + q] = (md->tf_gain*(inp[2 + n + q] + md->active[q]*x[2 * n + q]) - x[2 * n + q])/md->tf_time;
+        }
+        inp = fs;
+    }
+    switch (n) {
     case 3: pl_rhs3(md, x, out, inp, locked); break;
     case 2: pl_rhs2(md, x, out, inp, locked); break;
     case 1: pl_rhs1(md, x, out, inp, locked); break;
     default: pl_rhs_general(md, x, out, inp, locked);
     }
+    for (int64_t q = 0; q < nf; q++)
+        out[2 * n + q] = fs[2 + n + q];
 }
 
 void pl_moment_gains(const double *E, const double *C, const double *kd, const double *ld,
@@ -374,6 +402,8 @@ double pl_event_value(const pl_ctx *cx, int64_t kind, int64_t idx, double side, 
         double tau = cx->sc_inp[2 + idx];
         for (int64_t k = 0; k < n; k++)
             tau += tk[idx * n + k] * y[k] + tl[idx * n + k] * y[n + k];
+        for (int64_t q = 0; q < md->nf; q++)
+            tau += md->C[q * n + idx] * (md->active[q]*y[2 * n + q]);
         g = -md->lim[idx] + side*tau;
         break;
     }

@@ -48,11 +48,15 @@ typedef struct {
     const double *tilt_gain;            /* (4, n) joint moments per α(t), α̇(t), α(t−τ), α̇(t−τ) */
     double tilt_depth;                  /* tilt axis below the ankle [m] (0: the ankle's) */
     const double *mp;                   /* packed motor noise (mp[0] = 0: none) */
+    int64_t n_filters;                  /* torque feedback filter states after [Θ, Θ̇]: p, or 0 */
+    double filter_gain;                 /* K_t of the torque feedback [-] */
+    double filter_time;                 /* τ_t of its filter [s] */
+    const double *tilt_pair_gain;       /* (4, p) pair torques per α(t), α̇(t), α(t−τ), α̇(t−τ) */
 } pl_run;
 
 /* Outputs of one run (any pointer may be NULL where noted). */
 typedef struct {
-    double *samples;                    /* (2n, n_grid + 1) or NULL */
+    double *samples;                    /* (2n + n_filters, n_grid + 1) or NULL */
     double *fb;                         /* (2n, n_grid + 1) states the muscles responded to, or NULL */
     uint8_t *locked;                    /* (n_grid + 1) or NULL */
     double *switches;                   /* (switch_cap) or NULL */
@@ -72,6 +76,12 @@ typedef struct {
     double *base;        /* (3n) θ, sin θ, cos θ at the step's start */
     double *work;        /* (n, n + 4) */
     double *tau;         /* (n) receives the joint moments */
+    int64_t nf;          /* torque feedback filter states after [Θ, Θ̇] (0: none) */
+    double tf_gain;      /* K_t [-] */
+    double tf_time;      /* τ_t [s] */
+    const double *C;     /* (p, n) joint-crossing rows */
+    const double *active;  /* (p) which pairs act */
+    double *fscr;        /* (2 + n + nf) the inputs with the filters' moments, their rates */
 } pl_model;
 
 struct pl_history;
@@ -87,7 +97,8 @@ typedef struct {
     const double *mp;                      /* packed motor noise */
     const double *gains;                   /* (4, p) the run's pair gains */
     int64_t p;
-    double *sc_out, *sc_inp, *sc_x, *ys;   /* scratch (2n), (2 + n), (2n), (2n) */
+    double *sc_out, *sc_inp, *sc_x, *ys;   /* scratch (m), (2 + n + nf), (m), (m) */
+    const double *tilt_pair_gain;          /* (4, p) pair gains on the tilt */
 } pl_ctx;
 
 /* sin θ and cos θ from those of a nearby θ_b by the angle-sum formulas: within a step the

@@ -9,7 +9,10 @@
  * so each Newton system (c·I − Jac) v = r of size 2N reduces to
  * S(c) a = r₂ + (c·I − Q) r₁, b = c·a − r₁, S(c) = c²I − c·Q − P of size N, for the real
  * eigenvalue c = μ_r/h and the complex one (solved as the real 2N×2N system
- * [[Re S, −Im S], [Im S, Re S]]). The inputs rows are (t, t + c1 h, t + c2 h, t + h). */
+ * [[Re S, −Im S], [Im S, Re S]]). The inputs rows are (t, t + c1 h, t + c2 h, t + h).
+ * Torque feedback filter states Y (m = 2N + P) add the columns R = ∂Θ̈/∂Y and Ẏ's diagonal D
+ * (its only dependence on the state; jac's row n): Y's part v_y = r_y/(c − D) first, then
+ * r₂ + R v_y in place of r₂. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -63,7 +66,7 @@ static void prepared_solve(const radau_ws *w, const double *A, const int64_t *pi
 struct radau_ws {
     int64_t n, m;
     double *Z, *Z0, *W, *F;       /* (3, m) */
-    double *jac;                  /* (n, m) acceleration rows */
+    double *jac;                  /* (n + 1, m) acceleration rows, row n: D */
     double *lur; int64_t *pivr;   /* (n, n) real system: its factors, or inverse */
     double *luc; int64_t *pivc;   /* (2n, 2n) complex system, embedded: likewise */
     int closed;                   /* N = 3: closed-form inverses (matrix–vector solves) */
@@ -85,6 +88,7 @@ static int64_t jacobian(radau_ws *w, const pl_model *md, const double *x, const 
         w->xt[j] = x[j];
         for (int64_t i = 0; i < n; i++)
             w->jac[i * m + j] = (w->s1[n + i] - f0[n + i]) / d;
+        w->jac[n * m + j] = j < 2 * n ? 0.0 : (w->s1[j] - f0[j]) / d;
     }
     return m;
 }
@@ -155,10 +159,14 @@ static void prepared_solve(const radau_ws *w, const double *A, const int64_t *pi
 static void solve_real(radau_ws *w, double c, double *r)
 {
     const int64_t n = w->n, m = w->m;
+    for (int64_t j = 2 * n; j < m; j++)
+        r[j] /= c - w->jac[n * m + j];
     for (int64_t i = 0; i < n; i++) {
         double s = r[n + i] + c * r[i];
         for (int64_t j = 0; j < n; j++)
             s -= w->jac[i * m + n + j] * r[j];
+        for (int64_t j = 2 * n; j < m; j++)
+            s += w->jac[i * m + j] * r[j];
         w->tmp[i] = s;
     }
     prepared_solve(w, w->lur, w->pivr, w->tmp, n);
@@ -172,9 +180,18 @@ static void solve_real(radau_ws *w, double c, double *r)
 static void solve_complex(radau_ws *w, double cre, double cim, double *rr, double *ri)
 {
     const int64_t n = w->n, m = w->m;
+    for (int64_t j = 2 * n; j < m; j++) {  /* (rr + i ri)/(cre − D + i cim) */
+        const double dr = cre - w->jac[n * m + j], q = dr * dr + cim * cim, a = rr[j];
+        rr[j] = (a * dr + ri[j] * cim) / q;
+        ri[j] = (ri[j] * dr - a * cim) / q;
+    }
     for (int64_t i = 0; i < n; i++) {
         double ur = rr[n + i] + (cre * rr[i] - cim * ri[i]);
         double ui = ri[n + i] + (cre * ri[i] + cim * rr[i]);
+        for (int64_t j = 2 * n; j < m; j++) {
+            ur += w->jac[i * m + j] * rr[j];
+            ui += w->jac[i * m + j] * ri[j];
+        }
         for (int64_t j = 0; j < n; j++) {
             const double q = w->jac[i * m + n + j];
             ur -= q * rr[j];
@@ -198,7 +215,7 @@ static void solve_complex(radau_ws *w, double cre, double cim, double *rr, doubl
 static int newton(radau_ws *w, const pl_model *md, double h, const double *x, const double *inp,
                   int locked, int64_t *iters, double *rate_out)
 {
-    const int64_t m = w->m, width = 2 + md->n;
+    const int64_t m = w->m, width = 2 + md->n + md->nf;
     const double cr = MU_REAL / h, ccr = MU_CRE / h, cci = MU_CIM / h;
     double *Z = w->Z, *W = w->W, *F = w->F;
     for (int64_t i = 0; i < m; i++)
@@ -322,7 +339,7 @@ static int radau_attempt(pl_method *me, const pl_model *md, double t, double h,
                          double atol, int locked, double *h_next, int64_t *evals)
 {
     radau_ws *w = me->ws;
-    const int64_t m = w->m, width = 2 + md->n;
+    const int64_t m = w->m, width = 2 + md->n + md->nf;
     if (!w->last_rejected)
         w->h_start = h;
     if (h != w->h_lu)
@@ -439,7 +456,7 @@ static void radau_release(pl_method *me)
     me->ws = NULL;
 }
 
-int pl_radau_init(pl_method *me, int64_t n)
+int pl_radau_init(pl_method *me, int64_t n, int64_t m)
 {
     pl_radau_constants();
     radau_ws *w = calloc(1, sizeof(radau_ws));
@@ -449,14 +466,13 @@ int pl_radau_init(pl_method *me, int64_t n)
                       .refresh = radau_refresh};
     if (!w)
         return 0;
-    const int64_t m = 2 * n;
     w->n = n;
     w->m = m;
     w->Z = calloc(3 * m, sizeof(double));
     w->Z0 = calloc(3 * m, sizeof(double));
     w->W = calloc(3 * m, sizeof(double));
     w->F = calloc(3 * m, sizeof(double));
-    w->jac = calloc(n * m, sizeof(double));
+    w->jac = calloc((n + 1) * m, sizeof(double));
     w->lur = calloc(n * n, sizeof(double));
     w->luc = calloc(4 * n * n, sizeof(double));
     w->pivr = calloc(n, sizeof(int64_t));
