@@ -35,6 +35,7 @@ SUBCOMMANDS: dict[str, str] = {
     "design": "design",
     "compare": "compare",
     "explore": "explore",
+    "strategy": "strategy",
 }
 
 #: Subcommand name -> its line in ``posturelab --help`` (here, so that ``posturelab --help``
@@ -65,6 +66,8 @@ SUBCOMMAND_HELP: dict[str, str] = {
               "(Fisher information), and optimise its design",
     "compare": "overlay saved runs (posturelab simulate --out) in one figure, and tabulate them",
     "explore": "explore the model interactively in the web browser (a local page)",
+    "strategy": "strategy maps: the hip fraction across translation speeds or frequencies "
+                "(multi-joint LQR controller)",
 }
 
 

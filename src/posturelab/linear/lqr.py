@@ -39,7 +39,7 @@ from ..errors import ParameterError
 from ..model.body import Body
 from ..model.joint_feedback import JointFeedback
 from ..model.muscles import MuscleSet
-from .system import LinearSystem, link_torque_matrix, linear_system, sorted_poles
+from .system import LinearSystem, linear_system, link_torque_matrix, sorted_poles
 
 __all__ = ["lqr_gain", "lqr_joint_feedback", "LQRCheck", "closed_loop_check",
            "design_matrices", "knee_basis", "MultiJointController", "multijoint_controller",

@@ -28,7 +28,8 @@ from .._validation import finite_array
 from ..errors import ParameterError
 from .gains import DELAYED_STIFFNESS, DELAYED_VISCOSITY, IMMEDIATE_STIFFNESS, IMMEDIATE_VISCOSITY
 
-__all__ = ["JointFeedback", "joint_gain_rows", "joint_moment_gain_formula", "joint_feedback_moments",
+__all__ = ["JointFeedback", "joint_gain_rows", "joint_moment_gain_formula",
+           "joint_feedback_moments",
            "MAX_JOINT_GAIN"]
 
 #: Largest |entry| of F_θ or F_ω accepted (a thousand times a standing adult's m g h). [N·m/rad]
