@@ -242,10 +242,11 @@ class MultiJointPreset:
         ankle. [m]; None: the foot of :data:`posturelab.model.options.FOOT_FROM_LITERATURE`.
     other_effort_factor : float
         Every other joint's τ_max is this times the ankle's. [-]
-    intrinsic_stiffness : float
-        Each single-joint pair's intrinsic stiffness / (the body's m g h). [-]
-    intrinsic_viscosity_ratio : float
-        Their viscosity / stiffness. [s]
+    intrinsic_stiffness : tuple of 3 float
+        The intrinsic stiffness of the ankle's, the middle joints' (knee, …) and the top
+        joint's (hip) pair / (the body's m g h). [-]
+    intrinsic_viscosity : tuple of 3 float
+        Their viscosity / m g h, in the same order. [s]
     feedback_delay : float
         τ of the controller. [s]
     knee : {"free", "locked"}
@@ -262,8 +263,8 @@ class MultiJointPreset:
     angle_limit: float
     rate_limit: float
     other_effort_factor: float
-    intrinsic_stiffness: float
-    intrinsic_viscosity_ratio: float
+    intrinsic_stiffness: tuple
+    intrinsic_viscosity: tuple
     feedback_delay: float
     ankle_effort_centre_of_pressure: float | None = None
     knee: str = "free"
@@ -290,14 +291,20 @@ class MultiJointPreset:
         return out
 
     def muscles(self, body: Body) -> MuscleSet:
-        """One intrinsic pair per joint (ankle, knee, hip, …), stiffness
-        ``intrinsic_stiffness`` × mgh [N·m/rad]."""
-        k = self.intrinsic_stiffness * body.load_stiffness
-        names = (("ankle",) if body.n_links == 1 else ("ankle", "hip") if body.n_links == 2
-                 else ("ankle", "knee", "hip") + tuple(f"joint{j}"
-                                                      for j in range(4, body.n_links + 1)))
-        return MuscleSet(tuple(MusclePair(nm, j, j + 1, k, self.intrinsic_viscosity_ratio * k)
-                               for j, nm in enumerate(names)), body.n_links)
+        """One intrinsic pair per joint (ankle, knee, …, hip: the top joint), gains
+        ``intrinsic_stiffness`` × mgh [N·m/rad] and ``intrinsic_viscosity`` × mgh
+        [N·m·s/rad]."""
+        from .muscles import joint_pair_names
+
+        n, mgh = body.n_links, body.load_stiffness
+        names = joint_pair_names(n)
+
+        def part(values, j):
+            return values[0] if j == 0 else values[2] if j == n - 1 else values[1]
+
+        return MuscleSet(tuple(MusclePair(nm, j, j + 1, part(self.intrinsic_stiffness, j) * mgh,
+                                          part(self.intrinsic_viscosity, j) * mgh)
+                               for j, nm in enumerate(names)), n)
 
 
 _OURS = "posturelab's choice"
@@ -314,20 +321,23 @@ MULTIJOINT_CONTROLLERS: dict[str, MultiJointPreset] = {
                   "support translations); weights by Bryson's rule (Bryson AE, Ho YC 1975, "
                   "Applied Optimal Control) with the ankle's effort bounded by the foot; "
                   "every number is posturelab's choice, not a fitted value"),
-        angle_limit=2.0, rate_limit=float("inf"), other_effort_factor=0.5,
-        intrinsic_stiffness=0.1, intrinsic_viscosity_ratio=0.25, feedback_delay=0.08,
+        angle_limit=1.0, rate_limit=float("inf"), other_effort_factor=0.25,
+        intrinsic_stiffness=(0.1, 0.1, 0.05), intrinsic_viscosity=(0.05, 0.05, 0.025),
+        feedback_delay=0.08,
         knee="locked", joint_angle_limit=float("inf"),
         provenance=(
             ("angle_limit", Provenance(None, note=f"{_OURS}: a cheap-state, costly-effort design "
-                                       "(2 rad), so that the undelayed LQR keeps a delay margin "
-                                       "above the delay (0.114 s; 0.1 rad gives 0.03 s)")),
+                                       "(1 rad), so that the undelayed LQR keeps a delay margin "
+                                       "above the delay (0.095 s; 0.1 rad gives about 0.03 s)")),
             ("rate_limit", Provenance(None, note=f"{_OURS}: rates not weighted")),
-            ("other_effort_factor", Provenance(None, note=f"{_OURS}: the hip's τ_max half the "
-                                               "foot-limited ankle's (larger factors lower the "
-                                               "delay margin below the delay)")),
-            ("intrinsic_stiffness", Provenance(None, note=f"{_OURS}: a small intrinsic "
-                                               "stiffness, 10 % of mgh per joint")),
-            ("intrinsic_viscosity_ratio", Provenance(None, note="the paper's 0.25 s")),
+            ("other_effort_factor", Provenance(None, note=f"{_OURS}: the hip's τ_max a quarter "
+                                               "of the foot-limited ankle's (larger factors "
+                                               "lower the delay margin toward the delay)")),
+            ("intrinsic_stiffness", Provenance(None, note=f"{_OURS}: small intrinsic "
+                                               "stiffness, 10 % of mgh at ankle and knee, 5 % "
+                                               "at the hip")),
+            ("intrinsic_viscosity", Provenance(None, note=f"{_OURS}: 5 % and 2.5 % of mgh "
+                                               "[s]")),
             ("feedback_delay", Provenance(None, note=f"{_OURS}: 0.08 s, near the ~0.1 s latency "
                                           "of automatic postural responses, below the design's "
                                           "delay margin")),

@@ -22,6 +22,7 @@ from ...errors import ParameterError
 from ...model.body import Body
 from ...model.checks import check_model
 from ...model.gains import GAIN_ROWS
+from ...model.joint_feedback import joint_feedback_moments, joint_gain_rows
 from ...model.muscles import MuscleSet, feedback_gains, paper_muscles
 from ...model.platform import Disturbance
 from ...model.tilt import tilt_pair_gains
@@ -388,6 +389,9 @@ def simulate_batch(
         split = feedback_gains(kd_all, ld_all, ka_all, la_all, np.ones(M))
         pair_gains = tilt_pair_gains(split, muscles.spans_foot, delays, weights)
         tilt_gain_all = enc.readonly(np.ascontiguousarray(pair_gains @ muscles.crossing_matrix))
+    if common.joint_feedback is not None and len({bool(d > 0) for d in delays}) > 1:
+        raise ParameterError("a batch with a joint_feedback controller needs every run's "
+                             "feedback_delay > 0, or every one 0 (not a mix)")
     moments0 = np.empty((M, n))
     for d in np.unique(delays):
         rows = delays == d
@@ -395,6 +399,10 @@ def simulate_batch(
             muscles, x0_all[which[rows]], before_all[which[rows]], active_all[which[rows]],
             gains_all[rows], float(d), base.tilt,
             None if pair_gains is None else pair_gains[rows], base.motor_torque)
+        if common.joint_feedback is not None:  # the controller's moment at the start
+            moments0[rows] += joint_feedback_moments(
+                joint_gain_rows(common.joint_feedback, n, float(d)), x0_all[which[rows]],
+                before_all[which[rows]])
     sat0_all = enc.readonly(start_saturation(moments0, lims))
     lim_all = enc.readonly(lims)
     delay_all = enc.readonly(delays)
