@@ -47,7 +47,8 @@ def test_the_table_states_each_quantity_once_with_unit_bounds_and_meaning():
                                 "active_viscosity", "viscosity_ratio",
                                 "active_viscosity_ratio", "feedback_delay",
                                 "proprioceptive_weight", "torque_feedback_gain",
-                                "torque_feedback_time_constant", "torque_limit",
+                                "torque_feedback_time_constant", "joint_feedback_scale",
+                                "torque_limit",
                                 "disturbance_scale",
                                 "height", "mass", "step_speed", "tilt_amplitude"]
     for q in QUANTITIES.values():

@@ -273,8 +273,13 @@ class MultiJointPreset:
 
     def provenance_text(self) -> str:
         """Where each number comes from, in words."""
-        return "; ".join(p.text(name, getattr(self, name) if getattr(self, name) is not None
-                                else float("nan")) for name, p in self.provenance) + "."
+        def shown(name: str, p: Provenance) -> str:
+            value = getattr(self, name)
+            if isinstance(value, tuple):
+                return f"{name} = {', '.join(f'{v:g}' for v in value)}: {p.note}"
+            return p.text(name, value)
+
+        return "; ".join(shown(name, p) for name, p in self.provenance) + "."
 
     def effort_limits(self, body: Body):
         """τ_max per joint: the ankle's m g x_toe, the others ``other_effort_factor`` times

@@ -1,0 +1,107 @@
+"""Strategy maps: the hip fraction of runs built to be pure ankle and pure hip, the maps'
+records and JSON, the issue's targets on the paper's body with multijoint-default, and
+``posturelab strategy``."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+import posturelab as pl
+from posturelab.linear.lqr import multijoint_controller
+from posturelab.model.kinematics import hip_fraction
+from posturelab.studies.strategy import (
+    StrategyMap,
+    StrategyRun,
+    oscillation_map,
+    oscillation_profile,
+    translation_map,
+    translation_profile,
+)
+from tests._cli import cli, one_line_exit_2
+
+
+def _sway(t, leg, trunk):
+    """Θ (T, 3): shank and thigh at ``leg`` (a locked knee), trunk at ``trunk``. [rad]"""
+    return np.column_stack([leg(t), leg(t), trunk(t)])
+
+
+def test_pure_ankle_and_pure_hip_runs():
+    t = np.linspace(0.0, 10.0, 2001)
+    wave = lambda t: 0.05 * np.sin(2 * np.pi * 0.5 * t)  # noqa: E731
+    assert hip_fraction(_sway(t, wave, wave)) == pytest.approx(0.0, abs=1e-15)
+    assert hip_fraction(_sway(t, wave, lambda t: -wave(t))) == pytest.approx(1.0, abs=1e-15)
+    # leg still, trunk moving: u = 0, w ≠ 0, a = −b: half and half
+    assert hip_fraction(_sway(t, lambda t: 0 * t, wave)) == pytest.approx(0.5, abs=1e-12)
+
+
+def test_profiles_are_the_stated_ones():
+    ramp = translation_profile(0.3, "backward", 0.06)
+    assert ramp.displacement == -0.06 and ramp.duration == pytest.approx(0.4)  # 2D/speed
+    assert translation_profile(0.3, "forward", 0.06).displacement == 0.06
+    sine = oscillation_profile(0.05, 1.25)
+    t = np.linspace(0, 3, 7)
+    np.testing.assert_allclose(sine.acceleration(t)[:, 0],
+                               -0.05 * (2 * np.pi * 1.25) ** 2 * np.sin(2 * np.pi * 1.25 * t),
+                               atol=1e-12)
+    with pytest.raises(pl.ParameterError, match="backward"):
+        translation_profile(0.3, "sideways")
+
+
+def test_transition_frequency_is_the_first_recovered_run_where_the_hip_dominates():
+    runs = tuple(StrategyRun(f, h, o, 0.0, False, 0.0) for f, h, o in (
+        (0.5, 0.1, "recovered"), (0.8, 0.7, "fell"), (1.0, 0.6, "recovered"),
+        (1.2, 0.9, "recovered")))
+    smap = StrategyMap("oscillation", "frequency", runs, "", float("inf"))
+    assert smap.transition_frequency == 1.0
+    d = smap.to_dict()
+    assert d["transition_frequency"] == 1.0 and d["runs"][1]["outcome"] == "fell"
+    assert d["runs"][0]["frequency"] == 0.5 and d["ankle_torque_limit"] is None
+
+
+@pytest.fixture(scope="module")
+def paper():
+    body = pl.paper_body()
+    c = multijoint_controller(body)
+    return body, c, dict(ankle_torque_limit=c.effort_limits[0], **c.run_options())
+
+
+def test_issue_targets_backward_translations(paper):
+    """The issue's target: below 0.15 for the slowest backward translations, above 0.4 for
+    the fastest recovered."""
+    body, c, opts = paper
+    smap = translation_map(body, c.muscles, [0.05, 0.1, 0.6, 1.0], **opts)
+    h = [r.hip_fraction for r in smap.runs]
+    assert h[0] < 0.15 and h[1] < 0.15
+    recovered = [r for r in smap.runs if r.outcome == "recovered"]
+    assert recovered[-1].value == 1.0 and recovered[-1].hip_fraction > 0.4
+
+
+def test_issue_targets_sinusoidal_translations(paper):
+    """Under a 5 cm sinusoidal translation: below 0.15 at 0.1 Hz, above 0.4 at 1.25 Hz."""
+    body, c, opts = paper
+    smap = oscillation_map(body, c.muscles, 0.05, [0.1, 1.25], **opts)
+    assert smap.runs[0].hip_fraction < 0.15
+    assert smap.runs[1].hip_fraction > 0.4 and smap.runs[1].outcome == "recovered"
+    assert smap.transition_frequency == 1.25
+
+
+def test_strategy_command_json_and_figure(tmp_path):
+    fig = tmp_path / "map.png"
+    p = cli("strategy", "--translation", "backward", "--speeds", "0.05:0.3:2", "--json",
+            "--figure", str(fig))
+    assert p.returncode == 0, p.stderr
+    out = json.loads(p.stdout)
+    assert [r["speed"] for r in out["runs"]] == [0.05, 0.3]
+    assert {"hip_fraction", "outcome", "peak_ankle_moment"} <= set(out["runs"][0])
+    assert out["controller"] == "multijoint-default" and fig.stat().st_size > 1000
+
+
+def test_strategy_command_refusals():
+    one_line_exit_2(cli("strategy", "--translation", "backward", "--speeds", "1:0.5:3"),
+                    "--speeds")
+    one_line_exit_2(cli("strategy", "--oscillation", "0.05"), "--frequencies")
+    one_line_exit_2(cli("strategy", "--translation", "backward", "--speeds", "0.1:0.2:2",
+                        "--controller", "nope"), "multijoint-default")
