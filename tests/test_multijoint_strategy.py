@@ -8,6 +8,7 @@ import json
 
 import numpy as np
 import pytest
+from tests._cli import cli, one_line_exit_2
 
 import posturelab as pl
 from posturelab.linear.lqr import multijoint_controller
@@ -20,7 +21,6 @@ from posturelab.studies.strategy import (
     translation_map,
     translation_profile,
 )
-from tests._cli import cli, one_line_exit_2
 
 
 def _sway(t, leg, trunk):

@@ -42,7 +42,8 @@ from ..model.muscles import MuscleSet
 from .system import LinearSystem, linear_system, link_torque_matrix, sorted_poles
 
 __all__ = ["lqr_gain", "lqr_joint_feedback", "LQRCheck", "closed_loop_check",
-           "design_matrices", "knee_basis", "MultiJointController", "multijoint_controller",
+           "design_matrices", "knee_basis", "on_knee", "MultiJointController",
+           "multijoint_controller",
            "bryson_weights"]
 
 
@@ -58,6 +59,23 @@ def knee_basis(n: int, knee: str) -> np.ndarray:
     T[0, 0] = T[1, 0] = 1.0
     T[2:, 1:] = np.eye(n - 2)
     return T
+
+
+def on_knee(system: LinearSystem, knee: str) -> LinearSystem:
+    """``system`` in the coordinates q of :func:`knee_basis` (Θ = T q, each matrix M → Tᵀ M T;
+    the tilt input left out): the chain with its knee locked, or ``system`` itself for a free
+    knee."""
+    if knee == "free":
+        return system
+    T = knee_basis(system.n_links, knee)
+
+    def reduce(m):
+        return np.einsum("ji,mjk,kl->mil", T, m, T)
+
+    return LinearSystem(reduce(system.inertia), reduce(system.stiffness),
+                        reduce(system.viscosity), reduce(system.delayed_stiffness),
+                        reduce(system.delayed_viscosity), system.delay, None,
+                        system.translation_input @ T)
 
 
 def _inputs(n: int, knee: str) -> np.ndarray:
@@ -208,16 +226,8 @@ def closed_loop_check(body: Body, muscles: MuscleSet, feedback: JointFeedback,
     rows = _inputs(body.n_links, knee)
     F = np.hstack([Fth[rows] @ T, Fom[rows] @ T])
     design = sorted_poles(np.linalg.eigvals(A - B @ F))
-    system = linear_system(body, muscles, inputs=False, joint_feedback=feedback,
-                           delay=float(delay))
-    if knee != "free":
-        def reduce(m):
-            return (T.T @ m[0] @ T)[None]
-
-        system = LinearSystem(reduce(system.inertia), reduce(system.stiffness),
-                              reduce(system.viscosity), reduce(system.delayed_stiffness),
-                              reduce(system.delayed_viscosity), system.delay, None,
-                              (system.translation_input[0] @ T)[None])
+    system = on_knee(linear_system(body, muscles, inputs=False, joint_feedback=feedback,
+                                   delay=float(delay)), knee)
     poles = sorted_poles(np.linalg.eigvals(system.state_matrix()[0]))
     margin = delay_margins(system)
     return LQRCheck(design, poles, float(margin.delay_margin[0]),
