@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import functools
 
 from . import UsageError
 from ._common import print_json
@@ -62,8 +63,12 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--frequencies", metavar="LO:HI:N", help="frequencies [Hz].")
     p.add_argument("--displacement", type=float, default=0.06, metavar="M",
                    help="displacement of each transient translation [m] (default 0.06).")
-    p.add_argument("--ankle-torque-limit", type=float, metavar="N·m",
-                   help="the ankle's torque limit (default: m g x_toe, the foot's).")
+    limit = p.add_mutually_exclusive_group()
+    limit.add_argument("--ankle-torque-limit", type=float, metavar="N·m",
+                       help="the ankle's torque limit (default: m g x_toe, the foot's).")
+    limit.add_argument("--ankle-torque-limits", metavar="LO:HI:N",
+                       help="a two-parameter map: the family at each of these ankle torque "
+                            "limits [N·m] (each run then carries its ankle_torque_limit).")
     p.add_argument("--engine", choices=("compiled", "reference"), default="compiled")
     p.add_argument("--figure", metavar="PATH", help="also draw the map (PNG, SVG or PDF).")
     p.add_argument("--json", action="store_true", help="print one JSON object.")
@@ -72,7 +77,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     from ..linear.lqr import multijoint_controller
     from ..model.body import get_body
-    from ..studies.strategy import oscillation_map, translation_map
+    from ..studies.strategy import limit_maps, oscillation_map, translation_map
 
     if args.translation is not None and args.speeds is None:
         raise UsageError("strategy: --translation needs --speeds LO:HI:N")
@@ -86,14 +91,19 @@ def run(args: argparse.Namespace) -> int:
     controller = multijoint_controller(body, args.controller, args.joint_feedback_scale)
     limit = (controller.effort_limits[0] if args.ankle_torque_limit is None
              else args.ankle_torque_limit)
-    common = dict(ankle_torque_limit=limit, engine=args.engine, **controller.run_options())
+    common = dict(engine=args.engine, **controller.run_options())
     if args.translation is not None:
-        result = translation_map(body, controller.muscles, _grid(args.speeds, "--speeds"),
-                                 direction=args.translation, displacement=args.displacement,
-                                 **common)
+        make = functools.partial(translation_map, body, controller.muscles,
+                                 _grid(args.speeds, "--speeds"), direction=args.translation,
+                                 displacement=args.displacement, **common)
     else:
-        result = oscillation_map(body, controller.muscles, args.oscillation,
+        make = functools.partial(oscillation_map, body, controller.muscles, args.oscillation,
                                  _grid(args.frequencies, "--frequencies"), **common)
+    if args.ankle_torque_limits is not None:
+        return _two_parameters(args, controller,
+                               limit_maps(make, _grid(args.ankle_torque_limits,
+                                                      "--ankle-torque-limits")))
+    result = make(ankle_torque_limit=limit)
     if args.figure:
         from ..viz.maps import strategy_map_figure
         from ..viz.plots import save_figure
@@ -110,4 +120,27 @@ def run(args: argparse.Namespace) -> int:
               f"{r.outcome}{'  (ankle saturated)' if r.ankle_saturated else ''}")
     if result.kind == "oscillation":
         print(f"transition frequency: {result.transition_frequency}")
+    return 0
+
+
+def _two_parameters(args: argparse.Namespace, controller, maps) -> int:
+    """Print (and draw) a map over ankle torque limits."""
+    from ..studies.strategy import maps_to_dict
+
+    if args.figure:
+        from ..viz.maps import strategy_limit_figure
+        from ..viz.plots import save_figure
+
+        save_figure(strategy_limit_figure(maps), args.figure)
+    out = {**maps_to_dict(maps), "controller": controller.name,
+           "joint_feedback_scale": args.joint_feedback_scale}
+    if args.json:
+        print_json(out)
+        return 0
+    print(f"{out['profile']}; controller {controller.name}")
+    for m in maps:
+        cells = "  ".join(f"{r.hip_fraction:.2f}{'x' if r.outcome != 'recovered' else ''}"
+                          for r in m.runs)
+        print(f"  ankle limit {m.ankle_torque_limit:8.4g} N·m: {cells}")
+    print("(hip fraction per " + maps[0].variable + "; x: fell or failed)")
     return 0

@@ -34,7 +34,8 @@ from ..model.kinematics import hip_fraction, strategy_modes  # (defined with the
 __all__ = ["strategy_modes", "hip_fraction", "HipFractionStudy", "hip_fraction_study",
            "CREATH_2005_CITATION", "RUNGE_1999_CITATION", "MAX_STUDY_RUNS",
            "HORAK_NASHNER_1986_CITATION", "StrategyRun", "StrategyMap", "translation_map",
-           "oscillation_map", "translation_profile", "oscillation_profile"]
+           "oscillation_map", "translation_profile", "oscillation_profile", "limit_maps",
+           "maps_to_dict"]
 
 CREATH_2005_CITATION = (
     "Creath R, Kiemel T, Horak F, Peterka R, Jeka J (2005) A unified view of quiet and "
@@ -354,3 +355,27 @@ def _values(name: str, values, body) -> np.ndarray:
     if v.size == 0 or v.size > MAX_STUDY_RUNS or np.any(v <= 0):
         raise ParameterError(f"{name} must be 1 … {MAX_STUDY_RUNS:,} values > 0")
     return v
+
+
+def limit_maps(make, limits) -> tuple:
+    """A two-parameter map: ``make(ankle_torque_limit=L)`` (a :func:`translation_map` or
+    :func:`oscillation_map` with its other arguments bound) for each ankle torque limit L in
+    ``limits`` [N·m]; one :class:`StrategyMap` per limit."""
+    values = finite_array("ankle torque limits [N·m]", limits, (None,))
+    if values.size == 0 or values.size > MAX_STUDY_RUNS or np.any(values <= 0):
+        raise ParameterError(f"ankle torque limits [N·m] must be 1 … {MAX_STUDY_RUNS:,} values "
+                             "> 0")
+    return tuple(make(ankle_torque_limit=float(v)) for v in values)
+
+
+def maps_to_dict(maps) -> dict:
+    """Maps over ankle torque limits as one object: every run with its
+    ``ankle_torque_limit`` [N·m], and the transition frequency per limit (sinusoidal)."""
+    first = maps[0].to_dict()
+    runs = [{**run, "ankle_torque_limit": m.ankle_torque_limit}
+            for m in maps for run in m.to_dict()["runs"]]
+    out = {"runs": runs, "profile": first["profile"], "units": first["units"]}
+    if maps[0].kind == "oscillation":
+        out["transition_frequency"] = [{"ankle_torque_limit": m.ankle_torque_limit,
+                                        "frequency": m.transition_frequency} for m in maps]
+    return out

@@ -144,7 +144,7 @@ class _Task:
         limits = None if grid.torque_limits is None else tuple(grid.torque_limits[r])
         weight = (self.options.proprioceptive_weight if grid.proprioceptive_weight is None
                   else float(grid.proprioceptive_weight[r]))
-        run = simulate(sc.body, muscles, disturbance, options=self.options.replace(
+        run = simulate(sc.body, muscles, disturbance, options=self._options(grid, r).replace(
             torque_limits=limits, feedback_delay=float(grid.feedback_delay[r]),
             proprioceptive_weight=weight))
         return run.steady_sway(centre_of_pressure=False)
@@ -170,13 +170,30 @@ class _Task:
             rms[k], peak[k] = sway.rms_theta, sway.peak_theta
         return replace(result, steady_rms_theta=rms, steady_peak_theta=peak)
 
+    def _options(self, grid: SweepGrid, r: int) -> RunOptions:
+        """The options of row ``r``: the task's, with its joint controller's factor."""
+        if grid.joint_feedback_scale is None:
+            return self.options
+        return self.options.replace(joint_feedback=self.options.joint_feedback.scaled(
+            float(grid.joint_feedback_scale[r])))
+
     def _batch(self, grid: SweepGrid, lo: int, hi: int, parallel: bool) -> BatchResult:
+        scale = grid.joint_feedback_scale
+        if scale is None or np.all(scale[lo:hi] == scale[lo]):
+            return self._batch_of(grid, lo, hi, parallel, self._options(grid, lo))
+        # one batch per stretch of rows that share the controller's factor, in row order
+        cuts = [lo, *(lo + 1 + np.flatnonzero(np.diff(scale[lo:hi]) != 0)).tolist(), hi]
+        return _concatenate([self._batch_of(grid, a, b, parallel, self._options(grid, a))
+                             for a, b in zip(cuts[:-1], cuts[1:], strict=True)])
+
+    def _batch_of(self, grid: SweepGrid, lo: int, hi: int, parallel: bool,
+                  options: RunOptions) -> BatchResult:
         from ..simulation.compiled import simulate_batch
 
         sc = self.scenario
         return simulate_batch(
             sc.body, grid.stiffness[lo:hi], grid.viscosity[lo:hi], sc.disturbance,
-            muscles=sc.muscles, options=self.options,
+            muscles=sc.muscles, options=options,
             torque_limits=_rows(grid.torque_limits, lo, hi),
             feedback_delay=grid.feedback_delay[lo:hi],
             proprioceptive_weight=(self.options.proprioceptive_weight

@@ -8,7 +8,8 @@ from matplotlib.figure import Figure
 
 from .figure import new_figure
 
-__all__ = ["plot_stability_map", "plot_delay_stability_map", "strategy_map_figure"]
+__all__ = ["plot_stability_map", "plot_delay_stability_map", "strategy_map_figure",
+           "strategy_limit_figure"]
 
 
 def plot_stability_map(smap) -> Figure:
@@ -159,4 +160,24 @@ def strategy_map_figure(smap) -> Figure:
     ax.set_ylim(0, 1)
     ax.set_title(smap.profile[:70] + ("…" if len(smap.profile) > 70 else ""), fontsize=9)
     ax.legend(fontsize=8)
+    return fig
+
+
+def strategy_limit_figure(maps) -> Figure:
+    """A two-parameter strategy map (one :class:`posturelab.studies.strategy.StrategyMap` per
+    ankle torque limit): the hip fraction [-] in colour over the speed [m/s] or frequency
+    [Hz] and the ankle torque limit [N·m]; runs that fell or failed crossed."""
+    fig, ax = new_figure(figsize=(6.5, 4.5))
+    x = np.array([r.value for r in maps[0].runs])
+    y = np.array([m.ankle_torque_limit for m in maps])
+    h = np.array([[r.hip_fraction for r in m.runs] for m in maps])
+    mesh = ax.pcolormesh(x, y, h, shading="nearest", cmap="viridis", vmin=0, vmax=1)
+    fig.colorbar(mesh, ax=ax, label="hip fraction [-]")
+    for m in maps:
+        bad = [r.value for r in m.runs if r.outcome != "recovered"]
+        ax.plot(bad, [m.ankle_torque_limit] * len(bad), "x", color="w")
+    ax.set_xlabel("peak speed [m/s]" if maps[0].variable == "speed" else "frequency [Hz]")
+    ax.set_ylabel("ankle torque limit [N·m]")
+    ax.set_title(maps[0].profile[:70] + ("…" if len(maps[0].profile) > 70 else ""),
+                 fontsize=9)
     return fig

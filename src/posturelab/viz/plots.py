@@ -22,7 +22,12 @@ from .figure import (
     unique_legend,
 )
 from .frequency import plot_bode, plot_prts_cycles
-from .maps import plot_delay_stability_map, plot_stability_map, strategy_map_figure
+from .maps import (
+    plot_delay_stability_map,
+    plot_stability_map,
+    strategy_limit_figure,
+    strategy_map_figure,
+)
 from .run_figures import (
     plot_angle_angle,
     plot_cog_phase,
@@ -43,6 +48,7 @@ __all__ = [
     "save_figure",
     "plot_stability_map",
     "strategy_map_figure",
+    "strategy_limit_figure",
     "plot_delay_stability_map",
     "plot_bode",
     "plot_prts_cycles",
