@@ -105,3 +105,12 @@ def test_strategy_command_refusals():
     one_line_exit_2(cli("strategy", "--oscillation", "0.05"), "--frequencies")
     one_line_exit_2(cli("strategy", "--translation", "backward", "--speeds", "0.1:0.2:2",
                         "--controller", "nope"), "multijoint-default")
+
+
+def test_a_run_that_falls_before_its_steady_part_has_no_hip_fraction(paper):
+    body, c, opts = paper
+    smap = oscillation_map(body, c.muscles, 0.05, [1.25],
+                           **{**opts, "ankle_torque_limit": 60.0})
+    run = smap.runs[0]
+    assert run.outcome == "fell" and np.isnan(run.hip_fraction) and run.ankle_saturated
+    assert smap.transition_frequency is None

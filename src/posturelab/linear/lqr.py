@@ -11,8 +11,9 @@ is ẋ = A x + B τ with x = [Θ, Θ̇], τ the joint moments (ankle, knee, hip,
 The regulator τ = −F x minimises ∫ (xᵀ Q x + τᵀ R τ) dt, F = R⁻¹ Bᵀ P with P the stabilising
 solution of the continuous algebraic Riccati equation (``scipy.linalg.solve_continuous_are``),
 as in Kuo's optimal-control model of standing balance (Kuo 1995, IEEE Trans Biomed Eng
-42:87–101) and the delayed full-state feedback that Park, Horak & Kuo (2004, J Neurophysiol
-92:3367–3378) fitted to the joint responses to support translations.
+42:87–101) and the delayed full-state feedback that Park, Horak & Kuo (2004, Exp Brain Res
+154:417–427, doi:10.1007/s00221-003-1674-3) fitted to the joint responses to support
+translations.
 
 The weights follow Bryson's rule (Bryson & Ho 1975, *Applied Optimal Control*): each is one
 over the square of the largest value one is willing to accept, Q = diag(1/θ_max², …,

@@ -322,10 +322,11 @@ MULTIJOINT_CONTROLLERS: dict[str, MultiJointPreset] = {
                   "optimal control model for analyzing human postural balance, IEEE Trans "
                   "Biomed Eng 42:87–101, and Park S, Horak FB, Kuo AD (2004) Postural feedback "
                   "responses scale with biomechanical constraints in human standing, Exp Brain "
-                  "Res 154:417–427 (delayed full-state feedback fitted to responses to "
-                  "support translations); weights by Bryson's rule (Bryson AE, Ho YC 1975, "
-                  "Applied Optimal Control) with the ankle's effort bounded by the foot; "
-                  "every number is posturelab's choice, not a fitted value"),
+                  "Res 154:417–427, doi:10.1007/s00221-003-1674-3 (delayed full-state "
+                  "feedback fitted to responses to support translations); weights by "
+                  "Bryson's rule (Bryson AE, Ho YC 1975, Applied Optimal Control) with the "
+                  "ankle's effort bounded by the foot; every number is posturelab's choice, "
+                  "not a fitted value"),
         angle_limit=1.0, rate_limit=float("inf"), other_effort_factor=0.25,
         intrinsic_stiffness=(0.1, 0.1, 0.05), intrinsic_viscosity=(0.05, 0.05, 0.025),
         feedback_delay=0.08,

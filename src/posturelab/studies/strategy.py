@@ -264,7 +264,9 @@ def _run_record(result, value: float, limit: float, start: int = 0) -> StrategyR
     ankle = np.abs(result.joint_moments[:, 0])
     peak = float(ankle.max()) if ankle.size else 0.0
     hip = np.abs(theta[:, -1] - theta[:, 0])
-    return StrategyRun(float(value), float(hip_fraction(theta[start:])), outcome, peak,
+    steady = theta[start:]  # (a run that fell before its steady part has none: NaN)
+    share = float(hip_fraction(steady)) if steady.shape[0] > 1 else float("nan")
+    return StrategyRun(float(value), share, outcome, peak,
                        bool(np.isfinite(limit) and peak >= limit * (1 - 1e-9)),
                        float(hip.max()) if hip.size else 0.0)
 
