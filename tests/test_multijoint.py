@@ -187,3 +187,36 @@ def test_locked_knee_design_leaves_the_knee_row_empty(controller):
     check = closed_loop_check(pl.paper_body(), controller.muscles, controller.joint_feedback,
                               0.0, "locked")
     assert check.delay_margin == pytest.approx(controller.check().delay_margin)
+
+
+def test_the_controller_scale_is_swept_and_fitted(body, controller, tmp_path):
+    """A run made with the gains at 0.8 of the design gives back 0.8 when joint_feedback_scale
+    is fitted from its angles; a sweep over the factor gives each row the single run's
+    outcome."""
+    from posturelab.scenarios import Scenario
+    from posturelab.studies.identification import fit_stiffness
+    from posturelab.studies._sweep_grid import sweep_grid
+    from posturelab.studies.sweep import VaryRange, run_sweep
+
+    options = pl.RunOptions(duration=2.0, **controller.run_options())
+    sc = Scenario(name="mj", source="test", body=body, muscles=controller.muscles,
+                  disturbance=RampAndHold(-0.05, 0.4), options=options)
+    truth = pl.simulate(body, controller.muscles, sc.disturbance, options=options.replace(
+        joint_feedback=controller.joint_feedback.scaled(0.8)))
+    t, theta = truth.time[::20], truth.theta[::20]
+    # (the fit sets every pair viscosity to ratio × stiffness: the preset's ratio is 0.5 s)
+    fit = fit_stiffness(sc, t, theta, free=["joint_feedback_scale"], viscosity_ratio=0.5)
+    assert fit.parameter_names == ("joint_feedback_scale",)
+    assert fit.estimates[0] == pytest.approx(0.8, rel=1e-4)
+
+    varies = [VaryRange("joint_feedback_scale", 0.5, 1.5, 3),
+              VaryRange("torque_limit:ankle", 40.0, 120.0, 2)]
+    grid = sweep_grid(sc, varies)
+    table = run_sweep(sc, varies)
+    for r, (scale, limit) in enumerate(grid.values):
+        single = pl.simulate(body, controller.muscles, sc.disturbance, options=options.replace(
+            joint_feedback=controller.joint_feedback.scaled(scale),
+            torque_limits=(limit, np.inf, np.inf)))
+        assert table.outcomes.fell[r] == single.fell
+        np.testing.assert_allclose(table.outcomes.peak_theta[r],
+                                   np.abs(single.theta).max(axis=0), rtol=1e-3, atol=1e-5)
