@@ -194,8 +194,8 @@ def test_the_controller_scale_is_swept_and_fitted(body, controller, tmp_path):
     is fitted from its angles; a sweep over the factor gives each row the single run's
     outcome."""
     from posturelab.scenarios import Scenario
-    from posturelab.studies.identification import fit_stiffness
     from posturelab.studies._sweep_grid import sweep_grid
+    from posturelab.studies.identification import fit_stiffness
     from posturelab.studies.sweep import VaryRange, run_sweep
 
     options = pl.RunOptions(duration=2.0, **controller.run_options())

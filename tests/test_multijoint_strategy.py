@@ -114,3 +114,30 @@ def test_a_run_that_falls_before_its_steady_part_has_no_hip_fraction(paper):
     run = smap.runs[0]
     assert run.outcome == "fell" and np.isnan(run.hip_fraction) and run.ankle_saturated
     assert smap.transition_frequency is None
+
+
+def test_sweep_strategy_column_local_and_on_dask(paper):
+    """A two-parameter map through the sweep (ankle torque limit × translation size) with
+    its hip_fraction column: each row's the single run's, the same on a Dask cluster."""
+    distributed = pytest.importorskip("distributed")
+    from posturelab.scenarios import Scenario
+    from posturelab.studies.sweep import parse_vary, run_sweep
+
+    body, c, _ = paper
+    options = pl.RunOptions(duration=2.0, **c.run_options())
+    sc = Scenario(name="mj", source="test", body=body, muscles=c.muscles,
+                  disturbance=translation_profile(0.3, "backward"), options=options)
+    varies = [parse_vary("torque_limit:ankle=40:120:2"), parse_vary("disturbance_scale=0.5:2:3")]
+    local = run_sweep(sc, varies, strategy=True)
+    names = [name for name, _ in local.columns()]
+    assert "hip_fraction" in names and local.units()["hip_fraction"] == "-"
+    for r, (limit, scale) in enumerate(local.grid.values):
+        single = pl.simulate(body, c.muscles, sc.disturbance.scaled(scale),
+                             options=options.replace(torque_limits=(limit, np.inf, np.inf)))
+        assert local.outcomes.hip_fraction[r] == pytest.approx(hip_fraction(single.theta),
+                                                               abs=1e-6)
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=False,
+                                  dashboard_address=None) as cluster:
+        with distributed.Client(cluster) as client:
+            remote = run_sweep(sc, varies, client=client, chunk_size=2, strategy=True)
+    np.testing.assert_array_equal(local.outcomes.hip_fraction, remote.outcomes.hip_fraction)

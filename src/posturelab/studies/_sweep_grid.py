@@ -79,6 +79,8 @@ STEADY_COLUMN_PREFIXES = ("steady_rms_theta", "steady_peak_theta", "steady_rms_c
 
 
 def _steady_unit(name: str) -> str:
+    if name == "hip_fraction":
+        return "-"
     if name.startswith(("steady_rms_theta", "steady_peak_theta")):
         return "rad"
     return "m" if name in ("steady_rms_cop", "steady_peak_cop") else ""
@@ -405,6 +407,8 @@ class SweepResult:
         cols.append(("settling_time", o.settling_time))
         cols.append(("final_lean", np.abs(o.final_state[:, :n]).max(axis=1)))
         cols.append(("final_rate", np.abs(o.final_state[:, n:]).max(axis=1)))
+        if o.hip_fraction is not None:  # asked for: the share of the hip mode
+            cols.append(("hip_fraction", o.hip_fraction))
         if o.steady_rms_theta is not None:  # a sustained stimulus: the steady sway
             for i in range(n):
                 cols.append((f"steady_rms_theta{i + 1}", o.steady_rms_theta[:, i]))

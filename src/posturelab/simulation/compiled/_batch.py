@@ -107,6 +107,9 @@ class BatchResult:
         Under a sustained stimulus, the RMS and peak |θ_i| over each run's steady part
         (``SimulationResult.steady_sway``), NaN for a run that did not complete; None when
         not computed (the batch keeps no trajectories: a sweep computes them). [rad]
+    hip_fraction : numpy.ndarray, shape (M,), optional
+        Each run's hip fraction (:func:`posturelab.model.kinematics.hip_fraction`); None when
+        not computed (a sweep asked for its strategy computes it). [-]
     steady_rms_cop, steady_peak_cop : numpy.ndarray, shape (M,), optional
         The same of the centre of pressure. [m]
     """
@@ -126,6 +129,7 @@ class BatchResult:
     steady_peak_theta: np.ndarray | None = None
     steady_rms_cop: np.ndarray | None = None
     steady_peak_cop: np.ndarray | None = None
+    hip_fraction: np.ndarray | None = None
 
     @property
     def n_runs(self) -> int:
