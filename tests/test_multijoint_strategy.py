@@ -141,3 +141,24 @@ def test_sweep_strategy_column_local_and_on_dask(paper):
         with distributed.Client(cluster) as client:
             remote = run_sweep(sc, varies, client=client, chunk_size=2, strategy=True)
     np.testing.assert_array_equal(local.outcomes.hip_fraction, remote.outcomes.hip_fraction)
+
+
+def test_scenario_files_name_the_controller(tmp_path):
+    """[muscles] controller = "multijoint-default": the design on the file's body, its delay,
+    the knee locked; joint_feedback_scale scales it, and is refused without one."""
+    from posturelab.scenarios import load_scenario
+
+    good = tmp_path / "mj.toml"
+    good.write_text('duration = 1.0\n[muscles]\ncontroller = "multijoint-default"\n'
+                    'joint_feedback_scale = 0.5\n[disturbance]\ntype = "ramp-and-hold"\n'
+                    'displacement = -0.05\nduration = 0.4\n')
+    sc = load_scenario(good)
+    design = multijoint_controller(pl.paper_body())
+    assert sc.options.knee.mode == "locked" and sc.options.feedback_delay == 0.08
+    np.testing.assert_allclose(sc.options.joint_feedback.matrices()[0],
+                               0.5 * design.joint_feedback.matrices()[0])
+    bad = tmp_path / "bad.toml"
+    bad.write_text('duration = 1.0\n[muscles]\ncase = "1"\njoint_feedback_scale = 0.5\n')
+    one_line_exit_2(cli("simulate", "--scenario", str(bad)), "muscles.joint_feedback_scale")
+    one_line_exit_2(cli("poles", "--controller", "multijoint-default"),
+                    "multi-joint controller")

@@ -301,7 +301,7 @@ def _scenario_from_options(args: argparse.Namespace, command: str) -> Scenario:
 
     tables = experiment_tables(args, command)
     try:
-        sc = model_from_args(args, tables)
+        sc = model_from_args(args, tables, joint_feedback=True)
     except DataFileError as exc:
         if "tilt" in tables or "lacks column" not in str(exc):  # (a bad value: it is there)
             raise

@@ -17,6 +17,7 @@ import numpy as np
 from .._validation import finite_array, finite_float
 from ..errors import ParameterError, PostureLabError, ScenarioError, UnknownNameError
 from ..model.body import Body, Segment, get_body
+from ..model.controllers import MULTIJOINT_CONTROLLERS
 from ..model.muscles import MusclePair, MuscleSet, paper_muscles
 from ..model.noise import MotorNoise
 from ..model.options import FOOT_FROM_LITERATURE, BaseOfSupport, FallCriteria, KneeModel
@@ -111,7 +112,7 @@ def parse_tables(data: dict, base_dir: Path, origin: str,
             check_value(key, value, _name(names, f"muscles.{key}"))
         except ParameterError as exc:
             raise _error(origin, str(exc)) from None
-    multijoint = _multijoint_name(mt)
+    multijoint = _multijoint_name(mt, origin, names)
     body = body_from_table(data.get("body", {}), origin, names,
                            one_link="controller" in mt and multijoint is None)
     joint_feedback, knee_mode = None, "free"
@@ -163,34 +164,33 @@ def parse_tables(data: dict, base_dir: Path, origin: str,
                     disturbance=disturbance, options=options, case=case)
 
 
-def _multijoint_name(mt: dict) -> str | None:
+def _multijoint_name(mt: dict, origin: str, names) -> str | None:
     """The name of ``[muscles] controller`` when it is a multi-joint preset, else None."""
-    from ..model.controllers import MULTIJOINT_CONTROLLERS
-
     name = str(mt.get("controller", "")).strip().lower()
+    if name not in MULTIJOINT_CONTROLLERS and "joint_feedback_scale" in mt:
+        raise _error(origin, f"{_name(names, 'muscles.joint_feedback_scale')} scales a "
+                     f"multi-joint controller ({_name(names, 'muscles.controller')} "
+                     f"{', '.join(MULTIJOINT_CONTROLLERS)}), and none is given")
     return name if name in MULTIJOINT_CONTROLLERS else None
 
 
 def _multijoint(mt: dict, body: Body, origin: str, names: Mapping[str, str] | None):
-    """``[muscles] controller = multijoint-…``: the preset designed for ``body``
-    (:func:`posturelab.linear.lqr.multijoint_controller`), with ``joint_feedback_scale``:
-    (muscles, delay [s], weight [-], joint feedback, the design's knee mode)."""
+    """``[muscles] controller = multijoint-…`` designed for ``body`` with its scale: (muscles,
+    delay [s], weight [-], joint feedback, the design's knee mode)."""
     from ..linear.lqr import multijoint_controller
 
     ctl = _name(names, "muscles.controller")
     name = str(mt.pop("controller"))
-    others = [k for k in GAIN_KEYS if k in mt]
-    if others:
+    if others := [k for k in GAIN_KEYS if k in mt]:
         raise _error(origin, f"{ctl} sets every gain ({name}); "
                      f"{_name(names, 'muscles.' + others[0])} cannot be given with {ctl}")
     try:
         scale = check_value("joint_feedback_scale", mt.pop("joint_feedback_scale", 1.0),
                             _name(names, "muscles.joint_feedback_scale"))
         design = multijoint_controller(body, name, scale)
-        delay = check_value("feedback_delay", mt.pop("feedback_delay", design.feedback_delay),
-                            _name(names, "muscles.feedback_delay"))
-        weight = check_value("proprioceptive_weight", mt.pop("proprioceptive_weight", 1.0),
-                             _name(names, "muscles.proprioceptive_weight"))
+        delay, weight = (check_value(k, mt.pop(k, d), _name(names, f"muscles.{k}")) for k, d
+                         in (("feedback_delay", design.feedback_delay),
+                             ("proprioceptive_weight", 1.0)))
     except PostureLabError as exc:
         raise _error(origin, str(exc)) from None
     return design.muscles, delay, weight, design.joint_feedback, design.knee

@@ -357,6 +357,8 @@ def fit_stiffness(
                 if nm.startswith("viscosity:")}
         ratio = value.get(VISCOSITY_RATIO, viscosity_ratio)
         muscles = _muscles_with(scenario.muscles, stiff, ratio, visc)
+        if control is not None and not (stiff or visc or VISCOSITY_RATIO in value):
+            muscles = scenario.muscles  # (a joint controller's own pairs, none of them free)
         if any(nm.startswith("active_") for nm in names):
             ka = [value.get(f"active_stiffness:{p}", current[f"active_stiffness:{p}"])
                   for p in pairs]
