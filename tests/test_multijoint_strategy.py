@@ -37,6 +37,22 @@ def test_pure_ankle_and_pure_hip_runs():
     assert hip_fraction(_sway(t, lambda t: 0 * t, wave)) == pytest.approx(0.5, abs=1e-12)
 
 
+def test_runs_built_to_be_pure_ankle_and_legs_held():
+    """Simulated: a hip 25 times stiffer than the ankle (knee locked) sways as one pendulum,
+    hip fraction ~0; an ankle a thousand times stiffer than the hip holds the legs while the
+    trunk swings, u ≈ 0, hip fraction ~1/2 (a = −b)."""
+    from posturelab.model.options import KneeModel
+    from posturelab.model.platform import RampAndHold
+
+    body, locked = pl.paper_body(), KneeModel("locked")
+    rigid = pl.simulate(body, pl.paper_muscles(stiffness=(2000, 0, 50000, 0, 0)),
+                        RampAndHold(-0.03, 0.5), 3.0, knee=locked)
+    assert rigid.hip_fraction < 1e-4
+    held = pl.simulate(body, pl.paper_muscles(stiffness=(200000, 0, 300, 0, 0)),
+                       RampAndHold(-0.03, 0.5), 3.0, knee=locked)
+    assert held.hip_fraction == pytest.approx(0.5, abs=0.01)
+
+
 def test_profiles_are_the_stated_ones():
     ramp = translation_profile(0.3, "backward", 0.06)
     assert ramp.displacement == -0.06 and ramp.duration == pytest.approx(0.4)  # 2D/speed
