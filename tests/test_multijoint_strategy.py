@@ -115,6 +115,18 @@ def test_strategy_command_json_and_figure(tmp_path):
     assert out["controller"] == "multijoint-default" and fig.stat().st_size > 1000
 
 
+def test_strategy_command_oscillation_over_limits():
+    p = cli("strategy", "--oscillation", "0.05", "--frequencies", "0.1:1.25:2",
+            "--ankle-torque-limits", "60:121:2", "--json")
+    assert p.returncode == 0, p.stderr
+    out = json.loads(p.stdout)
+    assert [(r["ankle_torque_limit"], r["frequency"]) for r in out["runs"]] == [
+        (60.0, 0.1), (60.0, 1.25), (121.0, 0.1), (121.0, 1.25)]
+    assert [t["frequency"] for t in out["transition_frequency"]] == [None, 1.25]
+    assert out["delay_margin"] > out["feedback_delay"] == 0.08
+    assert all(z["re"] < 0 for z in out["design_poles"])
+
+
 def test_strategy_command_refusals():
     one_line_exit_2(cli("strategy", "--translation", "backward", "--speeds", "1:0.5:3"),
                     "--speeds")

@@ -23,7 +23,11 @@ delayed; posturelab.linear.lqr) and the ankle moment limited by the foot.
 
 --json prints {"runs": [{"speed" or "frequency": …, "hip_fraction": …, "outcome":
 "recovered"|"fell"|"failed", "peak_ankle_moment": N·m, "ankle_saturated": bool,
-"peak_hip_angle": rad}], "profile", "ankle_torque_limit", "units", "controller"}.
+"peak_hip_angle": rad}], "profile", "ankle_torque_limit", "units", "controller",
+"feedback_delay" [s], "delay_margin" [s] and "design_poles" [1/s] of its linear design}.
+--ankle-torque-limits LO:HI:N  a two-parameter map: the family at each limit [N·m], each
+run with its "ankle_torque_limit" (the sweep does the same with --vary
+torque_limit:ankle=… and --strategy, on Dask with --workers).
 
 Example: posturelab strategy --translation backward --speeds 0.05:0.6:8 --json
          posturelab strategy --oscillation 0.05 --frequencies 0.1:1.25:6 --figure map.png
@@ -109,7 +113,7 @@ def run(args: argparse.Namespace) -> int:
         from ..viz.plots import save_figure
 
         save_figure(strategy_map_figure(result), args.figure)
-    out = {**result.to_dict(), "controller": controller.name,
+    out = {**result.to_dict(), **_design(controller),
            "joint_feedback_scale": args.joint_feedback_scale}
     if args.json:
         print_json(out)
@@ -123,6 +127,16 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
+def _design(controller) -> dict:
+    """The controller's name and its linear design: the delay and the delayed loop's margin
+    [s], the designed poles [1/s]."""
+    check = controller.check()
+    return {"controller": controller.name, "feedback_delay": controller.feedback_delay,
+            "delay_margin": check.delay_margin,
+            "design_poles": [{"re": float(z.real), "im": float(z.imag)}
+                             for z in check.design_poles]}
+
+
 def _two_parameters(args: argparse.Namespace, controller, maps) -> int:
     """Print (and draw) a map over ankle torque limits."""
     from ..studies.strategy import maps_to_dict
@@ -132,7 +146,7 @@ def _two_parameters(args: argparse.Namespace, controller, maps) -> int:
         from ..viz.plots import save_figure
 
         save_figure(strategy_limit_figure(maps), args.figure)
-    out = {**maps_to_dict(maps), "controller": controller.name,
+    out = {**maps_to_dict(maps), **_design(controller),
            "joint_feedback_scale": args.joint_feedback_scale}
     if args.json:
         print_json(out)
