@@ -33,6 +33,7 @@ PUBLIC_NAMES: dict[str, tuple[str, ...]] = {
                                    "disturbance_sensitivity", "finite_difference_state_matrix",
                                    "state_matrix"),
     "posturelab.linear.delay": ("DelayMargin", "delay_margin", "rightmost_roots"),
+    "posturelab.linear.lqr": ("multijoint_controller",),
     "posturelab.linear.verdict": ("UprightVerdict", "upright_verdict"),
     "posturelab.model.anthropometry": ("body_from_anthropometry", "lump"),
     "posturelab.model.body": ("BODY_PRESETS", "Body", "Segment", "get_body", "paper_body"),
@@ -42,6 +43,7 @@ PUBLIC_NAMES: dict[str, tuple[str, ...]] = {
                                   "velocity_terms"),
     "posturelab.model.kinematics": ("centre_of_gravity", "centre_of_gravity_velocity",
                                     "physiological_state"),
+    "posturelab.model.joint_feedback": ("JointFeedback",),
     "posturelab.model.muscles": ("STIFFNESS_CASES", "MusclePair", "MuscleSet",
                                  "get_stiffness_case", "joint_torques", "pair_torques",
                                  "paper_muscles"),
@@ -127,4 +129,5 @@ __all__ = [
     "builtin_scenario_names", "load_scenario",
     "FOOT_FROM_LITERATURE", "BaseOfSupport", "FallCriteria", "KneeModel",
     "base_of_support_for_height", "simulate", "RunOptions",
+    "multijoint_controller", "JointFeedback",
 ]

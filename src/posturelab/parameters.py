@@ -152,6 +152,9 @@ def _g(v: float) -> str:
 
 
 #: The table: every quantity once.
+#: Largest factor on a joint-space controller's gains (model.joint_feedback). [-]
+MAX_JOINT_FEEDBACK_SCALE = 10.0
+
 QUANTITIES: dict[str, Quantity] = {q.name: q for q in (
     Quantity("stiffness", "N·m/rad", 0.0, MAX_PAIR_STIFFNESS,
              "a pair's stiffness K: its intrinsic (undelayed) part when it has active gains, "
@@ -179,6 +182,9 @@ QUANTITIES: dict[str, Quantity] = {q.name: q for q in (
     Quantity("torque_feedback_time_constant", "s", 0.0, MAX_TORQUE_FEEDBACK_TIME_CONSTANT,
              "τ_t of the torque feedback's low-pass filter (default 17.4 s, PMC5664365 "
              "Table 1)", "", 200.0, low_open=True),
+    Quantity("joint_feedback_scale", "-", 0.0, MAX_JOINT_FEEDBACK_SCALE,
+             "factor s on a joint-space controller's gain matrices (multijoint-default: "
+             "the LQR design at s = 1)", "", 2.0),
     Quantity("torque_limit", "N·m", 0.0, math.inf,
              "largest net muscle moment at a joint (inf: none)", "joint", low_open=True),
     Quantity("disturbance_scale", "-", 0.0, MAX_DISTURBANCE_SCALE,

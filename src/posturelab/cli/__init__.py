@@ -36,6 +36,7 @@ SUBCOMMANDS: dict[str, str] = {
     "compare": "compare",
     "explore": "explore",
     "step-threshold": "step_threshold",
+    "strategy": "strategy",
 }
 
 #: Subcommand name -> its line in ``posturelab --help`` (here, so that ``posturelab --help``
@@ -68,6 +69,8 @@ SUBCOMMAND_HELP: dict[str, str] = {
     "explore": "explore the model interactively in the web browser (a local page)",
     "step-threshold": "the largest platform translation withstood without a step (XCoM, Hof "
                       "2005), young or older",
+    "strategy": "strategy maps: the hip fraction across translation speeds or frequencies "
+                "(multi-joint LQR controller)",
 }
 
 

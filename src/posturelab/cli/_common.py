@@ -159,10 +159,13 @@ def model_tables(args: argparse.Namespace) -> dict[str, dict]:
     return tables
 
 
-def model_from_args(args: argparse.Namespace, tables: dict | None = None):
+def model_from_args(args: argparse.Namespace, tables: dict | None = None, *,
+                    joint_feedback: bool = False):
     """The :class:`~posturelab.Scenario` of the model flags (body, muscles, feedback delay
     and proprioceptive weight in its options) and of ``tables`` (a scenario file's other
-    tables), built by the scenario parser; a bad value names the flag the user typed."""
+    tables), built by the scenario parser; a bad value names the flag the user typed. A
+    multi-joint controller (``--controller multijoint-default``) is refused in one line
+    unless the command takes one (``joint_feedback``)."""
     from pathlib import Path
 
     from ..scenarios import SCENARIO_DEFAULTS
@@ -171,6 +174,11 @@ def model_from_args(args: argparse.Namespace, tables: dict | None = None):
     data = {"duration": SCENARIO_DEFAULTS.duration, **model_tables(args), **(tables or {})}
     with naming_given_options(args, MODEL_FIELD_OPTIONS):
         scenario = parse_tables(data, Path("."), "", FLAG_NAMES)
+    if scenario.options.joint_feedback is not None and not joint_feedback:
+        from . import UsageError
+
+        raise UsageError(f"--controller {args.controller} is a multi-joint controller: "
+                         "simulate, sweep, fit and strategy take it, this command does not")
     _note_one_link(args, scenario.body)
     return scenario
 

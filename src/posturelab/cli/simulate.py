@@ -301,7 +301,7 @@ def _scenario_from_options(args: argparse.Namespace, command: str) -> Scenario:
 
     tables = experiment_tables(args, command)
     try:
-        sc = model_from_args(args, tables)
+        sc = model_from_args(args, tables, joint_feedback=True)
     except DataFileError as exc:
         if "tilt" in tables or "lacks column" not in str(exc):  # (a bad value: it is there)
             raise
@@ -402,7 +402,8 @@ def run(args: argparse.Namespace) -> int:
     verdict = upright_verdict(
         sc.body, sc.muscles, sc.options.feedback_delay,
         torque_feedback_gain=sc.options.torque_feedback_gain,
-        torque_feedback_time_constant=sc.options.torque_feedback_time_constant)
+        torque_feedback_time_constant=sc.options.torque_feedback_time_constant,
+        joint_feedback=sc.options.joint_feedback, knee=sc.options.knee.mode)
     outcome = result.outcome
     if args.json:
         print_json({**result.summary(), "engine": args.engine,

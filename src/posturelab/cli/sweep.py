@@ -115,6 +115,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    "([tcp://]HOST:PORT; refused if it does not answer within 10 s).")
     g.add_argument("--chunk-size", type=int, default=None, metavar="RUNS",
                    help="runs per chunk (progress step / Dask task).")
+    g.add_argument("--strategy", action="store_true",
+                   help="also a hip_fraction column: each run's share of the hip (anti-phase) "
+                        "mode, after Creath et al. 2005 (every run again alone).")
     g.add_argument("--progress", action="store_true",
                    help="draw a progress bar on standard error even when it is not a terminal.")
     e = p.add_argument_group("PRTS experiments (--experiment prts)")
@@ -226,7 +229,7 @@ def _run_simulations(args: argparse.Namespace, scenario, varies, ratio) -> int:
         result, elapsed = _with_progress(args, total, lambda progress: run_sweep(
             scenario, varies, viscosity_ratio=ratio, workers=args.workers,
             scheduler=args.scheduler, chunk_size=args.chunk_size, progress=progress,
-            rtol=rtol, atol=atol))
+            rtol=rtol, atol=atol, strategy=args.strategy))
     result.write(args.out)
     o = result.outcomes
     shape = " × ".join(str(v.count) for v in varies)

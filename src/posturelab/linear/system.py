@@ -57,7 +57,7 @@ from ..model.tilt import tilt_pair_gains
 from .body_arrays import BodyArrays
 
 __all__ = ["BodyArrays", "LinearSystem", "linear_system", "sorted_poles", "OneSided",
-           "INPUTS"]
+           "INPUTS", "with_joint_feedback", "link_torque_matrix"]
 
 OneSided = Literal["active", "inactive"]
 
@@ -446,7 +446,7 @@ def linear_system(body: Body | BodyArrays, muscles: MuscleSet, *, stiffness=None
                   active_viscosity=None, delay=0.0, proprioceptive_weight=1.0,
                   one_sided: OneSided = "active", inputs: bool = True,
                   torque_feedback_gain=0.0,
-                  torque_feedback_time_constant=None) -> LinearSystem:
+                  torque_feedback_time_constant=None, joint_feedback=None) -> LinearSystem:
     """The chain linearised about upright (module notes), for one or M parameter sets.
 
     Parameters
@@ -478,6 +478,9 @@ def linear_system(body: Body | BodyArrays, muscles: MuscleSet, *, stiffness=None
         set): none. [-]
     torque_feedback_time_constant : float or array_like, shape (M,), optional
         τ_t, > 0; by default the parameter table's 17.4 s (PMC5664365 Table 1). [s]
+    joint_feedback : JointFeedback, optional
+        A joint-space controller (:mod:`posturelab.model.joint_feedback`), added to the
+        delayed matrices (:func:`with_joint_feedback`).
 
     Returns
     -------
@@ -551,4 +554,29 @@ def linear_system(body: Body | BodyArrays, muscles: MuscleSet, *, stiffness=None
         tilt_input=tilt, translation_input=-coefficients, torque_feedback_gain=feedback_gain,
         torque_feedback_time_constant=time_constant)
     system.n_sets  # noqa: B018 (checks that the arrays agree on M)
-    return system
+    return system if joint_feedback is None else with_joint_feedback(system, joint_feedback)
+
+
+def link_torque_matrix(n: int) -> np.ndarray:
+    """D with U = D τ: the generalised link torques from the joint moments
+    (:func:`posturelab.model.feedback.moments_to_link_torques`), shape (N, N). [-]"""
+    from ..model.feedback import moments_to_link_torques
+
+    return moments_to_link_torques(np.eye(n)).T
+
+
+def with_joint_feedback(system: LinearSystem, feedback) -> LinearSystem:
+    """``system`` with a joint-space controller τ_ctrl = −F_θ Θ(t − τ) − F_ω Θ̇(t − τ)
+    (:class:`posturelab.model.joint_feedback.JointFeedback`, its scale applied): its link
+    torques U = D τ_ctrl = −D F Θ(t − τ) − …, so K_a += D F_θ and L_a += D F_ω (at τ = 0
+    they act at once, as the engines add them to the immediate gains)."""
+    from dataclasses import replace
+
+    from ..model.joint_feedback import joint_gain_rows
+
+    n = system.n_links
+    rows = joint_gain_rows(feedback, n, 1.0)  # the delayed rows: −F_θ, −F_ω
+    D = link_torque_matrix(n)
+    return replace(system,
+                   delayed_stiffness=system.delayed_stiffness - D @ rows[DELAYED_STIFFNESS],
+                   delayed_viscosity=system.delayed_viscosity - D @ rows[DELAYED_VISCOSITY])

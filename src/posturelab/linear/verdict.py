@@ -204,7 +204,8 @@ def _side_muscles(muscles: MuscleSet, engaged: frozenset[str]) -> MuscleSet:
 
 def upright_verdict(body: Body, muscles: MuscleSet, feedback_delay: float = 0.0, *,
                     nodes: int = 40, torque_feedback_gain: float = 0.0,
-                    torque_feedback_time_constant: float | None = None) -> UprightVerdict:
+                    torque_feedback_time_constant: float | None = None,
+                    joint_feedback=None, knee: str = "free") -> UprightVerdict:
     """The one verdict about upright for this body, these gains and this delay.
 
     Parameters
@@ -222,6 +223,9 @@ def upright_verdict(body: Body, muscles: MuscleSet, feedback_delay: float = 0.0,
         Peterka 2002's torque feedback (:func:`posturelab.linear.system.linear_system`;
         gain 0: none): the roots are then those of the first-order form with the filter
         states. [-], [s]
+    joint_feedback : JointFeedback, optional
+        A joint-space controller (:mod:`posturelab.linear.lqr`); with it, ``knee="locked"``
+        takes the roots on the knee constraint (:func:`posturelab.linear.lqr.on_knee`).
 
     Returns
     -------
@@ -249,7 +253,6 @@ def upright_verdict(body: Body, muscles: MuscleSet, feedback_delay: float = 0.0,
         raise ParameterError(f"upright_verdict takes at most {MAX_SWITCHING_PAIRS} one-sided "
                              f"pairs (2**k linearisations), got {len(one_sided)}")
     names = [p.name for p in one_sided]
-    count = 2 * body.n_links
     sides = []
     # every one-sided pair engaged first, every one slack last
     for flags in itertools.product((True, False), repeat=len(names)):
@@ -257,8 +260,13 @@ def upright_verdict(body: Body, muscles: MuscleSet, feedback_delay: float = 0.0,
         slack = tuple(n for n, f in zip(names, flags, strict=True) if not f)
         side = linear_system(body, _side_muscles(muscles, frozenset(engaged)), inputs=False,
                              torque_feedback_gain=torque_feedback_gain,
-                             torque_feedback_time_constant=torque_feedback_time_constant)
-        roots = system_rightmost_roots(side, delay, count, nodes=nodes)
+                             torque_feedback_time_constant=torque_feedback_time_constant,
+                             joint_feedback=joint_feedback)
+        if joint_feedback is not None and knee == "locked":
+            from .lqr import on_knee
+
+            side = on_knee(side, knee)
+        roots = system_rightmost_roots(side, delay, 2 * side.n_links, nodes=nodes)
         top = complex(roots[0])
         sides.append(UprightSide(engaged, slack, _status(top), top,
                                  tuple(complex(z) for z in roots)))

@@ -25,7 +25,8 @@ from ..errors import ParameterError, UnknownNameError
 from .body import Body
 from .muscles import MusclePair, MuscleSet
 
-__all__ = ["ControllerPreset", "Provenance", "CONTROLLERS", "get_controller"]
+__all__ = ["ControllerPreset", "Provenance", "CONTROLLERS", "get_controller",
+           "MultiJointPreset", "MULTIJOINT_CONTROLLERS", "get_multijoint_controller"]
 
 
 #: The preset fields that carry a number, in print order, with the symbol used in words.
@@ -221,3 +222,140 @@ def get_controller(name: str) -> ControllerPreset:
     except KeyError:
         raise UnknownNameError(f"unknown controller {name!r}; known controllers: "
                                f"{', '.join(CONTROLLERS)}") from None
+
+
+@dataclass(frozen=True)
+class MultiJointPreset:
+    """A multi-joint controller for an N-link body, designed rather than tuned: the weights of
+    an LQR design (:mod:`posturelab.linear.lqr`, Bryson's rule) and the pairs acting beside it.
+
+    Attributes
+    ----------
+    name : str
+    citation : str
+    angle_limit : float
+        θ_max of Bryson's rule, every link. [rad]
+    rate_limit : float
+        ω_max, every link. [rad/s]
+    ankle_effort_centre_of_pressure : float
+        The ankle's τ_max is m g times this: the centre of pressure's reach in front of the
+        ankle. [m]; None: the foot of :data:`posturelab.model.options.FOOT_FROM_LITERATURE`.
+    other_effort_factor : float
+        Every other joint's τ_max is this times the ankle's. [-]
+    intrinsic_stiffness : tuple of 3 float
+        The intrinsic stiffness of the ankle's, the middle joints' (knee, …) and the top
+        joint's (hip) pair / (the body's m g h). [-]
+    intrinsic_viscosity : tuple of 3 float
+        Their viscosity / m g h, in the same order. [s]
+    feedback_delay : float
+        τ of the controller. [s]
+    knee : {"free", "locked"}
+        The knee the design assumes (and the runs should use). [-]
+    joint_angle_limit : float
+        φ_max of Bryson's rule on each joint angle above the ankle (the hip's θ3 − θ_leg):
+        a weight that keeps the body straight, the ankle strategy, while the ankle is not
+        limited. [rad]
+    provenance : tuple of (str, Provenance)
+    """
+
+    name: str
+    citation: str
+    angle_limit: float
+    rate_limit: float
+    other_effort_factor: float
+    intrinsic_stiffness: tuple
+    intrinsic_viscosity: tuple
+    feedback_delay: float
+    ankle_effort_centre_of_pressure: float | None = None
+    knee: str = "free"
+    joint_angle_limit: float = float("inf")
+    provenance: tuple[tuple[str, Provenance], ...] = ()
+
+    def provenance_text(self) -> str:
+        """Where each number comes from, in words."""
+        def shown(name: str, p: Provenance) -> str:
+            value = getattr(self, name)
+            if isinstance(value, tuple):
+                return f"{name} = {', '.join(f'{v:g}' for v in value)}: {p.note}"
+            return p.text(name, value)
+
+        return "; ".join(shown(name, p) for name, p in self.provenance) + "."
+
+    def effort_limits(self, body: Body):
+        """τ_max per joint: the ankle's m g x_toe, the others ``other_effort_factor`` times
+        it. [N·m]"""
+        import numpy as np
+
+        from .options import FOOT_FROM_LITERATURE
+
+        reach = (FOOT_FROM_LITERATURE.toe if self.ankle_effort_centre_of_pressure is None
+                 else self.ankle_effort_centre_of_pressure)
+        ankle = body.total_mass * body.gravity * reach
+        out = np.full(body.n_links, ankle * self.other_effort_factor)
+        out[0] = ankle
+        return out
+
+    def muscles(self, body: Body) -> MuscleSet:
+        """One intrinsic pair per joint (ankle, knee, …, hip: the top joint), gains
+        ``intrinsic_stiffness`` × mgh [N·m/rad] and ``intrinsic_viscosity`` × mgh
+        [N·m·s/rad]."""
+        from .muscles import joint_pair_names
+
+        n, mgh = body.n_links, body.load_stiffness
+        names = joint_pair_names(n)
+
+        def part(values, j):
+            return values[0] if j == 0 else values[2] if j == n - 1 else values[1]
+
+        return MuscleSet(tuple(MusclePair(nm, j, j + 1, part(self.intrinsic_stiffness, j) * mgh,
+                                          part(self.intrinsic_viscosity, j) * mgh)
+                               for j, nm in enumerate(names)), n)
+
+
+_OURS = "posturelab's choice"
+
+#: Multi-joint presets by name.
+MULTIJOINT_CONTROLLERS: dict[str, MultiJointPreset] = {
+    "multijoint-default": MultiJointPreset(
+        name="multijoint-default",
+        citation=("LQR full-state feedback of the chain about upright after Kuo AD (1995) An "
+                  "optimal control model for analyzing human postural balance, IEEE Trans "
+                  "Biomed Eng 42:87–101, and Park S, Horak FB, Kuo AD (2004) Postural feedback "
+                  "responses scale with biomechanical constraints in human standing, Exp Brain "
+                  "Res 154:417–427, doi:10.1007/s00221-003-1674-3 (delayed full-state "
+                  "feedback fitted to responses to support translations); weights by "
+                  "Bryson's rule (Bryson AE, Ho YC 1975, Applied Optimal Control) with the "
+                  "ankle's effort bounded by the foot; every number is posturelab's choice, "
+                  "not a fitted value"),
+        angle_limit=1.0, rate_limit=float("inf"), other_effort_factor=0.25,
+        intrinsic_stiffness=(0.1, 0.1, 0.05), intrinsic_viscosity=(0.05, 0.05, 0.025),
+        feedback_delay=0.08,
+        knee="locked", joint_angle_limit=float("inf"),
+        provenance=(
+            ("angle_limit", Provenance(None, note=f"{_OURS}: a cheap-state, costly-effort design "
+                                       "(1 rad), so that the undelayed LQR keeps a delay margin "
+                                       "above the delay (0.095 s; 0.1 rad gives about 0.03 s)")),
+            ("rate_limit", Provenance(None, note=f"{_OURS}: rates not weighted")),
+            ("other_effort_factor", Provenance(None, note=f"{_OURS}: the hip's τ_max a quarter "
+                                               "of the foot-limited ankle's (larger factors "
+                                               "lower the delay margin toward the delay)")),
+            ("intrinsic_stiffness", Provenance(None, note=f"{_OURS}: small intrinsic "
+                                               "stiffness, 10 % of mgh at ankle and knee, 5 % "
+                                               "at the hip")),
+            ("intrinsic_viscosity", Provenance(None, note=f"{_OURS}: 5 % and 2.5 % of mgh "
+                                               "[s]")),
+            ("feedback_delay", Provenance(None, note=f"{_OURS}: 0.08 s, near the ~0.1 s latency "
+                                          "of automatic postural responses, below the design's "
+                                          "delay margin")),
+        ),
+    ),
+}
+
+
+def get_multijoint_controller(name: str) -> MultiJointPreset:
+    """The multi-joint preset ``name``; an unknown name lists the known ones."""
+    try:
+        return MULTIJOINT_CONTROLLERS[str(name).strip().lower()]
+    except KeyError:
+        raise UnknownNameError(f"unknown multi-joint controller {name!r}; known: "
+                               f"{', '.join(MULTIJOINT_CONTROLLERS)}") from None

@@ -32,6 +32,7 @@ from .body import Body
 from .dynamics import angular_acceleration, constrained_acceleration, constrained_velocity
 from .feedback import feedback_pair_torques, moments_to_link_torques, muscle_set_gains
 from .gains import DELAYED_STIFFNESS, DELAYED_VISCOSITY, IMMEDIATE_STIFFNESS, IMMEDIATE_VISCOSITY
+from .joint_feedback import joint_feedback_moments
 from .kinematics import centre_of_pressure, ground_reaction
 from .muscles import MuscleSet
 from .noise import TorqueSeries, torque_at
@@ -211,6 +212,8 @@ class SwitchedModel:
         K_t of the torque feedback (0: none; :func:`torque_feedback_rate_formula`). [-]
     torque_feedback_time_constant : float
         τ_t. [s]
+    joint_gains : numpy.ndarray, shape (4, N, N), or None
+        A joint-space controller's moment gains (:mod:`.joint_feedback`). [N·m/rad, N·m·s/rad]
     """
 
     body: Body
@@ -228,6 +231,7 @@ class SwitchedModel:
     fall: FallCriteria = FallCriteria()
     torque_feedback_gain: float = 0.0
     torque_feedback_time_constant: float = 17.4
+    joint_gains: np.ndarray | None = None
 
     @property
     def n_links(self) -> int:
@@ -298,16 +302,17 @@ def torque_feedback_rate(model: SwitchedModel, t: float, feedback: np.ndarray,
 
 def raw_moments(model: SwitchedModel, t: float, x: np.ndarray, feedback: np.ndarray,
                 active: np.ndarray, filter_state: np.ndarray | None = None) -> np.ndarray:
-    """Unsaturated net muscle moment per joint at time ``t`` [s]: the immediate part on the
-    state ``x``, the delayed part on ``feedback`` (x(t − τ)), the tilt's part, the torque
-    feedback filters' ``filter_state`` (P,) (with their pairs' activity) and the motor
-    noise. [N·m]"""
+    """Unsaturated net muscle moment per joint at ``t`` [s]: the immediate part on the state
+    ``x``, the delayed part on ``feedback`` (x(t − τ)), the tilt's part, the torque feedback
+    filters' ``filter_state`` (P,), the joint-space controller's and the motor noise. [N·m]"""
     M = feedback_pair_torques(model.muscles, model.gains, x, feedback, active)
     if model.tilt is not None:
         M = M + tilt_pair_torques(model.tilt, model.tilt_gains, model.feedback_delay, t)
     if filter_state is not None and model.n_filter_states:
         M = M + np.asarray(active, dtype=float) * filter_state
     tau = M @ model.muscles.crossing_matrix
+    if model.joint_gains is not None:
+        tau = tau + joint_feedback_moments(model.joint_gains, x, feedback)
     if model.motor_torque is not None:
         tau = tau + torque_at(model.motor_torque, t)
     return tau

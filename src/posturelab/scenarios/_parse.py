@@ -17,6 +17,7 @@ import numpy as np
 from .._validation import finite_array, finite_float
 from ..errors import ParameterError, PostureLabError, ScenarioError, UnknownNameError
 from ..model.body import Body, Segment, get_body
+from ..model.controllers import MULTIJOINT_CONTROLLERS
 from ..model.muscles import MusclePair, MuscleSet, paper_muscles
 from ..model.noise import MotorNoise
 from ..model.options import FOOT_FROM_LITERATURE, BaseOfSupport, FallCriteria, KneeModel
@@ -68,6 +69,7 @@ OPTION_KEYS: dict[str, str] = {
     "proprioceptive_weight": "muscles.proprioceptive_weight",
     "torque_feedback_gain": "muscles.torque_feedback_gain",
     "torque_feedback_time_constant": "muscles.torque_feedback_time_constant", "tilt": "tilt",
+    "joint_feedback": "muscles.controller",
     "tilt_axis_depth": "tilt.axis_depth", "motor_noise": "motor_noise",
     "method": "solver.method", "rtol": "solver.rtol", "atol": "solver.atol",
     "sample_rate": "solver.sample_rate", "max_steps": "solver.max_steps",
@@ -110,10 +112,16 @@ def parse_tables(data: dict, base_dir: Path, origin: str,
             check_value(key, value, _name(names, f"muscles.{key}"))
         except ParameterError as exc:
             raise _error(origin, str(exc)) from None
+    multijoint = _multijoint_name(mt, origin, names)
     body = body_from_table(data.get("body", {}), origin, names,
-                           one_link="controller" in mt)
-    muscles, case, delay, weight = muscles_from_table(mt, body, origin, names,
-                                                      data.get("body", {}))
+                           one_link="controller" in mt and multijoint is None)
+    joint_feedback, knee_mode = None, "free"
+    if multijoint is not None:
+        muscles, delay, weight, joint_feedback, knee_mode = _multijoint(mt, body, origin, names)
+        case = None
+    else:
+        muscles, case, delay, weight = muscles_from_table(mt, body, origin, names,
+                                                          data.get("body", {}))
     tilt_table = data.get("tilt", {})
     tilt = tilt_from_table(tilt_table, base_dir, origin, names)
     disturbance = disturbance_from_tables(data.get("disturbance"), base_dir, origin, names)
@@ -131,7 +139,7 @@ def parse_tables(data: dict, base_dir: Path, origin: str,
                                          f"{_name(names, 'initial.rates')} [rad/s]", n), (n,))
         initial = np.concatenate([posture, rates])
     kt = data.get("knee", {})
-    knee = KneeModel(kt.get("mode", "free"), kt.get("stop_angle", 0.0))
+    knee = KneeModel(kt.get("mode", knee_mode), kt.get("stop_angle", 0.0))
     fall = fall_from_table(data.get("fall", {}), origin, names)
     torque_limits = None
     if "torque" in data.get("limits", {}):
@@ -144,6 +152,7 @@ def parse_tables(data: dict, base_dir: Path, origin: str,
         torque_limits=torque_limits, feedback_delay=delay, proprioceptive_weight=weight,
         torque_feedback_gain=feedback_gain, torque_feedback_time_constant=feedback_lag,
         tilt=tilt, tilt_axis_depth=tilt_table.get("axis_depth", 0.0), motor_noise=noise,
+        joint_feedback=joint_feedback,
         method=st.get("method"), rtol=st.get("rtol", DEFAULTS.rtol),
         atol=st.get("atol", DEFAULTS.atol),
         sample_rate=st.get("sample_rate", DEFAULTS.sample_rate),
@@ -153,6 +162,38 @@ def parse_tables(data: dict, base_dir: Path, origin: str,
     return Scenario(name=str(data.get("name", Path(origin).stem if origin else "")),
                     source=str(data.get("source", "")), body=body, muscles=muscles,
                     disturbance=disturbance, options=options, case=case)
+
+
+def _multijoint_name(mt: dict, origin: str, names) -> str | None:
+    """The name of ``[muscles] controller`` when it is a multi-joint preset, else None."""
+    name = str(mt.get("controller", "")).strip().lower()
+    if name not in MULTIJOINT_CONTROLLERS and "joint_feedback_scale" in mt:
+        raise _error(origin, f"{_name(names, 'muscles.joint_feedback_scale')} scales a "
+                     f"multi-joint controller ({_name(names, 'muscles.controller')} "
+                     f"{', '.join(MULTIJOINT_CONTROLLERS)}), and none is given")
+    return name if name in MULTIJOINT_CONTROLLERS else None
+
+
+def _multijoint(mt: dict, body: Body, origin: str, names: Mapping[str, str] | None):
+    """``[muscles] controller = multijoint-…`` designed for ``body`` with its scale: (muscles,
+    delay [s], weight [-], joint feedback, the design's knee mode)."""
+    from ..linear.lqr import multijoint_controller
+
+    ctl = _name(names, "muscles.controller")
+    name = str(mt.pop("controller"))
+    if others := [k for k in GAIN_KEYS if k in mt]:
+        raise _error(origin, f"{ctl} sets every gain ({name}); "
+                     f"{_name(names, 'muscles.' + others[0])} cannot be given with {ctl}")
+    try:
+        scale = check_value("joint_feedback_scale", mt.pop("joint_feedback_scale", 1.0),
+                            _name(names, "muscles.joint_feedback_scale"))
+        design = multijoint_controller(body, name, scale)
+        delay, weight = (check_value(k, mt.pop(k, d), _name(names, f"muscles.{k}")) for k, d
+                         in (("feedback_delay", design.feedback_delay),
+                             ("proprioceptive_weight", 1.0)))
+    except PostureLabError as exc:
+        raise _error(origin, str(exc)) from None
+    return design.muscles, delay, weight, design.joint_feedback, design.knee
 
 
 def _name(names: Mapping[str, str] | None, key: str) -> str:

@@ -78,6 +78,7 @@ class MusclesTable(_Table):
     torque_feedback_gain: float | None = None
     torque_feedback_time_constant: float | None = None
     controller: str | None = None
+    joint_feedback_scale: float | None = None
 
 
 class TiltTable(_Table):

@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..model.dynamics import angular_acceleration, mass_matrix
+from ..model.joint_feedback import joint_feedback_moments
 from ..model.kinematics import (
     centre_of_gravity,
     centre_of_gravity_velocity,
@@ -69,11 +70,14 @@ def derived_series(setup: RunSetup, time: np.ndarray, state: np.ndarray,
     if setup.tilt is not None:
         M = M + tilt_torques(setup.tilt, setup.tilt_gains, setup.feedback_delay, time)
     moments = M @ muscles.crossing_matrix
+    control = setup.options.joint_feedback is not None
+    if control:  # the joint-space controller's moments (posturelab.model.joint_feedback)
+        moments = moments + joint_feedback_moments(setup.joint_gains, state, fb)
     if setup.motor_torque is not None:
         moments = moments + torque_at(setup.motor_torque, time)
     if setup.torque_limits is not None:
         moments = np.clip(moments, -setup.torque_limits, setup.torque_limits)
-    if setup.torque_limits is not None or setup.motor_torque is not None:
+    if setup.torque_limits is not None or setup.motor_torque is not None or control:
         U = moments_to_link_torques(moments)
     else:
         U = -M @ muscles.selection_matrix

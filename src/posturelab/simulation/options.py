@@ -26,6 +26,7 @@ import numpy as np
 
 from .._validation import finite_array
 from ..errors import ParameterError
+from ..model.joint_feedback import JointFeedback
 from ..model.noise import MotorNoise
 from ..model.options import FallCriteria, KneeModel
 from ..model.tilt import Tilt
@@ -129,6 +130,11 @@ class RunOptions:
         ``feedback_delay``; both engines carry the filter states. [-]
     torque_feedback_time_constant : float
         τ_t of its low-pass filter (default 17.4 s, PMC5664365 Table 1). [s]
+    joint_feedback : JointFeedback or None
+        A joint-space full-state controller, τ_ctrl = −F_θ Θ(t − τ) − F_ω Θ̇(t − τ), added to
+        the pairs' moments before the torque limits (:mod:`posturelab.model.joint_feedback`;
+        the preset ``multijoint-default``: :func:`posturelab.linear.lqr.multijoint_controller`).
+        [N·m/rad], [N·m·s/rad]
     tilt : Tilt or None
         Support-surface tilt α(t), positive toes-up (:mod:`posturelab.model.tilt`). [rad]
     tilt_axis_depth : float
@@ -177,6 +183,9 @@ class RunOptions:
                                           "-")
     torque_feedback_time_constant: float = _option(
         TORQUE_FEEDBACK_TIME_CONSTANT, QUANTITIES["torque_feedback_time_constant"].meaning, "s")
+    joint_feedback: JointFeedback | None = _option(
+        None, "a joint-space full-state controller (delayed by feedback_delay)",
+        "N·m/rad, N·m·s/rad")
     tilt: Tilt | None = _option(None, "support-surface tilt, positive toes-up", "rad")
     tilt_axis_depth: float = _option(0.0, RUN_SETTINGS["tilt_axis_depth"].meaning, "m")
     motor_noise: MotorNoise | None = _option(None, "seeded random joint torque", "N·m")
@@ -213,6 +222,8 @@ class RunOptions:
                                                 self.torque_feedback_gain))
         put("torque_feedback_time_constant", check_value("torque_feedback_time_constant",
                                                          self.torque_feedback_time_constant))
+        if self.joint_feedback is not None:
+            _expect("joint_feedback", self.joint_feedback, JointFeedback)
         depth = _setting("tilt_axis_depth", self.tilt_axis_depth)
         put("tilt_axis_depth", depth)
         if self.tilt is not None:

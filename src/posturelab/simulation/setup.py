@@ -32,6 +32,7 @@ from ..model.dynamics import (
     mass_matrix,
     platform_vector,
 )
+from ..model.joint_feedback import joint_feedback_moments, joint_gain_rows
 from ..model.muscles import MuscleSet, muscle_set_gains
 from ..model.noise import MotorNoise, TorqueSeries, motor_noise_series, torque_at
 from ..model.options import FallCriteria, KneeModel, torque_limit_array
@@ -132,6 +133,10 @@ class RunSetup:
     motor_torque : TorqueSeries or None
         The motor noise's realisation over the run: added to each joint's moment before the
         limits. [N·m]
+    joint_gains : numpy.ndarray, shape (4, N, N)
+        The joint-space controller's moment gains by when they act
+        (:func:`posturelab.model.joint_feedback.joint_gain_rows`; zeros for none).
+        [N·m/rad], [N·m·s/rad]
     """
 
     body: Body
@@ -154,6 +159,7 @@ class RunSetup:
     tilt_gains: np.ndarray | None = None
     velocity_jump: tuple[float, float] = (0.0, 0.0)
     motor_torque: TorqueSeries | None = None
+    joint_gains: np.ndarray | None = None
 
     @property
     def n_links(self) -> int:
@@ -392,8 +398,9 @@ def _prepare(body: Body, muscles: MuscleSet, disturbance: Disturbance,
         tilt_gains = tilt_pair_gains(muscle_set_gains(muscles, 1.0), muscles.spans_foot, delay,
                                      options.proprioceptive_weight)
         tilt_gains.setflags(write=False)
+    joint_gains = joint_gain_rows(options.joint_feedback, n, delay)
     moments0 = moments_at_start(muscles, x0, before, active0, gains, delay, tilt, tilt_gains,
-                                motor_torque)
+                                motor_torque) + joint_feedback_moments(joint_gains, x0, before)
     saturation0 = start_saturation(moments0, limits)
     corners = set(disturbance.breakpoints)
     if tilt is not None:  # the tilt's corners, and where the delayed part feels them
@@ -405,7 +412,7 @@ def _prepare(body: Body, muscles: MuscleSet, disturbance: Disturbance,
     max_step = min(disturbance.max_step, duration, delay if delay > 0 else math.inf,
                    tilt.max_step if tilt is not None else math.inf,
                    noise.max_step if noise is not None else math.inf)
-    for arr in (before, x0, active0, saturation0, breakpoints, delay_bps, gains):
+    for arr in (before, x0, active0, saturation0, breakpoints, delay_bps, gains, joint_gains):
         arr.setflags(write=False)
     setup = RunSetup(
         body=body, muscles=muscles, disturbance=disturbance, options=options,
@@ -415,7 +422,7 @@ def _prepare(body: Body, muscles: MuscleSet, disturbance: Disturbance,
         delay_breakpoints=delay_bps, max_step=max_step, fall_at_start=None, knee_row=knee_row,
         tilt_gains=tilt_gains, velocity_jump=tuple(
             float(a + b) for a, b in zip(disturbance.velocity_change, jump, strict=True)),
-        motor_torque=motor_torque,
+        motor_torque=motor_torque, joint_gains=joint_gains,
     )
     object.__setattr__(setup, "fall_at_start", _fall_at_start(setup))
     return setup
@@ -462,7 +469,8 @@ def switched_model(setup: RunSetup) -> switched.SwitchedModel:
             tilt_axis_depth=setup.tilt_axis_depth, motor_torque=setup.motor_torque,
             knee_row=setup.knee_row, knee=setup.knee, fall=setup.fall,
             torque_feedback_gain=setup.options.torque_feedback_gain,
-            torque_feedback_time_constant=setup.options.torque_feedback_time_constant)
+            torque_feedback_time_constant=setup.options.torque_feedback_time_constant,
+            joint_gains=setup.joint_gains if setup.options.joint_feedback is not None else None)
         object.__setattr__(setup, "_switched_model", model)
     return model
 

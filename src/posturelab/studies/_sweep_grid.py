@@ -34,7 +34,8 @@ if TYPE_CHECKING:  # (the engine loads when a sweep runs: posturelab --help stay
 #: The quantities of the parameter table a sweep can vary (all but active_viscosity_ratio).
 SWEEP_QUANTITIES: tuple[str, ...] = (
     "stiffness", "viscosity", "active_stiffness", "active_viscosity", "viscosity_ratio",
-    "feedback_delay", "proprioceptive_weight", "torque_limit", "disturbance_scale")
+    "feedback_delay", "proprioceptive_weight", "torque_limit", "disturbance_scale",
+    "joint_feedback_scale")
 #: The joints whose torque limit a sweep can vary on the paper's body, in joint order.
 TORQUE_LIMIT_PARAMETERS: tuple[str, ...] = tuple(f"torque_limit:{j}" for j in PAPER_JOINTS)
 #: Names a sweep of the paper's body can vary (:data:`SWEEP_QUANTITIES` over its pairs and
@@ -78,6 +79,8 @@ STEADY_COLUMN_PREFIXES = ("steady_rms_theta", "steady_peak_theta", "steady_rms_c
 
 
 def _steady_unit(name: str) -> str:
+    if name == "hip_fraction":
+        return "-"
     if name.startswith(("steady_rms_theta", "steady_peak_theta")):
         return "rad"
     return "m" if name in ("steady_rms_cop", "steady_peak_cop") else ""
@@ -228,6 +231,9 @@ class SweepGrid:
         none is varied. [N·m/rad], [N·m·s/rad]
     proprioceptive_weight : numpy.ndarray, shape (M,), optional
         W per run; None for the base experiment's. [-]
+    joint_feedback_scale : numpy.ndarray, shape (M,), optional
+        The factor on the base experiment's joint controller per run; None when not varied.
+        [-]
     """
 
     names: tuple[str, ...]
@@ -240,6 +246,7 @@ class SweepGrid:
     active_stiffness: np.ndarray | None = None
     active_viscosity: np.ndarray | None = None
     proprioceptive_weight: np.ndarray | None = None
+    joint_feedback_scale: np.ndarray | None = None
 
     @property
     def n_runs(self) -> int:
@@ -316,7 +323,11 @@ def sweep_grid(scenario: Scenario, varies: Sequence[VaryRange],
         raise ParameterError("disturbance_scale multiplies the base experiment's platform "
                              "motion, and it has none: give --disturbance, a profile or a "
                              "scenario with a disturbance")
-    scale = None
+    scale = control = None
+    if "joint_feedback_scale" in names and scenario.options.joint_feedback is None:
+        raise ParameterError("joint_feedback_scale multiplies the base experiment's joint "
+                             "controller, and it has none: give --controller "
+                             "multijoint-default or [muscles] controller")
     delay = np.full(m, float(scenario.feedback_delay))
     n = scenario.body.n_links
     base_limits = (np.full(n, math.inf) if scenario.torque_limits is None
@@ -342,6 +353,8 @@ def sweep_grid(scenario: Scenario, varies: Sequence[VaryRange],
             delay = np.ascontiguousarray(column)
         elif quantity == "proprioceptive_weight":
             weight = np.ascontiguousarray(column)
+        elif quantity == "joint_feedback_scale":
+            control = np.ascontiguousarray(column)
         elif quantity == "torque_limit":
             limits[:, joints.index(member)] = column
         elif quantity == "active_viscosity":
@@ -356,7 +369,7 @@ def sweep_grid(scenario: Scenario, varies: Sequence[VaryRange],
     for j, column in viscosity.items():
         pair_viscosity[:, j] = column
     return SweepGrid(tuple(names), values, stiffness, pair_viscosity, scale, delay,
-                     None if np.all(np.isinf(limits)) else limits, ka, va, weight)
+                     None if np.all(np.isinf(limits)) else limits, ka, va, weight, control)
 
 
 # ---------------------------------------------------------------------------
@@ -394,6 +407,8 @@ class SweepResult:
         cols.append(("settling_time", o.settling_time))
         cols.append(("final_lean", np.abs(o.final_state[:, :n]).max(axis=1)))
         cols.append(("final_rate", np.abs(o.final_state[:, n:]).max(axis=1)))
+        if o.hip_fraction is not None:  # asked for: the share of the hip mode
+            cols.append(("hip_fraction", o.hip_fraction))
         if o.steady_rms_theta is not None:  # a sustained stimulus: the steady sway
             for i in range(n):
                 cols.append((f"steady_rms_theta{i + 1}", o.steady_rms_theta[:, i]))

@@ -72,7 +72,8 @@ VISCOSITY_RATIO = "viscosity_ratio"
 #: The quantities of the parameter table a time-domain fit can free.
 FIT_QUANTITIES = ("stiffness", "viscosity", "active_stiffness", "active_viscosity",
                   "viscosity_ratio", "feedback_delay", "proprioceptive_weight",
-                  "torque_feedback_gain", "torque_feedback_time_constant")
+                  "torque_feedback_gain", "torque_feedback_time_constant",
+                  "joint_feedback_scale")
 #: How the uncertainty treats the residuals (:func:`fit_stiffness`).
 RESIDUAL_MODELS = ("ar1", "independent")
 #: The engines ``fit_stiffness`` can run the model on ("fast" is a former name of "compiled").
@@ -252,7 +253,9 @@ def fit_stiffness(
         ``"active_stiffness:PAIR"`` [N·m/rad], ``"active_viscosity:PAIR"`` [N·m·s/rad],
         ``"viscosity_ratio"`` [s], ``"feedback_delay"`` [s], ``"proprioceptive_weight"``
         [-], ``"torque_feedback_gain"`` [-] and ``"torque_feedback_time_constant"`` [s]
-        (Peterka 2002's torque feedback, on either engine); a former
+        (Peterka 2002's torque feedback, on either engine),
+        ``"joint_feedback_scale"`` [-] (the factor on the experiment's joint controller,
+        :mod:`posturelab.model.joint_feedback`); a former
         spelling (``"ankle"``, ``"active_ankle"``) is refused naming the new.
     viscosity_ratio : float
         Viscosity / stiffness for every pair when the ratio is not fitted,
@@ -300,6 +303,10 @@ def fit_stiffness(
              for nm in free]
     if len(set(names)) != len(names):
         raise ParameterError(f"free names must be unique, got {names}")
+    control = scenario.options.joint_feedback
+    if "joint_feedback_scale" in names and control is None:
+        raise ParameterError("joint_feedback_scale scales the experiment's joint controller, "
+                             "and it has none: give --controller multijoint-default")
     n = scenario.body.n_links
     t = finite_array("time [s]", time, (None,))
     th = finite_array("theta [rad]", theta, (t.size, n))
@@ -324,7 +331,8 @@ def fit_stiffness(
                "feedback_delay": scenario.options.feedback_delay or 0.1,
                "proprioceptive_weight": scenario.options.proprioceptive_weight,
                "torque_feedback_gain": scenario.options.torque_feedback_gain,
-               "torque_feedback_time_constant": scenario.options.torque_feedback_time_constant}
+               "torque_feedback_time_constant": scenario.options.torque_feedback_time_constant,
+               "joint_feedback_scale": 1.0 if control is None else control.scale}
     if initial_guess is None:
         x0 = [special[nm] if nm in special else (current[nm] or 500.0) for nm in names]
     else:
@@ -349,6 +357,8 @@ def fit_stiffness(
                 if nm.startswith("viscosity:")}
         ratio = value.get(VISCOSITY_RATIO, viscosity_ratio)
         muscles = _muscles_with(scenario.muscles, stiff, ratio, visc)
+        if control is not None and not (stiff or visc or VISCOSITY_RATIO in value):
+            muscles = scenario.muscles  # (a joint controller's own pairs, none of them free)
         if any(nm.startswith("active_") for nm in names):
             ka = [value.get(f"active_stiffness:{p}", current[f"active_stiffness:{p}"])
                   for p in pairs]
@@ -363,7 +373,9 @@ def fit_stiffness(
             torque_feedback_gain=value.get("torque_feedback_gain",
                                            sc.options.torque_feedback_gain),
             torque_feedback_time_constant=value.get("torque_feedback_time_constant",
-                                                    sc.options.torque_feedback_time_constant))
+                                                    sc.options.torque_feedback_time_constant),
+            joint_feedback=(control if "joint_feedback_scale" not in value
+                            else control.scaled(value["joint_feedback_scale"])))
         result = trial.run(engine=engine)
         if result.status == "failed":  # never fit to a run that stopped short
             shown = ", ".join(f"{nm} = {v:.6g}" for nm, v in value.items())

@@ -116,15 +116,27 @@ class _Task:
 
     scenario: Scenario
     options: RunOptions  # (the scenario's, on the compiled engine at the sweep's tolerances)
+    strategy: bool = False  # each row's hip fraction too (run again alone)
 
     def run(self, grid: SweepGrid, lo: int, hi: int, parallel: bool) -> BatchResult:
         result = self._batch(grid, lo, hi, parallel)
         if result.stimulus is not None and result.stimulus.sustained:
             result = self._with_steady_sway(result, grid, lo, hi)
+        if self.strategy:
+            from dataclasses import replace
+
+            from ..model.kinematics import hip_fraction
+
+            share = [hip_fraction(self._row_run(grid, r).theta) for r in range(lo, hi)]
+            result = replace(result, hip_fraction=np.array(share, dtype=float))
         return result
 
     def _steady_row(self, grid: SweepGrid, r: int):
         """Row ``r`` run alone on the compiled engine: its steady sway (or None)."""
+        return self._row_run(grid, r).steady_sway(centre_of_pressure=False)
+
+    def _row_run(self, grid: SweepGrid, r: int):
+        """Row ``r`` run alone on the compiled engine (its trajectory)."""
         from dataclasses import replace
 
         from ..simulation.engines import simulate
@@ -144,10 +156,9 @@ class _Task:
         limits = None if grid.torque_limits is None else tuple(grid.torque_limits[r])
         weight = (self.options.proprioceptive_weight if grid.proprioceptive_weight is None
                   else float(grid.proprioceptive_weight[r]))
-        run = simulate(sc.body, muscles, disturbance, options=self.options.replace(
+        return simulate(sc.body, muscles, disturbance, options=self._options(grid, r).replace(
             torque_limits=limits, feedback_delay=float(grid.feedback_delay[r]),
             proprioceptive_weight=weight))
-        return run.steady_sway(centre_of_pressure=False)
 
     def _with_steady_sway(self, result: BatchResult, grid: SweepGrid, lo: int,
                           hi: int) -> BatchResult:
@@ -170,13 +181,30 @@ class _Task:
             rms[k], peak[k] = sway.rms_theta, sway.peak_theta
         return replace(result, steady_rms_theta=rms, steady_peak_theta=peak)
 
+    def _options(self, grid: SweepGrid, r: int) -> RunOptions:
+        """The options of row ``r``: the task's, with its joint controller's factor."""
+        if grid.joint_feedback_scale is None:
+            return self.options
+        return self.options.replace(joint_feedback=self.options.joint_feedback.scaled(
+            float(grid.joint_feedback_scale[r])))
+
     def _batch(self, grid: SweepGrid, lo: int, hi: int, parallel: bool) -> BatchResult:
+        scale = grid.joint_feedback_scale
+        if scale is None or np.all(scale[lo:hi] == scale[lo]):
+            return self._batch_of(grid, lo, hi, parallel, self._options(grid, lo))
+        # one batch per stretch of rows that share the controller's factor, in row order
+        cuts = [lo, *(lo + 1 + np.flatnonzero(np.diff(scale[lo:hi]) != 0)).tolist(), hi]
+        return _concatenate([self._batch_of(grid, a, b, parallel, self._options(grid, a))
+                             for a, b in zip(cuts[:-1], cuts[1:], strict=True)])
+
+    def _batch_of(self, grid: SweepGrid, lo: int, hi: int, parallel: bool,
+                  options: RunOptions) -> BatchResult:
         from ..simulation.compiled import simulate_batch
 
         sc = self.scenario
         return simulate_batch(
             sc.body, grid.stiffness[lo:hi], grid.viscosity[lo:hi], sc.disturbance,
-            muscles=sc.muscles, options=self.options,
+            muscles=sc.muscles, options=options,
             torque_limits=_rows(grid.torque_limits, lo, hi),
             feedback_delay=grid.feedback_delay[lo:hi],
             proprioceptive_weight=(self.options.proprioceptive_weight
@@ -199,7 +227,8 @@ def _concatenate(parts: list[BatchResult]) -> BatchResult:
         return parts[0]
     fields = ("fell", "fall_time", "peak_theta", "settling_time", "final_state", "status_code",
               "n_steps", "n_switches")
-    steady = ("steady_rms_theta", "steady_peak_theta", "steady_rms_cop", "steady_peak_cop")
+    steady = ("steady_rms_theta", "steady_peak_theta", "steady_rms_cop", "steady_peak_cop",
+              "hip_fraction")
     return BatchResult(**{f: np.concatenate([getattr(p, f) for p in parts]) for f in fields},
                        settle_tolerance=parts[0].settle_tolerance,
                        stimulus=parts[0].stimulus,
@@ -229,6 +258,7 @@ def run_sweep(
     client: Any = None,
     chunk_size: int | None = None,
     progress: Callable[[int, int], None] | None = None,
+    strategy: bool = False,
 ) -> SweepResult:
     """Simulate every run of the grid and collect the outcomes.
 
@@ -258,6 +288,9 @@ def run_sweep(
         Runs per chunk (a progress step, a Dask task). [-]
     progress : callable, optional
         ``progress(done, total)`` after each finished chunk.
+    strategy : bool
+        Also each run's hip fraction (a ``hip_fraction`` column; every row run again alone,
+        for its trajectory, which the batch does not keep).
 
     Returns
     -------
@@ -268,7 +301,7 @@ def run_sweep(
     options = scenario.run_options("compiled").replace(rtol=rtol, atol=atol)
     grid = sweep_grid(scenario, varies, viscosity_ratio)
     try:
-        parts = run_chunks(_Task(scenario, options), grid, workers=workers,
+        parts = run_chunks(_Task(scenario, options, bool(strategy)), grid, workers=workers,
                            scheduler=scheduler, client=client, chunk_size=chunk_size,
                            progress=progress)
     except SweepInterrupted as exc:

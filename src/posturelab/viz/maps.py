@@ -8,7 +8,8 @@ from matplotlib.figure import Figure
 
 from .figure import new_figure
 
-__all__ = ["plot_stability_map", "plot_delay_stability_map"]
+__all__ = ["plot_stability_map", "plot_delay_stability_map", "strategy_map_figure",
+           "strategy_limit_figure"]
 
 
 def plot_stability_map(smap) -> Figure:
@@ -130,4 +131,53 @@ def plot_delay_stability_map(dmap, *, mark=None) -> Figure:
     ax.set_ylabel(f"active viscosity of the {dmap.pair} pair / mgh [s]")
     ax.set_title(f"Stability with a feedback delay τ = {dmap.delay * 1000:.0f} ms "
                  f"(outlined: stable, {100 * dmap.stable.mean():.1f}% of the grid)", fontsize=10)
+    return fig
+
+
+def strategy_map_figure(smap) -> Figure:
+    """A strategy map (:class:`posturelab.studies.strategy.StrategyMap`): the hip fraction
+    [-] against the speed [m/s] or the frequency [Hz]; runs that fell marked with a cross,
+    runs whose ankle saturated filled; the levels 0.15 and 0.4 dotted and, for sinusoidal
+    translations, the transition frequency dashed."""
+    fig, ax = new_figure(figsize=(6.0, 4.0))
+    v = np.array([r.value for r in smap.runs])
+    h = np.array([r.hip_fraction for r in smap.runs])
+    fell = np.array([r.outcome != "recovered" for r in smap.runs])
+    sat = np.array([r.ankle_saturated for r in smap.runs])
+    ax.plot(v, h, color="0.5", lw=1)
+    ok = ~fell
+    ax.plot(v[ok & sat], h[ok & sat], "o", color="C3", label="ankle saturated")
+    ax.plot(v[ok & ~sat], h[ok & ~sat], "o", mfc="white", color="C0", label="recovered")
+    if fell.any():
+        ax.plot(v[fell], h[fell], "x", color="k", label="fell or failed")
+    for level in (0.15, 0.4):
+        ax.axhline(level, color="0.7", ls=":", lw=1)
+    if smap.kind == "oscillation" and smap.transition_frequency is not None:
+        ax.axvline(smap.transition_frequency, color="C2", ls="--", lw=1,
+                   label=f"transition {smap.transition_frequency:.3g} Hz")
+    ax.set_xlabel("peak speed [m/s]" if smap.variable == "speed" else "frequency [Hz]")
+    ax.set_ylabel("hip fraction [-]")
+    ax.set_ylim(0, 1)
+    ax.set_title(smap.profile[:70] + ("…" if len(smap.profile) > 70 else ""), fontsize=9)
+    ax.legend(fontsize=8)
+    return fig
+
+
+def strategy_limit_figure(maps) -> Figure:
+    """A two-parameter strategy map (one :class:`posturelab.studies.strategy.StrategyMap` per
+    ankle torque limit): the hip fraction [-] in colour over the speed [m/s] or frequency
+    [Hz] and the ankle torque limit [N·m]; runs that fell or failed crossed."""
+    fig, ax = new_figure(figsize=(6.5, 4.5))
+    x = np.array([r.value for r in maps[0].runs])
+    y = np.array([m.ankle_torque_limit for m in maps])
+    h = np.array([[r.hip_fraction for r in m.runs] for m in maps])
+    mesh = ax.pcolormesh(x, y, h, shading="nearest", cmap="viridis", vmin=0, vmax=1)
+    fig.colorbar(mesh, ax=ax, label="hip fraction [-]")
+    for m in maps:
+        bad = [r.value for r in m.runs if r.outcome != "recovered"]
+        ax.plot(bad, [m.ankle_torque_limit] * len(bad), "x", color="w")
+    ax.set_xlabel("peak speed [m/s]" if maps[0].variable == "speed" else "frequency [Hz]")
+    ax.set_ylabel("ankle torque limit [N·m]")
+    ax.set_title(maps[0].profile[:70] + ("…" if len(maps[0].profile) > 70 else ""),
+                 fontsize=9)
     return fig

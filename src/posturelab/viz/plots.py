@@ -22,7 +22,12 @@ from .figure import (
     unique_legend,
 )
 from .frequency import plot_bode, plot_prts_cycles
-from .maps import plot_delay_stability_map, plot_stability_map
+from .maps import (
+    plot_delay_stability_map,
+    plot_stability_map,
+    strategy_limit_figure,
+    strategy_map_figure,
+)
 from .run_figures import (
     plot_angle_angle,
     plot_cog_phase,
@@ -42,6 +47,8 @@ __all__ = [
     "figure_bytes",
     "save_figure",
     "plot_stability_map",
+    "strategy_map_figure",
+    "strategy_limit_figure",
     "plot_delay_stability_map",
     "plot_bode",
     "plot_prts_cycles",

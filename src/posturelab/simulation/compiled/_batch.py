@@ -22,6 +22,7 @@ from ...errors import ParameterError
 from ...model.body import Body
 from ...model.checks import check_model
 from ...model.gains import GAIN_ROWS
+from ...model.joint_feedback import joint_feedback_moments, joint_gain_rows
 from ...model.muscles import MuscleSet, feedback_gains, paper_muscles
 from ...model.platform import Disturbance
 from ...model.tilt import tilt_pair_gains
@@ -106,6 +107,9 @@ class BatchResult:
         Under a sustained stimulus, the RMS and peak |θ_i| over each run's steady part
         (``SimulationResult.steady_sway``), NaN for a run that did not complete; None when
         not computed (the batch keeps no trajectories: a sweep computes them). [rad]
+    hip_fraction : numpy.ndarray, shape (M,), optional
+        Each run's hip fraction (:func:`posturelab.model.kinematics.hip_fraction`); None when
+        not computed (a sweep asked for its strategy computes it). [-]
     steady_rms_cop, steady_peak_cop : numpy.ndarray, shape (M,), optional
         The same of the centre of pressure. [m]
     """
@@ -125,6 +129,7 @@ class BatchResult:
     steady_peak_theta: np.ndarray | None = None
     steady_rms_cop: np.ndarray | None = None
     steady_peak_cop: np.ndarray | None = None
+    hip_fraction: np.ndarray | None = None
 
     @property
     def n_runs(self) -> int:
@@ -390,6 +395,9 @@ def simulate_batch(
         pair_gains = tilt_pair_gains(split, muscles.spans_foot, delays, weights)
         tilt_gain_all = enc.readonly(np.ascontiguousarray(pair_gains @ muscles.crossing_matrix))
         tilt_pair_gain_all = enc.readonly(np.ascontiguousarray(pair_gains))
+    if common.joint_feedback is not None and len({bool(d > 0) for d in delays}) > 1:
+        raise ParameterError("a batch with a joint_feedback controller needs every run's "
+                             "feedback_delay > 0, or every one 0 (not a mix)")
     moments0 = np.empty((M, n))
     for d in np.unique(delays):
         rows = delays == d
@@ -397,6 +405,10 @@ def simulate_batch(
             muscles, x0_all[which[rows]], before_all[which[rows]], active_all[which[rows]],
             gains_all[rows], float(d), base.tilt,
             None if pair_gains is None else pair_gains[rows], base.motor_torque)
+        if common.joint_feedback is not None:  # the controller's moment at the start
+            moments0[rows] += joint_feedback_moments(
+                joint_gain_rows(common.joint_feedback, n, float(d)), x0_all[which[rows]],
+                before_all[which[rows]])
     sat0_all = enc.readonly(start_saturation(moments0, lims))
     lim_all = enc.readonly(lims)
     delay_all = enc.readonly(delays)

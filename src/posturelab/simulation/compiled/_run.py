@@ -100,6 +100,7 @@ def packed(setup: RunSetup) -> dict:
         "filter_gain": float(setup.options.torque_feedback_gain),
         "filter_time": float(setup.options.torque_feedback_time_constant),
         "mp": enc.encode_motor_noise(setup.motor_torque),
+        "joint_gain": enc.readonly(np.ascontiguousarray(setup.joint_gains)),
         "bps": enc.readonly(setup.breakpoints.astype(float)), "fpar": fpar, "ipar": ipar,
         "active0": enc.readonly(setup.active0), "slots": slots,
         "ev_offset": ev.EVENT_OFFSET, "ev_direction": ev.EVENT_DIRECTION,
@@ -129,7 +130,7 @@ def base_run_struct(a: dict, method: str) -> Run:
               n_filters=a["n_filters"], filter_gain=a["filter_gain"],
               filter_time=a["filter_time"])
     for name in ("x0", "before", "grid", "bp", "E", "C", "dp", "bps", "fpar", "active0",
-                 "ev_offset", "tp", "tilt_gain", "tilt_pair_gain", "mp"):
+                 "ev_offset", "tp", "tilt_gain", "tilt_pair_gain", "mp", "joint_gain"):
         setattr(run, name, pointer(a[name]))
     for name in ("one_sided", "ipar", "ev_direction", "ev_ends"):
         setattr(run, name, pointer(a[name], ctypes_int64))

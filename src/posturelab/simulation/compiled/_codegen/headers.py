@@ -41,6 +41,7 @@ RUN_FIELDS = [
     ("filter_gain", "f64", "K_t of the torque feedback [-]"),
     ("filter_time", "f64", "τ_t of its filter [s]"),
     ("tilt_pair_gain", "*f64", "(4, p) pair torques per α(t), α̇(t), α(t−τ), α̇(t−τ)"),
+    ("joint_gain", "*f64", "(4, n, n) joint-space controller's moment gains, rows GAIN_*"),
 ]
 #: ``pl_out``: where one run's outputs go (any pointer may be NULL where noted).
 OUT_FIELDS = [
@@ -198,6 +199,7 @@ void pl_rhs3(const pl_model *md, const double *x, double *out, const double *inp
 void pl_set_base(const double *x, double *base, int64_t n);
 void pl_moment_gains(const double *E, const double *C, const double *kd, const double *ld,
                      const double *active, int64_t p, int64_t n, double *tk, double *tl);
+void pl_add_joint_gains(const double *jg, int64_t n, double *tm);
 void pl_project_velocity(double *x, const double *bp, double *work, int64_t n);
 
 /* the inputs and the event values (pl_model.c) */

@@ -15,7 +15,7 @@ import inspect
 
 import sympy as sp
 
-from ....model import dynamics, kinematics, platform, switched, tilt
+from ....model import dynamics, joint_feedback, kinematics, platform, switched, tilt
 from ....model import events as ev
 from ....model.gains import GAIN_ROWS
 from . import filters_c
@@ -266,6 +266,7 @@ def _rhs() -> str:
                                                   SYMPY)
     xi, xj = symbols("x[i]", "x[j]")
     impact = dynamics.coupling_formula(symbols("bp[2 * n + i * n + j]"), xi, xj, SYMPY)
+    joint = joint_feedback.joint_moment_gain_formula(*symbols("tm[k]", "jg[k]"))
     return f"""
 void pl_set_base(const double *x, double *base, int64_t n)
 {{
@@ -340,6 +341,16 @@ void pl_moment_gains(const double *E, const double *C, const double *kd, const d
             tk[j * n + k] = sk;
             tl[j * n + k] = sl;
         }}
+}}
+
+/* The joint-space controller's moment gains (4, n, n), rows GAIN_*, added to the pairs' T_K,
+ * T_L and their delayed parts (model.joint_feedback); jg NULL: none. */
+void pl_add_joint_gains(const double *jg, int64_t n, double *tm)
+{{
+    if (!jg)
+        return;
+    for (int64_t k = 0; k < 4 * n * n; k++)
+        tm[k] = {c(joint)};
 }}
 
 /* Plastic impact onto the knee constraint, in place on x's rates:

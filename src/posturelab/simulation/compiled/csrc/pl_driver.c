@@ -258,6 +258,7 @@ int64_t pl_integrate(const pl_run *run, pl_out *out)
                             n, b.tm, b.tm + n * n);
             pl_moment_gains(run->E, run->C, run->gains + 2 * run->p, run->gains + 3 * run->p,
                             b.active, run->p, n, b.tm + 2 * n * n, b.tm + 3 * n * n);
+            pl_add_joint_gains(run->joint_gain, n, b.tm);
             pl_set_base(x, b.base, n);
             if (t == 0.0 && locked && run->ipar[I_KNEE_MODE] == KNEE_STOP
                 && pl_event_value(&cx, EV_KNEE_LEAVES_STOP, 1, 0.0, t, x, locked) < 0.0)

@@ -285,6 +285,16 @@ void pl_moment_gains(const double *E, const double *C, const double *kd, const d
         }
 }
 
+/* The joint-space controller's moment gains (4, n, n), rows GAIN_*, added to the pairs' T_K,
+ * T_L and their delayed parts (model.joint_feedback); jg NULL: none. */
+void pl_add_joint_gains(const double *jg, int64_t n, double *tm)
+{
+    if (!jg)
+        return;
+    for (int64_t k = 0; k < 4 * n * n; k++)
+        tm[k] = jg[k] + tm[k];
+}
+
 /* Plastic impact onto the knee constraint, in place on x's rates:
  * Θ̇ − J⁻¹C (C·Θ̇)/(C·J⁻¹C), C = (−1, 1, 0, …). work holds at least n·(n + 1). */
 void pl_project_velocity(double *x, const double *bp, double *work, int64_t n)

@@ -52,6 +52,7 @@ typedef struct {
     double filter_gain;                 /* K_t of the torque feedback [-] */
     double filter_time;                 /* τ_t of its filter [s] */
     const double *tilt_pair_gain;       /* (4, p) pair torques per α(t), α̇(t), α(t−τ), α̇(t−τ) */
+    const double *joint_gain;           /* (4, n, n) joint-space controller's moment gains, rows GAIN_* */
 } pl_run;
 
 /* Outputs of one run (any pointer may be NULL where noted). */
@@ -159,6 +160,7 @@ void pl_rhs3(const pl_model *md, const double *x, double *out, const double *inp
 void pl_set_base(const double *x, double *base, int64_t n);
 void pl_moment_gains(const double *E, const double *C, const double *kd, const double *ld,
                      const double *active, int64_t p, int64_t n, double *tk, double *tl);
+void pl_add_joint_gains(const double *jg, int64_t n, double *tm);
 void pl_project_velocity(double *x, const double *bp, double *work, int64_t n);
 
 /* the inputs and the event values (pl_model.c) */

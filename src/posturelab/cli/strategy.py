@@ -1,0 +1,160 @@
+"""``posturelab strategy``: the hip fraction across a family of platform translations."""
+
+from __future__ import annotations
+
+import argparse
+import functools
+
+from . import UsageError
+from ._common import print_json
+
+DESCRIPTION = """\
+Strategy maps: how much of the sway is the hip (anti-phase) mode of leg and trunk, the hip
+fraction Σb²/(Σa² + Σb²) (after Creath et al. 2005), across a family of translations of the
+support surface, with a multi-joint controller (an LQR design on the linearised chain,
+delayed; posturelab.linear.lqr) and the ankle moment limited by the foot.
+
+--translation backward|forward --speeds LO:HI:N   transient translations: a ramp-and-hold of
+    --displacement D (0.06 m) whose peak speed 2D/T is each speed (after Horak & Nashner
+    1986's ramp translations at a range of velocities).
+--oscillation A --frequencies LO:HI:N   sinusoidal translations of amplitude A [m]; the hip
+    fraction over the steady part (after 2 cycles), and "transition_frequency", the first
+    frequency at which the hip mode dominates (hip fraction > 0.5).
+
+--json prints {"runs": [{"speed" or "frequency": …, "hip_fraction": …, "outcome":
+"recovered"|"fell"|"failed", "peak_ankle_moment": N·m, "ankle_saturated": bool,
+"peak_hip_angle": rad}], "profile", "ankle_torque_limit", "units", "controller",
+"feedback_delay" [s], "delay_margin" [s] and "design_poles" [1/s] of its linear design}.
+--ankle-torque-limits LO:HI:N  a two-parameter map: the family at each limit [N·m], each
+run with its "ankle_torque_limit" (the sweep does the same with --vary
+torque_limit:ankle=… and --strategy, on Dask with --workers).
+
+Example: posturelab strategy --translation backward --speeds 0.05:0.6:8 --json
+         posturelab strategy --oscillation 0.05 --frequencies 0.1:1.25:6 --figure map.png
+"""
+
+
+def _grid(text: str, flag: str):
+    parts = text.split(":")
+    try:
+        lo, hi, n = float(parts[0]), float(parts[1]), int(parts[2])
+    except (IndexError, ValueError):
+        raise UsageError(f"{flag} must be LO:HI:N (numbers, N an integer), got {text!r}") \
+            from None
+    if len(parts) != 3 or not (0 < lo <= hi) or not 1 <= n <= 1000:
+        raise UsageError(f"{flag} must be LO:HI:N with 0 < LO <= HI and 1 <= N <= 1000, got "
+                         f"{text!r}")
+    import numpy as np
+
+    return np.linspace(lo, hi, n)
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    """The options of ``posturelab strategy``."""
+    p.add_argument("--body", default="paper", metavar="NAME",
+                   help="a body preset (default: the paper's three links).")
+    p.add_argument("--controller", default="multijoint-default", metavar="NAME",
+                   help="a multi-joint controller preset (default multijoint-default).")
+    p.add_argument("--joint-feedback-scale", type=float, default=1.0, metavar="S",
+                   help="factor on the controller's gain matrices (default 1).")
+    family = p.add_mutually_exclusive_group(required=True)
+    family.add_argument("--translation", choices=("backward", "forward"),
+                        help="transient translations in this direction (with --speeds).")
+    family.add_argument("--oscillation", type=float, metavar="AMPLITUDE",
+                        help="sinusoidal translations of this amplitude [m] (with "
+                             "--frequencies).")
+    p.add_argument("--speeds", metavar="LO:HI:N", help="peak speeds [m/s].")
+    p.add_argument("--frequencies", metavar="LO:HI:N", help="frequencies [Hz].")
+    p.add_argument("--displacement", type=float, default=0.06, metavar="M",
+                   help="displacement of each transient translation [m] (default 0.06).")
+    limit = p.add_mutually_exclusive_group()
+    limit.add_argument("--ankle-torque-limit", type=float, metavar="N·m",
+                       help="the ankle's torque limit (default: m g x_toe, the foot's).")
+    limit.add_argument("--ankle-torque-limits", metavar="LO:HI:N",
+                       help="a two-parameter map: the family at each of these ankle torque "
+                            "limits [N·m] (each run then carries its ankle_torque_limit).")
+    p.add_argument("--engine", choices=("compiled", "reference"), default="compiled")
+    p.add_argument("--figure", metavar="PATH", help="also draw the map (PNG, SVG or PDF).")
+    p.add_argument("--json", action="store_true", help="print one JSON object.")
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..linear.lqr import multijoint_controller
+    from ..model.body import get_body
+    from ..studies.strategy import limit_maps, oscillation_map, translation_map
+
+    if args.translation is not None and args.speeds is None:
+        raise UsageError("strategy: --translation needs --speeds LO:HI:N")
+    if args.oscillation is not None and args.frequencies is None:
+        raise UsageError("strategy: --oscillation needs --frequencies LO:HI:N")
+    if args.figure:
+        from ._common import check_writable
+
+        check_writable([args.figure])
+    body = get_body(args.body)
+    controller = multijoint_controller(body, args.controller, args.joint_feedback_scale)
+    limit = (controller.effort_limits[0] if args.ankle_torque_limit is None
+             else args.ankle_torque_limit)
+    common = dict(engine=args.engine, **controller.run_options())
+    if args.translation is not None:
+        make = functools.partial(translation_map, body, controller.muscles,
+                                 _grid(args.speeds, "--speeds"), direction=args.translation,
+                                 displacement=args.displacement, **common)
+    else:
+        make = functools.partial(oscillation_map, body, controller.muscles, args.oscillation,
+                                 _grid(args.frequencies, "--frequencies"), **common)
+    if args.ankle_torque_limits is not None:
+        return _two_parameters(args, controller,
+                               limit_maps(make, _grid(args.ankle_torque_limits,
+                                                      "--ankle-torque-limits")))
+    result = make(ankle_torque_limit=limit)
+    if args.figure:
+        from ..viz.maps import strategy_map_figure
+        from ..viz.plots import save_figure
+
+        save_figure(strategy_map_figure(result), args.figure)
+    out = {**result.to_dict(), **_design(controller),
+           "joint_feedback_scale": args.joint_feedback_scale}
+    if args.json:
+        print_json(out)
+        return 0
+    print(f"{result.profile}; ankle torque limit {limit:.4g} N·m; controller {controller.name}")
+    for r in result.runs:
+        print(f"  {result.variable} {r.value:8.4g}  hip fraction {r.hip_fraction:6.3f}  "
+              f"{r.outcome}{'  (ankle saturated)' if r.ankle_saturated else ''}")
+    if result.kind == "oscillation":
+        print(f"transition frequency: {result.transition_frequency}")
+    return 0
+
+
+def _design(controller) -> dict:
+    """The controller's name and its linear design: the delay and the delayed loop's margin
+    [s], the designed poles [1/s]."""
+    check = controller.check()
+    return {"controller": controller.name, "feedback_delay": controller.feedback_delay,
+            "delay_margin": check.delay_margin,
+            "design_poles": [{"re": float(z.real), "im": float(z.imag)}
+                             for z in check.design_poles]}
+
+
+def _two_parameters(args: argparse.Namespace, controller, maps) -> int:
+    """Print (and draw) a map over ankle torque limits."""
+    from ..studies.strategy import maps_to_dict
+
+    if args.figure:
+        from ..viz.maps import strategy_limit_figure
+        from ..viz.plots import save_figure
+
+        save_figure(strategy_limit_figure(maps), args.figure)
+    out = {**maps_to_dict(maps), **_design(controller),
+           "joint_feedback_scale": args.joint_feedback_scale}
+    if args.json:
+        print_json(out)
+        return 0
+    print(f"{out['profile']}; controller {controller.name}")
+    for m in maps:
+        cells = "  ".join(f"{r.hip_fraction:.2f}{'x' if r.outcome != 'recovered' else ''}"
+                          for r in m.runs)
+        print(f"  ankle limit {m.ankle_torque_limit:8.4g} N·m: {cells}")
+    print("(hip fraction per " + maps[0].variable + "; x: fell or failed)")
+    return 0
