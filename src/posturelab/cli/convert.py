@@ -15,7 +15,7 @@ A .c3d is read with ezc3d (pip install ezc3d, or posturelab[c3d]): every marker 
 LABEL_y, LABEL_z in m (scaled from POINT:UNITS), every analog channel by its label (its
 ANALOG:UNITS unit), each force plate k as fpk_fx, fpk_fy, fpk_fz [N] and its centre of
 pressure fpk_copx, fpk_copy, fpk_copz [m], at the marker rate or --rate HZ (analogs
-decimated with a zero-phase FIR low-pass). Labels are lower-cased. A CSV needs a time
+decimated by a zero-phase FIR low-pass). Labels are lower-cased. A CSV needs a time
 column; --angle-columns names its angle columns (read in --angle-unit), --length-unit the
 unit of the marker columns named in --markers.
 

@@ -10,12 +10,12 @@ the unit of ``ANALOG:UNITS``), and each force plate ``k`` as ``fpk_fx``, ``fpk_f
 other than letters, digits and ``_`` become ``_``.
 
 Rates: the table is at the marker rate unless another ``rate`` is asked for. Analog
-channels (and plates) are brought to it by scipy's ``decimate`` (an FIR low-pass run
-forwards and backwards: no delay) when the analog rate is an integer multiple of it, else
-by a cubic spline; markers, when the rate differs from theirs, by a cubic spline. A marker
-missing in some frames (NaN in ezc3d) is filled by the same spline when the gap is at most
-:data:`posturelab.recordings.resample.MAX_GAP_STEPS` frames, else refused naming the marker
-and the time. Time starts at 0 at the first frame.
+channels (and plates) are brought to it by scipy's ``resample_poly`` (a zero-phase FIR
+low-pass, Kaiser window, the ends extended by a line) when the analog rate is an integer
+multiple of it, else by a cubic spline; markers, when the rate differs from theirs, by a
+cubic spline. A marker missing in some frames (NaN in ezc3d) is filled by the same spline
+when the gap is at most :data:`posturelab.recordings.resample.MAX_GAP_STEPS` frames, else
+refused naming the marker and the time. Time starts at 0 at the first frame.
 
 A truncated file is refused: ezc3d reads as many frames as a cut file holds, so the data
 size the header announces is checked against the file's size first.
@@ -120,11 +120,13 @@ def _to_rate(t_in: np.ndarray, values: np.ndarray, grid: np.ndarray, ratio: floa
              what: str, name: str) -> np.ndarray:
     """Values sampled at ``t_in`` brought to ``grid``: decimation when ``ratio`` (input
     rate / output rate) is an integer > 1 and the grids line up, else a cubic spline."""
-    from scipy.signal import decimate
+    from scipy.signal import resample_poly
 
     r = int(round(ratio))
-    if r > 1 and abs(ratio - r) < 1e-9 and np.all(np.isfinite(values)) and values.size > 27 * r:
-        out = decimate(values, r, ftype="fir", zero_phase=True)
+    if r > 1 and abs(ratio - r) < 1e-9 and np.all(np.isfinite(values)):
+        # a zero-phase FIR low-pass (Kaiser window), the record extended by a line at each
+        # end so that its edges make no transient; output k is input k·r
+        out = resample_poly(values, 1, r, padtype="line")
         return out[:grid.size]
     if r == 1 and abs(ratio - 1) < 1e-9 and np.all(np.isfinite(values)):
         return values[:grid.size]
@@ -258,9 +260,6 @@ def write_c3d(path: str | Path, markers: dict[str, np.ndarray], point_rate: floa
     point_units : str
         ``mm`` (default) or ``m``.
     """
-    import os
-    import tempfile
-
     ezc3d = _ezc3d()
     c = ezc3d.c3d()
     names = list(markers)
@@ -282,13 +281,7 @@ def write_c3d(path: str | Path, markers: dict[str, np.ndarray], point_rate: floa
                                                        for n in labels]
         c["data"]["analogs"] = np.array([[np.asarray(analogs[n], dtype=float)
                                           for n in labels]])
-    path = Path(path)
-    fd, tmp = tempfile.mkstemp(suffix=".c3d.tmp", dir=path.parent or ".")
-    os.close(fd)
-    try:
-        c.write(tmp)
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
+    from .._files import atomic_outputs
+
+    with atomic_outputs([path], suffix=".c3d") as (tmp,):
+        c.write(str(tmp))  # ezc3d appends .c3d to a name without it
