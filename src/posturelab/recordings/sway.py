@@ -25,8 +25,8 @@ Three methods:
     body (knee angle 0.011 rad RMS, sway 0.085 rad RMS) 0.42 % of the sway's RMS
     (tests/test_recordings.py); it grows with the knee's motion. When only forward
     positions of hip and shoulder are recorded, their heights above the ankle come from
-    the subject's height by Winter's Fig. 4.1 (after Drillis & Contini 1966: greater trochanter 0.530 H, shoulder 0.818 H, lateral
-    malleolus 0.039 H).
+    the subject's height by Winter's Fig. 4.1 (after Drillis & Contini 1966: greater
+    trochanter 0.530 H, shoulder 0.818 H, lateral malleolus 0.039 H).
 ``cop``
     Force plates only: the inverted-pendulum relation between the centre of pressure and
     the centre of mass, ẍ_G = ω₀² (x_G − x_P) with ω₀² = m g h / I_A (m the body's mass,
