@@ -22,12 +22,26 @@ def add_recording_arguments(p: argparse.ArgumentParser) -> None:
     g.add_argument("--length-unit", choices=["m", "mm"], default="m",
                    help="the unit of length columns without a unit in their header "
                    "(default m; mm is converted).")
+    g.add_argument("--start", type=float, metavar="SECONDS",
+                   help="drop the samples before this time (where the stimulus's first "
+                   "cycle starts) [s].")
+
+
+def add_cycle_trim_argument(p: argparse.ArgumentParser) -> None:
+    """--drop-partial (for the commands that cut a trial into stimulus cycles)."""
+    p.add_argument("--drop-partial", action="store_true",
+                   help="drop a partial cycle at the end of the recording (said on "
+                   "standard error; default: a recording must hold whole cycles).")
 
 
 def recording_options(args: argparse.Namespace) -> dict:
     """:func:`posturelab.recordings.table.read_series`'s reading options."""
-    return {"resample": args.resample, "max_gap": args.max_gap,
-            "angle_unit": args.angle_unit, "length_unit": args.length_unit}
+    out = {"resample": args.resample, "max_gap": args.max_gap,
+           "angle_unit": args.angle_unit, "length_unit": args.length_unit,
+           "start": args.start}
+    if getattr(args, "drop_partial", False):
+        out["drop_partial"] = True
+    return out
 
 
 def print_resampling(report) -> None:

@@ -16,8 +16,8 @@ LABEL_y, LABEL_z in m (scaled from POINT:UNITS), every analog channel by its lab
 ANALOG:UNITS unit), each force plate k as fpk_fx, fpk_fy, fpk_fz [N] and its centre of
 pressure fpk_copx, fpk_copy, fpk_copz [m], at the marker rate or --rate HZ (analogs
 decimated by a zero-phase FIR low-pass). Labels are lower-cased. A CSV needs a time
-column; --angle-columns names its angle columns (read in --angle-unit), --length-unit the
-unit of the marker columns named in --markers.
+column. --angle-columns names the angle columns, converted to rad from the unit they
+declare (or --angle-unit); --length-unit is the unit of a CSV's marker columns (--markers).
 
 --sway METHOD writes com_angle: segments (ankle, knee, hip, shoulder markers; Winter 2009
 Table 4.1), two-marker (hip and shoulder; the knee on the ankle–hip line; forward
@@ -40,7 +40,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--rate", type=float, metavar="HZ",
                    help="C3D: the table's sample rate (default the marker rate).")
     p.add_argument("--angle-columns", default="", metavar="COL,...",
-                   help="CSV: the columns that are angles (read in --angle-unit).")
+                   help="columns that are angles: converted to rad from the unit they "
+                   "declare (ANALOG:UNITS, a CSV header's [deg]) or else --angle-unit.")
     p.add_argument("--sway", choices=["segments", "two-marker", "cop"],
                    help="write com_angle by this method (see above).")
     p.add_argument("--markers", default="", metavar="LANDMARK=LABEL,...",

@@ -72,7 +72,7 @@ def run(args: argparse.Namespace) -> int:
     free = [s.strip() for s in args.free.split(",") if s.strip()]
     for name in free:  # the names first, before the data are read
         resolve(name, sc.muscles.names, (), accepts=FIT_QUANTITIES)
-    if (args.resample is not None or args.angle_unit != "rad"
+    if (args.resample is not None or args.angle_unit != "rad" or args.start is not None
             or str(args.data).lower().endswith(".c3d")):
         import numpy as np
 
@@ -84,7 +84,9 @@ def run(args: argparse.Namespace) -> int:
                                           kinds=dict.fromkeys(names, "angle"),
                                           **recording_options(args))
         print_resampling(resampled)
-        start = float(read_table(args.data, names[:1])[0][0])
+        times = read_table(args.data, names[:1])[0]
+        start = float(times[times >= (args.start if args.start is not None else -np.inf)
+                            - 1e-9][0])
         time = start + np.arange(cols[names[0]].size) / fs
         theta = np.stack([cols[n] for n in names], axis=1)
     else:

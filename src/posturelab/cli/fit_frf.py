@@ -117,9 +117,10 @@ def add_fit_arguments(p: argparse.ArgumentParser, *, per_condition: bool) -> Non
                    help="bounds of fitted parameters, replacing the defaults (e.g. "
                    "active_stiffness:ankle=0:2000,feedback_delay=0.05:0.3 [N·m/rad], [s]); "
                    "within the table's ranges.")
-    from ._recording import add_recording_arguments
+    from ._recording import add_cycle_trim_argument, add_recording_arguments
 
     add_recording_arguments(p)
+    add_cycle_trim_argument(p)
 
 
 def reader_options(args: argparse.Namespace) -> dict:

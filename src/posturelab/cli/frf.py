@@ -6,7 +6,12 @@ import argparse
 import math
 
 from ._common import FIGURE_SUFFIXES, check_writable, print_json
-from ._recording import add_recording_arguments, print_resampling, recording_options
+from ._recording import (
+    add_cycle_trim_argument,
+    add_recording_arguments,
+    print_resampling,
+    recording_options,
+)
 
 #: Band names ``frf`` and ``frf-model`` both take (frequency.bands.SEQUENCE_BANDS; "peterka"
 #: is the historical name of the 80-state bands).
@@ -83,6 +88,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="write the stimulus over one cycle and the cycle-averaged response "
                    "(PNG/SVG/PDF).")
     add_recording_arguments(p)
+    add_cycle_trim_argument(p)
 
 
 def check_plot_path(*paths: str | None) -> None:
@@ -118,6 +124,7 @@ def run(args: argparse.Namespace) -> int:
     stim, resp = args.stimulus.strip().lower(), args.response.strip().lower()
     fs, cols, resampled = read_series(args.data, [stim, resp], {stim: ("rad", "m")},
                                       kinds=trial_kinds(stim, resp, args.length_unit),
+                                      cycle_length=args.cycle_length,
                                       **recording_options(args))
     print_resampling(resampled)
     sign = response_sign(args.response_sign)

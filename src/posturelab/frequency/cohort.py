@@ -84,7 +84,8 @@ def read_frf_file(path, *, stimulus: str | None = None, response: str | None = N
     stim, resp = stimulus.strip().lower(), response.strip().lower()
     fs, cols = read_series_csv(  # recording: read_series_csv's resample/unit options
         path, [stim, resp], {stim: ("rad",) if input == "tilt" else ("m",)},
-        kinds={stim: "angle" if input == "tilt" else "length", resp: "angle"}, **recording)
+        kinds={stim: "angle" if input == "tilt" else "length", resp: "angle"},
+        cycle_length=cycle_length, **recording)
     x, y, _ = whole_cycles(cols[stim], cols[resp], fs, cycle_length)
     return estimate_frf(x, y, fs, cycle_length, discard_cycles=discard_cycles,
                         response_sign=response_sign)

@@ -89,10 +89,11 @@ def convert_recording(path: str | Path, *, rate: float | None = None,
     max_gap : float, optional
         Longest gap the resampling accepts. [s]
     angle_unit, length_unit : str
-        CSV only: the unit of the ``angle_columns`` (rad, deg) and of the marker columns
-        (m, mm); converted to rad and m.
+        The unit of ``angle_columns`` that declare none (rad, deg), and (CSV) of the marker
+        columns (m, mm); converted to rad and m.
     angle_columns : tuple of str
-        CSV columns that are angles.
+        Columns that are angles, converted to rad from the unit they declare (a C3D
+        channel's ANALOG:UNITS, a CSV header's brackets) or else ``angle_unit``.
     sway : str, optional
         ``segments``, ``two-marker`` or ``cop`` (:data:`posturelab.recordings.sway.SWAY_METHODS`).
     markers : dict of str -> str, optional
@@ -140,14 +141,6 @@ def convert_recording(path: str | Path, *, rate: float | None = None,
         if rate is not None:
             raise ParameterError("--rate is for C3D files; give --resample HZ for a CSV")
         time, cols, units = read_table(path)
-        for c in angle_columns:
-            if c not in cols:
-                raise DataFileError(f"{what} has no column {c!r} (--angle-columns); columns: "
-                                    + ", ".join(cols)[:300])
-            if angle_unit == "deg" and units.get(c, "") in ("", "deg"):
-                cols[c] = cols[c] * SCALE["deg"]
-                notes.append(f"{c} from deg to rad")
-            units[c] = "rad"
         if length_unit == "mm":
             for label in markers.values():
                 for name in [label] + [f"{label}_{a}" for a in "xyz"]:
@@ -155,6 +148,18 @@ def convert_recording(path: str | Path, *, rate: float | None = None,
                         cols[name] = cols[name] * SCALE["mm"]
                         units[name] = "m"
             notes.append("marker columns from mm to m")
+    for c in angle_columns:
+        if c not in cols:
+            raise DataFileError(f"{what} has no column {c!r} (--angle-columns); columns: "
+                                + ", ".join(cols)[:300])
+        unit = units.get(c) or angle_unit
+        if unit not in ANGLE_UNITS:
+            raise DataFileError(f"{what}: column {c!r} is in {unit!r}, not an angle unit "
+                                f"({', '.join(ANGLE_UNITS)})")
+        if unit == "deg":
+            cols[c] = cols[c] * SCALE["deg"]
+            notes.append(f"{c} from deg to rad")
+        units[c] = "rad"
     if resample is not None:
         time, cols, report = resample_uniform(time, cols, resample, max_gap=max_gap,
                                               what=what)

@@ -133,7 +133,8 @@ def read_series(path: str | Path, columns: list[str],
                 units: dict[str, tuple[str, ...]] | None = None, *,
                 kinds: dict[str, str] | None = None, angle_unit: str = "rad",
                 length_unit: str = "m", resample: float | None = None,
-                max_gap: float | None = None
+                max_gap: float | None = None, start: float | None = None,
+                drop_partial: bool = False, cycle_length: float | None = None
                 ) -> tuple[float, dict[str, np.ndarray], ResampleReport | None]:
     """The sample rate and the named columns of a recording, in SI, on a uniform grid.
 
@@ -157,6 +158,13 @@ def read_series(path: str | Path, columns: list[str],
         time column or a missing sample is refused.
     max_gap : float, optional
         Longest gap the resampling accepts. [s]
+    start : float, optional
+        Drop the samples before this time (where the stimulus's first cycle starts). [s]
+    drop_partial : bool
+        Drop the samples after the last whole cycle of ``cycle_length`` [s] (a recording
+        that runs on past the stimulus); the cut is said on standard error.
+    cycle_length : float, optional
+        [s]
 
     Returns
     -------
@@ -191,12 +199,40 @@ def read_series(path: str | Path, columns: list[str],
             raise DataFileError(f"{what}: column {c!r} is in {header}; posturelab reads "
                                 f"{' or '.join(accepted)}{hint}")
         check_column_unit(what, f"{c} [{header}]" if header else c, accepted)
+    if start is not None:
+        keep = time >= float(start) - 1e-9
+        if not keep.any():
+            raise DataFileError(f"{what} ends at {time[-1]:g} s, before --start {start:g} s")
+        time, cols = time[keep], {c: v[keep] for c, v in cols.items()}
     if time.size < 8:
         raise DataFileError(f"{what} needs at least 8 samples, has {time.size}")
+    report = None
     if resample is not None:
-        grid, cols, report = resample_uniform(time, cols, resample, max_gap=max_gap,
-                                              what=what)
-        return float(report.rate), cols, report
+        _, cols, report = resample_uniform(time, cols, resample, max_gap=max_gap, what=what)
+        step = 1.0 / report.rate
+    else:
+        step = _uniform_or_refuse(time, cols, columns, what)
+    if drop_partial:
+        if cycle_length is None:
+            raise ParameterError("--drop-partial needs --cycle-length")
+        per = int(round(float(cycle_length) / step))
+        n = next(iter(cols.values())).size
+        whole = (n // per) * per if per > 0 else n
+        if whole == 0:
+            raise DataFileError(f"{what} holds {n * step:g} s, less than one cycle of "
+                                f"{cycle_length:g} s")
+        if whole < n:
+            import sys
+
+            print(f"note: {what}: dropped the last {n - whole} sample(s) "
+                  f"({(n - whole) * step:.4g} s), a partial cycle", file=sys.stderr)
+            cols = {c: v[:whole] for c, v in cols.items()}
+    return 1.0 / step, cols, report
+
+
+def _uniform_or_refuse(time: np.ndarray, cols: dict[str, np.ndarray], columns: list[str],
+                       what: str) -> float:
+    """The step of a uniform time column with no missing sample [s]; else refused."""
     step = uniform_step(time)
     if step is None:
         dt = np.diff(time)
@@ -211,4 +247,4 @@ def read_series(path: str | Path, columns: list[str],
             raise DataFileError(f"{what}: column {c!r} is missing at t = {time[bad[0]]:g} s "
                                 f"({bad.size} sample(s)); give --resample HZ to fill short "
                                 "gaps")
-    return 1.0 / step, cols, None
+    return step
