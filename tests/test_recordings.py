@@ -337,3 +337,34 @@ def test_bad_files_get_one_line_and_exit_2(tmp_path, capsys, rng):
         capsys, "frf", "--data", deg, "--stimulus", "tilt", "--response", "com_angle",
         "--cycle-length", "0.1")
     assert not (tmp_path / "o.csv").exists()
+
+
+def test_fit_reads_an_uneven_recording_in_degrees(tmp_path, capsys, rng):
+    """posturelab fit with --resample and --angle-unit deg gives the fit of the uniform
+    recording (Table I case 1 after a backward step, 2 s)."""
+    from scipy.interpolate import CubicSpline
+
+    fine = tmp_path / "fine.csv"
+    assert main(["simulate", "--case", "1", "--disturbance", "backward", "--duration", "2",
+                 "--sample-rate", "1000", "--out", str(fine)]) == 0
+    uniform = tmp_path / "uniform.csv"
+    assert main(["simulate", "--case", "1", "--disturbance", "backward", "--duration", "2",
+                 "--sample-rate", "100", "--out", str(uniform)]) == 0
+    capsys.readouterr()
+    data = np.genfromtxt(fine, delimiter=",", names=True)
+    t = jittered_times(rng, 2.0)
+    cols = [t] + [np.degrees(CubicSpline(data["t"], data[f"theta{i}"])(t))
+                  for i in (1, 2, 3)]
+    uneven = tmp_path / "uneven.csv"
+    np.savetxt(uneven, np.column_stack(cols), delimiter=",", header="t,theta1,theta2,theta3",
+               comments="")
+    args = ["fit", "--case", "1", "--disturbance", "backward", "--free", "stiffness:ankle",
+            "--json"]
+    code, out, err = run(capsys, *args, "--data", uneven, "--resample", "100",
+                         "--angle-unit", "deg")
+    assert code == 0, err
+    got = json.loads(out)["parameters"]["stiffness:ankle"]["estimate"]
+    code, out, err = run(capsys, *args, "--data", uniform)
+    assert code == 0, err
+    want = json.loads(out)["parameters"]["stiffness:ankle"]["estimate"]
+    assert got == pytest.approx(want, rel=1e-3)

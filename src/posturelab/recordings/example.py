@@ -81,7 +81,7 @@ def make_lab_csv(path: str | Path, seed: int = 21) -> None:
     cols = [t, CubicSpline(rec.time, rec.columns["tilt"])(t),  # ANALOG:UNITS deg
             1000 * CubicSpline(rec.time, rec.columns["hip_x"])(t),
             1000 * CubicSpline(rec.time, rec.columns["sho_x"])(t)]
-    rows = "".join(",".join(f"{v:.6f}" for v in row) + "\n" for row in zip(*cols))
+    rows = "".join(",".join(f"{v:.6f}" for v in row) + "\n" for row in zip(*cols, strict=True))
     atomic_write_text(path, "time,stim_pitch,hip_xpos,shld_xpos\n" + rows)
 
 

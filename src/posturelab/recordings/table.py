@@ -193,11 +193,13 @@ def read_series(path: str | Path, columns: list[str],
             cols[c] = cols[c] * SCALE[given]  # declared by the user (the header agrees)
             continue
         accepted = (units or {}).get(c, SI_UNITS)
-        hint = {"deg": "; give --angle-unit deg to read degrees",
-                "mm": "; give --length-unit mm to read millimetres"}.get(header.lower(), "")
+        hint = {("deg", "angle"): "; give --angle-unit deg to read degrees",
+                ("mm", "length"): "; give --length-unit mm to read millimetres"}.get(
+                    (header.lower(), kind or {"deg": "angle", "mm": "length"}.get(
+                        header.lower(), "")), "")
         if header and header.lower() not in {a.lower() for a in accepted} and hint:
-            raise DataFileError(f"{what}: column {c!r} is in {header}; posturelab reads "
-                                f"{' or '.join(accepted)}{hint}")
+            raise DataFileError(f"{what}: column {f'{c} [{header}]'!r} is in {header}; "
+                                f"posturelab reads {' or '.join(accepted)}{hint}")
         check_column_unit(what, f"{c} [{header}]" if header else c, accepted)
     if start is not None:
         keep = time >= float(start) - 1e-9
