@@ -368,3 +368,17 @@ def test_fit_reads_an_uneven_recording_in_degrees(tmp_path, capsys, rng):
     assert code == 0, err
     want = json.loads(out)["parameters"]["stiffness:ankle"]["estimate"]
     assert got == pytest.approx(want, rel=1e-3)
+
+
+def test_a_marker_missing_for_a_few_frames_is_filled_and_for_long_refused(tmp_path, rng):
+    m = rng.uniform(size=(100, 3))
+    m[10:12] = np.nan  # two frames: within the 3 frames accepted
+    write_c3d(tmp_path / "short.c3d", {"a": m}, 100.0)
+    rec = read_c3d(tmp_path / "short.c3d")
+    assert np.all(np.isfinite(rec.columns["a_x"]))
+    assert any("a_x: 2 missing frame(s) filled" in n for n in rec.notes)
+    m[10:30] = np.nan
+    write_c3d(tmp_path / "long.c3d", {"a": m}, 100.0)
+    with pytest.raises(DataFileError, match=r"'a_x' is missing for 0\.21 s at t = 0\.09 … "
+                       r"0\.3 s, longer than the 0\.03 s accepted \(3 frames\)"):
+        read_c3d(tmp_path / "long.c3d")

@@ -194,7 +194,9 @@ def read_c3d(path: str | Path, rate: float | None = None) -> C3DRecording:
             raise DataFileError(f"{what}: POINT:UNITS is {unit_words[0]!r}; posturelab reads "
                                 f"{', '.join(LENGTH_FACTORS)}")
         factor = LENGTH_FACTORS[unit_words[0]]
-        notes.append(f"markers scaled from {unit_words[0]} (POINT:UNITS) to m")
+        notes.append(f"markers scaled from {unit_words[0]} (POINT:UNITS) to m"
+                     + (f", from {point_rate:g} Hz to {out_rate:g} Hz by a cubic spline"
+                        if out_rate != point_rate else ""))
         gap = MAX_GAP_STEPS / point_rate
         for j, label in enumerate(markers):
             for a, axis in enumerate("xyz"):
@@ -203,9 +205,13 @@ def read_c3d(path: str | Path, rate: float | None = None) -> C3DRecording:
                 if np.isfinite(v).all() and out_rate == point_rate:
                     columns[name] = v
                 else:
-                    _, filled, _ = resample_uniform(t_points, {name: v}, out_rate,
-                                                    max_gap=gap, what=what)
+                    _, filled, report = resample_uniform(
+                        t_points, {name: v}, out_rate, max_gap=gap, what=what,
+                        gap_words=f"{MAX_GAP_STEPS:g} frames")
                     columns[name] = filled[name][:n_out]
+                    if report.filled:
+                        notes.append(f"{name}: {report.filled} missing frame(s) filled by a "
+                                     "cubic spline")
                 units[name] = "m"
     analogs = np.asarray(c["data"]["analogs"], dtype=float)
     labels = tuple(_clean(x) for x in params["ANALOG"]["LABELS"]["value"])

@@ -96,7 +96,8 @@ def uniform_step(time: np.ndarray) -> float | None:
 
 
 def resample_uniform(time: np.ndarray, columns: dict[str, np.ndarray], rate: float, *,
-                     max_gap: float | None = None, what: str = "the recording"
+                     max_gap: float | None = None, what: str = "the recording",
+                     gap_words: str | None = None
                      ) -> tuple[np.ndarray, dict[str, np.ndarray], ResampleReport]:
     """Columns sampled at (uneven) ``time`` interpolated onto a uniform grid.
 
@@ -114,6 +115,9 @@ def resample_uniform(time: np.ndarray, columns: dict[str, np.ndarray], rate: flo
         around a run of NaN. [s] (default :data:`MAX_GAP_STEPS` × the median step)
     what : str
         Names the data in messages.
+    gap_words : str, optional
+        What the limit is, in messages (default: "3 median steps" or "the given maximum
+        gap").
 
     Returns
     -------
@@ -148,7 +152,7 @@ def resample_uniform(time: np.ndarray, columns: dict[str, np.ndarray], rate: flo
     if dt[worst] > limit:
         raise DataFileError(f"{what}: a gap of {dt[worst]:.4g} s in the time column at "
                             f"t = {t[worst]:g} … {t[worst + 1]:g} s, longer than the "
-                            f"{limit:.4g} s accepted ({_limit_words(max_gap)})")
+                            f"{limit:.4g} s accepted ({gap_words or _limit_words(max_gap)})")
     n_out = int(np.floor((t[-1] - t[0]) * rate * (1 + 1e-12))) + 1
     grid = t[0] + np.arange(n_out) / rate
     out, filled = {}, 0
@@ -165,7 +169,7 @@ def resample_uniform(time: np.ndarray, columns: dict[str, np.ndarray], rate: flo
             end = t[-1] if k == tv.size else tv[k]
             raise DataFileError(f"{what}: column {name!r} is missing for {spans[k]:.4g} s at "
                                 f"t = {start:g} … {end:g} s, longer than the {limit:.4g} s "
-                                f"accepted ({_limit_words(max_gap)})")
+                                f"accepted ({gap_words or _limit_words(max_gap)})")
         filled += int((~ok).sum())
         out[name] = CubicSpline(tv, v[ok])(grid)
     report = ResampleReport(rate=rate, interpolation=INTERPOLATION, samples_in=int(t.size),
