@@ -36,9 +36,9 @@ def add_cycle_trim_argument(p: argparse.ArgumentParser) -> None:
 
 def recording_options(args: argparse.Namespace) -> dict:
     """:func:`posturelab.recordings.table.read_series`'s reading options."""
-    out = {"resample": args.resample, "max_gap": args.max_gap,
-           "angle_unit": args.angle_unit, "length_unit": args.length_unit,
-           "start": args.start}
+    given = {"resample": None, "max_gap": None, "angle_unit": "rad", "length_unit": "m",
+             "start": None}  # a command without these options reads as before
+    out = {k: getattr(args, k, default) for k, default in given.items()}
     if getattr(args, "drop_partial", False):
         out["drop_partial"] = True
     return out
