@@ -106,6 +106,8 @@ def test_resampled_frf_equals_the_uniform_one(tmp_path, capsys, rng, prts_trial)
     assert code == 0, err
     assert "cubic spline" in err
     got = json.loads(out)
+    assert got["resampling"]["rate_hz"] == 100.0
+    assert got["resampling"]["step_max_s"] <= 0.0117
     code, out, _ = run(capsys, *args, "--data", uniform)
     want = json.loads(out)
     # the PRTS tilt's velocity jumps at each state change: the spline rounds those corners,
@@ -382,3 +384,19 @@ def test_a_marker_missing_for_a_few_frames_is_filled_and_for_long_refused(tmp_pa
     with pytest.raises(DataFileError, match=r"'a_x' is missing for 0\.21 s at t = 0\.09 … "
                        r"0\.3 s, longer than the 0\.03 s accepted \(3 frames\)"):
         read_c3d(tmp_path / "long.c3d")
+
+
+def test_the_sway_tables_are_winters_printed_numbers():
+    """Winter DA (2009) Biomechanics and Motor Control of Human Movement, 4th ed.: Table 4.1
+    (leg 0.0465 of body mass, CoM 0.433 of its length from the knee; thigh 0.100, 0.433 from
+    the hip; HAT 0.678, 0.626 from the hip) and Fig. 4.1 (lateral malleolus 0.039 H, knee
+    0.285 H, greater trochanter 0.530 H, shoulder 0.818 H); tolerances by the printed
+    digits."""
+    from posturelab.recordings.sway import LANDMARK_HEIGHTS, WINTER_SEGMENTS
+
+    assert WINTER_SEGMENTS["leg"][:2] == pytest.approx((2 * 0.0465, 1 - 0.433), abs=5e-4)
+    assert WINTER_SEGMENTS["thigh"][:2] == pytest.approx((2 * 0.100, 1 - 0.433), abs=5e-4)
+    assert WINTER_SEGMENTS["hat"][:2] == pytest.approx((0.678, 0.626), abs=5e-4)
+    printed = {"ankle": 0.039, "knee": 0.285, "hip": 0.530, "shoulder": 0.818}
+    for name, value in printed.items():
+        assert LANDMARK_HEIGHTS[name] == pytest.approx(value, abs=5e-4)

@@ -51,8 +51,8 @@ says when that band's phase lies within 45 deg of +-180 deg with coherence >= 0.
 "coherence", "gain_ci95": [[low, high]], "phase_ci95_deg": [[low, high]],
 "harmonic_frequency" and "harmonic_weight" (each band's harmonics [Hz] and their share of
 its stimulus power), "frf_se" (standard error of the complex estimate), "dof",
-"frf_covariance" (of the bands), "response_sign", "sign_convention", "warnings"}; an
-undefined number is null. fit-frf reads it back.
+"frf_covariance" (of the bands), "response_sign", "sign_convention", "warnings", and with
+--resample "resampling" (what was done)}; an undefined number is null. fit-frf reads it back.
 --ci periodic (default) gives bounds exact for a periodic stimulus; --ci otnes-enochson the
 form Peterka used (wider).
 
@@ -154,7 +154,8 @@ def run(args: argparse.Namespace) -> int:
         for warning in est.warnings:
             print(f"warning: {warning}", file=sys.stderr)
     if args.json:
-        print_json({**est.to_dict(), "sign_convention": sign_convention(sign)})
+        extra = {} if resampled is None else {"resampling": resampled.to_dict()}
+        print_json({**est.to_dict(), "sign_convention": sign_convention(sign), **extra})
         return 0
     print(f"FRF of {resp} to {stim}, {sign_convention(sign)}: {est.n_cycles} cycles "
           f"of {est.cycle_length:g} s at {fs:g} Hz, {len(est.bands)} bands"

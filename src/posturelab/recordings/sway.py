@@ -48,6 +48,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import ParameterError
+from ..model.anthropometry import WINTER_TABLE
 
 __all__ = ["SWAY_METHODS", "com_angle_segments", "com_angle_two_markers", "com_angle_cop",
            "lower_body_fraction", "LANDMARK_HEIGHTS", "WINTER_SEGMENTS"]
@@ -59,23 +60,18 @@ SWAY_METHODS = {
     "cop": "a force plate's centre of pressure, height and mass (Caron et al. 1997)",
 }
 
-#: Winter (2009) Table 4.1 via posturelab.model.anthropometry.WINTER_TABLE: per segment,
-#: (total mass fraction of both sides [-], centre of mass from the segment's lower end as a
-#: fraction of its length [-]).
-WINTER_SEGMENTS = {"leg": (2 * 0.0465, 1 - 0.433), "thigh": (2 * 0.100, 1 - 0.433),
-                   "hat": (0.678, 0.626)}
-#: Heights of landmarks as fractions of standing height, Winter (2009) Fig. 4.1 (after
-#: Drillis & Contini 1966). [-]
-LANDMARK_HEIGHTS = {"ankle": 0.039, "knee": 0.285, "hip": 0.530, "shoulder": 0.818}
-
-
-def _table_check() -> None:
-    from ..model.anthropometry import WINTER_TABLE
-
-    for name, key in (("leg", "leg"), ("thigh", "thigh"), ("hat", "torso")):
-        mass, _, com, _, count = WINTER_TABLE[key]
-        assert abs(WINTER_SEGMENTS[name][0] - mass * count) < 1e-12
-        assert abs(WINTER_SEGMENTS[name][1] - com) < 1e-12
+#: Winter (2009) Table 4.1, from posturelab.model.anthropometry.WINTER_TABLE (stated once
+#: there): per segment, (mass fraction of both sides together [-], centre of mass from the
+#: segment's lower end as a fraction of its length [-], length as a fraction of height [-]).
+WINTER_SEGMENTS = {name: (WINTER_TABLE[key][0] * WINTER_TABLE[key][4], WINTER_TABLE[key][2],
+                          WINTER_TABLE[key][1])
+                   for name, key in (("leg", "leg"), ("thigh", "thigh"), ("hat", "torso"))}
+#: Heights of landmarks as fractions of standing height: the lateral malleolus at 0.039 H
+#: (Winter 2009 Fig. 4.1, after Drillis & Contini 1966) and the knee, hip (greater
+#: trochanter) and shoulder above it by the table's segment lengths (0.285, 0.530 and
+#: 0.818 H, as Fig. 4.1 gives them). [-]
+LANDMARK_HEIGHTS = dict(zip(("ankle", "knee", "hip", "shoulder"), np.cumsum(
+    [0.039, *(WINTER_SEGMENTS[n][2] for n in ("leg", "thigh", "hat"))]).tolist(), strict=True))
 
 
 def _xz(p, name: str) -> np.ndarray:
@@ -109,7 +105,7 @@ def com_angle_segments(ankle, knee, hip, shoulder) -> np.ndarray:
     """
     a, k, h, s = (_xz(p, n) for p, n in ((ankle, "ankle"), (knee, "knee"), (hip, "hip"),
                                          (shoulder, "shoulder")))
-    (ml, cl), (mt, ct), (mh, ch) = (WINTER_SEGMENTS[n] for n in ("leg", "thigh", "hat"))
+    (ml, cl, _), (mt, ct, _), (mh, ch, _) = (WINTER_SEGMENTS[n] for n in ("leg", "thigh", "hat"))
     com = (ml * (a + cl * (k - a)) + mt * (k + ct * (h - k)) + mh * (h + ch * (s - h))) \
         / (ml + mt + mh)
     return _angle(com, a)
@@ -119,8 +115,7 @@ def lower_body_fraction() -> float:
     """Centre of mass of both legs and thighs together along ankle–hip, from the ankle, as a
     fraction of the ankle–hip length, with Winter's segment lengths (leg 0.246 H, thigh
     0.245 H) on a straight knee. [-]"""
-    (ml, cl), (mt, ct) = WINTER_SEGMENTS["leg"], WINTER_SEGMENTS["thigh"]
-    leg, thigh = 0.246, 0.245
+    (ml, cl, leg), (mt, ct, thigh) = WINTER_SEGMENTS["leg"], WINTER_SEGMENTS["thigh"]
     return float((ml * cl * leg + mt * (leg + ct * thigh)) / ((ml + mt) * (leg + thigh)))
 
 
@@ -167,7 +162,7 @@ def com_angle_two_markers(hip, shoulder, ankle=None, *, height: float | None = N
         h, s = _xz(hip_a, "hip"), _xz(sh_a, "shoulder")
         a = np.zeros_like(h) if ankle is None else np.broadcast_to(
             np.asarray(ankle, dtype=float), h.shape)
-    (ml, _), (mt, _), (mh, ch) = (WINTER_SEGMENTS[n] for n in ("leg", "thigh", "hat"))
+    (ml, _, _), (mt, _, _), (mh, ch, _) = (WINTER_SEGMENTS[n] for n in ("leg", "thigh", "hat"))
     cl = lower_body_fraction()
     com = ((ml + mt) * (a + cl * (h - a)) + mh * (h + ch * (s - h))) / (ml + mt + mh)
     return _angle(com, a)
