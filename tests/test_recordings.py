@@ -295,6 +295,10 @@ def test_convert_c3d_to_parquet_has_units(tmp_path, capsys, winter_run):
     exact = np.arctan2(r.cog_position[:, 0], r.cog_position[:, 1])
     # markers stored as float32 millimetres: the angle to 1e-6 rad
     np.testing.assert_allclose(table.column("com_angle").to_numpy(), exact, atol=1e-6)
+    from posturelab.recordings.convert import convert_recording
+
+    later = convert_recording(path, start=20.0)
+    assert later.time[0] == pytest.approx(20.0) and later.time.size == 4001
     # frf and fit read the .c3d directly
     code, _, err = run(capsys, "frf", "--data", path, "--stimulus", "tilt", "--response",
                        "hip_x", "--cycle-length", "20", "--discard-cycles", "1", "--json")

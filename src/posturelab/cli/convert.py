@@ -82,7 +82,7 @@ def run(args: argparse.Namespace) -> int:
                             if c.strip()),
         sway=args.sway, markers=_mapping(args.markers), plate=args.plate,
         forward=args.forward.strip().lower(), up=args.up.strip().lower(),
-        height=args.height, mass=args.mass)
+        height=args.height, mass=args.mass, start=args.start)
     rec.write(args.out)
     print(f"{len(rec.columns)} columns, {rec.time.size} samples at {rec.rate:g} Hz "
           f"({rec.time[-1] - rec.time[0]:g} s)")

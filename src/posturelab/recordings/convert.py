@@ -75,7 +75,8 @@ def convert_recording(path: str | Path, *, rate: float | None = None,
                       angle_columns: tuple[str, ...] = (), sway: str | None = None,
                       markers: dict[str, str] | None = None, plate: int = 1,
                       forward: str = "x", up: str = "z", height: float | None = None,
-                      mass: float | None = None) -> ConvertedRecording:
+                      mass: float | None = None, start: float | None = None
+                      ) -> ConvertedRecording:
     """Read a recording and return it as a posturelab table, with ``com_angle`` if asked.
 
     Parameters
@@ -105,6 +106,8 @@ def convert_recording(path: str | Path, *, rate: float | None = None,
         The lab axes (x, y, z, with - to flip) pointing forward and up.
     height, mass : float, optional
         The subject's height [m] and mass [kg] (``cop``; ``two-marker`` on forward positions).
+    start : float, optional
+        Drop the samples before this time. [s]
 
     Returns
     -------
@@ -160,6 +163,13 @@ def convert_recording(path: str | Path, *, rate: float | None = None,
             cols[c] = cols[c] * SCALE["deg"]
             notes.append(f"{c} from deg to rad")
         units[c] = "rad"
+    if start is not None:
+        keep = time >= float(start) - 1e-9
+        if keep.sum() < 8:
+            raise DataFileError(f"{what} has fewer than 8 samples from --start {start:g} s "
+                                f"(it ends at {time[-1]:g} s)")
+        time, cols = time[keep], {c: v[keep] for c, v in cols.items()}
+        notes.append(f"samples before {start:g} s dropped")
     if resample is not None:
         time, cols, report = resample_uniform(time, cols, resample, max_gap=max_gap,
                                               what=what)
