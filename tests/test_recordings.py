@@ -404,3 +404,13 @@ def test_the_sway_tables_are_winters_printed_numbers():
     printed = {"ankle": 0.039, "knee": 0.285, "hip": 0.530, "shoulder": 0.818}
     for name, value in printed.items():
         assert LANDMARK_HEIGHTS[name] == pytest.approx(value, abs=5e-4)
+
+
+def test_convert_leaves_out_text_columns_and_says_so(tmp_path, capsys):
+    lab = tmp_path / "labels.csv"
+    lab.write_text("time,subject,tilt\n" + "".join(f"{k / 100},s01,{k}\n" for k in range(20)))
+    out = tmp_path / "t.csv"
+    code, text, err = run(capsys, "convert", lab, "--out", out)
+    assert code == 0, err
+    assert "left out (not numbers): subject" in text
+    assert out.read_text().splitlines()[0] == "time [s],tilt"

@@ -143,7 +143,10 @@ def convert_recording(path: str | Path, *, rate: float | None = None,
     else:
         if rate is not None:
             raise ParameterError("--rate is for C3D files; give --resample HZ for a CSV")
-        time, cols, units = read_table(path)
+        skipped: list[str] = []
+        time, cols, units = read_table(path, skipped=skipped)
+        if skipped:
+            notes.append("left out (not numbers): " + ", ".join(skipped))
         if length_unit == "mm":
             for label in markers.values():
                 for name in [label] + [f"{label}_{a}" for a in "xyz"]:

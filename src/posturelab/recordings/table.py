@@ -14,6 +14,7 @@ refused with a message naming the option that reads it. A ``.c3d`` file is read 
 
 from __future__ import annotations
 
+import itertools
 import math
 from pathlib import Path
 
@@ -43,7 +44,8 @@ def _name(header: str) -> str:
     return "time" if name == "t" else name
 
 
-def read_table(path: str | Path, columns: list[str] | None = None
+def read_table(path: str | Path, columns: list[str] | None = None, *,
+               skipped: list[str] | None = None
                ) -> tuple[np.ndarray, dict[str, np.ndarray], dict[str, str]]:
     """The time column and the named columns of a CSV or C3D recording, as stored.
 
@@ -52,7 +54,10 @@ def read_table(path: str | Path, columns: list[str] | None = None
     path : str or Path
         A CSV with a header row and a ``time`` (or ``t``) column [s], or a ``.c3d``.
     columns : list of str, optional
-        The columns wanted (default all; names are case-insensitive).
+        The columns wanted (default all numeric ones; names are case-insensitive).
+    skipped : list, optional
+        With ``columns`` None, receives the names of the CSV columns left out because their
+        first value is not a number (labels, comments).
 
     Returns
     -------
@@ -78,7 +83,7 @@ def read_table(path: str | Path, columns: list[str] | None = None
                                     f"{_listing(names)}")
         wanted = names if columns is None else list(columns)
         return rec.time, {c: rec.columns[c] for c in wanted}, {c: rec.units[c] for c in wanted}
-    return _read_csv(path, columns)
+    return _read_csv(path, columns, skipped)
 
 
 def _listing(names: list[str], most: int = 12) -> str:
@@ -86,7 +91,7 @@ def _listing(names: list[str], most: int = 12) -> str:
     return shown + (f", … ({len(names)} columns)" if len(names) > most else "")
 
 
-def _read_csv(path: Path, columns: list[str] | None):
+def _read_csv(path: Path, columns: list[str] | None, skipped: list[str] | None = None):
     from .._files import csv_rows, header_words, read_text
 
     what = repr(str(path))
@@ -98,7 +103,23 @@ def _read_csv(path: Path, columns: list[str] | None):
     if "time" not in names:
         raise DataFileError(f"{what} has no time column (named t or time, in s); "
                             f"{header_words(first[1])}")
-    wanted_cols = [n for n in names if n != "time"] if columns is None else list(columns)
+    first_row = next(rows_in, None)
+    if columns is None:  # every column whose first value is a number
+        wanted_cols = []
+        for j, n in enumerate(names):
+            if n == "time" or n in wanted_cols:
+                continue
+            cell = first_row[1][j].strip() if first_row and j < len(first_row[1]) else ""
+            try:
+                float(cell) if cell else None
+                wanted_cols.append(n)
+            except ValueError:
+                if skipped is not None:
+                    skipped.append(n)
+    else:
+        wanted_cols = list(columns)
+    if first_row is not None:
+        rows_in = itertools.chain([first_row], rows_in)
     for c in wanted_cols:
         if c not in names:
             raise DataFileError(f"{what} has no column {c!r}; {header_words(first[1])}")
