@@ -44,6 +44,7 @@ LAYERS: tuple[tuple[str, ...], ...] = (
     ("simulation",),     # both engines, the run set-up, results
     ("scenarios",),      # experiments as data (TOML), run through simulation
     ("studies",),        # sweeps, recovery, identification, strategies
+    ("recordings",),     # lab recordings: resampling, C3D, sway from markers and plates
     ("frequency",),      # FRF estimates, model FRFs, fits, PRTS populations (on studies' sweeps)
     ("viz",),            # figures of runs, maps and FRFs
     ("paper", "explore"),  # the reproduction report; the browser explorer

@@ -83,6 +83,7 @@ LAZY_SUBMODULES: dict[str, str] = {
     "parameters": "posturelab.parameters",
     "model": "posturelab.model",
     "paper": "posturelab.paper",
+    "recordings": "posturelab.recordings",
     "scenarios": "posturelab.scenarios",
     "simulation": "posturelab.simulation",
     "studies": "posturelab.studies",

@@ -26,6 +26,7 @@ SUBCOMMANDS: dict[str, str] = {
     "fit": "fit",
     "delay-margin": "delay_margin",
     "frf": "frf",
+    "convert": "convert",
     "frf-model": "frf_model",
     "fit-frf": "fit_frf",
     "compare-frf": "compare_frf",
@@ -53,6 +54,8 @@ SUBCOMMAND_HELP: dict[str, str] = {
     "delay-margin": "delay margin of the linearised model: the feedback delay at which it loses "
                     "stability",
     "frf": "frequency response function of a periodic-stimulus (PRTS) trial, from a CSV",
+    "convert": "a lab recording (C3D or CSV) to a posturelab table: uniform time, SI units, "
+               "com_angle from markers or force plates",
     "frf-model": "frequency response of the linearised model to tilt or translation (exact "
                  "delay)",
     "fit-frf": "fit controller gains, delay and sensory weight to FRFs (one or several "

@@ -17,7 +17,9 @@ measured link angles, by running the nonlinear simulation inside a least-squares
 fit. The experiment (body, disturbance, initial state) is described exactly as for
 'posturelab simulate' (--case/--stiffness give the starting guess and the fixed
 pairs; or --scenario / --builtin). --data is a CSV with columns t [s] and
-theta1..theta3 [rad] (what 'posturelab simulate --out' writes). Reports each
+theta1..theta3 [rad] (what 'posturelab simulate --out' writes), or a .c3d with those
+columns; --resample HZ puts an uneven time column on a uniform grid, --angle-unit deg
+reads angles in degrees. Reports each
 estimate with its standard error and 95 % confidence interval; by default these
 allow for residuals correlated from sample to sample (a first-order autoregression
 per link, estimated from the residuals), which measured sway always has.
@@ -48,6 +50,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    "s²(JᵀJ)⁻¹, too narrow when the residuals are correlated).")
     g.add_argument("--report", metavar="FIT.json", help="also write the JSON summary to a file.")
     g.add_argument("--json", action="store_true", help="print one JSON object instead of text.")
+    from ._recording import add_recording_arguments
+
+    add_recording_arguments(p)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -67,7 +72,25 @@ def run(args: argparse.Namespace) -> int:
     free = [s.strip() for s in args.free.split(",") if s.strip()]
     for name in free:  # the names first, before the data are read
         resolve(name, sc.muscles.names, (), accepts=FIT_QUANTITIES)
-    time, theta = read_trajectory_csv(args.data, sc.body.n_links)
+    if (args.resample is not None or args.angle_unit != "rad" or args.start is not None
+            or str(args.data).lower().endswith(".c3d")):
+        import numpy as np
+
+        from ..recordings.table import read_series, read_table
+        from ._recording import print_resampling, recording_options
+
+        names = [f"theta{i + 1}" for i in range(sc.body.n_links)]
+        fs, cols, resampled = read_series(args.data, names, {n: ("rad",) for n in names},
+                                          kinds=dict.fromkeys(names, "angle"),
+                                          **recording_options(args))
+        print_resampling(resampled)
+        times = read_table(args.data, names[:1])[0]
+        start = float(times[times >= (args.start if args.start is not None else -np.inf)
+                            - 1e-9][0])
+        time = start + np.arange(cols[names[0]].size) / fs
+        theta = np.stack([cols[n] for n in names], axis=1)
+    else:
+        time, theta = read_trajectory_csv(args.data, sc.body.n_links)
     sc = sc.replace(duration=max(float(time[-1]), 1e-3))
     ratio = 0.25 if args.viscosity_ratio is None else args.viscosity_ratio
     fit = fit_stiffness(sc, time, theta, free, viscosity_ratio=ratio,

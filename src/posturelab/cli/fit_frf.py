@@ -117,15 +117,21 @@ def add_fit_arguments(p: argparse.ArgumentParser, *, per_condition: bool) -> Non
                    help="bounds of fitted parameters, replacing the defaults (e.g. "
                    "active_stiffness:ankle=0:2000,feedback_delay=0.05:0.3 [N·m/rad], [s]); "
                    "within the table's ranges.")
+    from ._recording import add_cycle_trim_argument, add_recording_arguments
+
+    add_recording_arguments(p)
+    add_cycle_trim_argument(p)
 
 
 def reader_options(args: argparse.Namespace) -> dict:
     """:func:`posturelab.frequency.cohort.read_frf_file`'s options from the command line."""
+    from ._recording import recording_options
     from .frf import response_sign
 
     return {"stimulus": args.stimulus, "response": args.response,
             "cycle_length": args.cycle_length, "discard_cycles": args.discard_cycles,
-            "response_sign": response_sign(args.response_sign), "input": args.input}
+            "response_sign": response_sign(args.response_sign), "input": args.input,
+            **recording_options(args)}
 
 
 def _condition(path: str, args: argparse.Namespace):

@@ -6,6 +6,12 @@ import argparse
 import math
 
 from ._common import FIGURE_SUFFIXES, check_writable, print_json
+from ._recording import (
+    add_cycle_trim_argument,
+    add_recording_arguments,
+    print_resampling,
+    recording_options,
+)
 
 #: Band names ``frf`` and ``frf-model`` both take (frequency.bands.SEQUENCE_BANDS; "peterka"
 #: is the historical name of the 80-state bands).
@@ -19,8 +25,11 @@ averaged over cycles at the stimulus's odd harmonics and then over frequency ban
 FRF is G_xy/G_xx, with the coherence and 95 % bounds on gain and phase.
 
 The file has a header row and a uniform time column, t or time [s] (the sample rate comes
-from it). A header may declare units, e.g. com [rad]; posturelab reads SI (time in s,
-angles in rad, translations in m) and refuses a column in another unit (deg, ms, mm, ...).
+from it); --resample HZ puts an uneven one on a uniform grid (cubic spline; a gap over
+--max-gap refused). A header may declare units, e.g. com [rad]; posturelab reads SI (time
+in s, angles in rad, translations in m) and refuses a column in another unit (deg, ms,
+mm, ...) unless declared with --angle-unit deg / --length-unit mm. A .c3d is read directly
+(columns as posturelab convert names them).
 --bands peterka (default; the historical name, the same as posturelab-80 and comtest-80)
 averages the 11 bands of the 80-state protocol (COMTEST's analysis; 20 s: 0.05 … 2.20 Hz; for
 another cycle length the same harmonic numbers); --bands peterka-2002-242 the 17 bands
@@ -42,8 +51,8 @@ says when that band's phase lies within 45 deg of +-180 deg with coherence >= 0.
 "coherence", "gain_ci95": [[low, high]], "phase_ci95_deg": [[low, high]],
 "harmonic_frequency" and "harmonic_weight" (each band's harmonics [Hz] and their share of
 its stimulus power), "frf_se" (standard error of the complex estimate), "dof",
-"frf_covariance" (of the bands), "response_sign", "sign_convention", "warnings"}; an
-undefined number is null. fit-frf reads it back.
+"frf_covariance" (of the bands), "response_sign", "sign_convention", "warnings", and with
+--resample "resampling" (what was done)}; an undefined number is null. fit-frf reads it back.
 --ci periodic (default) gives bounds exact for a periodic stimulus; --ci otnes-enochson the
 form Peterka used (wider).
 
@@ -56,7 +65,7 @@ Example: posturelab simulate --controller peterka-2002 --tilt prts:0.035 --durat
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     """The options of ``posturelab frf``."""
-    p.add_argument("--data", required=True, metavar="FILE.csv", help="the trial.")
+    p.add_argument("--data", required=True, metavar="FILE.csv|FILE.c3d", help="the trial.")
     p.add_argument("--stimulus", required=True, metavar="COLUMN", help="stimulus column.")
     p.add_argument("--response", required=True, metavar="COLUMN", help="response column.")
     p.add_argument("--cycle-length", required=True, type=float, metavar="SECONDS",
@@ -78,12 +87,23 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--plot-cycles", metavar="CYCLES.png",
                    help="write the stimulus over one cycle and the cycle-averaged response "
                    "(PNG/SVG/PDF).")
+    add_recording_arguments(p)
+    add_cycle_trim_argument(p)
 
 
 def check_plot_path(*paths: str | None) -> None:
     """Each given figure path ends in .png, .svg or .pdf and can be written."""
     given = [p for p in paths if p]
     check_writable(given, {p: FIGURE_SUFFIXES for p in given})
+
+
+def trial_kinds(stimulus: str, response: str, length_unit: str = "m",
+                input: str | None = None) -> dict[str, str]:
+    """Which declared unit applies to the stimulus and response columns: the response is an
+    angle; the stimulus a length for a translation (``input``, or ``--length-unit mm`` given
+    to ``frf``), else an angle."""
+    translation = input == "translation" or (input is None and length_unit != "m")
+    return {stimulus: "length" if translation else "angle", response: "angle"}
 
 
 def response_sign(choice: str) -> int:
@@ -94,15 +114,19 @@ def response_sign(choice: str) -> int:
 def run(args: argparse.Namespace) -> int:
     from .._files import refuse_input_as_output
     from .._validation import float_in_range
-    from ..frequency.data import read_series_csv
     from ..frequency.estimate import estimate_frf, sign_convention, whole_cycles
+    from ..recordings.table import read_series
 
     refuse_input_as_output({"--data": args.data},
                            {"--plot": args.plot, "--plot-cycles": args.plot_cycles})
     check_plot_path(args.plot, args.plot_cycles)
     float_in_range("--cycle-length [s]", args.cycle_length, 1e-3, 1e5, unit="s")
     stim, resp = args.stimulus.strip().lower(), args.response.strip().lower()
-    fs, cols = read_series_csv(args.data, [stim, resp], {stim: ("rad", "m")})
+    fs, cols, resampled = read_series(args.data, [stim, resp], {stim: ("rad", "m")},
+                                      kinds=trial_kinds(stim, resp, args.length_unit),
+                                      cycle_length=args.cycle_length,
+                                      **recording_options(args))
+    print_resampling(resampled)
     sign = response_sign(args.response_sign)
     x, y, trimmed = whole_cycles(cols[stim], cols[resp], fs, args.cycle_length)
     est = estimate_frf(x, y, fs, args.cycle_length,
@@ -130,7 +154,8 @@ def run(args: argparse.Namespace) -> int:
         for warning in est.warnings:
             print(f"warning: {warning}", file=sys.stderr)
     if args.json:
-        print_json({**est.to_dict(), "sign_convention": sign_convention(sign)})
+        extra = {} if resampled is None else {"resampling": resampled.to_dict()}
+        print_json({**est.to_dict(), "sign_convention": sign_convention(sign), **extra})
         return 0
     print(f"FRF of {resp} to {stim}, {sign_convention(sign)}: {est.n_cycles} cycles "
           f"of {est.cycle_length:g} s at {fs:g} Hz, {len(est.bands)} bands"

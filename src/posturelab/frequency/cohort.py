@@ -55,7 +55,8 @@ def max_cohort_workers() -> int:
 
 def read_frf_file(path, *, stimulus: str | None = None, response: str | None = None,
                   cycle_length: float | None = None, discard_cycles: int = 0,
-                  response_sign: int = -1, input: str = "tilt", what: str = "FRF JSON"):
+                  response_sign: int = -1, input: str = "tilt", what: str = "FRF JSON",
+                  **recording):
     """One condition's FRF from a file: ``.json`` an FRF table
     (:func:`posturelab.frequency.table.read_frf_json`: what ``posturelab frf --json`` writes,
     or gain and phase with optional standard errors), anything else a trial CSV whose
@@ -81,8 +82,10 @@ def read_frf_file(path, *, stimulus: str | None = None, response: str | None = N
         raise ParameterError("a trial CSV needs --stimulus, --response and --cycle-length")
     float_in_range("--cycle-length [s]", cycle_length, 1e-3, 1e5, unit="s")
     stim, resp = stimulus.strip().lower(), response.strip().lower()
-    fs, cols = read_series_csv(path, [stim, resp],
-                               {stim: ("rad",) if input == "tilt" else ("m",)})
+    fs, cols = read_series_csv(  # recording: read_series_csv's resample/unit options
+        path, [stim, resp], {stim: ("rad",) if input == "tilt" else ("m",)},
+        kinds={stim: "angle" if input == "tilt" else "length", resp: "angle"},
+        cycle_length=cycle_length, **recording)
     x, y, _ = whole_cycles(cols[stim], cols[resp], fs, cycle_length)
     return estimate_frf(x, y, fs, cycle_length, discard_cycles=discard_cycles,
                         response_sign=response_sign)

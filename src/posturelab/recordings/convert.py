@@ -1,0 +1,224 @@
+"""A lab recording (C3D or CSV) turned into a posturelab table: uniform time, SI columns,
+and ``com_angle`` from markers or a force plate (:mod:`posturelab.recordings.sway`)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import DataFileError, ParameterError
+from .table import ANGLE_UNITS, LENGTH_UNITS, SCALE
+
+__all__ = ["ConvertedRecording", "convert_recording", "AXES"]
+
+#: Lab axes a marker coordinate may be taken along (a leading - flips it).
+AXES = ("x", "y", "z", "-x", "-y", "-z")
+
+
+@dataclass(frozen=True)
+class ConvertedRecording:
+    """A recording as a posturelab table.
+
+    Attributes
+    ----------
+    time : numpy.ndarray, shape (S,)
+        Uniform. [s]
+    columns : dict of str -> numpy.ndarray
+        [each column's unit]
+    units : dict of str -> str
+    rate : float
+        [Hz]
+    notes : tuple of str
+        What was done: units scaled, rates changed, resampling, the sway method.
+    """
+
+    time: np.ndarray
+    columns: dict[str, np.ndarray]
+    units: dict[str, str]
+    rate: float
+    notes: tuple[str, ...]
+
+    def write(self, path: str | Path) -> None:
+        """Write the table (.csv with units in the header, or .parquet with units in the
+        fields' metadata), atomically."""
+        from .._files import atomic_write_text
+        from ..studies._sweep_grid import table_csv_text, table_format, table_parquet_bytes
+
+        cols = [("time", self.time), *self.columns.items()]
+        units = {"time": "s", **self.units}
+        if table_format(path) == "csv":
+            text = table_csv_text(cols)
+            head, _, body = text.partition("\n")
+            named = ",".join(f"{n} [{units[n]}]" if units.get(n) else n for n, _ in cols)
+            atomic_write_text(path, named + "\n" + body)
+        else:
+            from .._files import atomic_write_bytes
+
+            atomic_write_bytes(path, table_parquet_bytes(cols, units))
+
+
+def _axis(table: dict, label: str, axis: str, what: str) -> np.ndarray:
+    sign = -1.0 if axis.startswith("-") else 1.0
+    name = f"{label}_{axis.lstrip('-')}"
+    if name not in table:
+        raise DataFileError(f"{what} has no marker {label!r} (column {name!r}); markers: "
+                            + ", ".join(sorted({k.rsplit('_', 1)[0] for k in table
+                                                if k.endswith(('_x', '_y', '_z'))}))[:300])
+    return sign * table[name]
+
+
+def convert_recording(path: str | Path, *, rate: float | None = None,
+                      resample: float | None = None, max_gap: float | None = None,
+                      angle_unit: str = "rad", length_unit: str = "m",
+                      angle_columns: tuple[str, ...] = (), sway: str | None = None,
+                      markers: dict[str, str] | None = None, plate: int = 1,
+                      forward: str = "x", up: str = "z", height: float | None = None,
+                      mass: float | None = None, start: float | None = None
+                      ) -> ConvertedRecording:
+    """Read a recording and return it as a posturelab table, with ``com_angle`` if asked.
+
+    Parameters
+    ----------
+    path : str or Path
+        A ``.c3d`` (markers in m from POINT:UNITS) or a CSV with a ``time`` column [s].
+    rate : float, optional
+        C3D only: the table's rate [Hz] (default the marker rate).
+    resample : float, optional
+        Put an uneven time column on a uniform grid at this rate [Hz] (cubic spline).
+    max_gap : float, optional
+        Longest gap the resampling accepts. [s]
+    angle_unit, length_unit : str
+        The unit of ``angle_columns`` that declare none (rad, deg), and (CSV) of the marker
+        columns (m, mm); converted to rad and m.
+    angle_columns : tuple of str
+        Columns that are angles, converted to rad from the unit they declare (a C3D
+        channel's ANALOG:UNITS, a CSV header's brackets) or else ``angle_unit``.
+    sway : str, optional
+        ``segments``, ``two-marker`` or ``cop`` (:data:`posturelab.recordings.sway.SWAY_METHODS`).
+    markers : dict of str -> str, optional
+        Landmark (ankle, knee, hip, shoulder) → marker label (its ``LABEL_x`` … columns), or
+        for a CSV with forward positions only, the column itself.
+    plate : int
+        The force plate ``cop`` uses (1-based).
+    forward, up : str
+        The lab axes (x, y, z, with - to flip) pointing forward and up.
+    height, mass : float, optional
+        The subject's height [m] and mass [kg] (``cop``; ``two-marker`` on forward positions).
+    start : float, optional
+        Drop the samples before this time. [s]
+
+    Returns
+    -------
+    ConvertedRecording
+    """
+    from . import sway as sw
+    from .c3d import read_c3d
+    from .resample import resample_uniform, uniform_step
+    from .table import read_table
+
+    path = Path(path)
+    what = repr(str(path))
+    if angle_unit not in ANGLE_UNITS or length_unit not in LENGTH_UNITS:
+        raise ParameterError(f"angle unit must be one of {', '.join(ANGLE_UNITS)} and length "
+                             f"unit one of {', '.join(LENGTH_UNITS)}")
+    for a in (forward, up):
+        if a not in AXES:
+            raise ParameterError(f"an axis must be one of {', '.join(AXES)}, got {a!r}")
+    if sway is not None and sway not in sw.SWAY_METHODS:
+        raise ParameterError(f"unknown sway method {sway!r}; known: "
+                             + ", ".join(sw.SWAY_METHODS))
+    markers = {k.strip().lower(): v.strip().lower() for k, v in (markers or {}).items()}
+    known = ("ankle", "knee", "hip", "shoulder")
+    for k in markers:
+        if k not in known:
+            raise ParameterError(f"unknown landmark {k!r} in --markers; known: "
+                                 + ", ".join(known))
+    notes: list[str] = []
+    if path.suffix.lower() == ".c3d":
+        rec = read_c3d(path, rate=rate)
+        time, cols, units = rec.time, dict(rec.columns), dict(rec.units)
+        notes += list(rec.notes)
+    else:
+        if rate is not None:
+            raise ParameterError("--rate is for C3D files; give --resample HZ for a CSV")
+        skipped: list[str] = []
+        time, cols, units = read_table(path, skipped=skipped)
+        if skipped:
+            notes.append("left out (not numbers): " + ", ".join(skipped))
+        if length_unit == "mm":
+            for label in markers.values():
+                for name in [label] + [f"{label}_{a}" for a in "xyz"]:
+                    if name in cols and units.get(name, "") in ("", "mm"):
+                        cols[name] = cols[name] * SCALE["mm"]
+                        units[name] = "m"
+            notes.append("marker columns from mm to m")
+    for c in angle_columns:
+        if c not in cols:
+            raise DataFileError(f"{what} has no column {c!r} (--angle-columns); columns: "
+                                + ", ".join(cols)[:300])
+        unit = units.get(c) or angle_unit
+        if unit not in ANGLE_UNITS:
+            raise DataFileError(f"{what}: column {c!r} is in {unit!r}, not an angle unit "
+                                f"({', '.join(ANGLE_UNITS)})")
+        if unit == "deg":
+            cols[c] = cols[c] * SCALE["deg"]
+            notes.append(f"{c} from deg to rad")
+        units[c] = "rad"
+    if start is not None:
+        keep = time >= float(start) - 1e-9
+        if keep.sum() < 8:
+            raise DataFileError(f"{what} has fewer than 8 samples from --start {start:g} s "
+                                f"(it ends at {time[-1]:g} s)")
+        time, cols = time[keep], {c: v[keep] for c, v in cols.items()}
+        notes.append(f"samples before {start:g} s dropped")
+    if resample is not None:
+        time, cols, report = resample_uniform(time, cols, resample, max_gap=max_gap,
+                                              what=what)
+        notes.append(report.text())
+    elif uniform_step(time) is None:
+        dt = np.diff(time)
+        i = int(np.argmax(np.abs(dt - np.median(dt))))
+        raise DataFileError(f"{what}: the time column is not uniform (step "
+                            f"{np.median(dt):g} s, but {dt[i]:g} s at t = {time[i]:g} s); "
+                            "give --resample HZ to interpolate it onto a uniform grid")
+    step = float(np.median(np.diff(time)))
+    if sway is not None:
+        cols["com_angle"] = _sway(sway, cols, markers, plate, forward, up, height, mass,
+                                  1.0 / step, what)
+        units["com_angle"] = "rad"
+        notes.append(f"com_angle by the {sway} method: {sw.SWAY_METHODS[sway]}")
+    return ConvertedRecording(time=time, columns=cols, units=units, rate=1.0 / step,
+                              notes=tuple(notes))
+
+
+def _sway(method, cols, markers, plate, forward, up, height, mass, rate, what):
+    from . import sway as sw
+
+    need = {"segments": ("ankle", "knee", "hip", "shoulder"), "two-marker": ("hip", "shoulder"),
+            "cop": ()}[method]
+    missing = [n for n in need if n not in markers]
+    if missing:
+        raise ParameterError(f"--sway {method} needs --markers {'=LABEL,'.join(need)}=LABEL; "
+                             f"{missing[0]} not given")
+    if method == "cop":
+        if height is None or mass is None:
+            raise ParameterError("--sway cop needs --height [m] and --mass [kg]")
+        name = f"fp{plate}_cop{forward.lstrip('-')}"
+        if name not in cols:
+            raise DataFileError(f"{what} has no force plate {plate} (column {name!r})")
+        sign = -1.0 if forward.startswith("-") else 1.0
+        return sw.com_angle_cop(sign * cols[name], rate, height=height, mass=mass)
+
+    def point(landmark):
+        label = markers[landmark]
+        if label in cols:  # a forward position only
+            return cols[label]
+        return np.stack([_axis(cols, label, forward, what), _axis(cols, label, up, what)],
+                        axis=1)
+
+    if method == "segments":
+        return sw.com_angle_segments(*(point(n) for n in need))
+    ankle = point("ankle") if "ankle" in markers else None
+    return sw.com_angle_two_markers(point("hip"), point("shoulder"), ankle, height=height)
