@@ -24,7 +24,7 @@ from ...model.checks import check_model
 from ...model.gains import GAIN_ROWS
 from ...model.muscles import MuscleSet, feedback_gains, paper_muscles
 from ...model.platform import Disturbance
-from ...model.tilt import tilt_pair_gains
+from ...model.tilt import tilt_pair_gains, visual_pair_gains
 from ..options import OPTION_NAMES, RunOptions
 from ..outcome import StimulusTiming, stimulus_timing
 from ..setup import (
@@ -388,13 +388,21 @@ def simulate_batch(
         split = feedback_gains(kd_all, ld_all, ka_all, la_all, np.ones(M))
         pair_gains = tilt_pair_gains(split, muscles.spans_foot, delays, weights)
         tilt_gain_all = enc.readonly(np.ascontiguousarray(pair_gains @ muscles.crossing_matrix))
+    visual_gain_all = enc.readonly(np.zeros((M, len(GAIN_ROWS), n)))
+    visual_gains = None
+    if base.visual_tilt is not None:  # (the common visual weight, each run's gains and delay)
+        split = feedback_gains(kd_all, ld_all, ka_all, la_all, np.ones(M))
+        visual_gains = visual_pair_gains(split, muscles.spans_foot, delays, base.visual_weight)
+        visual_gain_all = enc.readonly(np.ascontiguousarray(
+            visual_gains @ muscles.crossing_matrix))
     moments0 = np.empty((M, n))
     for d in np.unique(delays):
         rows = delays == d
         moments0[rows] = moments_at_start(
             muscles, x0_all[which[rows]], before_all[which[rows]], active_all[which[rows]],
             gains_all[rows], float(d), base.tilt,
-            None if pair_gains is None else pair_gains[rows], base.motor_torque)
+            None if pair_gains is None else pair_gains[rows], base.motor_torque,
+            base.visual_tilt, None if visual_gains is None else visual_gains[rows])
     sat0_all = enc.readonly(start_saturation(moments0, lims))
     lim_all = enc.readonly(lims)
     delay_all = enc.readonly(delays)
@@ -433,7 +441,8 @@ def simulate_batch(
                       sat0_all=pointer(sat0_all), method_all=pointer(method_all, ctypes_int64),
                       results=pointer(results),
                       peaks=pointer(peaks), finals=pointer(finals),
-                      tilt_gain_all=pointer(tilt_gain_all))
+                      tilt_gain_all=pointer(tilt_gain_all),
+                      visual_gain_all=pointer(visual_gain_all))
         _run_rows(batch, todo, parallel, int(chunk))
     if at_start.any():
         results[at_start] = 0.0
@@ -447,7 +456,7 @@ def simulate_batch(
     fall_time = np.where(fell, results[:, R_FALL_TIME], np.nan)
     final_outside = results[:, R_FINAL_OUTSIDE] > 0
     any_outside = results[:, R_ANY_OUTSIDE] > 0
-    timing = stimulus_timing(base.disturbance, base.tilt, base.motor_noise)
+    timing = stimulus_timing(base.disturbance, base.tilt, base.motor_noise, base.visual_tilt)
     # counted from the end of the perturbation (the C engine gives the last time outside)
     # (none when the run ends before its perturbation does: recovery is measured within it)
     cut_short = not timing.sustained and timing.end > base.duration + 1e-9

@@ -94,6 +94,10 @@ def packed(setup: RunSetup) -> dict:
             else np.zeros((len(GAIN_ROWS), n)))),
         "tilt_depth": float(setup.tilt_axis_depth),
         "mp": enc.encode_motor_noise(setup.motor_torque),
+        "vp": enc.encode_tilt(setup.visual_tilt),
+        "visual_gain": enc.readonly(np.ascontiguousarray(
+            setup.visual_gains @ muscles.crossing_matrix if setup.visual_gains is not None
+            else np.zeros((len(GAIN_ROWS), n)))),
         "bps": enc.readonly(setup.breakpoints.astype(float)), "fpar": fpar, "ipar": ipar,
         "active0": enc.readonly(setup.active0), "slots": slots,
         "ev_offset": ev.EVENT_OFFSET, "ev_direction": ev.EVENT_DIRECTION,
@@ -121,7 +125,7 @@ def base_run_struct(a: dict, method: str) -> Run:
               n_slots=len(a["slots"]), method=METHOD_RADAU if tab is None else METHOD_EXPLICIT,
               delay_multiples=DELAY_BREAKPOINT_MULTIPLES, tilt_depth=a["tilt_depth"])
     for name in ("x0", "before", "grid", "bp", "E", "C", "dp", "bps", "fpar", "active0",
-                 "ev_offset", "tp", "tilt_gain", "mp"):
+                 "ev_offset", "tp", "tilt_gain", "mp", "vp", "visual_gain"):
         setattr(run, name, pointer(a[name]))
     for name in ("one_sided", "ipar", "ev_direction", "ev_ends"):
         setattr(run, name, pointer(a[name], ctypes_int64))
@@ -230,7 +234,8 @@ def integrate_compiled(setup: RunSetup, method: str | None = None) -> Simulation
         fall_time=fall_time, fall_reason=fall_reason,
         switch_times=tuple(float(v) for v in switches), description=setup.description,
         derived=derive,
-        stimulus=stimulus_timing(setup.disturbance, setup.tilt, setup.motor_noise),
+        stimulus=stimulus_timing(setup.disturbance, setup.tilt, setup.motor_noise,
+                                 setup.visual_tilt),
     )
 
 

@@ -37,6 +37,8 @@ RUN_FIELDS = [
     ("tilt_gain", "*f64", "(4, n) joint moments per α(t), α̇(t), α(t−τ), α̇(t−τ)"),
     ("tilt_depth", "f64", "tilt axis below the ankle [m] (0: the ankle's)"),
     ("mp", "*f64", "packed motor noise (mp[0] = 0: none)"),
+    ("vp", "*f64", "packed visual-scene tilt (vp[0] = 0: none)"),
+    ("visual_gain", "*f64", "(4, n) joint moments per v(t), v̇(t), v(t−τ), v̇(t−τ)"),
 ]
 #: ``pl_out``: where one run's outputs go (any pointer may be NULL where noted).
 OUT_FIELDS = [
@@ -145,6 +147,7 @@ typedef struct {
     const double *gains;                   /* (4, p) the run's pair gains */
     int64_t p;
     double *sc_out, *sc_inp, *sc_x, *ys;   /* scratch (2n), (2 + n), (2n), (2n) */
+    const double *vp, *visual_gain;        /* packed visual-scene tilt, (4, n) gains on it */
 } pl_ctx;
 """
 

@@ -48,6 +48,8 @@ typedef struct {
     const double *tilt_gain;            /* (4, n) joint moments per α(t), α̇(t), α(t−τ), α̇(t−τ) */
     double tilt_depth;                  /* tilt axis below the ankle [m] (0: the ankle's) */
     const double *mp;                   /* packed motor noise (mp[0] = 0: none) */
+    const double *vp;                   /* packed visual-scene tilt (vp[0] = 0: none) */
+    const double *visual_gain;          /* (4, n) joint moments per v(t), v̇(t), v(t−τ), v̇(t−τ) */
 } pl_run;
 
 /* Outputs of one run (any pointer may be NULL where noted). */
@@ -88,6 +90,7 @@ typedef struct {
     const double *gains;                   /* (4, p) the run's pair gains */
     int64_t p;
     double *sc_out, *sc_inp, *sc_x, *ys;   /* scratch (2n), (2 + n), (2n), (2n) */
+    const double *vp, *visual_gain;        /* packed visual-scene tilt, (4, n) gains on it */
 } pl_ctx;
 
 /* sin θ and cos θ from those of a nearby θ_b by the angle-sum formulas: within a step the

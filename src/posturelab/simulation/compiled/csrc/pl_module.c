@@ -41,6 +41,7 @@ typedef struct {
     const int64_t *method_all;   /* per run: METHOD_RADAU or METHOD_EXPLICIT (the tableau) */
     double *results, *peaks, *finals;
     const double *tilt_gain_all; /* per run (4, n) */
+    const double *visual_gain_all; /* per run (4, n): on the visual-scene tilt */
 } pl_batch;
 
 PL_EXPORT void pl_run_batch(const pl_batch *b, int64_t begin, int64_t end)
@@ -60,6 +61,7 @@ PL_EXPORT void pl_run_batch(const pl_batch *b, int64_t begin, int64_t end)
         run.sat0 = b->sat0_all + r * n;
         run.method = b->method_all[r];
         run.tilt_gain = b->tilt_gain_all + r * 4 * n;
+        run.visual_gain = b->visual_gain_all + r * 4 * n;
         pl_out out = {NULL, NULL, NULL, NULL, 0, b->peaks + r * n, b->finals + r * m,
                       b->results + r * N_RESULT};
         pl_integrate(&run, &out);
