@@ -349,19 +349,21 @@ def check_value(name: str, value, field: str | None = None) -> float:
     return v
 
 
-def check_weights(proprioceptive_weight, visual_weight) -> float:
+def check_weights(proprioceptive_weight, visual_weight,
+                  fields: tuple[str, str] = ("proprioceptive_weight", "visual_weight")) -> float:
     """The visual weight W_v [-], each weight within its bounds and W_p + W_v <= 1 (the
-    graviceptive weight 1 − W_p − W_v is not negative: Peterka 2002's independent channels).
+    graviceptive weight 1 − W_p − W_v is not negative: Peterka 2002's independent channels);
+    ``fields`` are how a message names the two (a file's keys, the command line's flags).
 
     Raises
     ------
     ParameterError
         One line naming both weights and their sum when it is over 1.
     """
-    wp = check_value("proprioceptive_weight", proprioceptive_weight)
-    wv = check_value("visual_weight", visual_weight)
+    wp = check_value("proprioceptive_weight", proprioceptive_weight, fields[0])
+    wv = check_value("visual_weight", visual_weight, fields[1])
     if wp + wv > 1.0 + 1e-12:
-        raise ParameterError(f"proprioceptive_weight + visual_weight [-] must be at most 1 "
+        raise ParameterError(f"{fields[0]} + {fields[1]} [-] must be at most 1 "
                              f"(the rest is graviceptive), got {wp:g} + {wv:g} = {wp + wv:g}")
     return wv
 

@@ -40,7 +40,7 @@ from ..model.tilt import (
     get_prts_sequence,
     read_tilt_csv,
 )
-from ..parameters import check_value
+from ..parameters import check_value, check_weights
 from ..simulation.options import RunOptions
 from ._scenario import SCENARIO_DEFAULTS as DEFAULTS
 from ._scenario import Scenario
@@ -68,6 +68,7 @@ OPTION_KEYS: dict[str, str] = {
     "proprioceptive_weight": "muscles.proprioceptive_weight",
     "torque_feedback_gain": "muscles.torque_feedback_gain",
     "torque_feedback_time_constant": "muscles.torque_feedback_time_constant", "tilt": "tilt",
+    "visual_weight": "muscles.visual_weight", "visual_tilt": "visual_tilt",
     "tilt_axis_depth": "tilt.axis_depth", "motor_noise": "motor_noise",
     "method": "solver.method", "rtol": "solver.rtol", "atol": "solver.atol",
     "sample_rate": "solver.sample_rate", "max_steps": "solver.max_steps",
@@ -104,8 +105,10 @@ def parse_tables(data: dict, base_dir: Path, origin: str,
     feedback_gain = mt.pop("torque_feedback_gain", DEFAULTS.torque_feedback_gain)
     feedback_lag = mt.pop("torque_feedback_time_constant",
                           DEFAULTS.torque_feedback_time_constant)
+    visual_weight = mt.pop("visual_weight", DEFAULTS.visual_weight)
     for key, value in (("torque_feedback_gain", feedback_gain),
-                       ("torque_feedback_time_constant", feedback_lag)):
+                       ("torque_feedback_time_constant", feedback_lag),
+                       ("visual_weight", visual_weight)):
         try:  # the parameter table's bounds, before the muscles are built
             check_value(key, value, _name(names, f"muscles.{key}"))
         except ParameterError as exc:
@@ -114,8 +117,15 @@ def parse_tables(data: dict, base_dir: Path, origin: str,
                            one_link="controller" in mt)
     muscles, case, delay, weight = muscles_from_table(mt, body, origin, names,
                                                       data.get("body", {}))
+    try:
+        check_weights(weight, visual_weight, (_name(names, "muscles.proprioceptive_weight"),
+                                              _name(names, "muscles.visual_weight")))
+    except ParameterError as exc:
+        raise _error(origin, str(exc)) from None
     tilt_table = data.get("tilt", {})
     tilt = tilt_from_table(tilt_table, base_dir, origin, names)
+    visual = tilt_from_table(data.get("visual_tilt", {}), base_dir, origin, names,
+                             "visual_tilt")
     disturbance = disturbance_from_tables(data.get("disturbance"), base_dir, origin, names)
     noise = motor_noise_from_table(data.get("motor_noise", {}), body.n_links, origin, names)
     it = data.get("initial", {})
@@ -144,6 +154,7 @@ def parse_tables(data: dict, base_dir: Path, origin: str,
         torque_limits=torque_limits, feedback_delay=delay, proprioceptive_weight=weight,
         torque_feedback_gain=feedback_gain, torque_feedback_time_constant=feedback_lag,
         tilt=tilt, tilt_axis_depth=tilt_table.get("axis_depth", 0.0), motor_noise=noise,
+        visual_tilt=visual, visual_weight=visual_weight,
         method=st.get("method"), rtol=st.get("rtol", DEFAULTS.rtol),
         atol=st.get("atol", DEFAULTS.atol),
         sample_rate=st.get("sample_rate", DEFAULTS.sample_rate),
@@ -194,12 +205,13 @@ TILT_KEYS = ("type", "amplitude", "frequency", "phase", "duration", "start", "st
 
 
 def tilt_from_table(tt: dict, base_dir: Path, origin: str = "",
-                    names: Mapping[str, str] | None = None) -> Tilt | None:
+                    names: Mapping[str, str] | None = None, key: str = "tilt") -> Tilt | None:
     """The [tilt] table (module docstring), or None when there is none; the command line's
-    ``--tilt`` as this table too."""
+    ``--tilt`` as this table too; ``key`` "visual_tilt" for the visual scene's table (the
+    same types, without axis_depth)."""
     if not tt:
         return None
-    where = _name(names, "tilt")
+    where = _name(names, key)
     kind = tt.get("type")
     allowed = {"sine": ("amplitude", "frequency", "phase"),
                "raised-cosine": ("amplitude", "duration", "start"),
@@ -207,8 +219,9 @@ def tilt_from_table(tt: dict, base_dir: Path, origin: str = "",
                         "sequence"),
                "profile": ("file",)}
     if kind not in allowed:
-        raise _error(origin, f"tilt.type must be one of {', '.join(allowed)}; got {kind!r}")
-    _reject(tt, ("type", "axis_depth", *allowed[kind]), f"tilt (type {kind})", origin)
+        raise _error(origin, f"{key}.type must be one of {', '.join(allowed)}; got {kind!r}")
+    _reject(tt, ("type", *(("axis_depth",) if key == "tilt" else ()), *allowed[kind]),
+            f"{key} (type {kind})", origin)
     try:
         if kind == "sine":
             return SineTilt(tt.get("amplitude"), tt.get("frequency"), tt.get("phase", 0.0))
@@ -348,6 +361,7 @@ def muscles_from_table(mt: dict, body: Body, origin: str = "",
     [-] (a controller preset's unless the table gives them), each checked against the
     parameter table."""
     mt = dict(mt)
+    mt.pop("visual_weight", None)  # (a run option: parse_tables reads it)
     preset = _controller(mt, body, origin, names, bt or {})
     delay = mt.pop("feedback_delay", 0.0 if preset is None else preset.feedback_delay)
     weight = mt.pop("proprioceptive_weight",
