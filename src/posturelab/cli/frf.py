@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import math
 
+from ..errors import ParameterError
 from ._common import FIGURE_SUFFIXES, check_writable, print_json
 
 #: Band names ``frf`` and ``frf-model`` both take (frequency.bands.SEQUENCE_BANDS; "peterka"
@@ -47,6 +48,14 @@ undefined number is null. fit-frf reads it back.
 --ci periodic (default) gives bounds exact for a periodic stimulus; --ci otnes-enochson the
 form Peterka used (wider).
 
+Dual-stimulus trials (a surface and a visual-scene tilt at once, posturelab.frequency.dual):
+--stimulus tilt,visual_tilt (the default when the file has both columns: without --stimulus
+the trial's tilt and visual_tilt columns, and com_angle without --response) estimates each
+FRF at its own stimulus's harmonics over the common --cycle-length; the two stimuli must not
+share a harmonic (a PRTS and one of half its cycle: simulate --tilt prts:0.035 --visual-tilt
+prts:0.035:0.125). --json then prints {"tilt": {...}, "visual_tilt": {...}}, one FRF object
+each.
+
 Example: posturelab simulate --controller peterka-2002 --tilt prts:0.035 --duration 120 \\
              --engine compiled --sample-rate 100 --out trial.csv
          posturelab frf --data trial.csv --stimulus tilt --response com_angle \\
@@ -57,8 +66,11 @@ Example: posturelab simulate --controller peterka-2002 --tilt prts:0.035 --durat
 def add_arguments(p: argparse.ArgumentParser) -> None:
     """The options of ``posturelab frf``."""
     p.add_argument("--data", required=True, metavar="FILE.csv", help="the trial.")
-    p.add_argument("--stimulus", required=True, metavar="COLUMN", help="stimulus column.")
-    p.add_argument("--response", required=True, metavar="COLUMN", help="response column.")
+    p.add_argument("--stimulus", metavar="COLUMN[,COLUMN]",
+                   help="stimulus column, or two of a dual-stimulus trial (default: the "
+                   "trial's tilt and visual_tilt columns).")
+    p.add_argument("--response", metavar="COLUMN",
+                   help="response column (default com_angle).")
     p.add_argument("--cycle-length", required=True, type=float, metavar="SECONDS",
                    help="stimulus cycle [s] (20 for the 80-state PRTS).")
     p.add_argument("--discard-cycles", type=int, default=0, metavar="N",
@@ -101,9 +113,38 @@ def run(args: argparse.Namespace) -> int:
                            {"--plot": args.plot, "--plot-cycles": args.plot_cycles})
     check_plot_path(args.plot, args.plot_cycles)
     float_in_range("--cycle-length [s]", args.cycle_length, 1e-3, 1e5, unit="s")
-    stim, resp = args.stimulus.strip().lower(), args.response.strip().lower()
-    fs, cols = read_series_csv(args.data, [stim, resp], {stim: ("rad", "m")})
+    from ..frequency.dual import read_trial_frfs, stimulus_columns
+
+    resp = (args.response or "com_angle").strip().lower()
+    stimuli = ([s.strip().lower() for s in args.stimulus.split(",") if s.strip()]
+               if args.stimulus else stimulus_columns(args.data))
+    if not stimuli:
+        raise ParameterError(f"--data {args.data!r} has no tilt or visual_tilt column: give "
+                             "--stimulus COLUMN")
     sign = response_sign(args.response_sign)
+    if len(stimuli) > 1:
+        if args.plot_cycles:
+            raise ParameterError("--plot-cycles draws one stimulus; give --stimulus COLUMN")
+        fs, ests, trimmed = read_trial_frfs(args.data, stimuli, resp, args.cycle_length,
+                                            discard_cycles=args.discard_cycles,
+                                            response_sign=sign, bands=args.bands, ci=args.ci)
+        if args.plot:
+            from ..viz.plots import plot_bode, save_figure
+
+            save_figure(plot_bode(list(ests.values()),
+                                  [f"{'−' if sign < 0 else ''}{resp} / {s}" for s in ests]),
+                        args.plot)
+        if args.json:
+            print_json({s: {**e.to_dict(), "sign_convention": sign_convention(sign)}
+                        for s, e in ests.items()})
+            return 0
+        for s, e in ests.items():
+            _table(e, s, resp, sign, fs, trimmed)
+        if args.plot:
+            print(f"wrote {args.plot}")
+        return 0
+    stim = stimuli[0]
+    fs, cols = read_series_csv(args.data, [stim, resp], {stim: ("rad", "m")})
     x, y, trimmed = whole_cycles(cols[stim], cols[resp], fs, args.cycle_length)
     est = estimate_frf(x, y, fs, args.cycle_length,
                        discard_cycles=args.discard_cycles, bands=args.bands,
@@ -132,6 +173,17 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         print_json({**est.to_dict(), "sign_convention": sign_convention(sign)})
         return 0
+    _table(est, stim, resp, sign, fs, trimmed)
+    for path in (args.plot, args.plot_cycles):
+        if path:
+            print(f"wrote {path}")
+    return 0
+
+
+def _table(est, stim: str, resp: str, sign: int, fs: float, trimmed: bool) -> None:
+    """Print one FRF as a table, with its warnings."""
+    from ..frequency.estimate import sign_convention
+
     print(f"FRF of {resp} to {stim}, {sign_convention(sign)}: {est.n_cycles} cycles "
           f"of {est.cycle_length:g} s at {fs:g} Hz, {len(est.bands)} bands"
           + (" (the record's end point, one sample past the last cycle, left out)"
@@ -147,7 +199,3 @@ def run(args: argparse.Namespace) -> int:
     if low.any():
         print(f"warning: coherence below 0.5 at {int(low.sum())} band(s): those estimates are "
               "noisy")
-    for path in (args.plot, args.plot_cycles):
-        if path:
-            print(f"wrote {path}")
-    return 0

@@ -43,7 +43,7 @@ from ..errors import ParameterError
 from .estimate import FRFEstimate, estimate_frf
 
 __all__ = ["harmonic_step", "estimate_frfs", "dual_prts", "read_trial_frfs", "input_of",
-           "STIMULUS_INPUTS"]
+           "STIMULUS_INPUTS", "stimulus_columns"]
 
 #: The model input of each stimulus column posturelab writes. [-]
 STIMULUS_INPUTS = {"tilt": "tilt", "visual_tilt": "visual-tilt"}
@@ -166,10 +166,11 @@ def dual_prts(surface_amplitude: float, visual_amplitude: float,
 
 def read_trial_frfs(path, stimuli, response: str, cycle_length: float, *,
                     discard_cycles: int = 0, response_sign: int = -1, bands="peterka",
-                    ci: str = "periodic") -> dict[str, FRFEstimate]:
+                    ci: str = "periodic") -> tuple[float, dict[str, FRFEstimate], bool]:
     """Each stimulus column's FRF from one trial CSV (:func:`estimate_frfs`): ``stimuli``
     the column names (tilts [rad]), ``response`` the response column, ``cycle_length`` the
-    common cycle [s]."""
+    common cycle [s]. Returns the sample rate [Hz], the FRFs by column and whether the
+    record's end point (one sample past whole cycles) was left out."""
     from .._validation import float_in_range
     from .data import read_series_csv
     from .estimate import whole_cycles
@@ -178,8 +179,22 @@ def read_trial_frfs(path, stimuli, response: str, cycle_length: float, *,
     names = [s.strip().lower() for s in stimuli]
     resp = response.strip().lower()
     fs, cols = read_series_csv(path, [*names, resp], {n: ("rad",) for n in names})
-    x = {}
+    x, trimmed = {}, False
     for n in names:
-        x[n], y, _ = whole_cycles(cols[n], cols[resp], fs, cycle_length)
-    return estimate_frfs(x, y, fs, cycle_length, discard_cycles=discard_cycles, bands=bands,
-                         response_sign=response_sign, ci=ci)
+        x[n], y, trimmed = whole_cycles(cols[n], cols[resp], fs, cycle_length)
+    return fs, estimate_frfs(x, y, fs, cycle_length, discard_cycles=discard_cycles,
+                             bands=bands, response_sign=response_sign, ci=ci), trimmed
+
+
+def stimulus_columns(path) -> list[str]:
+    """The stimulus columns of :data:`STIMULUS_INPUTS` a trial CSV's header has, in that
+    order (its first row only is read)."""
+    from pathlib import Path
+
+    from .._files import csv_rows, read_text
+    from .data import MAX_ROWS, _name
+
+    first = next(csv_rows(read_text(Path(path), "data file"), repr(str(path)),
+                          max_rows=MAX_ROWS), None)
+    names = {_name(h) for h in (first[1] if first else [])}
+    return [c for c in STIMULUS_INPUTS if c in names]

@@ -22,7 +22,8 @@ The output is y = c·Θ: the centre-of-mass angle Σ a_i θ_i / Σ a_i (``com_an
 angle (``theta1`` …) or a joint angle (``ankle_angle`` = θ1, ``knee_angle`` = θ2 − θ1, …).
 Tilt FRFs are reported in the literature's sign, H = −y/α, so that a body that follows the
 surface (θ = −α: perpendicular to it) has H = 1 (and H = −y/v for the scene, positive
-toes-up like the surface: a body that follows the scene has H = 1); translation FRFs are H = y/x_d [rad/m].
+toes-up like the surface: a body that follows the scene has H = 1); translation FRFs are
+H = y/x_d [rad/m].
 The gains split as :func:`posturelab.model.muscles.feedback_gains` states (without active
 gains the whole feedback is delayed, and W applies to it).
 
@@ -109,7 +110,8 @@ def model_frf_batch(body: Body, muscles: MuscleSet, frequencies, stiffness, visc
     torque_feedback_time_constant : float or array_like, shape (M,), optional
         τ_t (default: the parameter table's 17.4 s). [s]
     visual_weight : float or array_like, shape (M,)
-        W_v, with W + W_v <= 1. [-]
+        W_v. Each weight is checked against its range here; W + W_v <= 1 by
+        :func:`model_frf` and by a run (a fit may search beyond it, and says so). [-]
 
     Returns
     -------
@@ -142,9 +144,6 @@ def model_frf_batch(body: Body, muscles: MuscleSet, frequencies, stiffness, visc
         bad = ~((values >= QUANTITIES[name].low) & (values <= QUANTITIES[name].high))
         if np.any(bad):  # the parameter table's bounds (NaN fails too)
             check_value(name, float(values[np.argmax(bad)]))
-    over = w + wv > 1.0 + 1e-12
-    if np.any(over):
-        check_weights(float(w[np.argmax(over)]), float(wv[np.argmax(over)]))
     system = linear_system(body, muscles, stiffness=k, viscosity=viscosity,
                            active_stiffness=active_stiffness, active_viscosity=active_viscosity,
                            delay=tau, proprioceptive_weight=w, visual_weight=wv,

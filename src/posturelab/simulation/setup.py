@@ -456,7 +456,8 @@ def moments_at_start(muscles: MuscleSet, state: np.ndarray, before: np.ndarray,
     """Unsaturated joint moments at t = 0 of one run, or of runs that share a delay (a batch):
     the pairs' feedback (:func:`start_moments`, ``state``, ``before`` (..., 2N), ``active``
     (..., P), ``gains`` (..., 4, P)), the tilt's part with ``tilt_gains`` (..., 4, P), the
-    visual-scene tilt's with ``visual_gains`` (..., 4, P) and the motor noise. Returns (..., N). [N·m]
+    visual-scene tilt's with ``visual_gains`` (..., 4, P) and the motor noise. Returns
+    (..., N). [N·m]
 
     ``delay`` is the runs' feedback delay τ. [s]
     """
