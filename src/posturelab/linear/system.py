@@ -16,7 +16,7 @@ inputs are the surface tilt α [rad] (:func:`posturelab.model.tilt.tilt_pair_gai
 pairs that span the foot feel it, the active part weighted by the proprioceptive weight
 W) and the horizontal platform acceleration ẍ_d [m/s²] (h = −a, the linearised −H(Θ));
 and the visual-scene tilt v [rad], which acts only through the active part of the pairs that
-span the foot, weighted by the visual weight W_v (:func:`posturelab.model.tilt.visual_pair_gains`:
+span the foot, weighted by the visual weight W_v (:func:`posturelab.model.visual.visual_pair_gains`:
 its moments c0 … c3 on v, v̇, v(t − τ), v̇(t − τ) are those of b with the intrinsic part
 removed and W_v for W; Peterka 2002's independent channels).
 
@@ -57,7 +57,8 @@ from ..model.gains import (
     IMMEDIATE_VISCOSITY,
 )
 from ..model.muscles import MuscleSet, feedback_gains
-from ..model.tilt import tilt_pair_gains, visual_pair_gains
+from ..model.tilt import tilt_pair_gains
+from ..model.visual import visual_pair_gains
 from .body_arrays import BodyArrays
 
 __all__ = ["BodyArrays", "LinearSystem", "linear_system", "sorted_poles", "OneSided",

@@ -199,7 +199,7 @@ class SwitchedModel:
     tilt, visual_tilt : Tilt or None
         The surface's α(t) and the visual scene's v(t). [rad]
     tilt_gains, visual_gains : numpy.ndarray, shape (4, P), or None
-        Pair gains on α(t), α̇(t), α(t − τ), α̇(t − τ), and on v (:mod:`.tilt`). [N·m/rad], …
+        Gains on α(t), α̇(t), α(t − τ), α̇(t − τ), and on v (:mod:`.visual`). [N·m/rad], …
     tilt_axis_depth : float  (the tilt axis's depth below the ankle [m])
     motor_torque : TorqueSeries or None
         Motor noise added to each joint's moment before the limits. [N·m]

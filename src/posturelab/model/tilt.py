@@ -10,11 +10,7 @@ the foot only; 0: relative to the vertical only). A muscle set without active ga
 its pair gains as the whole (neural) feedback, so W applies to them. The axis is the
 ankle's: the ankle does not move, and the tilt acts on the chain only through the pairs.
 
-A visual-scene tilt v(t) (the same profiles; positive toes-up like the surface: the scene's
-vertical leans back by v) adds the visual channel: the active error becomes
-W_p·(θ_hi + α) + W_v·(θ_hi + v) + (1 − W_p − W_v)·θ_hi = θ_hi + W_p·α + W_v·v (Peterka 2002,
-J Neurophysiol 88:1097), so v acts only through the delayed active feedback
-(:func:`visual_pair_gains`), with no mechanical effect.
+A visual-scene tilt v(t) takes the same profiles (:mod:`.visual`: the visual channel).
 
 Profiles (each gives α(t) and α̇(t) for any t; before t = 0 the surface is held at α(0)):
 
@@ -66,7 +62,6 @@ __all__ = [
     "MeasuredTilt",
     "prts_sequence",
     "tilt_pair_gains",
-    "visual_pair_gains",
     "read_tilt_csv",
     "axis_translation",
     "MAX_AXIS_DEPTH",
@@ -569,36 +564,6 @@ def tilt_pair_gains(split_gains: np.ndarray, spans_foot: np.ndarray, delay,
         np.where(delayed, active_k, zero),
         np.where(delayed, active_l, zero),
     ], axis=-2)
-
-
-def visual_pair_gains(split_gains: np.ndarray, spans_foot: np.ndarray, delay,
-                      visual_weight) -> np.ndarray:
-    """Pair gains on the visual-scene tilt, (…, 4, P): on v(t), v̇(t), v(t − τ), v̇(t − τ).
-
-    The scene has no mechanical effect: only the active part of a pair that spans the foot
-    feels it, as W_v·v in its sensory-weighted error (module notes; Peterka 2002, J
-    Neurophysiol 88:1097). Without a delay the active gains act at once (rows 0, 1).
-
-    Parameters
-    ----------
-    split_gains : numpy.ndarray, shape (..., 4, P)
-        As for :func:`tilt_pair_gains`. [N·m/rad], [N·m·s/rad]
-    spans_foot : numpy.ndarray of bool, shape (P,)
-    delay : float or array_like, shape (...)
-        τ. [s]
-    visual_weight : float or array_like, shape (...)
-        W_v in [0, 1]. [-]
-
-    Returns
-    -------
-    numpy.ndarray, shape (..., 4, P)
-        [N·m/rad], [N·m·s/rad], [N·m/rad], [N·m·s/rad]
-    """
-    from .gains import IMMEDIATE_STIFFNESS, IMMEDIATE_VISCOSITY
-
-    active_only = np.array(split_gains, dtype=float)
-    active_only[..., [IMMEDIATE_STIFFNESS, IMMEDIATE_VISCOSITY], :] = 0.0
-    return tilt_pair_gains(active_only, spans_foot, delay, visual_weight)
 
 
 def axis_acceleration_formula(depth, angle, rate, accel, xp=np):

@@ -36,7 +36,8 @@ from ..model.muscles import MuscleSet, muscle_set_gains
 from ..model.noise import MotorNoise, TorqueSeries, motor_noise_series, torque_at
 from ..model.options import FallCriteria, KneeModel, torque_limit_array
 from ..model.platform import Disturbance, NoDisturbance
-from ..model.tilt import Tilt, axis_translation, tilt_pair_gains, visual_pair_gains
+from ..model.tilt import Tilt, axis_translation, tilt_pair_gains
+from ..model.visual import visual_pair_gains
 from ..parameters import MAX_DURATION, MAX_FEEDBACK_DELAY, MAX_STEP_BUDGET, MAX_TIME_LIMIT
 from .messages import outcome_message
 from .options import MAX_OUTPUT_SAMPLES, OPTION_NAMES, RunOptions, default_step_budget
@@ -127,9 +128,8 @@ class RunSetup:
         (:func:`posturelab.model.tilt.tilt_pair_gains`); None without a tilt.
         [N·m/rad], [N·m·s/rad], [N·m/rad], [N·m·s/rad]
     visual_gains : numpy.ndarray, shape (4, P), or None
-        Pair gains on the visual-scene tilt v(t), v̇(t), v(t − τ), v̇(t − τ)
-        (:func:`posturelab.model.tilt.visual_pair_gains`); None without one.
-        [N·m/rad], [N·m·s/rad], [N·m/rad], [N·m·s/rad]
+        Gains on the visual-scene tilt v(t), v̇(t), v(t − τ), v̇(t − τ), as tilt_gains
+        (:func:`posturelab.model.visual.visual_pair_gains`); None without one.
     velocity_jump : (float, float)
         The ankle's velocity change at t = 0: the disturbance's step and the start of a
         tilt about an axis below the ankle. [m/s]

@@ -24,7 +24,8 @@ from ...model.checks import check_model
 from ...model.gains import GAIN_ROWS
 from ...model.muscles import MuscleSet, feedback_gains, paper_muscles
 from ...model.platform import Disturbance
-from ...model.tilt import tilt_pair_gains, visual_pair_gains
+from ...model.tilt import tilt_pair_gains
+from ...model.visual import visual_pair_gains
 from ..options import OPTION_NAMES, RunOptions
 from ..outcome import StimulusTiming, stimulus_timing
 from ..setup import (
@@ -166,8 +167,10 @@ def _per_run(name: str, value, m: int, width: int | None) -> np.ndarray:
 
 
 def _shared_options(options: RunOptions | None, duration, initial_state,
-                    keywords: dict[str, Any]) -> RunOptions:
-    """The options every run of a batch shares, on the compiled engine."""
+                    keywords: dict[str, Any], weights=None) -> RunOptions:
+    """The options every run of a batch shares, on the compiled engine (with the smallest
+    of the per-run proprioceptive ``weights``, so that the shared visual weight is checked
+    against it here and against each run's later)."""
     unknown = [k for k in keywords if k not in OPTION_NAMES or k in PER_RUN_OPTIONS]
     if unknown:
         shared_names = ", ".join(k for k in OPTION_NAMES if k not in PER_RUN_OPTIONS)
@@ -178,6 +181,11 @@ def _shared_options(options: RunOptions | None, duration, initial_state,
         changes["duration"] = duration
     if initial_state is not None:
         changes["initial_state"] = initial_state
+    if weights is not None and "visual_weight" in changes:
+        try:
+            changes["proprioceptive_weight"] = float(np.min(np.asarray(weights, float)))
+        except (TypeError, ValueError):
+            pass  # (refused with its name by the per-run check)
     shared = (options or RunOptions()).replace(**changes)
     if shared.engine != "compiled":
         raise ParameterError("simulate_batch runs the compiled engine; got engine "
@@ -286,7 +294,7 @@ def simulate_batch(
     BatchResult
     """
     check_model(body, muscles)
-    common = _shared_options(options, duration, initial_state, keywords)
+    common = _shared_options(options, duration, initial_state, keywords, proprioceptive_weight)
     common.refuse_torque_feedback_on_compiled()
     method = common.method
     if method is not None:
