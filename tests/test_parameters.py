@@ -46,7 +46,8 @@ def test_the_table_states_each_quantity_once_with_unit_bounds_and_meaning():
     assert list(QUANTITIES) == ["stiffness", "viscosity", "active_stiffness",
                                 "active_viscosity", "viscosity_ratio",
                                 "active_viscosity_ratio", "feedback_delay",
-                                "proprioceptive_weight", "torque_feedback_gain",
+                                "proprioceptive_weight", "visual_weight",
+                                "torque_feedback_gain",
                                 "torque_feedback_time_constant", "torque_limit",
                                 "disturbance_scale",
                                 "height", "mass", "step_speed", "tilt_amplitude"]
