@@ -356,3 +356,27 @@ def test_simulate_frf_and_fit_frf_on_a_dual_trial(tmp_path, capsys):
     got = {q["name"]: q["estimate"] for q in fit["parameters"]}
     assert got["proprioceptive_weight"] == pytest.approx(0.55, abs=0.01)
     assert got["visual_weight"] == pytest.approx(0.3, abs=0.01)
+
+
+# ---- the explorer -------------------------------------------------------------------------
+
+
+def test_the_explorer_takes_the_visual_weight_and_a_visual_tilt():
+    from posturelab.explore import compute_views, parse_parameters
+
+    with pytest.raises(ParameterError, match=r"W \+ visual weight W_v must be at most 1") as e:
+        parse_parameters({"visual_weight": 0.5})  # W is 1 by default
+    assert e.value.field == "visual_weight"
+    p = parse_parameters({"perturbation": "visual tilt", "proprioceptive_weight": 0.5,
+                          "visual_weight": 0.4, "feedback_delay": 0.0, "duration": 2.0})
+    v = compute_views(p)
+    from posturelab.explore.views import FRF_FREQUENCIES, build_model
+
+    body, muscles, _, scene = build_model(p)
+    H = model_frf(body, muscles, FRF_FREQUENCIES, input="visual-tilt", feedback_delay=0.0,
+                  proprioceptive_weight=0.5, visual_weight=0.4)
+    np.testing.assert_allclose(v["frf"]["gain"], np.abs(H), rtol=0, atol=1e-9)  # (9 decimals)
+    assert np.all(np.asarray(v["run"]["surface_tilt"]) == 0.0)  # the scene moves, not the floor
+    run = pl.simulate(body, muscles, None, 2.0, visual_tilt=scene, visual_weight=0.4,
+                      proprioceptive_weight=0.5, sample_rate=100)
+    assert np.abs(run.theta).max() > 0
