@@ -133,6 +133,17 @@ def reader_options(args: argparse.Namespace) -> dict:
             "response_sign": response_sign(args.response_sign), "input": args.input}
 
 
+def _condition(path: str, args: argparse.Namespace):
+    """The one FRF of a --data file (commands that take one condition per file: a
+    dual-stimulus trial needs --stimulus COLUMN there)."""
+    found = _conditions(path, args)
+    if len(found) > 1:
+        raise ParameterError(f"--data {path!r} is a dual-stimulus trial "
+                             f"({', '.join(label for _, _, label in found)}): give "
+                             "--stimulus COLUMN")
+    return found[0][0]
+
+
 def _conditions(path: str, args: argparse.Namespace) -> list[tuple]:
     """The conditions of one --data file as (FRF, model input, label): one, or each
     stimulus of a dual-stimulus trial (--stimulus tilt,visual_tilt, or a trial with both
