@@ -148,13 +148,11 @@ def _conditions(path: str, args: argparse.Namespace) -> list[tuple]:
     """The conditions of one --data file as (FRF, model input, label): one, or each
     stimulus of a dual-stimulus trial (--stimulus tilt,visual_tilt, or a trial with both
     columns and no --stimulus: posturelab.frequency.dual)."""
-    from pathlib import Path
-
     from ..frequency.cohort import read_frf_file
     from ..frequency.dual import input_of, read_trial_frfs, stimulus_columns
 
     if path.lower().endswith(".json"):
-        return [(read_frf_file(path, what="--data FRF JSON"), args.input, Path(path).name)]
+        return [(read_frf_file(path, what="--data FRF JSON"), args.input, path)]
     stimuli = ([s.strip().lower() for s in args.stimulus.split(",") if s.strip()]
                if args.stimulus else stimulus_columns(path))
     if len(stimuli) > 1:
@@ -164,7 +162,7 @@ def _conditions(path: str, args: argparse.Namespace) -> list[tuple]:
         _, ests, _ = read_trial_frfs(path, stimuli, args.response or "com_angle",
                                      args.cycle_length, discard_cycles=args.discard_cycles,
                                      response_sign=options["response_sign"])
-        return [(e, input_of(s), f"{Path(path).name} [{s}]") for s, e in ests.items()]
+        return [(e, input_of(s), f"{path} [{s}]") for s, e in ests.items()]
     options = reader_options(args)
     if stimuli and not args.stimulus:  # the trial's one stimulus column
         options["stimulus"] = stimuli[0]
@@ -173,7 +171,7 @@ def _conditions(path: str, args: argparse.Namespace) -> list[tuple]:
     source = args.input  # a visual_tilt column is the scene's (a tilt [rad] to the reader)
     if options["stimulus"] is not None and input_of(options["stimulus"]) == "visual-tilt":
         source = "visual-tilt"
-    return [(read_frf_file(path, **options), source, Path(path).name)]
+    return [(read_frf_file(path, **options), source, path)]
 
 
 def _names(text: str) -> list[str]:
@@ -198,6 +196,8 @@ def _bounds(text: str) -> dict:
 
 
 def run(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
     from .._files import refuse_input_as_output
     from ..frequency.fit import check_fit_request, fit_frf
     from .frf import check_plot_path
@@ -235,7 +235,7 @@ def run(args: argparse.Namespace) -> int:
 
         compare.pop("out"), compare.pop("plot")
         comparison = compare_conditions(body, muscles, conditions, free, per_condition=per,
-                                        labels=names,
+                                        labels=[Path(n).name for n in names],
                                         **compare, **fit_options)
         fit = comparison.general
         _write_comparison(comparison, args)
@@ -244,7 +244,7 @@ def run(args: argparse.Namespace) -> int:
     if args.plot:
         from ..viz.plots import plot_bode, save_figure
 
-        labels = [p + ("" if getattr(c, "response_sign", None) is None
+        labels = [Path(p).name + ("" if getattr(c, "response_sign", None) is None
                        else f" (response × {int(c.response_sign):+d})")
                   for p, c in zip(names, conditions, strict=True)]
         curves = [(f, h, f"fit: {label}") for (f, h), label in zip(fit.curves, labels,
@@ -262,9 +262,11 @@ def run(args: argparse.Namespace) -> int:
 
         for w in sign_warnings:
             print(f"warning: {w}", file=sys.stderr)
-    kinds = [{"data": p, "kind": "trial" if isinstance(c, FRFEstimate) else "table",
-              "input": source} for p, c, (_, source, _) in zip(names, conditions, found,
-                                                               strict=True)]
+    kinds = [{"data": p, "kind": "trial" if isinstance(c, FRFEstimate) else "table"}
+             for p, c in zip(names, conditions, strict=True)]
+    if any(source != args.input for _, source, _ in found):  # (a visual tilt among them)
+        for kind, (_, source, _) in zip(kinds, found, strict=True):
+            kind["input"] = source
     if args.json:
         out = fit.to_dict()
         extra = {} if comparison is None else {"reweighting": comparison.to_dict()}
