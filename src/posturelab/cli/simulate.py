@@ -54,7 +54,8 @@ U1..3 [N·m], joint_moment1..3 [N·m], cog_x, cog_y [m], cog_vx, cog_vy [m/s],
 platform_ax, platform_ay [m/s²], platform_vx, platform_vy [m/s], platform_x,
 platform_y [m], cop_x [m] (centre of pressure from the ankle), ground_fx, ground_fy [N]
 (force of the platform on the foot), and with a tilt, tilt and com_angle [rad] (with a
-visual-scene tilt, visual_tilt [rad] before com_angle). The first line printed (outcome in --json) is recovered, not recovered, steady sway, fell or failed.
+visual-scene tilt, visual_tilt [rad] before com_angle). The first line printed (outcome
+in --json) is recovered, not recovered, steady sway, fell or failed.
 Settling is counted from the end of the platform motion or tilt (0 for a velocity step). A
 sustained stimulus (a sine or PRTS tilt, a sum of sines, motor noise) has no settling time:
 its outcome is a steady sway, the RMS (about upright) and peak |·| of each θ_i [rad] and of

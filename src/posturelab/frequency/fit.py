@@ -70,6 +70,7 @@ Bands with coherence below 0.5 raise a warning in ``warnings``.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -298,7 +299,7 @@ def check_fit_request(muscles: MuscleSet, free, per_condition=(), bounds=None) -
     return canon[:len(free)], canon[len(free):], specs, canon, bounds
 
 
-def fit_frf(body: Body, muscles: MuscleSet, data, free, *, input: str = "tilt",
+def fit_frf(body: Body, muscles: MuscleSet, data, free, *, input: str | Sequence[str] = "tilt",
             output: str = "com_angle", feedback_delay: float = 0.0,
             proprioceptive_weight: float = 1.0, per_condition=(), bounds=None,
             model_error: float | None = None, torque_feedback_gain: float = 0.0,
