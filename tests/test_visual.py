@@ -380,3 +380,13 @@ def test_the_explorer_takes_the_visual_weight_and_a_visual_tilt():
     run = pl.simulate(body, muscles, None, 2.0, visual_tilt=scene, visual_weight=0.4,
                       proprioceptive_weight=0.5, sample_rate=100)
     assert np.abs(run.theta).max() > 0
+
+
+def test_the_harmonic_step_of_a_measured_stimulus_with_noise(rng):
+    """A PRTS of half the cycle, recorded with noise 1 % of its amplitude: step 2 still."""
+    t = np.arange(0, 40.0, 0.01)
+    scene = PRTSTilt(0.035, 0.125).angle(t)
+    noisy = scene + 0.01 * 0.035 * rng.standard_normal(t.size)
+    assert harmonic_step(noisy, 100, 20.0) == 2
+    with pytest.raises(ParameterError, match="not a PRTS"):
+        harmonic_step(rng.standard_normal(t.size), 100, 20.0)

@@ -47,8 +47,11 @@ __all__ = ["harmonic_step", "estimate_frfs", "dual_prts", "read_trial_frfs", "in
 
 #: The model input of each stimulus column posturelab writes. [-]
 STIMULUS_INPUTS = {"tilt": "tilt", "visual_tilt": "visual-tilt"}
-#: The share of a stimulus's power that must lie at odd multiples of its lowest harmonic. [-]
-_PURITY = 0.999
+#: The share of a stimulus's power that must lie at odd multiples of its lowest harmonic
+#: (a measured stimulus carries some noise at every bin). [-]
+_PURITY = 0.99
+#: A bin is the stimulus's lowest harmonic from this share of its largest bin's power on. [-]
+_LOWEST = 1e-3
 
 
 def input_of(column: str) -> str:
@@ -66,7 +69,7 @@ def harmonic_step(stimulus, sample_rate: float, cycle_length: float) -> int:
     ------
     ParameterError
         A record shorter than a cycle, a stimulus without power, or one whose power is not
-        (to 99.9 %) at the odd multiples of its lowest harmonic.
+        (to 99 %) at the odd multiples of its lowest harmonic.
     """
     x = np.asarray(stimulus, dtype=float)
     L = int(round(sample_rate * cycle_length))
@@ -79,7 +82,7 @@ def harmonic_step(stimulus, sample_rate: float, cycle_length: float) -> int:
     total = power.sum()
     if not total > 0:
         raise ParameterError("the stimulus has no power at any harmonic of the cycle")
-    lowest = int(np.argmax(power > 1e-9 * power.max()))
+    lowest = int(np.argmax(power > _LOWEST * power.max()))
     odd = np.arange(lowest, power.size, 2 * lowest)
     if power[odd].sum() < _PURITY * total:
         raise ParameterError(f"the stimulus's power is not at the odd multiples of its lowest "
