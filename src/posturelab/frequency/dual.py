@@ -5,7 +5,7 @@ proprioceptive, visual and graviceptive orientation cues by W_p, W_v and 1 − W
 surface tilt alone measures W_p (and the visual weight only through what is left of 1); a
 visual-scene tilt alone measures W_v. Peterka's group gave surface and visual-surround
 stimuli in separate and in combined tests (Cenciarini and Peterka 2006, J Neurophysiol
-95:2733–2750; the "central sensorimotor integration" tests of Peterka, Murchison, Parrington,
+95:2733; the "central sensorimotor integration" tests of Peterka, Murchison, Parrington,
 Fino and King 2018, Front Neurol 9:1045, PMC6300494, which rotate the stance surface and/or
 the visual surround with cyclically repeated pseudorandom stimuli). Here both stimuli run in
 one trial and each FRF is estimated from it.
