@@ -12,7 +12,9 @@ gains has K_i = L_i = 0: its whole feedback is delayed). Its characteristic matr
 
     Δ(s) = s² J0 − g A + K_i + s L_i + (K_a + s L_a) e^{−sτ},
 
-(the matrices of the one linear system, :mod:`posturelab.linear.system`), and the roots of
+(the matrices of the one linear system, :mod:`posturelab.linear.system`; with Peterka 2002's
+torque feedback the delayed part is multiplied by g(s) = (τ_t s + 1)/(τ_t s + 1 − K_t) and
+the first-order form below carries the filter states, 3N in all), and the roots of
 det Δ(s) = 0 are the characteristic roots (infinitely many; finitely
 many to the right of any vertical line: the equation is of retarded type).
 
