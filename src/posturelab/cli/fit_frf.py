@@ -330,8 +330,9 @@ def _write_comparison(comparison, args: argparse.Namespace) -> None:
 
 
 def _print_comparison(c) -> None:
-    print(f"{c.parameter} per condition [{c.unit}] (95 % CI; amplitude peak to peak "
-          f"[{c.amplitude_unit}]):")
+    print(f"{c.parameter} per condition [{c.unit}] "
+          + ("(its vision label's value; " if c.grouping == "vision" else "(")
+          + f"95 % CI; amplitude peak to peak [{c.amplitude_unit}]):")
     for k, (label, a, v, e, (lo, hi)) in enumerate(zip(
             c.labels, c.amplitudes, c.vision, c.estimates, c.confidence_intervals,
             strict=True)):
