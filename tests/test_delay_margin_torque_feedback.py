@@ -13,6 +13,7 @@ from __future__ import annotations
 import json
 import math
 
+import numpy as np
 import pytest
 
 import posturelab as pl
@@ -137,3 +138,38 @@ def test_delay_margin_command_takes_the_filter():
     assert "torque feedback K_t = 0.5, τ_t = 17.4 s" in text.stdout
     one_line_exit_2(cli("delay-margin", "--torque-feedback-gain", "9"),
                     "--torque-feedback-gain", "9")
+
+
+@pytest.mark.parametrize("name, tau, m", [("paper-1link", 0.15, 300),
+                                          pytest.param("paper-2link", 0.05, 120,
+                                                       marks=pytest.mark.slow)])
+def test_margins_split_the_batched_rightmost_roots(rng, name, tau, m):
+    """D-subdivision by brute force: random sets (gains, K_t in [0, 2.5], τ_t in
+    [0.5, 40] s), their rightmost roots at one delay τ (delay_batch, 16 Chebyshev
+    intervals): every set whose margin exceeds τ by 2 % has its rightmost root in the left
+    half-plane, and every set whose margin is 2 % below τ in the right (all agree: no
+    stability switch back among them)."""
+    from posturelab.linear.delay_batch import batch_rightmost_root
+    from posturelab.model.muscles import MusclePair, MuscleSet
+
+    body = pl.get_body(name)
+    if name == "paper-1link":
+        layout = _one_link()[1]
+    else:
+        layout = MuscleSet(tuple(MusclePair(p, lo, lo + 1, 1.0, 1.0, active_stiffness=1.0,
+                                            active_viscosity=1.0)
+                                 for p, lo in (("ankle", 0), ("hip", 1))), 2)
+    pairs = len(layout.pairs)
+    k = rng.uniform(0.0, 1.0, (m, pairs)) * body.load_stiffness
+    ka = rng.uniform(0.0, 2.5, (m, pairs)) * body.load_stiffness
+    la = rng.uniform(0.05, 0.5, (m, pairs)) * ka
+    filters = dict(torque_feedback_gain=rng.uniform(0.0, 2.5, m),
+                   torque_feedback_time_constant=rng.uniform(0.5, 40.0, m))
+    out = batch_delay_margin(body, layout, stiffness=k, viscosity=0.1 * k,
+                             active_stiffness=ka, active_viscosity=la, **filters)
+    roots = batch_rightmost_root(body, layout, k, 0.1 * k, ka, la, tau, nodes=16, **filters)
+    clear = out.stable_without_delay & (np.abs(out.delay_margin - tau) > 0.02 * tau)
+    assert clear.sum() >= m // 2
+    stable = roots.real[clear] < 0
+    np.testing.assert_array_equal(stable, out.delay_margin[clear] > tau)
+    assert 0 < stable.sum() < clear.sum()
