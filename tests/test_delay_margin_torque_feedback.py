@@ -36,7 +36,8 @@ def _one_link():
 @pytest.mark.parametrize("links", [1, 3])
 def test_margin_by_three_routes(links, gain, lag):
     """Chen–Gu–Nett (3N states) = the delay pencil to 1e-8; the rightmost root is in the
-    left half-plane at 0.99 τ_m and in the right at 1.01 τ_m."""
+    left half-plane at 0.99 τ_m and in the right at 1.01 τ_m, as the crossing's direction
+    says."""
     body, muscles = _one_link() if links == 1 else (pl.paper_body(), pl.paper_muscles("1"))
     single = delay_margin(body, muscles, torque_feedback_gain=gain,
                           torque_feedback_time_constant=lag)
@@ -51,6 +52,7 @@ def test_margin_by_three_routes(links, gain, lag):
     below = system_rightmost_roots(system, 0.99 * tau, 1)[0]
     above = system_rightmost_roots(system, 1.01 * tau, 1)[0]
     assert below.real < 0 < above.real, (below, above)
+    assert single.crossings[0].direction == 1  # Re ds/dτ > 0 with the filter's factor
     assert abs(above.imag) == pytest.approx(single.crossing_frequency, rel=0.05)
 
 
