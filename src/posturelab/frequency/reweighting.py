@@ -112,7 +112,7 @@ class ConditionComparison:
     statistic : float
         The value referred to ``distribution``: ΔS (χ²), ΔS/r or (ΔS/r)/s² (F). [-]
     df : int
-        r = C − 1, the parameters the restriction removes. [-]
+        r = C − 1 (by vision: the labels − 1), the parameters the restriction removes. [-]
     denominator_dof : float
         ν of the F reference (∞ for the χ² one). [-]
     distribution : str
