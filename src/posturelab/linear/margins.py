@@ -360,7 +360,7 @@ def _pencil(m: int, J, S, L, K, La, gain=None, lag=None) -> tuple[np.ndarray, np
     companion[:, :-size, size:] = np.eye((degree - 1) * size)
     companion[:, -size:, :] = -np.linalg.solve(coefficients[-1],
                                                np.concatenate(coefficients[:-1], axis=-1))
-    lam = np.linalg.eigvals(companion)                                   # (M, 2N²)
+    lam = np.linalg.eigvals(companion)                  # (M, 2N²), 3N² with the filter
     real = (lam.real < 0) & (np.abs(lam.imag) <= _REAL * np.abs(lam))
     sets, which = np.nonzero(real)
     margin = np.full(m, np.inf)
