@@ -287,7 +287,8 @@ def test_fit_frees_torque_feedback_on_a_tilted_run():
 
 def test_explorer_views_take_torque_feedback():
     """The explorer's controls take K_t and τ_t: its FRF is model_frf's with them, its poles
-    the first-order form's with the filter states, its run on the compiled engine; K_t > 0
+    the first-order form's with the filter states, its delay margin delay_margin's with the
+    filter, its run on the compiled engine; K_t > 0
     without a delay and τ_t = 0 are refused naming the control."""
     from posturelab.explore import compute_views, parse_parameters
     from posturelab.explore.views import FRF_FREQUENCIES
@@ -307,7 +308,10 @@ def test_explorer_views_take_torque_feedback():
                           torque_feedback_time_constant=17.4).poles()[0]
     np.testing.assert_allclose(sorted(z["re"] for z in views["poles"]), np.sort(poles.real),
                                rtol=1e-9)
-    assert views["stable"] and views["delay_margin_note"]
+    assert views["stable"] and views["delay_margin_note"] is None
+    margin = pl.delay_margin(body, muscles, torque_feedback_gain=1.7,
+                             torque_feedback_time_constant=17.4)
+    assert views["delay_margin"] == pytest.approx(margin.delay_margin, rel=1e-12)
     for bad, field in (({"torque_feedback_time_constant": 0.0}, "torque_feedback_time_constant"),
                        ({"feedback_delay": 0.0}, "torque_feedback_gain")):
         with pytest.raises(ParameterError) as info:

@@ -5,7 +5,13 @@ from __future__ import annotations
 import argparse
 import math
 
-from ._common import add_muscle_arguments, feedback_given, model_from_args, print_json
+from ._common import (
+    add_muscle_arguments,
+    add_torque_feedback_arguments,
+    feedback_given,
+    model_from_args,
+    print_json,
+)
 
 DESCRIPTION = """\
 The delay margin of the chain linearised about upright: the smallest feedback delay τ at
@@ -17,6 +23,11 @@ reaches the imaginary axis, and the frequency ω [rad/s] of that crossing. K_i, 
 intrinsic gains (immediate), K_a, L_a the active ones (delayed); without active gains every
 pair's whole feedback is delayed. Computed exactly (Chen, Gu and Nett's matrix pencil, each
 crossing polished by Newton's method), not by a frequency grid.
+
+--torque-feedback-gain K (and --torque-feedback-time-constant S) adds Peterka 2002's torque
+feedback: the delayed part is multiplied by g(s) = (S s + 1)/(S s + 1 − K), the filter's
+states join the quasi-polynomial (docs/design.md), and the margin is of that loop ("torque
+feedback": {"gain", "time_constant"} in --json).
 
 Prints the margin in s and ms and the crossing frequency; with --feedback-delay also the
 rightmost roots at that delay. --json prints one object:
@@ -31,6 +42,7 @@ load, det(K − g A) < 0, so a real positive root exists at every delay}).
 
 Example: posturelab delay-margin --case 1
          posturelab delay-margin --controller peterka-2002 --json
+         posturelab delay-margin --controller peterka-2002 --torque-feedback-gain 0.5
 """
 
 
@@ -41,24 +53,43 @@ JSON_UNITS = {"delay_margin": "s", "crossing_frequency": "rad/s"}
 def add_arguments(p: argparse.ArgumentParser) -> None:
     """The options of ``posturelab delay-margin``."""
     add_muscle_arguments(p)
+    add_torque_feedback_arguments(p)
     p.add_argument("--json", action="store_true", help="print one JSON object instead of text.")
 
 
 def run(args: argparse.Namespace) -> int:
     from ..linear.delay import delay_margin
     from ..linear.verdict import upright_verdict
+    from ..parameters import TORQUE_FEEDBACK_TIME_CONSTANT
+    from ._common import torque_feedback_options_from_args
 
+    # the filter is read here, not into the model: the margin needs no feedback delay
+    given = torque_feedback_options_from_args(args)
+    args.torque_feedback_gain = args.torque_feedback_time_constant = None
     model = model_from_args(args)
     body, muscles = model.body, model.muscles
     delay = model.options.feedback_delay if feedback_given(args) else None
-    result = delay_margin(body, muscles)
-    unstable = _unstable_sides(body, muscles) if muscles.one_sided_mask.any() else []
+    gain = float(given.get("torque_feedback_gain", 0.0))
+    torque_feedback = dict(torque_feedback_gain=gain,
+                           torque_feedback_time_constant=float(given.get(
+                               "torque_feedback_time_constant", TORQUE_FEEDBACK_TIME_CONSTANT)))
+    result = delay_margin(body, muscles, **torque_feedback)
+    unstable = (_unstable_sides(body, muscles, torque_feedback)
+                if muscles.one_sided_mask.any() else [])
+    filtered = ({"torque_feedback": {"gain": gain, "time_constant":
+                                     torque_feedback["torque_feedback_time_constant"]}}
+                if gain > 0 else {})
     if args.json:
         sides = {"unstable_sides": unstable} if muscles.one_sided_mask.any() else {}
-        print_json({**result.to_dict(), **sides, "units": JSON_UNITS})
+        units = {**JSON_UNITS, "torque_feedback": {"gain": "-", "time_constant": "s"}} \
+            if filtered else JSON_UNITS
+        print_json({**result.to_dict(), **sides, **filtered, "units": units})
         return 0
     kind = ("intrinsic gains at once, active gains delayed" if muscles.has_active_feedback
             else "every pair's whole feedback delayed")
+    if filtered:
+        kind += (f"; torque feedback K_t = {gain:g}, τ_t = "
+                 f"{torque_feedback['torque_feedback_time_constant']:g} s")
     for side in unstable:
         root = side["rightmost_root_without_delay"]
         when = ("whatever the delay (its stiffness does not hold the gravitational load, "
@@ -82,29 +113,31 @@ def run(args: argparse.Namespace) -> int:
                  else ")"))
     if delay is not None or muscles.one_sided_mask.any():
         # the one verdict about upright (posturelab poles and simulate give it too)
-        verdict = upright_verdict(body, muscles, delay or 0.0)
+        verdict = upright_verdict(body, muscles, delay or 0.0, **torque_feedback)
         roots = verdict.side(engaged=True).roots[:4]
         print(f"at τ = {delay or 0.0:g} s: {verdict.describe()}; rightmost roots [1/s]: "
               + ", ".join(f"{z.real:.4g}{z.imag:+.4g}j" for z in roots))
     return 0
 
 
-def _unstable_sides(body, muscles) -> list[dict]:
+def _unstable_sides(body, muscles, torque_feedback: dict) -> list[dict]:
     """The sides of the one-sided pairs' switch, other than all engaged, on which upright is
-    unstable without delay; ``unstable_at_every_delay`` when det Δ(0) = det(K − g A) < 0
-    (Δ(0) does not depend on τ and det Δ(s) → +∞ along the positive real axis, so a real
-    positive root exists at every delay)."""
+    unstable without delay; ``unstable_at_every_delay`` when the characteristic function
+    det(s I − A0 − A1 e^{−sτ}) of the first-order form is negative at s = 0, where it is
+    det(−A0 − A1) whatever τ (without torque feedback of the sign of det(K − g A)): it tends
+    to +∞ along the positive real axis, so a real positive root exists at every delay."""
     import numpy as np
 
     from ..linear.delay import delayed_system
     from ..linear.verdict import _side_muscles, upright_verdict
 
     found = []
-    for side in upright_verdict(body, muscles, 0.0).sides[1:]:
+    for side in upright_verdict(body, muscles, 0.0, **torque_feedback).sides[1:]:
         if side.status != "unstable":
             continue
-        system = delayed_system(body, _side_muscles(muscles, frozenset(side.engaged)))
-        static = float(np.linalg.det(system.without_delay()[2][0])) < 0  # det(K − g A)
+        system = delayed_system(body, _side_muscles(muscles, frozenset(side.engaged)),
+                                **torque_feedback)
+        static = float(np.linalg.det(-system.state_matrix()[0])) < 0
         z = side.rightmost_root
         found.append({"engaged": list(side.engaged), "slack": list(side.slack),
                       "rightmost_root_without_delay": {"re": float(z.real),

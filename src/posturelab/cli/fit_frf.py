@@ -65,7 +65,11 @@ of squares) against χ²(C − 1) for known standard errors, F(C − 1, ν) for 
 peak: --amplitudes, else a trial's measured) and vision (--vision open,closed,...), the
 shared value and the test ("reweighting" in --json, with "p_value"); --compare-out writes
 the table (.json with the test, or .csv), --compare-plot the figure. Peterka (2002) found
-the proprioceptive weight falling as the tilt grows.
+the proprioceptive weight falling as the tilt grows. --compare-by vision (with a --vision
+label for every condition, both present) tests eyes open against eyes closed instead: NAME
+takes one value per vision label (the conditions of a label share it; other
+--per-condition parameters also one per label) against one shared, χ²(1) or F(1, ν)
+("grouping": "vision" and "vision_groups" in --json).
 
 Example: posturelab fit-frf --data trial.csv --stimulus tilt --response com_angle \\
              --cycle-length 20 --discard-cycles 1 --controller peterka-2002 \\
@@ -93,6 +97,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--vision", metavar="open|closed,...",
                    help="with --compare: each condition's vision, open or closed (or - for "
                    "not given).")
+    p.add_argument("--compare-by", choices=["condition", "vision"], default=None,
+                   help="with --compare: one value of NAME per condition (default) or per "
+                   "vision label (eyes open against closed; needs --vision).")
     p.add_argument("--compare-out", metavar="TABLE.json|.csv",
                    help="with --compare: write the per-condition table (and the test, in "
                    "JSON).")
@@ -281,8 +288,12 @@ def run(args: argparse.Namespace) -> int:
         return 0
     print(f"fitted {len(fit.names)} parameter(s) to {len(conditions)} condition(s); fit error "
           f"{fit.fit_error:.3g} (√(χ²/dof); about 1 when the model explains the data)")
-    print("conditions (NAME#k is condition k's value): " + ", ".join(
-        f"#{k + 1} {c['data']} ({c['kind']})" for k, c in enumerate(kinds)))
+    by_vision = comparison is not None and comparison.grouping == "vision"
+    print(("conditions: " if by_vision else "conditions (NAME#k is condition k's value): ")
+          + ", ".join(f"#{k + 1} {c['data']} ({c['kind']})" for k, c in enumerate(kinds)))
+    if by_vision:
+        print("per vision label, NAME#g is label g's value: " + ", ".join(
+            f"#{g + 1} eyes {v}" for g, v in enumerate(comparison.groups)))
     print(f"weighting: {fit.weighting_text()}")
     if signs:
         print("response sign applied: " + ", ".join(f"{v:+d}" for v in signs))
@@ -316,6 +327,7 @@ def run(args: argparse.Namespace) -> int:
 def _compare_request(args: argparse.Namespace) -> dict | None:
     """--compare and its options, checked before any work (None without --compare)."""
     given = [o for o, v in (("--amplitudes", args.amplitudes), ("--vision", args.vision),
+                            ("--compare-by", args.compare_by),
                             ("--compare-out", args.compare_out),
                             ("--compare-plot", args.compare_plot)) if v]
     if not args.compare:
@@ -349,7 +361,7 @@ def _compare_request(args: argparse.Namespace) -> dict | None:
             raise ParameterError(f"--vision gives {len(vision)} label(s) for "
                                  f"{len(args.data)} --data")
     return {"amplitudes": amplitudes, "vision": vision, "out": args.compare_out,
-            "plot": args.compare_plot}
+            "plot": args.compare_plot, "by": args.compare_by or "condition"}
 
 
 def _write_comparison(comparison, args: argparse.Namespace) -> None:
@@ -362,17 +374,24 @@ def _write_comparison(comparison, args: argparse.Namespace) -> None:
 
 
 def _print_comparison(c) -> None:
-    print(f"{c.parameter} per condition [{c.unit}] (95 % CI; amplitude peak to peak "
-          f"[{c.amplitude_unit}]):")
+    print(f"{c.parameter} per condition [{c.unit}] "
+          + ("(its vision label's value; " if c.grouping == "vision" else "(")
+          + f"95 % CI; amplitude peak to peak [{c.amplitude_unit}]):")
     for k, (label, a, v, e, (lo, hi)) in enumerate(zip(
             c.labels, c.amplitudes, c.vision, c.estimates, c.confidence_intervals,
             strict=True)):
         seen = "" if v is None else f", eyes {v}"
         print(f"  #{k + 1} {label}: {e:.4g} ({lo:.4g} … {hi:.4g}); amplitude {a:.4g}{seen}")
+    if c.grouping == "vision":
+        for group in c.to_dict()["vision_groups"]:
+            lo, hi = group["ci95"]
+            print(f"  eyes {group['vision']} (#{', #'.join(map(str, group['conditions']))}): "
+                  f"{group['estimate']:.4g} ({lo:.4g} … {hi:.4g})")
     lo, hi = c.shared_interval
     print(f"  shared: {c.shared_estimate:.4g} ({lo:.4g} … {hi:.4g})")
     verdict = "differs" if c.significant else "no significant difference"
-    print(f"likelihood-ratio test of one shared {c.parameter} against one per condition: "
+    against = "one per condition" if c.grouping == "condition" else "one per vision label"
+    print(f"likelihood-ratio test of one shared {c.parameter} against {against}: "
           f"ΔS = {c.likelihood_ratio:.4g}, statistic {c.statistic:.4g} ~ {c.distribution}, "
           f"p = {c.p_value:.3g} ({verdict} at p < 0.05)")
     for w in c.warnings[:len(c.warnings) - len(c.general.warnings)]:

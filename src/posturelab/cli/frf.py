@@ -64,6 +64,14 @@ FRF at its own stimulus's harmonics over the common --cycle-length; the two stim
 share a harmonic (a PRTS and one of half its cycle: simulate --tilt prts:0.035 --visual-tilt
 prts:0.035:0.125). --json then prints {"tilt": {...}, "visual_tilt": {...}}, one FRF object
 each.
+--bootstrap N (1 … 100,000) adds bootstrap bands over the stimulus cycles (the cycles
+resampled with replacement N times, --seed; posturelab.frequency.bootstrap_frf_bands): per
+band 95 % percentile intervals of Re, Im, the gain and the phase, the pointwise circle
+about the estimate and the simultaneous circles that hold every band at once ("bootstrap"
+in --json: {"re_ci", "im_ci", "gain_ci", "phase_ci_deg": [[low, high]] per band, "radius",
+"simultaneous_radius", "level": 0.95, "resamples", "n_cycles", "seed"}); --plot draws the
+gain and phase intervals as dashed lines. Few cycles make them narrow (under about 12
+cycles, prefer the estimate's own 95 % bounds).
 
 Example: posturelab simulate --controller peterka-2002 --tilt prts:0.035 --duration 120 \\
              --engine compiled --sample-rate 100 --out trial.csv
@@ -94,6 +102,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    "convention; see above).")
     p.add_argument("--ci", choices=["periodic", "otnes-enochson"], default="periodic",
                    help="form of the 95 %% bounds (default periodic).")
+    p.add_argument("--bootstrap", type=int, default=None, metavar="N",
+                   help="also bootstrap 95 %% bands over the cycles, N resamples "
+                   "(1 … 100,000; see above).")
+    p.add_argument("--seed", type=int, default=0, metavar="SEED",
+                   help="of the bootstrap's resampling (default 0).")
     p.add_argument("--json", action="store_true", help="print one JSON object.")
     p.add_argument("--plot", metavar="BODE.png", help="write a Bode plot (PNG/SVG/PDF).")
     p.add_argument("--plot-cycles", metavar="CYCLES.png",
@@ -101,6 +114,18 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    "(PNG/SVG/PDF).")
     add_recording_arguments(p)
     add_cycle_trim_argument(p)
+
+
+def _check_bootstrap(args: argparse.Namespace) -> None:
+    """--bootstrap in 1 … MAX_RESAMPLES and --seed >= 0, before any work."""
+    from ..errors import ParameterError
+    from ..frequency.statistics import MAX_RESAMPLES
+
+    if args.bootstrap is not None and not 1 <= args.bootstrap <= MAX_RESAMPLES:
+        raise ParameterError(f"--bootstrap must be 1 … {MAX_RESAMPLES:,} resamples, got "
+                             f"{args.bootstrap}")
+    if args.seed < 0:
+        raise ParameterError(f"--seed must be >= 0, got {args.seed}")
 
 
 def check_plot_path(*paths: str | None) -> None:
@@ -133,6 +158,7 @@ def run(args: argparse.Namespace) -> int:
                            {"--plot": args.plot, "--plot-cycles": args.plot_cycles})
     check_plot_path(args.plot, args.plot_cycles)
     float_in_range("--cycle-length [s]", args.cycle_length, 1e-3, 1e5, unit="s")
+    _check_bootstrap(args)
     from ..frequency.dual import estimate_frfs, stimulus_columns
 
     resp = (args.response or "com_angle").strip().lower()
@@ -154,8 +180,9 @@ def run(args: argparse.Namespace) -> int:
     print_resampling(resampled)
     sign = response_sign(args.response_sign)
     if len(stimuli) > 1:
-        if args.plot_cycles:
-            raise ParameterError("--plot-cycles draws one stimulus; give --stimulus COLUMN")
+        if args.plot_cycles or args.bootstrap:
+            raise ParameterError(f"{'--plot-cycles' if args.plot_cycles else '--bootstrap'} "
+                                 "takes one stimulus; give --stimulus COLUMN")
         x, trimmed = {}, False
         for s in stimuli:
             x[s], y, trimmed = whole_cycles(cols[s], cols[resp], fs, args.cycle_length)
@@ -183,10 +210,19 @@ def run(args: argparse.Namespace) -> int:
                        discard_cycles=args.discard_cycles, bands=args.bands,
                        response_sign=sign, ci=args.ci)
     label = f"{'−' if sign < 0 else ''}{resp} / {stim} (response × {sign:+d})"
+    boot = None
+    if args.bootstrap is not None:
+        from ..frequency.statistics import bootstrap_frf_bands
+
+        boot = bootstrap_frf_bands(x, y, fs, args.cycle_length,
+                                   discard_cycles=args.discard_cycles, bands=args.bands,
+                                   response_sign=sign, resamples=args.bootstrap,
+                                   seed=args.seed)
     if args.plot:
         from ..viz.plots import plot_bode, save_figure
 
-        save_figure(plot_bode([est], [label]), args.plot)
+        save_figure(plot_bode([est], [label], bootstrap=None if boot is None else [boot]),
+                    args.plot)
     if args.plot_cycles:
         from ..viz.plots import plot_prts_cycles, save_figure
 
@@ -205,17 +241,21 @@ def run(args: argparse.Namespace) -> int:
             print(f"warning: {warning}", file=sys.stderr)
     if args.json:
         extra = {} if resampled is None else {"resampling": resampled.to_dict()}
+        if boot is not None:
+            extra["bootstrap"] = {k: v for k, v in boot.to_dict().items()
+                                  if k not in ("frequency", "frf")}
         print_json({**est.to_dict(), "sign_convention": sign_convention(sign), **extra})
         return 0
-    _table(est, stim, resp, sign, fs, trimmed)
+    _table(est, stim, resp, sign, fs, trimmed, boot)
     for path in (args.plot, args.plot_cycles):
         if path:
             print(f"wrote {path}")
     return 0
 
 
-def _table(est, stim: str, resp: str, sign: int, fs: float, trimmed: bool) -> None:
-    """Print one FRF as a table, with its warnings."""
+def _table(est, stim: str, resp: str, sign: int, fs: float, trimmed: bool,
+           boot=None) -> None:
+    """Print one FRF as a table (with its bootstrap intervals, ``boot``), and its warnings."""
     from ..frequency.estimate import sign_convention
 
     print(f"FRF of {resp} to {stim}, {sign_convention(sign)}: {est.n_cycles} cycles "
@@ -229,6 +269,14 @@ def _table(est, stim: str, resp: str, sign: int, fs: float, trimmed: bool) -> No
                  else f"undefined (n_d = {est.averages[k]})")
         print(f"{est.frequency[k]:8.3f} {est.gain[k]:10.4g} {est.phase_deg[k]:12.1f} "
               f"{est.coherence[k]:10.3f}  {bound}")
+    if boot is not None:
+        print(f"bootstrap over {boot.n_cycles} cycles ({boot.resamples} resamples, seed "
+              f"{boot.seed}), {100 * boot.level:g} % percentile intervals:")
+        print(f"{'f [Hz]':>8} {'gain':>22} {'phase [deg]':>22}")
+        for k in range(est.frequency.size):
+            (glo, ghi), (plo, phi) = boot.gain_ci[k], boot.phase_ci_deg[k]
+            print(f"{est.frequency[k]:8.3f} {f'{glo:.4g} … {ghi:.4g}':>22} "
+                  f"{f'{plo:.1f} … {phi:.1f}':>22}")
     low = est.coherence < 0.5
     if low.any():
         print(f"warning: coherence below 0.5 at {int(low.sum())} band(s): those estimates are "

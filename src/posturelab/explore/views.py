@@ -319,13 +319,16 @@ FRF_FREQUENCIES = np.logspace(-2, 1, 140)
 
 
 @functools.lru_cache(maxsize=64)
-def _linear(body, muscles):
-    """The poles and the delay margin, which depend on the body and gains only: kept for
-    the changes of delay, weight or perturbation that follow."""
+def _linear(body, muscles, torque_feedback_gain: float = 0.0,
+            torque_feedback_time_constant: float | None = None):
+    """The poles and the delay margin (with the torque feedback's filter, K_t [-], τ_t
+    [s]), which do not depend on the delay, weight or perturbation: kept for the changes of
+    those that follow."""
     import posturelab as pl
 
-    return pl.analyse(body, muscles), pl.delay_margin(body, muscles,
-                                                        max_delay=MAX_FEEDBACK_DELAY)
+    return pl.analyse(body, muscles), pl.delay_margin(
+        body, muscles, max_delay=MAX_FEEDBACK_DELAY, torque_feedback_gain=torque_feedback_gain,
+        torque_feedback_time_constant=torque_feedback_time_constant)
 #: Output samples per second of the simulated response. [Hz]
 SAMPLE_RATE = 100.0
 #: Stick-figure frames per second. [Hz]
@@ -352,8 +355,9 @@ def compute_views(p: dict) -> dict:
         time [s], link angles [rad], CoG position [m] and velocity [m/s], joint positions
         [m] of the stick figure and the surface tilt [rad] at :data:`FRAME_RATE`).
         With torque feedback (``torque_feedback_gain`` > 0) the verdict, ``poles`` and
-        ``roots`` are the linear system's with its filter states, ``delay_margin_note``
-        says the margin is not computed; the run is on the compiled engine as always.
+        ``roots`` are the linear system's with its filter states and ``delay_margin`` is
+        that loop's (``delay_margin_note`` None, kept for the page); the run is on the
+        compiled engine as always.
     """
     import posturelab as pl
 
@@ -366,20 +370,18 @@ def compute_views(p: dict) -> dict:
     stimulus = {"visual_tilt" if visual else "tilt": tilt, "visual_weight": p["visual_weight"]}
     torque_feedback = {"torque_feedback_gain": p["torque_feedback_gain"],
                        "torque_feedback_time_constant": p["torque_feedback_time_constant"]}
-    lin, margin = _linear(body, muscles)
+    lin, margin = _linear(body, muscles, **torque_feedback)
     # the one verdict about upright (posturelab poles, simulate and the report give it too)
     verdict = pl.upright_verdict(body, muscles, delay, **torque_feedback)
     engaged = verdict.side(engaged=True)  # the side the model FRF linearises
     roots = engaged.roots
     status = engaged.status
     poles = lin.poles
-    margin_note = None
     if p["torque_feedback_gain"] > 0:  # the poles with the filter states
         from ..linear.system import linear_system
 
         poles = linear_system(body, muscles, delay=0.0, inputs=False,
                               **torque_feedback).poles()[0]
-        margin_note = "not computed with torque feedback"
     if status == "stable":
         frf = model_frf(body, muscles, FRF_FREQUENCIES, input="visual-tilt" if visual else "tilt",
                         output="com_angle", feedback_delay=delay, proprioceptive_weight=weight,
@@ -412,7 +414,7 @@ def compute_views(p: dict) -> dict:
         "delay_margin": (None if margin.delay_margin is None
                          or math.isinf(margin.delay_margin) else float(margin.delay_margin)),
         "stable_without_delay": bool(margin.stable_without_delay),
-        "delay_margin_note": margin_note,
+        "delay_margin_note": None,
         "delayed_part": "active" if muscles.has_active_feedback else "all",
         "frf": frf_view,
         "run": {"outcome": outcome.kind, "message": outcome.message,

@@ -304,7 +304,8 @@ def fit_frf(body: Body, muscles: MuscleSet, data, free, *, input: str | Sequence
             proprioceptive_weight: float = 1.0, per_condition=(), bounds=None,
             model_error: float | None = None, torque_feedback_gain: float = 0.0,
             torque_feedback_time_constant: float | None = None,
-            visual_weight: float = 0.0) -> FRFFit:
+            visual_weight: float = 0.0,
+            condition_groups=None) -> FRFFit:
     """Fit controller parameters to one or several FRFs (module notes).
 
     Parameters
@@ -339,6 +340,10 @@ def fit_frf(body: Body, muscles: MuscleSet, data, free, *, input: str | Sequence
         17.4 s). [-], [s]
     visual_weight : float
         Starting W_v. [-]
+    condition_groups : sequence of int, optional
+        Per condition its group 0 … G − 1 (each used): the ``per_condition`` parameters
+        then take one value per group (``NAME#g``, g = 1 … G), as for conditions grouped
+        by vision; by default each condition is its own group.
 
     Raises
     ------
@@ -380,7 +385,8 @@ def fit_frf(body: Body, muscles: MuscleSet, data, free, *, input: str | Sequence
     targets = [_target(c, k) for k, c in enumerate(conditions)]
     base = np.stack([muscles.stiffnesses, muscles.viscosities, muscles.active_stiffnesses,
                      muscles.active_viscosities])
-    C = len(conditions)
+    group_of = _condition_groups(condition_groups, len(conditions))
+    C = max(group_of) + 1  # the values of each per-condition parameter
     slots = [(i, None) for i in range(len(free))] + [
         (len(free) + j, k) for j in range(len(per)) for k in range(C)]
     labels = free + [f"{per[j]}#{k + 1}" for j in range(len(per)) for k in range(C)]
@@ -409,7 +415,7 @@ def fit_frf(body: Body, muscles: MuscleSet, data, free, *, input: str | Sequence
             gains = base.copy()
             values = dict(scalars)
             for (i, cond), value in zip(slots, p, strict=True):
-                if cond is not None and cond != k:
+                if cond is not None and cond != group_of[k]:
                     continue
                 b, j = specs[i]
                 if b in values:
@@ -526,6 +532,21 @@ def fit_frf(body: Body, muscles: MuscleSet, data, free, *, input: str | Sequence
                   bool(mismatch), float(delta), systematic, sides,
                   np.stack([lo, hi], axis=1), clipped, float(u_all @ u_all), float(dof),
                   float(nu))
+
+
+def _condition_groups(groups, count: int) -> list[int]:
+    """Each condition's group (default its own), checked: integers 0 … G − 1, each used."""
+    if groups is None:
+        return list(range(count))
+    if isinstance(groups, str) or len(groups) != count or not all(
+            isinstance(g, int | np.integer) and not isinstance(g, bool) for g in groups):
+        raise ParameterError(f"condition_groups must give an integer group per condition "
+                             f"({count}), got {groups!r}"[:200])
+    out = [int(g) for g in groups]
+    if sorted(set(out)) != list(range(max(out) + 1)):
+        raise ParameterError(f"condition_groups must number the groups 0 … G − 1, each "
+                             f"used, got {out}")
+    return out
 
 
 def _systematic_bound(J: np.ndarray, targets: list, delta: float, seen: np.ndarray

@@ -39,6 +39,14 @@ optimiser leaves it so, ΔS is taken as 0 and a warning says so. An estimate on 
 (W = 0 or 1) breaks the interior-point condition: the χ² reference is then approximate
 (Self and Liang 1987, J Am Stat Assoc 82:605–610) and a warning says so.
 
+**Eyes open against eyes closed** (``by="vision"``): every condition carries its vision
+label, and the general fit gives the parameter one value per label (the conditions of one
+label share it, :func:`~posturelab.frequency.fit.fit_frf`'s ``condition_groups``; other
+``per_condition`` parameters then also take one value per label), the restricted one a
+single value: r = 1, the same likelihood-ratio test. Peterka (2002) reported W for eyes
+open and closed at each amplitude; this test asks whether vision moves it, with the
+amplitudes pooled within each label.
+
 The stimulus amplitude of a condition is its peak-to-peak stimulus [rad for a tilt, m for a
 translation]: given, or, for an :class:`~posturelab.frequency.FRFEstimate`, measured from its
 cycle-averaged stimulus; a table without it has none (NaN).
@@ -55,12 +63,15 @@ from ..errors import ParameterError
 from .fit import FRFFit, check_fit_request, fit_frf
 
 __all__ = ["ConditionComparison", "compare_conditions", "stimulus_amplitude", "VISION",
-           "SIGNIFICANCE"]
+           "SIGNIFICANCE", "GROUPINGS"]
 
 #: The vision labels a condition may carry.
 VISION = ("open", "closed")
 #: The level below which a difference is called significant in words. [-]
 SIGNIFICANCE = 0.05
+#: What :func:`compare_conditions` gives one value each: every condition, or every vision
+#: label.
+GROUPINGS = ("condition", "vision")
 
 
 def stimulus_amplitude(condition) -> float:
@@ -101,7 +112,7 @@ class ConditionComparison:
     statistic : float
         The value referred to ``distribution``: ΔS (χ²), ΔS/r or (ΔS/r)/s² (F). [-]
     df : int
-        r = C − 1, the parameters the restriction removes. [-]
+        r = C − 1 (by vision: the labels − 1), the parameters the restriction removes. [-]
     denominator_dof : float
         ν of the F reference (∞ for the χ² one). [-]
     distribution : str
@@ -113,6 +124,12 @@ class ConditionComparison:
     warnings : tuple of str
     amplitude_unit : str
         ``"rad"`` (a tilt) or ``"m"`` (a translation).
+    grouping : {"condition", "vision"}
+        What took one value each in the general fit (with ``"vision"`` each condition's
+        ``estimates`` row is its label's value).
+    groups : tuple of str
+        The general fit's values in order: the labels, or the vision labels (``"open"``,
+        ``"closed"``).
     """
 
     parameter: str
@@ -136,6 +153,8 @@ class ConditionComparison:
     restricted: FRFFit
     warnings: tuple = ()
     amplitude_unit: str = "rad"
+    grouping: str = "condition"
+    groups: tuple = ()
 
     @property
     def significant(self) -> bool:
@@ -163,7 +182,19 @@ class ConditionComparison:
         return {
             "parameter": self.parameter, "unit": self.unit,
             "amplitude_unit": self.amplitude_unit,
-            "test": "likelihood ratio, shared against per-condition",
+            "test": ("likelihood ratio, shared against per-condition"
+                     if self.grouping == "condition" else
+                     "likelihood ratio, shared against per vision label"),
+            "grouping": self.grouping,
+            **({"vision_groups": [
+                {"vision": g, "conditions": [k + 1 for k, v in enumerate(self.vision)
+                                             if v == g],
+                 "estimate": num(self.general.estimates[i]),
+                 "standard_error": num(self.general.standard_errors[i]),
+                 "ci95": [num(v) for v in self.general.confidence_intervals[i]]}
+                for i, g in ((self.general.names.index(f"{self.parameter}#{j + 1}"), g)
+                             for j, g in enumerate(self.groups))]}
+               if self.grouping == "vision" else {}),
             "conditions": [
                 {"condition": k + 1, "label": lab, "amplitude": num(a), "vision": v,
                  "estimate": num(e), "standard_error": num(s), "ci95": [num(lo), num(hi)],
@@ -236,7 +267,7 @@ def _vision(vision, count: int) -> tuple:
 
 def compare_conditions(body, muscles, data, free, *, parameter: str = "proprioceptive_weight",
                        per_condition=(), amplitudes=None, vision=None, labels=None,
-                       **fit_options) -> ConditionComparison:
+                       by: str = "condition", **fit_options) -> ConditionComparison:
     """Fit ``parameter`` per condition and shared, and test whether it differs (module notes).
 
     Parameters
@@ -257,6 +288,9 @@ def compare_conditions(body, muscles, data, free, *, parameter: str = "proprioce
     vision : sequence of {"open", "closed", None}, optional
     labels : sequence of str, optional
         Names of the conditions (default ``condition k``).
+    by : {"condition", "vision"}
+        One value per condition, or per vision label (every condition labelled, both
+        labels present; module notes).
     **fit_options
         ``input``, ``output``, ``feedback_delay``, ``proprioceptive_weight``, ``bounds`` of
         :func:`~posturelab.frequency.fit.fit_frf`.
@@ -302,9 +336,11 @@ def compare_conditions(body, muscles, data, free, *, parameter: str = "proprioce
         f"condition {k + 1}" for k in range(C))
     if len(labels) != C:
         raise ParameterError(f"labels must name each of the {C} conditions")
+    group_of, groups = _grouping(by, seen, labels)
     general = fit_frf(body, muscles, conditions, free_c, per_condition=per_c + [name],
-                      **fit_options)
+                      condition_groups=group_of, **fit_options)
     restricted = fit_frf(body, muscles, conditions, free_c + [name], per_condition=per_c,
+                         condition_groups=group_of,
                          model_error=general.model_error, **fit_options)
     warnings = []
     delta_s = restricted.objective - general.objective
@@ -313,7 +349,7 @@ def compare_conditions(body, muscles, data, free, *, parameter: str = "proprioce
                         f"{general.objective:.6g} > {restricted.objective:.6g}): the optimiser "
                         "did not reach its optimum; ΔS taken as 0")
     delta_s = max(delta_s, 0.0)
-    r = C - 1
+    r = len(groups) - 1
     if general.weighting == "relative":
         nu = general.residual_dof
         statistic = (delta_s / r) / max(general.objective / nu, 1e-300)
@@ -324,7 +360,7 @@ def compare_conditions(body, muscles, data, free, *, parameter: str = "proprioce
         p_value, distribution = float(chi2.sf(statistic, r)), f"chi2({r})"
     else:
         p_value, distribution = float(fisher.sf(statistic, r, nu)), f"F({r}, {nu:g})"
-    idx = [general.names.index(f"{name}#{k + 1}") for k in range(C)]
+    idx = [general.names.index(f"{name}#{group_of[k] + 1}") for k in range(C)]
     j = restricted.names.index(name)
     sides = [general.at_bound[i] for i in idx] + [restricted.at_bound[j]]
     if any(side is not None for side in sides):
@@ -340,4 +376,22 @@ def compare_conditions(body, muscles, data, free, *, parameter: str = "proprioce
         restricted.confidence_intervals[j].copy(), float(delta_s), float(statistic), r,
         float(nu), distribution, p_value, general, restricted,
         tuple(warnings) + general.warnings,
-        "m" if fit_options.get("input", "tilt") == "translation" else "rad")
+        "m" if fit_options.get("input", "tilt") == "translation" else "rad", by, groups)
+
+
+def _grouping(by: str, vision: tuple, labels: tuple) -> tuple[list[int], tuple]:
+    """Each condition's group and the groups' names: every condition its own, or the
+    vision labels (each condition labelled, both labels present)."""
+    if by not in GROUPINGS:
+        raise ParameterError(f"by must be one of {', '.join(GROUPINGS)}, got {by!r}"[:200])
+    if by == "condition":
+        return list(range(len(labels))), labels
+    missing = [k + 1 for k, v in enumerate(vision) if v is None]
+    if missing:
+        raise ParameterError(f"grouping by vision needs every condition's vision label "
+                             f"(open or closed); condition(s) {missing} have none")
+    groups = tuple(v for v in VISION if v in vision)
+    if len(groups) < 2:
+        raise ParameterError(f"grouping by vision needs conditions with eyes open and with "
+                             f"eyes closed; all are {vision[0]}")
+    return [groups.index(v) for v in vision], groups

@@ -12,7 +12,9 @@ gains has K_i = L_i = 0: its whole feedback is delayed). Its characteristic matr
 
     Δ(s) = s² J0 − g A + K_i + s L_i + (K_a + s L_a) e^{−sτ},
 
-(the matrices of the one linear system, :mod:`posturelab.linear.system`), and the roots of
+(the matrices of the one linear system, :mod:`posturelab.linear.system`; with Peterka 2002's
+torque feedback the delayed part is multiplied by g(s) = (τ_t s + 1)/(τ_t s + 1 − K_t) and
+the first-order form below carries the filter states, 3N in all), and the roots of
 det Δ(s) = 0 are the characteristic roots (infinitely many; finitely
 many to the right of any vertical line: the equation is of retarded type).
 
@@ -72,8 +74,9 @@ MAX_DELAY_FOR_ROOTS = MAX_FEEDBACK_DELAY
 DelayedSystem = LinearSystem
 
 
-def delayed_system(body: Body, muscles: MuscleSet, one_sided: OneSided = "active"
-                   ) -> LinearSystem:
+def delayed_system(body: Body, muscles: MuscleSet, one_sided: OneSided = "active", *,
+                   torque_feedback_gain: float = 0.0,
+                   torque_feedback_time_constant: float | None = None) -> LinearSystem:
     """The linearised delayed chain of one body and muscle set, as a
     :class:`~posturelab.linear.system.LinearSystem` of one set (see the module notes).
 
@@ -85,9 +88,14 @@ def delayed_system(body: Body, muscles: MuscleSet, one_sided: OneSided = "active
         delayed part).
     one_sided : {"active", "inactive"}
         How a one-sided pair is linearised (:func:`posturelab.analyse`).
+    torque_feedback_gain, torque_feedback_time_constant : float
+        Peterka 2002's torque feedback (:func:`posturelab.linear.system.linear_system`; K_t
+        0: none; τ_t by default the parameter table's). [-], [s]
     """
     _check_match(body, muscles)
-    return linear_system(body, muscles, one_sided=one_sided, inputs=False)
+    return linear_system(body, muscles, one_sided=one_sided, inputs=False,
+                         torque_feedback_gain=torque_feedback_gain,
+                         torque_feedback_time_constant=torque_feedback_time_constant)
 
 
 def characteristic_matrix(system: LinearSystem, s, delay: float) -> np.ndarray:
@@ -254,14 +262,16 @@ def _direction(system: LinearSystem, omega: float, delay: float) -> int:
     u, _, vh = np.linalg.svd(D)
     right, left = vh[-1].conj(), u[:, -1]
     _, _, _, Ka, La = _matrices(system)
-    d_tau = -s * (Ka + s * La) * np.exp(-s * delay)
+    factor = system.torque_feedback_factor(np.array([s]))[0]
+    d_tau = -s * (Ka + s * La) * np.exp(-s * delay) * factor
     d_s = _slope(system, s, delay)
     ds_dtau = -(left.conj() @ d_tau @ right) / (left.conj() @ d_s @ right)
     return 1 if ds_dtau.real > 0 else -1
 
 
 def delay_margin(body: Body, muscles: MuscleSet, *, max_delay: float = 2.0,
-                 one_sided: OneSided = "active") -> DelayMargin:
+                 one_sided: OneSided = "active", torque_feedback_gain: float = 0.0,
+                 torque_feedback_time_constant: float | None = None) -> DelayMargin:
     """The delay margin of the chain linearised about upright (see the module notes).
 
     Parameters
@@ -275,6 +285,10 @@ def delay_margin(body: Body, muscles: MuscleSet, *, max_delay: float = 2.0,
         [s]
     one_sided : {"active", "inactive"}
         How a one-sided pair is linearised.
+    torque_feedback_gain, torque_feedback_time_constant : float
+        Peterka 2002's torque feedback (K_t 0: none; τ_t by default 17.4 s): its filter
+        states join the first-order form (3N states, :meth:`LinearSystem.first_order`) and
+        its factor g(s) the delayed part of Δ(s). [-], [s]
 
     Returns
     -------
@@ -294,7 +308,8 @@ def delay_margin(body: Body, muscles: MuscleSet, *, max_delay: float = 2.0,
     88.6
     """
     max_delay = float_in_range("max_delay [s]", max_delay, 0.0, 1e3, unit="s")
-    system = delayed_system(body, muscles, one_sided)
+    system = delayed_system(body, muscles, one_sided, torque_feedback_gain=torque_feedback_gain,
+                            torque_feedback_time_constant=torque_feedback_time_constant)
     A0, A1 = (a[0] for a in system.first_order())
     stable0 = bool(np.all(np.linalg.eigvals(A0 + A1).real < 0))
     if not stable0:

@@ -32,6 +32,20 @@ margin.
 **One link.** Δ₀ is a scalar quadratic in u = ω²: J² u² + (L_i² − L_a² − 2 J S) u + S² −
 K_a² = 0 (the delayed inverted pendulum's |A(iω)| = |B(iω)|), solved in closed form.
 
+**Torque feedback** (Peterka 2002; :mod:`.system`): the delayed part is B(s) g(s) with
+g(s) = n(s)/d(s), n(s) = τ_t s + 1, d(s) = τ_t s + 1 − K_t. Multiplied by d(s)^N, which
+does not vanish at s = iω, ω > 0, det Δ(s) is the quasi-polynomial det(Â(s) + B̂(s)
+e^{−sτ}) with Â = d A (cubic) and B̂ = n B (quadratic): the characteristic function of the
+3N-state first-order form with the filter states, of retarded type still. Everything above
+holds with Â, B̂: as d(s) d(−s) = (1 − K_t)² − τ_t² λ and n(s) n(−s) = 1 − τ_t² λ are real
+polynomials in λ, E = d d̄ E_A − n n̄ E_B and O = d d̄ O_A − n n̄ O_B (E_A, O_A the even and
+odd parts of A(s) ⊗ A(−s), E_B, O_B those of B(s) ⊗ B(−s)) keep their symmetry, and T(λ)
+is cubic, its leading coefficient −τ_t² times the one above (block triangular, invertible):
+a companion form of size 3N². For one link the crossing condition |Â(iω)| = |B̂(iω)| is the
+cubic in u = ω²::
+
+    ((1 − K_t)² + τ_t² u) ((S − J u)² + L_i² u) − (1 + τ_t² u) (K_a² + L_a² u) = 0.
+
 A set unstable without delay has no margin (NaN); a stable set that no delay destabilises
 has an infinite one.
 """
@@ -102,7 +116,8 @@ class BatchDelayMargin:
 
 def batch_delay_margin(body: Body | BodyArrays, muscles: MuscleSet, *, stiffness=None,
                        viscosity=None, viscosity_ratio=None, active_stiffness=None,
-                       active_viscosity=None, one_sided: OneSided = "active"
+                       active_viscosity=None, one_sided: OneSided = "active",
+                       torque_feedback_gain=0.0, torque_feedback_time_constant=None
                        ) -> BatchDelayMargin:
     """The delay margins of M parameter sets (module notes).
 
@@ -117,6 +132,9 @@ def batch_delay_margin(body: Body | BodyArrays, muscles: MuscleSet, *, stiffness
         delayed.
     one_sided : {"active", "inactive"}
         How a one-sided pair is linearised at upright.
+    torque_feedback_gain, torque_feedback_time_constant : float or array_like, shape (M,)
+        Peterka 2002's torque feedback (K_t 0: none; τ_t by default 17.4 s; module
+        notes). [-], [s]
 
     Returns
     -------
@@ -138,7 +156,10 @@ def batch_delay_margin(body: Body | BodyArrays, muscles: MuscleSet, *, stiffness
                                        viscosity=viscosity, viscosity_ratio=viscosity_ratio,
                                        active_stiffness=active_stiffness,
                                        active_viscosity=active_viscosity,
-                                       one_sided=one_sided, inputs=False))
+                                       one_sided=one_sided, inputs=False,
+                                       torque_feedback_gain=torque_feedback_gain,
+                                       torque_feedback_time_constant=(
+                                           torque_feedback_time_constant)))
 
 
 def delay_margins(system: LinearSystem) -> BatchDelayMargin:
@@ -156,11 +177,12 @@ def delay_margins(system: LinearSystem) -> BatchDelayMargin:
         sub = system[part]
         mats = (sub.inertia, sub.stiffness, sub.viscosity, sub.delayed_stiffness,
                 sub.delayed_viscosity)
+        gain, lag = _filter(sub, part.size)
         if system.n_links == 1:
             tau, omega = _one_link(*(np.broadcast_to(x, (part.size, 1, 1))[:, 0, 0]
-                                     for x in mats))
+                                     for x in mats), gain, lag)
         else:
-            tau, omega = _pencil(part.size, *mats)
+            tau, omega = _pencil(part.size, *mats, gain, lag)
         margin[part], frequency[part] = tau, omega
 
     starts = range(0, index.size, _CHUNK)
@@ -176,10 +198,18 @@ def delay_margins(system: LinearSystem) -> BatchDelayMargin:
     return BatchDelayMargin(margin, frequency, stable)
 
 
+def _filter(system: LinearSystem, m: int) -> tuple[np.ndarray | None, np.ndarray | None]:
+    """(K_t, τ_t) of the torque feedback, each (M,), or (None, None) without it. [-], [s]"""
+    if not system.has_torque_feedback:
+        return None, None
+    return (np.broadcast_to(system.torque_feedback_gain, (m,)),
+            np.broadcast_to(system.torque_feedback_time_constant, (m,)))
+
+
 def _stable_without_delay(system: LinearSystem) -> np.ndarray:
     """Every root with a negative real part at τ = 0 (the eigenvalues of the state matrix;
-    for one link the Routh conditions L > 0, K − g a > 0)."""
-    if system.n_links == 1:
+    for one link without torque feedback the Routh conditions L > 0, K − g a > 0)."""
+    if system.n_links == 1 and not system.has_torque_feedback:
         _, damp, load = system.without_delay()
         return np.broadcast_to((damp[:, 0, 0] > 0) & (load[:, 0, 0] > 0),
                                (system.n_sets,)).copy()
@@ -196,9 +226,14 @@ def _delays(z: np.ndarray, omega: np.ndarray) -> np.ndarray:
     return np.where(tau > 0, tau, 2 * math.pi / omega)
 
 
-def _one_link(J, S, L, K, La) -> tuple[np.ndarray, np.ndarray]:
+def _one_link(J, S, L, K, La, gain=None, lag=None) -> tuple[np.ndarray, np.ndarray]:
     """The margin and crossing frequency of one-link sets: the positive roots u = ω² of
-    J² u² + (L² − La² − 2 J S) u + S² − K² = 0, τ from z = −A(iω)/B(iω). [s], [rad/s]"""
+    J² u² + (L² − La² − 2 J S) u + S² − K² = 0, τ from z = −A(iω)/B(iω); with torque
+    feedback (K_t ``gain``, τ_t ``lag``, each (M,)) the positive roots of the cubic
+    (c0 + c1 u)((S − J u)² + L² u) − (1 + c1 u)(K² + La² u) = 0, c0 = (1 − K_t)²,
+    c1 = τ_t² (module notes), and z = −d(iω) A(iω)/(n(iω) B(iω)). [s], [rad/s]"""
+    if gain is not None:
+        return _one_link_filtered(J, S, L, K, La, gain, lag)
     a = J * J
     b = L * L - La * La - 2 * J * S
     c = (S - K) * (S + K)
@@ -212,10 +247,38 @@ def _one_link(J, S, L, K, La) -> tuple[np.ndarray, np.ndarray]:
         s = 1j * omega
         z = -(J * s * s + L * s + S) / (K + La * s)
         tau = np.where(ok & np.isfinite(z), _delays(z, omega), np.inf)
+    return _first(tau, omega)
+
+
+def _first(tau: np.ndarray, omega: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The smallest delay over the candidates (axis 0) and its frequency. [s], [rad/s]"""
     best = np.argmin(tau, axis=0)
     cols = np.arange(tau.shape[1])
     margin = tau[best, cols]
     return margin, np.where(np.isfinite(margin), omega[best, cols], np.nan)
+
+
+def _one_link_filtered(J, S, L, K, La, gain, lag) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`_one_link` with torque feedback: the cubic's roots (the eigenvalues of its
+    companion matrix, all sets at once). [s], [rad/s]"""
+    c0 = (1.0 - gain) ** 2
+    c1 = lag * lag
+    cubic = np.stack([c1 * J * J,
+                      c0 * J * J + c1 * (L * L - 2 * J * S) - c1 * La * La,
+                      c0 * (L * L - 2 * J * S) + c1 * S * S - La * La - c1 * K * K,
+                      c0 * S * S - K * K], axis=-1)                      # (M, 4), u³ first
+    companion = np.zeros((J.size, 3, 3))
+    companion[:, 0, :] = -cubic[:, 1:] / cubic[:, :1]
+    companion[:, 1, 0] = companion[:, 2, 1] = 1.0
+    u = np.linalg.eigvals(companion).T                                   # (3, M)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ok = (np.abs(u.imag) <= _REAL * np.abs(u)) & (u.real > 0)
+        omega = np.sqrt(np.where(ok, u.real, 1.0))
+        s = 1j * omega
+        z = -((lag * s + 1.0 - gain) * (J * s * s + L * s + S)
+              / ((lag * s + 1.0) * (K + La * s)))
+        tau = np.where(ok & np.isfinite(z), _delays(z, omega), np.inf)
+    return _first(tau, omega)
 
 
 def _tensor_basis(n: int) -> tuple[np.ndarray, int]:
@@ -244,9 +307,20 @@ def _kron(x: np.ndarray, y: np.ndarray) -> np.ndarray:
     return out.reshape(out.shape[:-4] + (n * n, n * n))
 
 
-def _pencil(m: int, J, S, L, K, La) -> tuple[np.ndarray, np.ndarray]:
+def _polymul(p: list, q: list) -> list:
+    """The coefficients (constant first) of the product of two polynomials whose
+    coefficients are arrays that broadcast."""
+    out = [0.0] * (len(p) + len(q) - 1)
+    for i, a in enumerate(p):
+        for j, b in enumerate(q):
+            out[i + j] = out[i + j] + a * b
+    return out
+
+
+def _pencil(m: int, J, S, L, K, La, gain=None, lag=None) -> tuple[np.ndarray, np.ndarray]:
     """The margin and crossing frequency of ``m`` N-link sets by the delay pencil (module
-    notes); each matrix argument (M or 1, N, N). [s], [rad/s]"""
+    notes); each matrix argument (M or 1, N, N); ``gain``, ``lag`` the torque feedback's
+    K_t [-] and τ_t [s], each (M,), or None. [s], [rad/s]"""
     n = S.shape[-1]
     J, S, L, K, La = (np.broadcast_to(x, (m, n, n)) if x.shape[0] != 1 else x
                       for x in (J, S, L, K, La))
@@ -256,26 +330,37 @@ def _pencil(m: int, J, S, L, K, La) -> tuple[np.ndarray, np.ndarray]:
     def project(x):
         return q.T @ x @ q
 
-    e2 = project(_kron(J, J))
-    e1 = project(_kron(J, S) + _kron(S, J) - _kron(L, L) + _kron(La, La))
-    e0 = project(_kron(S, S) - _kron(K, K))
-    o1 = project(_kron(L, J) - _kron(J, L))
-    o0 = project(_kron(L, S) - _kron(S, L) + _kron(K, La) - _kron(La, K))
-    # T2 = [[E2_ss, 0], [O1_as, E2_aa]], T1 = [[E1_ss, O1_sa], [O0_as, E1_aa]],
-    # T0 = [[E0_ss, O0_sa], [0, E0_aa]] (E's off-diagonal and O's diagonal blocks are 0)
-    t2 = np.array(np.broadcast_to(e2, (m, size, size)))
-    t2[:, :ns, ns:] = 0.0
-    t2[:, ns:, :ns] = o1[:, ns:, :ns]
-    t1 = e1.copy()
-    t1[:, :ns, ns:] = o1[:, :ns, ns:]
-    t1[:, ns:, :ns] = o0[:, ns:, :ns]
-    t0 = e0.copy()
-    t0[:, :ns, ns:] = o0[:, :ns, ns:]
-    t0[:, ns:, :ns] = 0.0
-    companion = np.zeros((m, 2 * size, 2 * size))
-    companion[:, :size, size:] = np.eye(size)
-    companion[:, size:, :] = -np.linalg.solve(t2, np.concatenate([t0, t1], axis=-1))
-    lam = np.linalg.eigvals(companion)                                   # (M, 2N²)
+    # A(s) ⊗ A(−s) = E_A(λ) + s O_A(λ) and B(s) ⊗ B(−s) = E_B(λ) + s O_B(λ), λ = s²
+    even_a = [project(_kron(S, S)), project(_kron(J, S) + _kron(S, J) - _kron(L, L)),
+              project(_kron(J, J))]
+    even_b = [project(_kron(K, K)), -project(_kron(La, La))]
+    odd_a = [project(_kron(L, S) - _kron(S, L)), project(_kron(L, J) - _kron(J, L))]
+    odd_b = [project(_kron(La, K) - _kron(K, La))]
+    if gain is None:
+        ones = [np.ones((1, 1, 1))]
+        p_d = p_n = ones
+    else:  # d(s) d(−s) = (1 − K_t)² − τ_t² λ,  n(s) n(−s) = 1 − τ_t² λ
+        c = (lag * lag)[:, None, None]
+        p_d = [((1.0 - gain) ** 2)[:, None, None], -c]
+        p_n = [np.ones((1, 1, 1)), -c]
+    even = [x - y for x, y in zip(_polymul(p_d, even_a),
+                                  _polymul(p_n, even_b) + [0.0] * len(p_d), strict=False)]
+    odd = [x - y for x, y in zip(_polymul(p_d, odd_a),
+                                 _polymul(p_n, odd_b) + [0.0] * len(p_d), strict=False)]
+    degree = len(even) - 1
+    # T_k = [[E_k,ss, O_k,sa], [O_{k−1},as, E_k,aa]] (E's off-diagonal and O's diagonal
+    # blocks are 0); T_degree is block triangular with invertible diagonal blocks
+    coefficients = []
+    for k in range(degree + 1):
+        t = np.array(np.broadcast_to(even[k], (m, size, size)))
+        t[:, :ns, ns:] = odd[k][..., :ns, ns:] if k < len(odd) else 0.0
+        t[:, ns:, :ns] = odd[k - 1][..., ns:, :ns] if 0 < k <= len(odd) else 0.0
+        coefficients.append(t)
+    companion = np.zeros((m, degree * size, degree * size))
+    companion[:, :-size, size:] = np.eye((degree - 1) * size)
+    companion[:, -size:, :] = -np.linalg.solve(coefficients[-1],
+                                               np.concatenate(coefficients[:-1], axis=-1))
+    lam = np.linalg.eigvals(companion)                  # (M, 2N²), 3N² with the filter
     real = (lam.real < 0) & (np.abs(lam.imag) <= _REAL * np.abs(lam))
     sets, which = np.nonzero(real)
     margin = np.full(m, np.inf)
@@ -289,6 +374,10 @@ def _pencil(m: int, J, S, L, K, La) -> tuple[np.ndarray, np.ndarray]:
 
     a = s * s * rows(J) + s * rows(L) + rows(S)
     b = rows(K) + s * rows(La)
+    if gain is not None:  # Â = d(s) A(s), B̂ = n(s) B(s)
+        lag_c, gain_c = lag[sets][:, None, None], gain[sets][:, None, None]
+        a = a * (lag_c * s + 1.0 - gain_c)
+        b = b * (lag_c * s + 1.0)
     # A + z B singular ⇔ z = −1/μ, μ an eigenvalue of A⁻¹B (A(iω) is regular there)
     try:
         mu = np.linalg.eigvals(np.linalg.solve(a, b))                    # (C, N)

@@ -180,8 +180,8 @@ class LinearSystem:
             polynomial; :meth:`first_order` carries it)."""
         if self.has_torque_feedback:
             raise ParameterError("this analysis does not take torque feedback yet (its "
-                                 "filter is not a matrix polynomial); poles, the FRFs and "
-                                 "the rightmost roots do")
+                                 "filter is not a matrix polynomial); poles, the FRFs, "
+                                 "the rightmost roots and the delay margins do")
         return (self.inertia, _add(self.viscosity, self.delayed_viscosity),
                 _add(self.stiffness, self.delayed_stiffness))
 

@@ -62,7 +62,9 @@ def plot_reweighting(comparison, ax=None) -> Figure:
     unit = comparison.unit
     ax.set_ylabel(f"{comparison.parameter} [{unit}]")
     p = comparison.p_value
-    ax.set_title(f"{comparison.parameter} per condition: likelihood-ratio test "
+    per = ("per vision label" if comparison.grouping == "vision"
+           else "per condition")
+    ax.set_title(f"{comparison.parameter} {per}: likelihood-ratio test "
                  f"{comparison.distribution}, p = {p:.3g}" if math.isfinite(p) else
                  comparison.parameter, fontsize=9)
     ax.grid(True, alpha=0.3)

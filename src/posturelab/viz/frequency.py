@@ -11,7 +11,7 @@ from .figure import new_figure
 __all__ = ["plot_bode", "plot_prts_cycles"]
 
 
-def plot_bode(estimates, labels=None, model=None) -> Figure:
+def plot_bode(estimates, labels=None, model=None, bootstrap=None) -> Figure:
     """Gain, phase [deg] and coherence against frequency [Hz] of FRF estimates, with their 95 %
     bounds as bands, and optionally model curves.
 
@@ -23,6 +23,9 @@ def plot_bode(estimates, labels=None, model=None) -> Figure:
     labels : sequence of str, optional
     model : sequence of (frequency [Hz], complex FRF, label), optional
         Curves to overlay.
+    bootstrap : sequence of BootstrapBands or None, optional
+        Per estimate, bootstrap bands (:func:`posturelab.frequency.bootstrap_frf_bands`)
+        whose gain and phase intervals are drawn as dashed lines.
 
     Returns
     -------
@@ -30,8 +33,17 @@ def plot_bode(estimates, labels=None, model=None) -> Figure:
     """
     fig, (ax_g, ax_p, ax_c) = new_figure(3, 1, figsize=(6.5, 7.5), sharex=True)
     labels = list(labels or [f"condition {i + 1}" for i in range(len(estimates))])
-    for est, label in zip(map(_with_bounds, estimates), labels, strict=True):
+    boots = list(bootstrap) if bootstrap is not None else [None] * len(labels)
+    for est, label, boot in zip(map(_with_bounds, estimates), labels, boots, strict=True):
         line, = ax_g.loglog(est.frequency, est.gain, "o-", ms=4, label=label)
+        if boot is not None:
+            for side in (0, 1):
+                ax_g.loglog(boot.frequency, np.maximum(boot.gain_ci[:, side], 1e-6), "--",
+                            lw=0.9, color=line.get_color(),
+                            label=(f"bootstrap {100 * boot.level:g} %" if side == 0
+                                   else None))
+                ax_p.semilogx(boot.frequency, boot.phase_ci_deg[:, side], "--", lw=0.9,
+                              color=line.get_color())
         ok = np.all(np.isfinite(est.gain_ci95), axis=1)
         if ok.any():
             ax_g.fill_between(est.frequency[ok], np.maximum(est.gain_ci95[ok, 0], 1e-6),
