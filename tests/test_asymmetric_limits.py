@@ -128,3 +128,26 @@ def test_batch_with_pairs_equals_single_runs():
         assert out.fell[r] == one.fell and out.n_switches[r] == len(one.switch_times)
         if one.fell:
             assert out.fall_time[r] == one.fall_time
+
+
+def test_sweep_over_a_base_with_limits_per_side_equals_single_runs():
+    """A base experiment with the ankle's limits per side and the knee's varied (both ways):
+    the grid holds (lower, upper) per joint and each row is its single run."""
+    from posturelab.scenarios import Scenario
+    from posturelab.simulation.tolerances import DEFAULT_ATOL, DEFAULT_RTOL
+    from posturelab.studies.sweep import parse_vary, run_sweep
+
+    options = pl.RunOptions(duration=1.0, feedback_delay=0.01,
+                            torque_limits=((LOWER, UPPER), math.inf, math.inf))
+    sc = Scenario(name="sides", source="test", body=pl.paper_body(),
+                  muscles=pl.paper_muscles("1"), disturbance=pl.VelocityStep.backward(0.25),
+                  options=options)
+    out = run_sweep(sc, [parse_vary("torque_limit:knee=40:400:2")])
+    assert out.grid.torque_limits.shape == (2, 3, 2)
+    for r, (knee,) in enumerate(out.grid.values):
+        one = pl.simulate(sc.body, sc.muscles, sc.disturbance, options=options.replace(
+            torque_limits=((LOWER, UPPER), (-knee, knee), math.inf)),
+            rtol=DEFAULT_RTOL, atol=DEFAULT_ATOL)
+        assert bool(out.outcomes.fell[r]) == one.fell
+        if one.fell:
+            assert out.outcomes.fall_time[r] == pytest.approx(one.fall_time, abs=1e-9)

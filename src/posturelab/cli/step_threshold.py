@@ -9,7 +9,9 @@ from ._common import print_json
 DESCRIPTION = """\
 The largest platform translation a subject withstands with the feet in place: a one-link
 body scaled from --height and --mass (Winter's table), an ankle controller with the
-population's gains, feedback delay and ankle strength, on a foot of 0.152 × height. A run
+population's gains, feedback delay and ankle strength, on a foot of 0.152 × height; the
+ankle moment limited to min(strength, m g × toe) toward the toes and m g × |heel| toward the
+heel, what a flat foot carries (--symmetric-ankle-cap: the first both ways). A run
 needs a step when the extrapolated centre of mass x + v/ω0 (Hof, Gazendam & Sinke 2005,
 J Biomech 38:1–8; ω0 = √(g/l), l the centre of mass's height) leaves the foot, or when
 the body falls. The platform moves are ramp-and-holds over 0.5 s (posturelab's assumption),

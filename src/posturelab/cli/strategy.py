@@ -12,7 +12,9 @@ DESCRIPTION = """\
 Strategy maps: how much of the sway is the hip (anti-phase) mode of leg and trunk, the hip
 fraction Σb²/(Σa² + Σb²) (after Creath et al. 2005), across a family of translations of the
 support surface, with a multi-joint controller (an LQR design on the linearised chain,
-delayed; posturelab.linear.lqr) and the ankle moment limited by the foot.
+delayed; posturelab.linear.lqr) and the ankle moment limited to m g x_toe both ways, the
+design's τ_max (--ankle-limit-from-foot: m g x_toe toward the toes, m g |x_heel| toward the
+heel, what a flat foot carries).
 
 --translation backward|forward --speeds LO:HI:N   transient translations: a ramp-and-hold of
     --displacement D (0.06 m) whose peak speed 2D/T is each speed (after Horak & Nashner
