@@ -51,6 +51,20 @@ def test_engines_agree_with_one_side_unlimited():
     assert fast.joint_moments[:, 0].min() < -10 * abs(LOWER)
 
 
+@pytest.mark.parametrize("lean,start", [(-0.05, LOWER), (0.05, 40.0)])
+def test_a_start_beyond_one_side_saturates_there_only(lean, start):
+    """Leaning back, the start moment (−40 N·m) is beyond the dorsiflexion limit: the ankle
+    starts saturated at it; leaning forward the same +40 N·m is inside the plantarflexion
+    limit. Both engines."""
+    runs = [pl.simulate(pl.paper_body(), pl.paper_muscles("1"), None, 0.5,
+                        initial_state=[lean] * 3 + [0.0] * 3,
+                        torque_limits=[(LOWER, UPPER), math.inf, math.inf], engine=engine,
+                        **TOLERANCES) for engine in ("compiled", "reference")]
+    for r in runs:
+        assert r.joint_moments[0, 0] == pytest.approx(start, abs=1e-9)
+    np.testing.assert_allclose(runs[0].theta, runs[1].theta, rtol=0, atol=THETA_TOL)
+
+
 @pytest.mark.parametrize("engine", ["compiled", "reference"])
 def test_an_equal_pair_is_the_symmetric_limit_bit_for_bit(engine):
     one = _run(engine, [60.0, math.inf, math.inf], 0.5)
@@ -111,6 +125,9 @@ def test_scenario_and_command_line_forms(tmp_path, capsys):
                  "--torque-limits", "5:60,inf,inf"]) == 2
     err = capsys.readouterr().err.strip()
     assert "\n" not in err and "--torque-limits" in err and "LO" in err
+    assert main(["simulate", "--case", "1", "--duration", "0.3", "--ankle-limit-from-foot"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "--ankle-limit-from-foot" in err and "--foot" in err
 
 
 def test_batch_with_pairs_equals_single_runs():

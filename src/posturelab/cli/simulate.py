@@ -267,6 +267,10 @@ def run_options_from_args(args: argparse.Namespace, sc: Scenario,
     if getattr(args, "ankle_limit_from_foot", False):
         torque_limits = ("foot",) + tuple(torque_limits[1:] if torque_limits is not None
                                           else (math.inf,) * (n - 1))
+    if torque_limits is not None and "foot" in torque_limits and fall.base_of_support is None:
+        raise UsageError(f"{command}: the ankle's limits from the foot (--ankle-limit-from-foot "
+                         "or 'foot' in --torque-limits / [limits] torque) need a foot: give "
+                         "--foot literature (or HEEL,TOE)")
     with naming_option("--motor-noise"):
         motor_noise = motor_noise_from_args(args, n)
     if motor_noise is not None:

@@ -56,7 +56,13 @@ def run(args: argparse.Namespace) -> int:
     from dataclasses import replace
 
     from .._validation import float_in_range
-    from ..studies.stepping import PROTOCOL, UNITS, get_population, step_threshold
+    from ..studies.stepping import (
+        COP_TOLERANCE,
+        PROTOCOL,
+        UNITS,
+        get_population,
+        step_threshold,
+    )
 
     population = get_population(args.population)
     protocol = PROTOCOL if args.move_duration is None else replace(
@@ -87,9 +93,9 @@ def run(args: argparse.Namespace) -> int:
           f"{result.ankle_moment_cap:.0f} N·m, dorsiflexion {result.dorsiflexion_cap:.0f} "
           "N·m), foot "
           f"{result.heel * cm:.1f} … {result.toe * cm:.1f} cm, ω0 = {result.omega0:.2f} 1/s")
-    if result.cop_overrun > 0.0:
+    if result.cop_overrun > COP_TOLERANCE:
         print(f"  the centre of pressure went {result.cop_overrun * cm:.1f} cm beyond the foot "
-              "at the threshold (the caps are static, m g × toe and heel; see the guide)")
+              "at the threshold (see the guide)")
     if result.published_mean is not None:
         verdict = "within" if result.within_two_sd else "outside"
         print(f"published: {result.published_mean * cm:.1f} ± {result.published_sd * cm:.1f} "
