@@ -7,15 +7,18 @@ designed on the undelayed linear model and applied 0.08 s late, the knee locked)
 hip fraction (after Creath et al. 2005; 0 for a body swaying as one pendulum, 1 for pure
 counter-rotation about the hip) against the peak speed of a 6 cm backward ramp-and-hold
 (after Horak & Nashner 1986's ramp translations). Right: against the frequency of a 5 cm
-sinusoidal translation, over the steady part. Blue: the ankle moment limited to what the foot
-carries (m g x_toe, 121 N·m); grey: no limit. Filled markers: the ankle saturated; crosses:
-the run fell.
+sinusoidal translation, over the steady part. Blue: the ankle moment limited both ways to
+m g x_toe, 121 N·m (the design's τ_max, the default of ``posturelab strategy``); orange:
+limited per side to what the foot carries, m g x_toe toward the toes and m g |x_heel|, 40 N·m,
+toward the heel (:mod:`posturelab.model.limits`, ``--ankle-limit-from-foot``); grey: no
+limit. Filled markers: the ankle saturated; crosses: the run fell.
 
 With the foot's limit the hip fraction stays below 0.1 for the slowest translations and at
 0.1–0.5 Hz and rises above 0.8 for the fastest translations and at 1.25 Hz, as the ankle
 saturates, and at 1.5 Hz the body falls; without the limit it rises less (the fast ramp
 excites the anti-phase mode on its own), and at 1 Hz it stays low: the limit is what hands
-the sway to the hip there.
+the sway to the hip there. With the heel's 40 N·m the ends of the maps are the same, but in
+between the body falls backward once dorsiflexion saturates (at 0.3 m/s, at 0.75 and 1 Hz).
 
 Usage: python examples/multijoint_strategy_maps.py [OUTPUT_DIR]   (default: current directory)
 """
@@ -27,6 +30,7 @@ import numpy as np
 
 import posturelab as pl
 from posturelab.linear.lqr import multijoint_controller
+from posturelab.model.limits import foot_moment_limits
 from posturelab.studies.strategy import oscillation_map, translation_map
 from posturelab.viz.plots import new_figure, save_figure
 
@@ -52,8 +56,12 @@ def make_figure():
     body = pl.paper_body()
     c = multijoint_controller(body)
     limit = float(c.effort_limits[0])
+    foot = pl.FOOT_FROM_LITERATURE
+    pair = foot_moment_limits(body.total_mass * body.gravity, foot.heel, foot.toe)
     fig, (ax_t, ax_o) = new_figure(1, 2, figsize=(10.0, 4.2))
-    for lim, colour, label in ((limit, "#1f77b4", f"ankle ≤ {limit:.0f} N·m (the foot)"),
+    for lim, colour, label in ((limit, "#1f77b4", f"|ankle| ≤ {limit:.0f} N·m"),
+                               (pair, "#ff7f0e",
+                                f"ankle in [{pair[0]:.0f}, {pair[1]:.0f}] N·m (the foot)"),
                                (None, "0.5", "ankle unlimited")):
         t = translation_map(body, c.muscles, SPEEDS, ankle_torque_limit=lim,
                             **c.run_options())

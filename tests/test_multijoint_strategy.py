@@ -104,6 +104,47 @@ def test_issue_targets_sinusoidal_translations(paper):
     assert smap.transition_frequency == 1.25
 
 
+@pytest.fixture(scope="module")
+def foot_bounded(paper):
+    """The paper's options with the ankle limited by the foot both ways: m g x_heel and
+    m g x_toe (posturelab.model.limits; −40 and 121 N·m)."""
+    from posturelab.model.limits import foot_moment_limits
+
+    body, c, opts = paper
+    foot = pl.FOOT_FROM_LITERATURE
+    pair = foot_moment_limits(body.total_mass * body.gravity, foot.heel, foot.toe)
+    return body, c, {**opts, "ankle_torque_limit": pair}
+
+
+def test_issue_targets_hold_with_the_foot_bounded_ankle(foot_bounded):
+    """The same targets with dorsiflexion limited to m g |x_heel| (not the default: between
+    them runs fall, docs/design.md)."""
+    body, c, opts = foot_bounded
+    smap = translation_map(body, c.muscles, [0.05, 0.1, 0.6, 1.0], **opts)
+    h = [r.hip_fraction for r in smap.runs]
+    assert h[0] < 0.15 and h[1] < 0.15
+    recovered = [r for r in smap.runs if r.outcome == "recovered"]
+    assert recovered[-1].value == 1.0 and recovered[-1].hip_fraction > 0.4
+    assert smap.ankle_dorsiflexion_limit == pytest.approx(-opts["ankle_torque_limit"][0])
+    assert smap.to_dict()["ankle_dorsiflexion_limit"] == smap.ankle_dorsiflexion_limit
+    osc = oscillation_map(body, c.muscles, 0.05, [0.1, 1.25], **opts)
+    assert osc.runs[0].hip_fraction < 0.15
+    assert osc.runs[1].hip_fraction > 0.4 and osc.runs[1].outcome == "recovered"
+    for m in (smap, osc):  # the ankle moment stays within the foot's limits
+        assert all(r.peak_ankle_moment <= opts["ankle_torque_limit"][1] + 1e-6 for r in m.runs)
+
+
+def test_strategy_command_ankle_limit_from_foot():
+    p = cli("strategy", "--translation", "backward", "--speeds", "0.05:0.05:1",
+            "--ankle-limit-from-foot", "--json")
+    assert p.returncode == 0, p.stderr
+    out = json.loads(p.stdout)
+    body, foot = pl.paper_body(), pl.FOOT_FROM_LITERATURE
+    weight = body.total_mass * body.gravity
+    assert out["ankle_torque_limit"] == pytest.approx(weight * foot.toe, rel=1e-12)
+    assert out["ankle_dorsiflexion_limit"] == pytest.approx(-weight * foot.heel, rel=1e-12)
+
+
 def test_strategy_command_json_and_figure(tmp_path):
     fig = tmp_path / "map.png"
     p = cli("strategy", "--translation", "backward", "--speeds", "0.05:0.3:2", "--json",

@@ -187,12 +187,31 @@ def thresholds():
     return {p: step_threshold(HEIGHT, MASS, p) for p in ("young", "older")}
 
 
-def test_thresholds_within_two_published_sd_and_older_below_young(thresholds):
+def test_the_foot_keeps_the_centre_of_pressure_on_it_and_older_is_below_young(thresholds):
+    """With the ankle limited by the foot both ways (m g × toe, m g × |heel|) the centre of
+    pressure stays on the foot but for the vertical force's departure from m g (under
+    COP_TOLERANCE), where the symmetric cap let it pass the heel by centimetres."""
+    from posturelab.studies.stepping import COP_TOLERANCE
+
     young, older = thresholds["young"], thresholds["older"]
+    for r in (young, older):
+        assert r.cop_overrun <= COP_TOLERANCE
+        # (both populations' strength is above m g × toe: the caps are m g × toe and heel)
+        assert r.dorsiflexion_cap / r.ankle_moment_cap == pytest.approx(-r.heel / r.toe,
+                                                                       rel=1e-12)
+    assert older.largest_translation < young.largest_translation
+
+
+def test_the_symmetric_cap_is_within_two_published_sd_but_overruns_the_heel():
+    """The cap of before issue 22 (plantarflexion's both ways): both thresholds within two
+    published SD, older below young, but the centre of pressure centimetres behind the heel."""
+    young, older = (step_threshold(HEIGHT, MASS, p, heel_limit=False) for p in ("young", "older"))
     assert abs(young.largest_translation - KOUSHYAR_YOUNG[0]) <= 2 * KOUSHYAR_YOUNG[1]
     assert abs(older.largest_translation - KOUSHYAR_OLDER[0]) <= 2 * KOUSHYAR_OLDER[1]
     assert older.largest_translation < young.largest_translation
     assert young.within_two_sd and older.within_two_sd
+    assert min(young.cop_overrun, older.cop_overrun) > 0.02
+    assert young.dorsiflexion_cap == young.ankle_moment_cap
 
 
 def test_a_threshold_says_what_happened(thresholds):
@@ -203,7 +222,9 @@ def test_a_threshold_says_what_happened(thresholds):
     assert r.peak_velocity == pytest.approx(2 * r.largest_translation / r.move_duration)
     assert r.ankle_moment_cap <= r.ankle_strength
     d = r.to_dict()
-    assert d["largest_translation"] == r.largest_translation and d["within_two_sd"] is True
+    assert d["largest_translation"] == r.largest_translation
+    assert d["within_two_sd"] is r.within_two_sd is (
+        abs(r.largest_translation - KOUSHYAR_YOUNG[0]) <= 2 * KOUSHYAR_YOUNG[1])
 
 
 def test_the_guide_prints_the_thresholds_computed(thresholds):
@@ -218,12 +239,14 @@ def test_the_guide_prints_the_thresholds_computed(thresholds):
                    if line.startswith(f"{name} ") and "±" in line)
         printed = float(row.split()[1]) / 100.0
         assert thresholds[name].largest_translation == pytest.approx(printed, abs=5e-4)
+        assert row.split()[5] == ("yes" if thresholds[name].within_two_sd else "no")
 
 
 @pytest.mark.parametrize("duration", [0.4, 0.7, 1.0])
 def test_the_comparison_holds_for_other_move_durations(duration):
-    """The protocol's T = 0.5 s is posturelab's assumption: at other durations of the move
-    the thresholds stay within two published SD, older below young."""
+    """The protocol's T = 0.5 s is posturelab's assumption: at these other durations of the
+    move the thresholds are within two published SD, older below young (not at 0.5–0.65 s,
+    where the young preset's rebound reaches the heel: docs/guide/stepping.rst)."""
     from dataclasses import replace
 
     from posturelab.studies.stepping import PROTOCOL
@@ -265,8 +288,10 @@ def test_threshold_falls_with_the_delay():
     assert values[-1] < values[0]
 
 
-def test_threshold_rises_with_ankle_strength():
-    values = [step_threshold(HEIGHT, MASS, "young", ankle_strength=s).largest_translation
+def test_threshold_rises_with_ankle_strength_under_the_symmetric_cap():
+    """(With the foot's heel limit it does not: docs/guide/stepping.rst.)"""
+    values = [step_threshold(HEIGHT, MASS, "young", ankle_strength=s,
+                             heel_limit=False).largest_translation
               for s in (40.0, 80.0, 120.0, 200.0, 300.0)]
     assert all(b >= a for a, b in zip(values[:-1], values[1:], strict=True)), values
     assert values[-1] > values[0]

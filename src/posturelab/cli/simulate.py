@@ -167,7 +167,13 @@ def add_experiment_arguments(p: argparse.ArgumentParser) -> None:
                      "of the measurement noise too.")
     src.add_argument("--torque-limits", metavar="ANKLE,KNEE,HIP",
                      help="largest net muscle moment at each joint [N·m], each > 0 ('inf' for "
-                     "none).")
+                     "none); or LO:HI, the moment kept in [LO, HI], LO < 0 < HI (at the ankle "
+                     "HI is plantarflexion, pressing toward the toes, LO dorsiflexion, toward "
+                     "the heel); or 'foot' for the ankle: LO = m g x_heel, HI = m g x_toe "
+                     "from the body's weight and --foot.")
+    src.add_argument("--ankle-limit-from-foot", action="store_true",
+                     help="limit the ankle to what the foot can carry, m g x_heel : m g x_toe "
+                     "(the same as 'foot' as the first --torque-limits entry; needs --foot).")
     src.add_argument("--max-link-angle", type=float, default=None, metavar="RAD",
                      help="fall when any |θ_i| exceeds this [rad] (default π/3).")
     run = p.add_argument_group("integration")
@@ -258,6 +264,13 @@ def run_options_from_args(args: argparse.Namespace, sc: Scenario,
     torque_limits = base.torque_limits
     if args.torque_limits:
         torque_limits = torque_limits_from_table(args.torque_limits, n, "", FLAG_NAMES)
+    if getattr(args, "ankle_limit_from_foot", False):
+        torque_limits = ("foot",) + tuple(torque_limits[1:] if torque_limits is not None
+                                          else (math.inf,) * (n - 1))
+    if torque_limits is not None and "foot" in torque_limits and fall.base_of_support is None:
+        raise UsageError(f"{command}: the ankle's limits from the foot (--ankle-limit-from-foot "
+                         "or 'foot' in --torque-limits / [limits] torque) need a foot: give "
+                         "--foot literature (or HEEL,TOE)")
     with naming_option("--motor-noise"):
         motor_noise = motor_noise_from_args(args, n)
     if motor_noise is not None:

@@ -9,7 +9,9 @@ from ._common import print_json
 DESCRIPTION = """\
 The largest platform translation a subject withstands with the feet in place: a one-link
 body scaled from --height and --mass (Winter's table), an ankle controller with the
-population's gains, feedback delay and ankle strength, on a foot of 0.152 × height. A run
+population's gains, feedback delay and ankle strength, on a foot of 0.152 × height; the
+ankle moment limited to min(strength, m g × toe) toward the toes and m g × |heel| toward the
+heel, what a flat foot carries (--symmetric-ankle-cap: the first both ways). A run
 needs a step when the extrapolated centre of mass x + v/ω0 (Hof, Gazendam & Sinke 2005,
 J Biomech 38:1–8; ω0 = √(g/l), l the centre of mass's height) leaves the foot, or when
 the body falls. The platform moves are ramp-and-holds over 0.5 s (posturelab's assumption),
@@ -41,6 +43,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--cop-criterion", action="store_true",
                    help="also count a step when the centre of pressure leaves the foot (the "
                    "heel would rise or the toes lift).")
+    p.add_argument("--symmetric-ankle-cap", action="store_true",
+                   help="cap dorsiflexion at the plantarflexion cap (the same both ways, as "
+                   "before issue 22) instead of at m g |x_heel|, the foot's: the centre of "
+                   "pressure may then pass the heel.")
     p.add_argument("--sources", action="store_true",
                    help="also print where each number of the population comes from.")
     p.add_argument("--json", action="store_true", help="print one JSON object instead of text.")
@@ -50,7 +56,13 @@ def run(args: argparse.Namespace) -> int:
     from dataclasses import replace
 
     from .._validation import float_in_range
-    from ..studies.stepping import PROTOCOL, UNITS, get_population, step_threshold
+    from ..studies.stepping import (
+        COP_TOLERANCE,
+        PROTOCOL,
+        UNITS,
+        get_population,
+        step_threshold,
+    )
 
     population = get_population(args.population)
     protocol = PROTOCOL if args.move_duration is None else replace(
@@ -59,7 +71,8 @@ def run(args: argparse.Namespace) -> int:
     result = step_threshold(args.height, args.mass, population, args.direction,
                             protocol=protocol, feedback_delay=args.feedback_delay,
                             ankle_strength=args.ankle_strength,
-                            cop_criterion=args.cop_criterion)
+                            cop_criterion=args.cop_criterion,
+                            heel_limit=not args.symmetric_ankle_cap)
     out = result.to_dict()
     if args.json:
         out["units"] = UNITS
@@ -76,11 +89,13 @@ def run(args: argparse.Namespace) -> int:
     print(f"  platform move over {result.move_duration:g} s: peak {result.peak_velocity:.2f} "
           f"m/s, {result.peak_acceleration:.2f} m/s² at the threshold")
     print(f"  τ = {result.feedback_delay * 1000:.0f} ms, ankle strength "
-          f"{result.ankle_strength:.0f} N·m (cap {result.ankle_moment_cap:.0f} N·m), foot "
+          f"{result.ankle_strength:.0f} N·m (caps: plantarflexion "
+          f"{result.ankle_moment_cap:.0f} N·m, dorsiflexion {result.dorsiflexion_cap:.0f} "
+          "N·m), foot "
           f"{result.heel * cm:.1f} … {result.toe * cm:.1f} cm, ω0 = {result.omega0:.2f} 1/s")
-    if result.cop_overrun > 0.0:
+    if result.cop_overrun > COP_TOLERANCE:
         print(f"  the centre of pressure went {result.cop_overrun * cm:.1f} cm beyond the foot "
-              "at the threshold (the moment cap is the same both ways; see the guide)")
+              "at the threshold (see the guide)")
     if result.published_mean is not None:
         verdict = "within" if result.within_two_sd else "outside"
         print(f"published: {result.published_mean * cm:.1f} ± {result.published_sd * cm:.1f} "

@@ -12,7 +12,9 @@ DESCRIPTION = """\
 Strategy maps: how much of the sway is the hip (anti-phase) mode of leg and trunk, the hip
 fraction Σb²/(Σa² + Σb²) (after Creath et al. 2005), across a family of translations of the
 support surface, with a multi-joint controller (an LQR design on the linearised chain,
-delayed; posturelab.linear.lqr) and the ankle moment limited by the foot.
+delayed; posturelab.linear.lqr) and the ankle moment limited to m g x_toe both ways, the
+design's τ_max (--ankle-limit-from-foot: m g x_toe toward the toes, m g |x_heel| toward the
+heel, what a flat foot carries).
 
 --translation backward|forward --speeds LO:HI:N   transient translations: a ramp-and-hold of
     --displacement D (0.06 m) whose peak speed 2D/T is each speed (after Horak & Nashner
@@ -23,7 +25,8 @@ delayed; posturelab.linear.lqr) and the ankle moment limited by the foot.
 
 --json prints {"runs": [{"speed" or "frequency": …, "hip_fraction": …, "outcome":
 "recovered"|"fell"|"failed", "peak_ankle_moment": N·m, "ankle_saturated": bool,
-"peak_hip_angle": rad}], "profile", "ankle_torque_limit", "units", "controller",
+"peak_hip_angle": rad}], "profile", "ankle_torque_limit" (and, with
+--ankle-limit-from-foot, "ankle_dorsiflexion_limit", its magnitude), "units", "controller",
 "feedback_delay" [s], "delay_margin" [s] and "design_poles" [1/s] of its linear design}.
 --ankle-torque-limits LO:HI:N  a two-parameter map: the family at each limit [N·m], each
 run with its "ankle_torque_limit" (the sweep does the same with --vary
@@ -70,6 +73,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     limit = p.add_mutually_exclusive_group()
     limit.add_argument("--ankle-torque-limit", type=float, metavar="N·m",
                        help="the ankle's torque limit (default: m g x_toe, the foot's).")
+    limit.add_argument("--ankle-limit-from-foot", action="store_true",
+                       help="limit the ankle both ways to what the foot can carry: "
+                            "plantarflexion m g x_toe, dorsiflexion m g |x_heel| (the foot of "
+                            "0.152 × 1.65 m, ankle at a quarter from the heel).")
     limit.add_argument("--ankle-torque-limits", metavar="LO:HI:N",
                        help="a two-parameter map: the family at each of these ankle torque "
                             "limits [N·m] (each run then carries its ankle_torque_limit).")
@@ -95,6 +102,11 @@ def run(args: argparse.Namespace) -> int:
     controller = multijoint_controller(body, args.controller, args.joint_feedback_scale)
     limit = (controller.effort_limits[0] if args.ankle_torque_limit is None
              else args.ankle_torque_limit)
+    if args.ankle_limit_from_foot:
+        from ..model.limits import foot_moment_limits
+        from ..model.options import FOOT_FROM_LITERATURE as FOOT
+
+        limit = foot_moment_limits(body.total_mass * body.gravity, FOOT.heel, FOOT.toe)
     common = dict(engine=args.engine, **controller.run_options())
     if args.translation is not None:
         make = functools.partial(translation_map, body, controller.muscles,
@@ -118,7 +130,9 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         print_json(out)
         return 0
-    print(f"{result.profile}; ankle torque limit {limit:.4g} N·m; controller {controller.name}")
+    shown = (f"{limit:.4g} N·m" if result.ankle_dorsiflexion_limit is None else
+             f"{-result.ankle_dorsiflexion_limit:.4g} … {result.ankle_torque_limit:.4g} N·m")
+    print(f"{result.profile}; ankle torque limit {shown}; controller {controller.name}")
     for r in result.runs:
         print(f"  {result.variable} {r.value:8.4g}  hip fraction {r.hip_fraction:6.3f}  "
               f"{r.outcome}{'  (ankle saturated)' if r.ankle_saturated else ''}")

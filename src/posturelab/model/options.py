@@ -1,5 +1,5 @@
-"""Options of a run that belong to the model, not to an engine: the foot, falls, the knee,
-joint torque limits.
+"""Options of a run that belong to the model, not to an engine: the foot, falls, the knee
+(joint torque limits: :mod:`.limits`).
 
 Both simulators take these frozen objects (validated on construction) and treat
 them the same way; the events that enforce them are stated in :mod:`.events`.
@@ -11,10 +11,9 @@ import math
 from dataclasses import dataclass
 from typing import Literal
 
-import numpy as np
-
 from .._validation import float_in_range
 from ..errors import ParameterError
+from .limits import torque_limit_array  # (its home is .limits; kept importable from here)
 
 __all__ = [
     "BaseOfSupport",
@@ -144,35 +143,3 @@ class KneeModel:
             raise ParameterError(f"knee mode must be 'free', 'locked' or 'stop', got {self.mode!r}")
         object.__setattr__(self, "stop_angle",
                            float_in_range("knee stop_angle [rad]", self.stop_angle, -0.5, 0.5))
-
-
-def torque_limit_array(torque_limits, n_links: int) -> np.ndarray | None:
-    """Validated joint torque limits: N numbers > 0 (``inf`` for none), or None if none limit.
-
-    Parameters
-    ----------
-    torque_limits : array_like, shape (N,), or None
-        Largest net muscle moment at the ankle, knee, hip, … [N·m]
-    n_links : int
-        Number of links N. [-]
-
-    Returns
-    -------
-    numpy.ndarray, shape (N,), or None
-        The limits [N·m]; None when none is given or every one is infinite.
-    """
-    if torque_limits is None:
-        return None
-    try:
-        limits = np.array(torque_limits, dtype=float).reshape(-1)
-    except (TypeError, ValueError):
-        limits = np.array([math.nan])
-    if limits.shape != (n_links,) or np.any(np.isnan(limits)) or np.any(limits <= 0):
-        shown = torque_limits if not hasattr(torque_limits, "tolist") else torque_limits.tolist()
-        raise ParameterError(
-            f"torque_limits [N·m] must be {n_links} numbers > 0 (inf for none), got {shown!r}"
-        )
-    if np.all(np.isinf(limits)):
-        return None
-    limits.setflags(write=False)
-    return limits

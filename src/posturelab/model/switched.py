@@ -34,6 +34,7 @@ from .feedback import feedback_pair_torques, moments_to_link_torques, muscle_set
 from .gains import DELAYED_STIFFNESS, DELAYED_VISCOSITY, IMMEDIATE_STIFFNESS, IMMEDIATE_VISCOSITY
 from .joint_feedback import joint_feedback_moments
 from .kinematics import centre_of_pressure, ground_reaction
+from .limits import NEGATIVE, POSITIVE, start_saturation
 from .muscles import MuscleSet
 from .noise import TorqueSeries, torque_at
 from .options import FallCriteria, KneeModel
@@ -66,10 +67,13 @@ def pull_value_formula(torque, stiffness, stretch, xp=np):
     return xp.minimum(torque, xp.where(stiffness > 0, stiffness, 1.0) * stretch)
 
 
-def saturated_moment_formula(moment, saturation, limit, xp=np):
-    """A joint's moment with its saturation applied: ±limit while saturated (saturation
-    ±1), the moment itself while free (saturation 0). [N·m]"""
-    return xp.where(xp.not_equal(saturation, 0), saturation * limit, moment)
+def saturated_moment_formula(moment, saturation, negative_limit, positive_limit, xp=np):
+    """A joint's moment with its saturation applied: +positive_limit while saturated at +1,
+    −negative_limit at −1 (both limits >= 0, :mod:`.limits`), the moment itself while free
+    (saturation 0). [N·m]"""
+    return xp.where(xp.not_equal(saturation, 0),
+                    saturation * xp.where(saturation > 0, positive_limit, negative_limit),
+                    moment)
 
 
 def tilt_pair_torque_formula(gain_angle, gain_rate, gain_delayed_angle, gain_delayed_rate,
@@ -110,8 +114,8 @@ def _cop_heel(heel, vertical_reaction, ankle_moment, xp=np):
     return ankle_moment - heel * vertical_reaction
 
 
-def _saturation(side, moment, limit, xp=np):
-    return side * moment - limit
+def _saturation(side, moment, negative_limit, positive_limit, xp=np):
+    return side * moment - xp.where(side > 0, positive_limit, negative_limit)
 
 
 def _stretch(stretch, xp=np):
@@ -142,7 +146,8 @@ def _knee_leaves_stop(free_knee_acceleration, xp=np):
 #: segment's switches), moment τ_j before saturation, stretch s_p and stretch_rate ṡ_p of the
 #: fed-back state, pair_stiffness and pair_viscosity (immediate plus delayed gains),
 #: knee_angle θ2 − θ1, free_knee_acceleration θ̈2 − θ̈1 with the knee free; and the options
-#: max_link_angle, toe, heel, side, limit, stop_angle.
+#: max_link_angle, toe, heel, side, negative_limit and positive_limit (the joint's, >= 0,
+#: :mod:`.limits`), stop_angle.
 EVENT_VALUES = {
     ev.LINK_ANGLE: _link_angle, ev.COG_TOE: _cog_toe, ev.COG_HEEL: _cog_heel,
     ev.COP_TOE: _cop_toe, ev.COP_HEEL: _cop_heel, ev.SATURATES: _saturation,
@@ -172,8 +177,9 @@ class SwitchedModel:
         Pair gains by when they act (rows named in :mod:`.gains`).
         [N·m/rad], [N·m·s/rad], [N·m/rad], [N·m·s/rad]
     disturbance : Disturbance
-    torque_limits : numpy.ndarray, shape (N,), or None
-        ``inf`` where a joint has none. [N·m]
+    torque_limits : numpy.ndarray, shape (2, N), or None
+        The magnitudes of each joint's negative and positive limits (:mod:`.limits`),
+        ``inf`` where a side has none. [N·m]
     feedback_delay : float
         τ. [s]
     tilt, visual_tilt : Tilt or None
@@ -303,13 +309,14 @@ def raw_moments(model: SwitchedModel, t: float, x: np.ndarray, feedback: np.ndar
 
 
 def saturated_moments(moments: np.ndarray, saturation: np.ndarray | None,
-                      limits: np.ndarray | None) -> np.ndarray:
+                      bounds: np.ndarray | None) -> np.ndarray:
     """Moments (..., N) with the joints' saturation (..., N) applied
-    (:func:`saturated_moment_formula`; a joint without a limit never saturates). [N·m]"""
-    if saturation is None or limits is None:
+    (:func:`saturated_moment_formula`; ``bounds`` (..., 2, N) the limits of :mod:`.limits`; a
+    side without a limit never saturates). [N·m]"""
+    if saturation is None or bounds is None:
         return moments
-    bound = np.where(np.isfinite(limits), limits, 0.0)
-    return saturated_moment_formula(moments, saturation, bound)
+    b = np.where(np.isfinite(bounds), bounds, 0.0)
+    return saturated_moment_formula(moments, saturation, b[..., NEGATIVE, :], b[..., POSITIVE, :])
 
 
 def _acceleration(model: SwitchedModel, x: np.ndarray, tau: np.ndarray, a: np.ndarray,
@@ -341,7 +348,7 @@ def model_response(model: SwitchedModel, t: float, x: np.ndarray, feedback: np.n
     locked : bool
         The knee constraint holds.
     saturation : numpy.ndarray, shape (N,), or None
-        ±1 for a saturated joint (its moment is ±limit), 0 for a free one. [-]
+        ±1 for a joint saturated at its positive or negative limit, 0 for a free one. [-]
     filter_state : numpy.ndarray, shape (P,), or None
         The torque feedback filters' states Y (:func:`torque_feedback_rate`). [N·m]
 
@@ -398,6 +405,9 @@ def event_value(model: SwitchedModel, kind: int, j: int, side: float, t: float, 
     bos = fall.base_of_support
     E = model.muscles.selection_matrix
 
+    def limit(row: int) -> float:
+        return model.torque_limits[row, j] if model.torque_limits is not None else 0.0
+
     def quantity(name: str):
         if name == "link_angle":
             return x[j]
@@ -422,7 +432,7 @@ def event_value(model: SwitchedModel, kind: int, j: int, side: float, t: float, 
         return {"max_link_angle": fall.max_link_angle, "side": side,
                 "toe": bos.toe if bos is not None else 0.0,
                 "heel": bos.heel if bos is not None else 0.0,
-                "limit": model.torque_limits[j] if model.torque_limits is not None else 0.0,
+                "negative_limit": limit(NEGATIVE), "positive_limit": limit(POSITIVE),
                 "stop_angle": model.knee.stop_angle}[name]
 
     names = EVENT_QUANTITIES[kind]
@@ -550,26 +560,13 @@ def start_moments(muscles: MuscleSet, state: np.ndarray, before: np.ndarray,
     return feedback_pair_torques(muscles, gains, state, before, active) @ muscles.crossing_matrix
 
 
-def start_saturation(moments: np.ndarray, limits: np.ndarray | None) -> np.ndarray:
-    """±1 for each joint whose moment starts beyond its limit, else 0 (shape of moments)."""
-    moments = np.asarray(moments, dtype=float)
-    sat = np.zeros(moments.shape)
-    if limits is not None:
-        limits = np.broadcast_to(np.asarray(limits, dtype=float), moments.shape)
-        over = np.isfinite(limits) & (np.abs(moments) > limits)
-        sat[over] = np.sign(moments[over])
-    return sat
-
-
 def start_centre_of_pressure(model: SwitchedModel, x0: np.ndarray, locked0: bool,
                              moments: np.ndarray, limits, saturation) -> np.ndarray:
     """Centre of pressure at t = 0 from the state ``x0`` (2N,) for runs that differ in their
-    moments (..., N) [N·m], limits (..., N) [N·m] and saturation (..., N): x_p (...). [m]"""
+    moments (..., N) [N·m], limits (..., 2, N) [N·m] (:mod:`.limits`) and saturation
+    (..., N): x_p (...). [m]"""
     n = model.n_links
-    tau = np.asarray(moments, dtype=float)
-    if limits is not None:
-        bound = np.where(np.isfinite(limits), limits, 0.0)
-        tau = saturated_moment_formula(tau, saturation, bound)
+    tau = saturated_moments(np.asarray(moments, dtype=float), saturation, limits)
     a = platform_acceleration(model, 0.0)
     theta = np.broadcast_to(x0[:n], tau.shape)
     omega = np.broadcast_to(x0[n:], tau.shape)

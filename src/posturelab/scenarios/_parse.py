@@ -300,28 +300,52 @@ def fall_from_table(ft: dict, origin: str = "", names: Mapping[str, str] | None 
 
 
 def torque_limits_from_table(values, n_joints: int, origin: str = "",
-                             names: Mapping[str, str] | None = None) -> tuple[float, ...]:
-    """limits.torque: one largest net moment per joint [N·m], each > 0, or "inf" / "none"
-    for no limit; a list, or its text ``"120,inf,80"``."""
+                             names: Mapping[str, str] | None = None) -> tuple:
+    """limits.torque: per joint the largest net moment [N·m] both ways, > 0, or "inf" /
+    "none" for no limit; or LO:HI (a list [LO, HI]), the moment kept in [LO, HI] with
+    LO < 0 < HI (at the ankle HI plantarflexion, toward the toes; LO dorsiflexion, toward the
+    heel; -inf / inf for none); or "foot" (the ankle: m g x_heel : m g x_toe from the foot,
+    :mod:`posturelab.model.limits`). A list, or its text ``"120,inf,80"`` /
+    ``"-40:130,inf,inf"`` / ``"foot,inf,inf"``."""
     where = f"{_name(names, 'limits.torque')} [N·m]"
     if isinstance(values, str):
         values = [v.strip().lower() for v in values.split(",")]
     if len(values) != n_joints:
         raise _error(origin, f"{where} needs {n_joints} values (one per joint), got "
                      f"{len(values)}")
-    out = []
-    for value in values:
-        if value in ("inf", "none"):
-            out.append(math.inf)
+
+    def number(value, ok, what: str) -> float:
+        text = value.strip().lower() if isinstance(value, str) else None
+        if text in ("inf", "none", "-inf"):
+            v = -math.inf if text == "-inf" else math.inf
+        else:
+            try:
+                v = math.nan if isinstance(value, bool) else float(value)
+            except (TypeError, ValueError):
+                v = math.nan
+        if not ok(v):  # (NaN fails)
+            raise _error(origin, f"{where} {what}, got {value!r}")
+        return v
+
+    out: list = []
+    for j, value in enumerate(values):
+        if isinstance(value, str) and value.strip().lower() == "foot":
+            if j != 0:
+                raise _error(origin, f"{where}: 'foot' is for the ankle (the first joint) only")
+            out.append("foot")
             continue
-        try:
-            v = float(value)
-        except (TypeError, ValueError):
-            raise _error(origin, f"{where} must be numbers or 'inf', got {value!r}") from None
-        if isinstance(value, bool) or not (math.isfinite(v) and v > 0):
-            raise _error(origin, f"{where} must each be in (0, inf] (a number > 0, or 'inf' "
-                         f"for no limit), got {value!r}")
-        out.append(v)
+        if isinstance(value, str) and ":" in value:
+            value = value.split(":")
+        if isinstance(value, (list, tuple)):
+            if len(value) != 2:
+                raise _error(origin, f"{where} LO:HI needs two numbers, got {value!r}")
+            out.append((number(value[0], lambda v: v < 0, "LO (at the ankle dorsiflexion, "
+                               "toward the heel) must be in [-inf, 0)"),
+                        number(value[1], lambda v: v > 0, "HI (at the ankle plantarflexion, "
+                               "toward the toes) must be in (0, inf]")))
+            continue
+        out.append(number(value, lambda v: v > 0, "must each be in (0, inf] (a number > 0, "
+                          "'inf' for no limit, LO:HI or 'foot')"))
     return tuple(out)
 
 

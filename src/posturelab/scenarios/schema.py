@@ -153,9 +153,10 @@ class FallTable(_Table):
 
 class LimitsTable(_Table):
     """``[limits]``: the largest net moment per joint [N·m], ``"inf"`` or ``"none"`` for
-    no limit."""
+    no limit; or per joint ``[LO, HI]`` / ``"LO:HI"`` (LO < 0 < HI; at the ankle HI is
+    plantarflexion, toward the toes), or ``"foot"`` for the ankle (m g x_heel, m g x_toe)."""
 
-    torque: list[float | Literal["inf", "none"]] | None = None
+    torque: list[float | str | list[float | str]] | None = None
 
 
 class SolverTable(_Table):

@@ -17,6 +17,7 @@ from ..model.kinematics import (
     centre_of_pressure,
     ground_reaction,
 )
+from ..model.limits import clip_moments
 from ..model.muscles import feedback_pair_torques, moments_to_link_torques
 from ..model.noise import torque_at
 from .results import DerivedSeries
@@ -78,7 +79,7 @@ def derived_series(setup: RunSetup, time: np.ndarray, state: np.ndarray,
     if setup.motor_torque is not None:
         moments = moments + torque_at(setup.motor_torque, time)
     if setup.torque_limits is not None:
-        moments = np.clip(moments, -setup.torque_limits, setup.torque_limits)
+        moments = clip_moments(moments, setup.torque_limits)
     if setup.torque_limits is not None or setup.motor_torque is not None or control:
         U = moments_to_link_torques(moments)
     else:

@@ -120,9 +120,14 @@ class RunOptions:
         Free (default), locked, or with a hyper-extension stop. Needs N >= 2.
     fall : FallCriteria
         Fall criteria; default: any |θ_i| > π/3, no foot limit (the paper's model).
-    torque_limits : tuple of float, or None
+    torque_limits : tuple, or None
         Largest net muscle moment at the ankle, knee, hip, … (the sum of the pairs crossing
-        each joint); ``inf`` for no limit. A joint saturates and lets go at events. [N·m]
+        each joint), per joint: a number L (|τ_j| <= L; ``inf`` for no limit), a pair
+        (lower, upper) with lower < 0 < upper (τ_j in [lower, upper]; at the ankle a
+        positive moment is plantarflexion, pressing the centre of pressure toward the toes),
+        or ``"foot"`` for the ankle: (m g x_heel, m g x_toe) from the body's weight and
+        ``fall.base_of_support`` (:mod:`posturelab.model.limits`). A joint saturates and lets
+        go at events. [N·m]
     feedback_delay : float
         Neural delay τ. With active gains in the muscles it delays their part only (the
         intrinsic gains act at once); without any, every pair's whole torque responds to
@@ -187,8 +192,9 @@ class RunOptions:
         "upright", "where J⁻¹H is evaluated for a velocity step")
     knee: KneeModel = _option(KneeModel(), "the knee: free, locked or with a stop")
     fall: FallCriteria = _option(FallCriteria(), "the fall criteria")
-    torque_limits: tuple[float, ...] | None = _option(
-        None, "largest net muscle moment per joint (inf: none)", "N·m")
+    torque_limits: tuple | None = _option(
+        None, "largest net muscle moment per joint: L, (lower, upper) or 'foot' (inf: none)",
+        "N·m")
     feedback_delay: float = _option(0.0, QUANTITIES["feedback_delay"].meaning, "s")
     proprioceptive_weight: float = _option(1.0, QUANTITIES["proprioceptive_weight"].meaning,
                                            "-")
@@ -375,14 +381,13 @@ def _step_budget(value: Any) -> int:
     return int(value)
 
 
-def _limit_tuple(value: Any) -> tuple[float, ...]:
-    """Torque limits as a tuple of floats (their values are checked per joint when the run is
-    set up, :func:`posturelab.model.options.torque_limit_array`)."""
-    try:
-        return tuple(np.asarray(value, dtype=float).ravel().tolist())
-    except (TypeError, ValueError):
-        raise ParameterError(f"torque_limits [N·m] must be numbers (inf for none), got "
-                             f"{value!r:.60}") from None
+def _limit_tuple(value: Any) -> tuple:
+    """Torque limits as a tuple with a float, a (lower, upper) pair or "foot" per joint (their
+    values are checked per joint when the run is set up,
+    :func:`posturelab.model.limits.torque_limit_array`)."""
+    from ..model.limits import limit_entries
+
+    return limit_entries(value)
 
 
 def _expect(name: str, value: Any, kind: type) -> None:

@@ -148,7 +148,8 @@ def integrate_reference(setup: RunSetup, method: str = "DOP853") -> SimulationRe
         return y[m:] if filters else None
 
     limits = setup.torque_limits
-    limited = np.isfinite(limits).astype(np.int64) if limits is not None else np.zeros(n, int)
+    limited = (np.isfinite(limits).any(axis=0).astype(np.int64) if limits is not None
+               else np.zeros(n, int))
     x = np.concatenate([setup.x0, np.zeros(filters)])  # the filters start at rest
     locked = setup.locked0
     active = setup.active0.copy()

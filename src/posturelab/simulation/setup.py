@@ -33,9 +33,10 @@ from ..model.dynamics import (
     platform_vector,
 )
 from ..model.joint_feedback import joint_feedback_moments, joint_gain_rows
+from ..model.limits import body_torque_limits
 from ..model.muscles import MuscleSet, muscle_set_gains
 from ..model.noise import MotorNoise, TorqueSeries, motor_noise_series, torque_at
-from ..model.options import FallCriteria, KneeModel, torque_limit_array
+from ..model.options import FallCriteria, KneeModel
 from ..model.platform import Disturbance, NoDisturbance
 from ..model.tilt import Tilt, axis_translation, tilt_pair_gains
 from ..model.visual import visual_pair_gains
@@ -78,8 +79,9 @@ class RunSetup:
     disturbance : Disturbance
     options : RunOptions
         The run's options as given (checked).
-    torque_limits : numpy.ndarray, shape (N,), or None
-        Largest net muscle moment per joint, ``inf`` where none; None if none limit. [N·m]
+    torque_limits : numpy.ndarray, shape (2, N), or None
+        Each joint's largest negative (its magnitude, row 0) and positive net muscle moment
+        (:mod:`posturelab.model.limits`), ``inf`` where none; None if none limit. [N·m]
     gains : numpy.ndarray, shape (4, P)
         The pair gains by when they act (:func:`posturelab.model.muscles.feedback_gains`):
         immediate stiffness and viscosity, delayed stiffness and viscosity.
@@ -374,7 +376,7 @@ def _prepare(body: Body, muscles: MuscleSet, disturbance: Disturbance,
     n = body.n_links
     if knee.mode != "free" and n < 2:
         raise ParameterError("knee mode 'locked' or 'stop' needs a body with at least 2 links")
-    limits = torque_limit_array(options.torque_limits, n)
+    limits = body_torque_limits(options.torque_limits, body, options.fall.base_of_support)
     initial_state = options.initial_state
     before = (np.zeros(2 * n) if initial_state is None
               else finite_array("initial_state [rad, rad/s]", initial_state, (2 * n,)).copy())

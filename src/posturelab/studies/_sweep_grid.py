@@ -223,9 +223,10 @@ class SweepGrid:
         varied (every run has the base motion). [-]
     feedback_delay : numpy.ndarray, shape (M,)
         Neural delay of the muscle feedback per run. [s]
-    torque_limits : numpy.ndarray, shape (M, N), optional
-        Largest net moment at each joint per run (inf for none); None when no run has a
-        limit. [N·m]
+    torque_limits : numpy.ndarray, shape (M, N) or (M, N, 2), optional
+        Largest net moment at each joint per run, both ways (inf for none), or (lower,
+        upper) per joint when the base experiment's limits differ by side
+        (:mod:`posturelab.model.limits`); None when no run has a limit. [N·m]
     active_stiffness, active_viscosity : numpy.ndarray, shape (M, P), optional
         Active (delayed) pair gains per run; None when the base experiment has none and
         none is varied. [N·m/rad], [N·m·s/rad]
@@ -285,6 +286,21 @@ def check_base(scenario: Scenario, names: Sequence[str] = ()) -> list[str]:
                          what="sweep parameter") for name in names]
 
 
+
+def _base_limits(scenario, n: int) -> np.ndarray:
+    """The base experiment's limits: (N,) both ways, or (N, 2) (lower, upper) when a joint's
+    differ by side or the ankle's come from the foot. [N·m]"""
+    from ..model.limits import NEGATIVE, POSITIVE, body_torque_limits
+
+    given = scenario.torque_limits
+    if given is None:
+        return np.full(n, math.inf)
+    if all(isinstance(e, float) for e in given):
+        return np.asarray(given, dtype=float)
+    bounds = body_torque_limits(given, scenario.body, scenario.fall.base_of_support)
+    bounds = np.full((2, n), math.inf) if bounds is None else bounds
+    return np.stack([-bounds[NEGATIVE], bounds[POSITIVE]], axis=1)
+
 def sweep_grid(scenario: Scenario, varies: Sequence[VaryRange],
                viscosity_ratio: float | None = None) -> SweepGrid:
     """The full grid of a sweep around ``scenario`` (see the module docstring).
@@ -330,9 +346,8 @@ def sweep_grid(scenario: Scenario, varies: Sequence[VaryRange],
                              "multijoint-default or [muscles] controller")
     delay = np.full(m, float(scenario.feedback_delay))
     n = scenario.body.n_links
-    base_limits = (np.full(n, math.inf) if scenario.torque_limits is None
-                   else np.asarray(scenario.torque_limits, dtype=float))
-    limits = np.tile(base_limits, (m, 1))
+    base_limits = _base_limits(scenario, n)
+    limits = np.tile(base_limits, (m,) + (1,) * base_limits.ndim)
     muscles = scenario.muscles
     pairs = list(muscles.names)
     joints = list(joints_of(n))
@@ -355,8 +370,12 @@ def sweep_grid(scenario: Scenario, varies: Sequence[VaryRange],
             weight = np.ascontiguousarray(column)
         elif quantity == "joint_feedback_scale":
             control = np.ascontiguousarray(column)
-        elif quantity == "torque_limit":
-            limits[:, joints.index(member)] = column
+        elif quantity == "torque_limit":  # (both ways)
+            j = joints.index(member)
+            if limits.ndim == 3:
+                limits[:, j, 0], limits[:, j, 1] = -column, column
+            else:
+                limits[:, j] = column
         elif quantity == "active_viscosity":
             va[:, pairs.index(member)] = column
         elif quantity == "active_stiffness":

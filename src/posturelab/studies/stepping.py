@@ -16,10 +16,15 @@ earlier (:func:`posturelab.simulate`'s ``feedback_delay``). The XCoM is judged a
 delayed trajectory, so what it reaches during the delay counts; the result reports ξ at the
 response onset t = τ.
 
-**Ankle strength** caps the net ankle moment (``torque_limits``) at the smaller of the
-plantarflexor strength and m g × toe (:func:`~posturelab.model.stepping.ankle_moment_cap`):
-a flat foot cannot press in front of its toe (a heel rise is not modelled). The engine's cap
-is the same both ways (dorsiflexion too).
+**Ankle strength and the foot** limit the net ankle moment (``torque_limits``, a pair per
+side, :mod:`posturelab.model.limits`): plantarflexion to the smaller of the plantarflexor
+strength and m g × toe (:func:`~posturelab.model.stepping.ankle_moment_cap`), dorsiflexion to
+m g × |heel|: a flat foot cannot press its centre of pressure in front of its toe nor behind
+its heel (a heel rise or a toe lift is not modelled). The dorsiflexors' own strength is
+taken not to bind (posturelab's assumption: m g |heel| is about 50 N·m for the bodies
+studied). ``heel_limit=False`` caps dorsiflexion at the plantarflexion cap instead (the
+symmetric cap of posturelab before issue 22), which lets the centre of pressure pass the
+heel.
 
 **The body** is a one-link inverted pendulum about the ankle, scaled from height and mass by
 Winter's table (:func:`posturelab.model.anthropometry.one_link`), with the foot of
@@ -154,7 +159,10 @@ class StepThreshold:
     ankle_strength : float
         Plantarflexion strength of both ankles. [N·m]
     ankle_moment_cap : float
-        The moment cap used, min(strength, m g × toe). [N·m]
+        The plantarflexion cap used, min(strength, m g × toe). [N·m]
+    dorsiflexion_cap : float
+        The dorsiflexion cap used (its magnitude): m g × |heel|, or ``ankle_moment_cap``
+        with ``heel_limit=False``. [N·m]
     heel, toe : float
         The foot from the ankle. [m]
     com_height : float
@@ -167,8 +175,9 @@ class StepThreshold:
         ξ at t = τ (when the neural response starts) in that run, from the ankle. [m]
     cop_overrun : float
         How far the centre of pressure went beyond the foot (either end) in that run, 0 if
-        it stayed on it: the engine's moment cap is the same both ways, so the dorsiflexors
-        may pull it behind the heel, where a real foot's toes would lift. [m]
+        it stayed on it: with the foot's caps only by the vertical force's departure from
+        m g (millimetres); with ``heel_limit=False`` the dorsiflexors may pull it behind the
+        heel, where a real foot's toes would lift. [m]
     n_simulations : int
         Runs made. [-]
     published_mean, published_sd : float or None
@@ -190,6 +199,7 @@ class StepThreshold:
     feedback_delay: float
     ankle_strength: float
     ankle_moment_cap: float
+    dorsiflexion_cap: float
     heel: float
     toe: float
     com_height: float
@@ -222,6 +232,7 @@ class StepThreshold:
 UNITS = {"largest_translation": "m", "smallest_stepping": "m", "height": "m", "mass": "kg",
          "move_duration": "s", "peak_velocity": "m/s", "peak_acceleration": "m/s²",
          "feedback_delay": "s", "ankle_strength": "N·m", "ankle_moment_cap": "N·m",
+         "dorsiflexion_cap": "N·m",
          "heel": "m", "toe": "m", "com_height": "m", "omega0": "1/s", "minimum_margin": "m",
          "xcom_at_response_onset": "m", "cop_overrun": "m", "published_mean": "m",
          "published_sd": "m"}
@@ -230,7 +241,8 @@ UNITS = {"largest_translation": "m", "smallest_stepping": "m", "height": "m", "m
 def step_threshold(height: float, mass: float, population: str | Population = "young",
                    direction: str = "backward", *, protocol: PlatformProtocol = PROTOCOL,
                    feedback_delay: float | None = None, ankle_strength: float | None = None,
-                   cop_criterion: bool = False, engine: str = "compiled") -> StepThreshold:
+                   cop_criterion: bool = False, heel_limit: bool = True,
+                   engine: str = "compiled") -> StepThreshold:
     """The largest platform translation a subject withstands without stepping.
 
     Parameters
@@ -250,7 +262,10 @@ def step_threshold(height: float, mass: float, population: str | Population = "y
     cop_criterion : bool
         Also count a step when the centre of pressure leaves the foot by more than
         :data:`COP_TOLERANCE` (the heel would rise or the toes lift): stricter than Hof's
-        criterion, and a check on the both-ways moment cap (see ``cop_overrun``).
+        criterion, and a check on the moment caps (see ``cop_overrun``).
+    heel_limit : bool
+        Cap dorsiflexion at m g × |heel| (default), or, False, at the plantarflexion cap
+        (the same both ways, as before issue 22). [-]
     engine : {"compiled", "reference"}
         The simulator.
 
@@ -266,6 +281,7 @@ def step_threshold(height: float, mass: float, population: str | Population = "y
         An unknown population (listing the known ones).
     """
     from ..model.anthropometry import body_from_anthropometry, one_link
+    from ..model.limits import foot_moment_limits
     from ..model.options import FallCriteria, base_of_support_for_height
     from ..model.stepping import ankle_moment_cap, pendulum_frequency, xcom
     from ..simulation.engines import simulate
@@ -284,6 +300,7 @@ def step_threshold(height: float, mass: float, population: str | Population = "y
     foot = base_of_support_for_height(h)
     weight = body.total_mass * body.gravity
     cap = ankle_moment_cap(strength, weight, foot.toe)
+    heel_cap = foot_moment_limits(weight, foot.heel, foot.toe)[0] if heel_limit else -cap
     com_height = float(body.gravity_coefficients.sum() / body.total_mass)
     omega0 = float(pendulum_frequency(com_height, body.gravity))
     muscles = pop.muscles(body)
@@ -296,7 +313,8 @@ def step_threshold(height: float, mass: float, population: str | Population = "y
         run = simulate(body, muscles, protocol.disturbance(sign * size),
                           duration=protocol.move_duration + protocol.settle_time,
                           feedback_delay=delay, proprioceptive_weight=pop.proprioceptive_weight,
-                          torque_limits=(cap,), fall=FallCriteria(base_of_support=foot),
+                          torque_limits=((heel_cap, cap),),
+                          fall=FallCriteria(base_of_support=foot),
                           sample_rate=SAMPLE_RATE, engine=engine)
         if run.status == "failed":
             raise PostureLabError(f"the run at a {size:g} m translation failed: {run.message}")
@@ -344,7 +362,8 @@ def step_threshold(height: float, mass: float, population: str | Population = "y
         population=pop.name, direction=direction, height=h, mass=m,
         move_duration=duration, peak_velocity=2 * low / duration,
         peak_acceleration=2 * math.pi * low / duration**2, feedback_delay=delay,
-        ankle_strength=strength, ankle_moment_cap=cap, heel=foot.heel, toe=foot.toe,
+        ankle_strength=strength, ankle_moment_cap=cap, dorsiflexion_cap=-heel_cap,
+        heel=foot.heel, toe=foot.toe,
         com_height=com_height, omega0=omega0, minimum_margin=margin,
         xcom_at_response_onset=onset, cop_overrun=overrun, n_simulations=count,
         published_mean=None if published is None else published.mean,

@@ -30,6 +30,7 @@ import numpy as np
 from .._validation import finite_array, float_in_range
 from ..errors import ParameterError
 from ..model.kinematics import hip_fraction, strategy_modes  # (defined with the kinematics)
+from ..model.limits import limit_entries
 
 __all__ = ["strategy_modes", "hip_fraction", "HipFractionStudy", "hip_fraction_study",
            "CREATH_2005_CITATION", "RUNGE_1999_CITATION", "MAX_STUDY_RUNS",
@@ -221,7 +222,10 @@ class StrategyMap:
     profile : str
         The profile in words, with its source.
     ankle_torque_limit : float
-        [N·m] (inf: none).
+        The ankle's plantarflexion limit (positive moments) [N·m] (inf: none).
+    ankle_dorsiflexion_limit : float or None
+        The magnitude of its dorsiflexion limit (negative moments) when it differs
+        (:mod:`posturelab.model.limits`); None: the same as ``ankle_torque_limit``. [N·m]
     """
 
     kind: str
@@ -229,6 +233,7 @@ class StrategyMap:
     runs: tuple
     profile: str
     ankle_torque_limit: float
+    ankle_dorsiflexion_limit: float | None = None
 
     @property
     def transition_frequency(self) -> float | None:
@@ -252,31 +257,52 @@ class StrategyMap:
                "units": {self.variable: "m/s" if self.variable == "speed" else "Hz",
                          "hip_fraction": "-", "peak_ankle_moment": "N·m",
                          "peak_hip_angle": "rad", "ankle_torque_limit": "N·m"}}
+        if self.ankle_dorsiflexion_limit is not None:
+            out["ankle_dorsiflexion_limit"] = (None if np.isinf(self.ankle_dorsiflexion_limit)
+                                               else self.ankle_dorsiflexion_limit)
+            out["units"]["ankle_dorsiflexion_limit"] = "N·m"
         if self.kind == "oscillation":
             out["transition_frequency"] = self.transition_frequency
         return out
 
 
-def _run_record(result, value: float, limit: float, start: int = 0) -> StrategyRun:
+def _run_record(result, value: float, limit: float, start: int = 0,
+                lower: float | None = None) -> StrategyRun:
     theta = result.theta
     outcome = ("fell" if result.fell else "recovered" if result.status == "completed"
                else "failed")
-    ankle = np.abs(result.joint_moments[:, 0])
+    moment = result.joint_moments[:, 0]
+    ankle = np.abs(moment)
     peak = float(ankle.max()) if ankle.size else 0.0
+    lower = limit if lower is None else lower
+    saturated = ankle.size > 0 and bool(
+        (np.isfinite(limit) and moment.max() >= limit * (1 - 1e-9))
+        or (np.isfinite(lower) and moment.min() <= -lower * (1 - 1e-9)))
     hip = np.abs(theta[:, -1] - theta[:, 0])
     steady = theta[start:]  # (a run that fell before its steady part has none: NaN)
     share = float(hip_fraction(steady)) if steady.shape[0] > 1 else float("nan")
-    return StrategyRun(float(value), share, outcome, peak,
-                       bool(np.isfinite(limit) and peak >= limit * (1 - 1e-9)),
+    return StrategyRun(float(value), share, outcome, peak, saturated,
                        float(hip.max()) if hip.size else 0.0)
 
 
-def _limits(body, ankle_torque_limit: float | None, torque_limits) -> tuple[np.ndarray, float]:
-    limits = (np.full(body.n_links, np.inf) if torque_limits is None
-              else np.array(torque_limits, dtype=float))
+def _limits(body, ankle_torque_limit, torque_limits, fall=None
+            ) -> tuple[tuple, float, float | None]:
+    """The runs' ``torque_limits`` entries, the ankle's plantarflexion limit and the
+    magnitude of its dorsiflexion limit if it differs (None), [N·m]; ``ankle_torque_limit``
+    a number (both ways), a pair (lower, upper) or "foot" (needs ``fall``'s foot)."""
+    from ..model.limits import NEGATIVE, POSITIVE, body_torque_limits
+
+    n = body.n_links
+    entries = [np.inf] * n if torque_limits is None else list(limit_entries(torque_limits))
     if ankle_torque_limit is not None:
-        limits[0] = float_in_range("ankle_torque_limit [N·m]", ankle_torque_limit, 1e-6, 1e6)
-    return limits, float(limits[0])
+        entries[0] = (float_in_range("ankle_torque_limit [N·m]", ankle_torque_limit, 1e-6, 1e6)
+                      if np.ndim(ankle_torque_limit) == 0 and not isinstance(
+                          ankle_torque_limit, str) else limit_entries([ankle_torque_limit])[0])
+    bounds = body_torque_limits(entries, body, None if fall is None else fall.base_of_support)
+    if bounds is None:
+        return tuple(entries), float("inf"), None
+    upper, lower = float(bounds[POSITIVE, 0]), float(bounds[NEGATIVE, 0])
+    return tuple(entries), upper, None if lower == upper else lower
 
 
 def translation_map(body, muscles, speeds, *, direction: str = "backward",
@@ -298,10 +324,11 @@ def translation_map(body, muscles, speeds, *, direction: str = "backward",
         [m]
     duration : float
         Simulated time of each run. [s]
-    ankle_torque_limit : float, optional
-        The ankle's limit (else ``torque_limits``' or none). [N·m]
-    torque_limits : array_like, shape (N,), optional
-        [N·m]
+    ankle_torque_limit : float, (lower, upper) or "foot", optional
+        The ankle's limit, both ways, per side (lower < 0 < upper: dorsiflexion,
+        plantarflexion), or from the foot of ``fall`` (else ``torque_limits``' or none). [N·m]
+    torque_limits : sequence, optional
+        As :func:`posturelab.simulate`'s. [N·m]
     progress : callable(done, total), optional
     **run_options
         Passed to :func:`posturelab.simulate` (``feedback_delay``, ``joint_feedback``,
@@ -310,17 +337,18 @@ def translation_map(body, muscles, speeds, *, direction: str = "backward",
     from ..simulation.engines import simulate
 
     values = _values("speeds [m/s]", speeds, body)
-    limits, limit = _limits(body, ankle_torque_limit, torque_limits)
+    limits, limit, lower = _limits(body, ankle_torque_limit, torque_limits,
+                                   run_options.get("fall"))
     runs = []
     for i, v in enumerate(values):
         r = simulate(body, muscles, translation_profile(v, direction, displacement), duration,
                      torque_limits=limits, **run_options)
-        runs.append(_run_record(r, v, limit))
+        runs.append(_run_record(r, v, limit, lower=lower))
         if progress is not None:
             progress(i + 1, values.size)
     return StrategyMap("translation", "speed", tuple(runs),
                        f"{direction} ramp-and-hold of {displacement:g} m, peak speed 2D/T "
-                       f"(after {HORAK_NASHNER_1986_CITATION})", limit)
+                       f"(after {HORAK_NASHNER_1986_CITATION})", limit, lower)
 
 
 def oscillation_map(body, muscles, amplitude: float, frequencies, *,
@@ -334,7 +362,8 @@ def oscillation_map(body, muscles, amplitude: float, frequencies, *,
     from ..simulation.engines import simulate
 
     values = _values("frequencies [Hz]", frequencies, body)
-    limits, limit = _limits(body, ankle_torque_limit, torque_limits)
+    limits, limit, lower = _limits(body, ankle_torque_limit, torque_limits,
+                                   run_options.get("fall"))
     runs = []
     for i, f in enumerate(values):
         settle = SETTLE_CYCLES / f
@@ -342,12 +371,12 @@ def oscillation_map(body, muscles, amplitude: float, frequencies, *,
         r = simulate(body, muscles, oscillation_profile(amplitude, f), duration,
                      torque_limits=limits, **run_options)
         start = int(np.searchsorted(r.time, settle))
-        runs.append(_run_record(r, f, limit, start))
+        runs.append(_run_record(r, f, limit, start, lower))
         if progress is not None:
             progress(i + 1, values.size)
     return StrategyMap("oscillation", "frequency", tuple(runs),
                        f"sinusoidal translation of amplitude {amplitude:g} m, the hip fraction "
-                       f"after {SETTLE_CYCLES} cycles", limit)
+                       f"after {SETTLE_CYCLES} cycles", limit, lower)
 
 
 def _values(name: str, values, body) -> np.ndarray:

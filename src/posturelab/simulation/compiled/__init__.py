@@ -35,6 +35,7 @@ from typing import Any
 import numpy as np
 
 from ...model.body import Body
+from ...model.limits import torque_limit_array
 from ...model.muscles import MuscleSet, muscle_set_gains
 from ...model.platform import Disturbance
 from ..options import RunOptions
@@ -98,8 +99,10 @@ def state_derivative(body: Body, muscles: MuscleSet, state, *, active=None, lock
         (ẍ_d, ÿ_d). [m/s²]
     delayed_moments : array_like, shape (N,), optional
         τ_delayed added to the joint moments. [N·m]
-    saturation, torque_limits : array_like, shape (N,), optional
-        ±1 where a joint saturates at its limit [N·m].
+    saturation : array_like, shape (N,), optional
+        ±1 where a joint saturates at its positive or negative limit. [-]
+    torque_limits : sequence, optional
+        As a run's (:func:`posturelab.model.limits.torque_limit_array`). [N·m]
     general : bool
         Use the general-N code even where generated straight-line code exists.
 
@@ -113,7 +116,7 @@ def state_derivative(body: Body, muscles: MuscleSet, state, *, active=None, lock
     x = np.ascontiguousarray(state, dtype=float)
     act = np.ones(P) if active is None else np.ascontiguousarray(active, dtype=float)
     g = np.ascontiguousarray(muscle_set_gains(muscles, 0.0))
-    lim = np.ascontiguousarray(enc.limits(torque_limits, n))
+    lim = np.ascontiguousarray(enc.limits(torque_limit_array(torque_limits, n), n))
     sat = np.zeros(n) if saturation is None else np.ascontiguousarray(saturation, dtype=float)
     inp = np.zeros(2 + n)
     inp[:2] = platform_acceleration

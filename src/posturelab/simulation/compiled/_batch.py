@@ -23,6 +23,7 @@ from ...model.body import Body
 from ...model.checks import check_model
 from ...model.gains import GAIN_ROWS
 from ...model.joint_feedback import joint_feedback_moments, joint_gain_rows
+from ...model.limits import body_torque_limits, limits_as_entries
 from ...model.muscles import MuscleSet, feedback_gains, paper_muscles
 from ...model.platform import Disturbance
 from ...model.tilt import tilt_pair_gains
@@ -171,6 +172,29 @@ def _per_run(name: str, value, m: int, width: int | None) -> np.ndarray:
                          f"per run), got shape {arr.shape}")
 
 
+def _batch_limits(value, m: int, n: int, common: RunOptions, body: Body) -> np.ndarray:
+    """Per-run limits as bounds (M, 2, N) (:mod:`posturelab.model.limits`) from numbers (N,)
+    or (M, N) (both ways), pairs (M, N, 2) (lower, upper), or one run's ``torque_limits``
+    entries (pairs, "foot") for every run; each row is checked later as a single run's."""
+    if value is None:
+        return np.full((m, 2, n), math.inf)
+    try:
+        arr = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        arr = None
+    if arr is not None and arr.ndim == 3:
+        if arr.shape != (m, n, 2):
+            raise ParameterError(f"torque_limits [N·m] as pairs must have shape ({m}, {n}, 2) "
+                                 f"(lower, upper per run and joint), got shape {arr.shape}")
+        return np.ascontiguousarray(np.stack([-arr[..., 0], arr[..., 1]], axis=1))
+    if arr is not None and arr.ndim in (1, 2) and (arr.ndim == 2 or arr.size == n):
+        sym = _per_run("torque_limits [N·m]", arr, m, n)
+        return np.ascontiguousarray(np.stack([sym, sym], axis=1))
+    one = body_torque_limits(value, body, common.fall.base_of_support)
+    one = np.full((2, n), math.inf) if one is None else one
+    return np.ascontiguousarray(np.broadcast_to(one, (m, 2, n)))
+
+
 def _shared_options(options: RunOptions | None, duration, initial_state,
                     keywords: dict[str, Any], weights=None) -> RunOptions:
     """The options every run of a batch shares, on the compiled engine (with the smallest
@@ -268,9 +292,11 @@ def simulate_batch(
     proprioceptive_weight : float or array_like, shape (M,), optional
         W of the active part's error for pairs that span the foot, in [0, 1], for every
         run or per run (default ``options.proprioceptive_weight``). [-]
-    torque_limits : array_like, shape (N,) or (M, N), optional
-        Largest net muscle moment per joint, for every run or per run; ``inf`` for
-        none (default ``options.torque_limits``). [N·m]
+    torque_limits : array_like, shape (N,), (M, N) or (M, N, 2), or a run's entries, optional
+        Largest net muscle moment per joint, both ways, for every run or per run (``inf``
+        for none); per run and joint a pair (lower < 0, upper > 0); or a single run's
+        ``torque_limits`` (numbers, pairs, "foot") for every run (default
+        ``options.torque_limits``; :mod:`posturelab.model.limits`). [N·m]
     active_stiffness, active_viscosity : array_like, shape (M, P), optional
         Active (neural, delayed) pair gains per run; with either given, ``stiffness`` and
         ``viscosity`` are the intrinsic (undelayed) part and the delay applies to these
@@ -343,8 +369,7 @@ def simulate_batch(
         torque_limits = common.torque_limits
     delays = _per_run("feedback_delay [s]", feedback_delay, M, None)
     weights = _per_run("proprioceptive_weight [-]", proprioceptive_weight, M, None)
-    lims = (np.full((M, n), math.inf) if torque_limits is None
-            else _per_run("torque_limits [N·m]", torque_limits, M, n))
+    lims = _batch_limits(torque_limits, M, n, common, body)  # (M, 2, N)
     scale = (np.ones(M) if disturbance_scale is None
              else finite_array("disturbance_scale [-]", disturbance_scale, (M,)))
 
@@ -364,11 +389,12 @@ def simulate_batch(
     any_limit = bool(np.isfinite(lims).any())
     some_delay = 1.0 if common.torque_feedback_gain > 0 else 0.0  # (it needs one)
     for row in (np.unique(lims, axis=0) if M and any_limit else []):
-        level_setup(1.0, some_delay, None if np.all(np.isinf(row)) else row)
+        level_setup(1.0, some_delay, None if np.all(np.isinf(row)) else limits_as_entries(row))
     # one level per distinct (scale, delayed or not, pairs acting at the start): start
     # state, disturbance, knee, pairs (a pull-only pair's start depends on the run's gains)
     delayed = delays > 0
-    slot_limits = np.where(np.isfinite(lims).any(axis=0), 1.0, math.inf) if any_limit else None
+    slot_limits = (tuple(np.where(np.isfinite(lims).any(axis=(0, 1)), 1.0, math.inf))
+                   if any_limit else None)
     # (a level's limits only decide which event slots exist: the finite ones of any run)
     gains_all = enc.readonly(np.ascontiguousarray(
         feedback_gains(kd_all, ld_all, ka_all, la_all, delays)))

@@ -168,7 +168,8 @@ def options(setup: RunSetup, settle_tolerance: float = 0.01) -> tuple[np.ndarray
 
 
 def limits(torque_limits: np.ndarray | None, n: int) -> np.ndarray:
-    """Torque limits per joint, inf where none. [N·m]"""
+    """Torque limits (2N,): the magnitudes of the N negative limits, then the N positive
+    ones (:mod:`posturelab.model.limits`), inf where none. [N·m]"""
     if torque_limits is None:
-        return np.full(n, math.inf)
-    return np.asarray(torque_limits, dtype=float)
+        return np.full(2 * n, math.inf)
+    return np.ascontiguousarray(np.asarray(torque_limits, dtype=float).reshape(2 * n))

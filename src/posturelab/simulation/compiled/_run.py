@@ -78,7 +78,7 @@ def packed(setup: RunSetup) -> dict:
     n = setup.n_links
     fpar, ipar = enc.options(setup)
     muscles = setup.muscles
-    limited = (np.isfinite(setup.torque_limits) if setup.torque_limits is not None
+    limited = (np.isfinite(setup.torque_limits).any(axis=0) if setup.torque_limits is not None
                else np.zeros(n, bool))
     slots = ev.event_slots(n, setup.fall.base_of_support is not None,
                            setup.fall.centre_of_pressure, limited, muscles.one_sided_mask,

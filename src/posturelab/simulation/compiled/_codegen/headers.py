@@ -21,7 +21,8 @@ RUN_FIELDS = [
     ("E", "*f64", "(p, n) stretch rows"), ("C", "*f64", "(p, n) joint-crossing rows"),
     ("one_sided", "*i64", "(p)"),
     ("gains", "*f64", "(4, p) rows GAIN_*: immediate k, l, delayed k, l"),
-    ("lim", "*f64", "(n) torque limits, inf for none [N·m]"),
+    ("lim", "*f64", "(2n) torque limits >= 0: the negative side's (n), the positive "
+            "side's (n), inf for none [N·m]"),
     ("delay", "f64", "feedback delay [s]"),
     ("dp", "*f64", "packed disturbance"), ("bps", "*f64", "breakpoints in (0, duration)"),
     ("fpar", "*f64", "F_*"), ("ipar", "*i64", "I_*"),
@@ -132,7 +133,7 @@ typedef struct {
     int64_t n;
     const double *bp;
     double *tm;          /* (4, n, n): T_K, T_L, delayed T_K, delayed T_L */
-    const double *lim;   /* (n) */
+    const double *lim;   /* (2n): negative, positive limits */
     double *sat;         /* (n) saturation signs */
     double *base;        /* (3n) θ, sin θ, cos θ at the step's start */
     double *work;        /* (n, n + 4) */

@@ -32,7 +32,8 @@ HEADER = """/* The switched model for any N links: GENERATED, do not edit.
  *   J(Θ)Θ̈ + B(Θ,Θ̇)Θ̇ − (g + ÿ_d)G(Θ) + ẍ_d H(Θ) = U,   U_i = τ_{i+1} − τ_i,
  *
  * τ the net muscle moments at the joints: τ = T_K Θ + T_L Θ̇ + inp[2 + j] (T_K = Cᵀ
- * diag(k·active) E, pl_moment_gains), or ±limit_j while joint j saturates;
+ * diag(k·active) E, pl_moment_gains), or its positive or negative limit (pl_model.lim)
+ * while joint j saturates;
  * inp = (ẍ_d, ÿ_d, delayed, tilt and noise moments, then each torque feedback filter's
  * input), from pl_inputs_at; with torque feedback the state is [Θ, Θ̇, Y] (filters_c.py). */
 #include <math.h>
@@ -273,8 +274,8 @@ def _rhs() -> str:
     coupling = _trig_symbols(dynamics.coupling_formula(cij, thi, thj, SYMPY), trig)
     centripetal = _trig_symbols(dynamics.centripetal_formula(cij, thi, thj, wj, SYMPY), trig)
     load = _trig_symbols(dynamics.load_formula(a_i, thi, *symbols("ga", "ax"), SYMPY), trig)
-    saturated = switched.saturated_moment_formula(*symbols("t", "md->sat[j]", "md->lim[j]"),
-                                                  SYMPY)
+    saturated = switched.saturated_moment_formula(
+        *symbols("t", "md->sat[j]", "md->lim[j]", "md->lim[n + j]"), SYMPY)
     xi, xj = symbols("x[i]", "x[j]")
     impact = dynamics.coupling_formula(symbols("bp[2 * n + i * n + j]"), xi, xj, SYMPY)
     joint = joint_feedback.joint_moment_gain_formula(*symbols("tm[k]", "jg[k]"))
@@ -474,7 +475,8 @@ _QUANTITIES = {
     "heel": ((), "fpar[F_HEEL]"),
     "stop_angle": ((), "fpar[F_STOP_ANGLE]"),
     "side": ((), "side"),
-    "limit": ((), "md->lim[idx]"),
+    "negative_limit": ((), "md->lim[idx]"),
+    "positive_limit": ((), "md->lim[n + idx]"),
     "cog_x": (("cog",), "xc"),
     "stretch": (("feedback",), "st"),
     "stretch_rate": (("feedback",), "sd"),

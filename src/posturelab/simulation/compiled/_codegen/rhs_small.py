@@ -7,7 +7,8 @@ load, saturation) are the formulas of :mod:`posturelab.model.dynamics` and
 :mod:`posturelab.model.switched` printed through :mod:`.spec`, as in the general-N code of
 ``csrc/pl_model.c``, unrolled: for link i,
 
-* τ_j = (T_K Θ + T_L Θ̇ + τ_delayed)_j, or ±limit_j while joint j saturates; U_i = τ_{i+1} − τ_i
+* τ_j = (T_K Θ + T_L Θ̇ + τ_delayed)_j, or its positive or negative limit while joint j
+  saturates; U_i = τ_{i+1} − τ_i
 * r_i = U_i − Σ_{j≠i} c_ij sin(θ_i − θ_j) θ̇_j² + a_i ((g + ÿ_d) sin θ_i − ẍ_d cos θ_i)
 * J_ii = I_i + m_i k_i² + …, J_ij = c_ij cos(θ_j − θ_i); Θ̈ = adj(J) r / det J
 * with the knee locked, Θ̈ − J⁻¹C (C·Θ̈)/(C·J⁻¹C), C = (−1, 1, 0).
@@ -100,12 +101,12 @@ def _load(i: int) -> str:
                                SYMPY), i)
 
 
-def _saturated(j: int) -> str:
+def _saturated(j: int, n: int) -> str:
     from ....model.switched import saturated_moment_formula
     from .spec import SYMPY, c, symbols
 
-    return c(saturated_moment_formula(*symbols(f"t[{j}]", f"md->sat[{j}]", f"md->lim[{j}]"),
-                                      SYMPY))
+    return c(saturated_moment_formula(*symbols(f"t[{j}]", f"md->sat[{j}]", f"md->lim[{j}]",
+                                               f"md->lim[{n + j}]"), SYMPY))
 
 
 def _rhs_function(n: int, printer) -> str:
@@ -120,7 +121,7 @@ def _rhs_function(n: int, printer) -> str:
         k_terms = " + ".join(f"tk[{j * n + k}] * th[{k}]" for k in range(n))
         l_terms = " + ".join(f"tl[{j * n + k}] * w[{k}]" for k in range(n))
         L.append(f"    t[{j}] = inp[{2 + j}] + ({k_terms}) + ({l_terms});")
-        L.append(f"    t[{j}] = {_saturated(j)};")
+        L.append(f"    t[{j}] = {_saturated(j, n)};")
     for i in range(n):
         rhs = f"t[{i + 1}] - t[{i}]" if i + 1 < n else f"-t[{i}]"
         L.append(f"    const double u{i} = {rhs};")

@@ -7,7 +7,8 @@
  *   J(Θ)Θ̈ + B(Θ,Θ̇)Θ̇ − (g + ÿ_d)G(Θ) + ẍ_d H(Θ) = U,   U_i = τ_{i+1} − τ_i,
  *
  * τ the net muscle moments at the joints: τ = T_K Θ + T_L Θ̇ + inp[2 + j] (T_K = Cᵀ
- * diag(k·active) E, pl_moment_gains), or ±limit_j while joint j saturates;
+ * diag(k·active) E, pl_moment_gains), or its positive or negative limit (pl_model.lim)
+ * while joint j saturates;
  * inp = (ẍ_d, ÿ_d, delayed, tilt and noise moments, then each torque feedback filter's
  * input), from pl_inputs_at; with torque feedback the state is [Θ, Θ̇, Y] (filters_c.py). */
 #include <math.h>
@@ -218,7 +219,7 @@ void pl_rhs_general(const pl_model *md, const double *x, double *out, const doub
         double t = inp[2 + j];
         for (int64_t k = 0; k < n; k++)
             t += tk[j * n + k] * x[k] + tl[j * n + k] * x[n + k];
-        tau[j] = ((md->sat[j] != 0.0) ? (md->lim[j]*md->sat[j]) : (t));
+        tau[j] = ((md->sat[j] != 0.0) ? (md->sat[j]*((md->sat[j] > 0.0) ? (md->lim[n + j]) : (md->lim[j]))) : (t));
     }
     for (int64_t i = 0; i < n; i++) {
         const double si = work[i * w + n + 2], ci = work[i * w + n + 3];
@@ -426,7 +427,7 @@ double pl_event_value(const pl_ctx *cx, int64_t kind, int64_t idx, double side, 
             tau += tk[idx * n + k] * y[k] + tl[idx * n + k] * y[n + k];
         for (int64_t q = 0; q < md->nf; q++)
             tau += md->C[q * n + idx] * (md->active[q]*y[2 * n + q]);
-        g = -md->lim[idx] + side*tau;
+        g = side*tau - ((side > 0.0) ? (md->lim[n + idx]) : (md->lim[idx]));
         break;
     }
     case EV_PAIR_SLACKENS:

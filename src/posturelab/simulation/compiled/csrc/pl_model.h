@@ -23,7 +23,7 @@ typedef struct {
     const double *C;                    /* (p, n) joint-crossing rows */
     const int64_t *one_sided;           /* (p) */
     const double *gains;                /* (4, p) rows GAIN_*: immediate k, l, delayed k, l */
-    const double *lim;                  /* (n) torque limits, inf for none [N·m] */
+    const double *lim;                  /* (2n) torque limits >= 0: the negative side's (n), the positive side's (n), inf for none [N·m] */
     double delay;                       /* feedback delay [s] */
     const double *dp;                   /* packed disturbance */
     const double *bps;                  /* breakpoints in (0, duration) */
@@ -75,7 +75,7 @@ typedef struct {
     int64_t n;
     const double *bp;
     double *tm;          /* (4, n, n): T_K, T_L, delayed T_K, delayed T_L */
-    const double *lim;   /* (n) */
+    const double *lim;   /* (2n): negative, positive limits */
     double *sat;         /* (n) saturation signs */
     double *base;        /* (3n) θ, sin θ, cos θ at the step's start */
     double *work;        /* (n, n + 4) */

@@ -56,7 +56,7 @@ PL_EXPORT void pl_run_batch(const pl_batch *b, int64_t begin, int64_t end)
         run.ipar = b->ipar_all + lv * N_IPAR;
         run.active0 = b->active0_all + lv * p;
         run.gains = b->gains_all + r * 4 * p;
-        run.lim = b->lim_all + r * n;
+        run.lim = b->lim_all + r * 2 * n;  /* (2n): negative limits, positive limits */
         run.delay = b->delay_all[r];
         run.sat0 = b->sat0_all + r * n;
         run.method = b->method_all[r];

@@ -12,7 +12,7 @@ void pl_rhs1(const pl_model *md, const double *x, double *out, const double *inp
     (void)locked;
     pl_small_unpack(md, x, inp, 1, th, w, s, c, &ax, &ga);
     t[0] = inp[2] + (tk[0] * th[0]) + (tl[0] * w[0]);
-    t[0] = ((md->sat[0] != 0.0) ? (md->lim[0]*md->sat[0]) : (t[0]));
+    t[0] = ((md->sat[0] != 0.0) ? (md->sat[0]*((md->sat[0] > 0.0) ? (md->lim[1]) : (md->lim[0]))) : (t[0]));
     const double u0 = -t[0];
     const double r0 = u0 + bp[0]*(-ax*c[0] + ga*s[0]);
     const double j00 = bp[1];
@@ -28,9 +28,9 @@ void pl_rhs2(const pl_model *md, const double *x, double *out, const double *inp
     double th[2], w[2], s[2], c[2], t[2], a[2], ax, ga;
     pl_small_unpack(md, x, inp, 2, th, w, s, c, &ax, &ga);
     t[0] = inp[2] + (tk[0] * th[0] + tk[1] * th[1]) + (tl[0] * w[0] + tl[1] * w[1]);
-    t[0] = ((md->sat[0] != 0.0) ? (md->lim[0]*md->sat[0]) : (t[0]));
+    t[0] = ((md->sat[0] != 0.0) ? (md->sat[0]*((md->sat[0] > 0.0) ? (md->lim[2]) : (md->lim[0]))) : (t[0]));
     t[1] = inp[3] + (tk[2] * th[0] + tk[3] * th[1]) + (tl[2] * w[0] + tl[3] * w[1]);
-    t[1] = ((md->sat[1] != 0.0) ? (md->lim[1]*md->sat[1]) : (t[1]));
+    t[1] = ((md->sat[1] != 0.0) ? (md->sat[1]*((md->sat[1] > 0.0) ? (md->lim[3]) : (md->lim[1]))) : (t[1]));
     const double u0 = t[1] - t[0];
     const double u1 = -t[1];
     const double r0 = u0 - (bp[5]*(w[1] * w[1])*(-c[0]*s[1] + c[1]*s[0])) + bp[0]*(-ax*c[0] + ga*s[0]);
@@ -62,11 +62,11 @@ void pl_rhs3(const pl_model *md, const double *x, double *out, const double *inp
     double th[3], w[3], s[3], c[3], t[3], a[3], ax, ga;
     pl_small_unpack(md, x, inp, 3, th, w, s, c, &ax, &ga);
     t[0] = inp[2] + (tk[0] * th[0] + tk[1] * th[1] + tk[2] * th[2]) + (tl[0] * w[0] + tl[1] * w[1] + tl[2] * w[2]);
-    t[0] = ((md->sat[0] != 0.0) ? (md->lim[0]*md->sat[0]) : (t[0]));
+    t[0] = ((md->sat[0] != 0.0) ? (md->sat[0]*((md->sat[0] > 0.0) ? (md->lim[3]) : (md->lim[0]))) : (t[0]));
     t[1] = inp[3] + (tk[3] * th[0] + tk[4] * th[1] + tk[5] * th[2]) + (tl[3] * w[0] + tl[4] * w[1] + tl[5] * w[2]);
-    t[1] = ((md->sat[1] != 0.0) ? (md->lim[1]*md->sat[1]) : (t[1]));
+    t[1] = ((md->sat[1] != 0.0) ? (md->sat[1]*((md->sat[1] > 0.0) ? (md->lim[4]) : (md->lim[1]))) : (t[1]));
     t[2] = inp[4] + (tk[6] * th[0] + tk[7] * th[1] + tk[8] * th[2]) + (tl[6] * w[0] + tl[7] * w[1] + tl[8] * w[2]);
-    t[2] = ((md->sat[2] != 0.0) ? (md->lim[2]*md->sat[2]) : (t[2]));
+    t[2] = ((md->sat[2] != 0.0) ? (md->sat[2]*((md->sat[2] > 0.0) ? (md->lim[5]) : (md->lim[2]))) : (t[2]));
     const double u0 = t[1] - t[0];
     const double u1 = t[2] - t[1];
     const double u2 = -t[2];
