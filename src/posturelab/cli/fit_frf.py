@@ -119,7 +119,7 @@ def add_fit_arguments(p: argparse.ArgumentParser, *, per_condition: bool) -> Non
                    "within the table's ranges.")
     from ._recording import add_cycle_trim_argument, add_recording_arguments
 
-    add_recording_arguments(p)
+    add_recording_arguments(p, subject=False)  # the body's --height and --mass
     add_cycle_trim_argument(p)
 
 
@@ -134,12 +134,19 @@ def reader_options(args: argparse.Namespace) -> dict:
             **recording_options(args)}
 
 
-def _condition(path: str, args: argparse.Namespace):
-    from ..frequency.cohort import read_frf_file
+def _condition(path: str, args: argparse.Namespace, readings: dict | None = None):
+    """One FRF from a file (a trial recording or an FRF JSON); what reading a trial did is
+    put in ``readings[path]`` (a :class:`~posturelab.recordings.reading.Recording`)."""
+    from ..frequency.cohort import read_frf_file, read_trial_frf
+    from ._recording import check_sway_response
 
     if path.lower().endswith(".json"):
         return read_frf_file(path, what="--data FRF JSON")
-    return read_frf_file(path, **reader_options(args))
+    check_sway_response(args, args.response)
+    frf, rec = read_trial_frf(path, **reader_options(args))
+    if readings is not None:
+        readings[path] = rec
+    return frf
 
 
 def _names(text: str) -> list[str]:
@@ -183,7 +190,8 @@ def run(args: argparse.Namespace) -> int:
         check_fit_request(muscles, moved, [compare["parameter"]], _bounds(args.bounds))
     else:
         check_fit_request(muscles, free, per, _bounds(args.bounds))
-    conditions = [_condition(path, args) for path in args.data]
+    readings: dict = {}
+    conditions = [_condition(path, args, readings) for path in args.data]
     fit_options = dict(input=args.input, output=args.output.strip().lower(),
                        feedback_delay=options.feedback_delay,
                        proprioceptive_weight=options.proprioceptive_weight,
@@ -227,7 +235,8 @@ def run(args: argparse.Namespace) -> int:
 
         for w in sign_warnings:
             print(f"warning: {w}", file=sys.stderr)
-    kinds = [{"data": p, "kind": "trial" if isinstance(c, FRFEstimate) else "table"}
+    kinds = [{"data": p, "kind": "trial" if isinstance(c, FRFEstimate) else "table",
+              **(readings[p].report_dict() if p in readings else {})}
              for p, c in zip(args.data, conditions, strict=True)]
     if args.json:
         out = fit.to_dict()
@@ -235,6 +244,10 @@ def run(args: argparse.Namespace) -> int:
         print_json({**out, "conditions": kinds, "response_sign": signs,
                     "warnings": sign_warnings + out["warnings"], **extra})
         return 0
+    from ._recording import print_reading
+
+    for path, rec in readings.items():
+        print_reading(rec, path)
     print(f"fitted {len(fit.names)} parameter(s) to {len(conditions)} condition(s); fit error "
           f"{fit.fit_error:.3g} (√(χ²/dof); about 1 when the model explains the data)")
     print("conditions (NAME#k is condition k's value): " + ", ".join(

@@ -9,7 +9,8 @@ from ._common import FIGURE_SUFFIXES, check_writable, print_json
 from ._recording import (
     add_cycle_trim_argument,
     add_recording_arguments,
-    print_resampling,
+    check_sway_response,
+    print_reading,
     recording_options,
 )
 
@@ -28,8 +29,10 @@ The file has a header row and a uniform time column, t or time [s] (the sample r
 from it); --resample HZ puts an uneven one on a uniform grid (cubic spline; a gap over
 --max-gap refused). A header may declare units, e.g. com [rad]; posturelab reads SI (time
 in s, angles in rad, translations in m) and refuses a column in another unit (deg, ms,
-mm, ...) unless declared with --angle-unit deg / --length-unit mm. A .c3d is read directly
-(columns as posturelab convert names them).
+mm, ...) unless declared with --angle-unit deg / --length-unit mm / --time-unit ms. A .c3d
+is read directly (columns as posturelab convert names them). --sway METHOD with its markers
+(--hip-marker LABEL --shoulder-marker LABEL, ...) computes com_angle from a C3D's or a lab
+CSV's markers as posturelab convert --sway does; then --response com_angle.
 --bands peterka (default; the historical name, the same as posturelab-80 and comtest-80)
 averages the 11 bands of the 80-state protocol (COMTEST's analysis; 20 s: 0.05 … 2.20 Hz; for
 another cycle length the same harmonic numbers); --bands peterka-2002-242 the 17 bands
@@ -52,7 +55,8 @@ says when that band's phase lies within 45 deg of +-180 deg with coherence >= 0.
 "harmonic_frequency" and "harmonic_weight" (each band's harmonics [Hz] and their share of
 its stimulus power), "frf_se" (standard error of the complex estimate), "dof",
 "frf_covariance" (of the bands), "response_sign", "sign_convention", "warnings", and with
---resample "resampling" (what was done)}; an undefined number is null. fit-frf reads it back.
+--resample "resampling" (what was done), with --start or --drop-partial "trimming" (what
+was cut)}; an undefined number is null. fit-frf reads it back.
 --ci periodic (default) gives bounds exact for a periodic stimulus; --ci otnes-enochson the
 form Peterka used (wider).
 
@@ -115,18 +119,20 @@ def run(args: argparse.Namespace) -> int:
     from .._files import refuse_input_as_output
     from .._validation import float_in_range
     from ..frequency.estimate import estimate_frf, sign_convention, whole_cycles
-    from ..recordings.table import read_series
+    from ..recordings.reading import read_recording
 
     refuse_input_as_output({"--data": args.data},
                            {"--plot": args.plot, "--plot-cycles": args.plot_cycles})
     check_plot_path(args.plot, args.plot_cycles)
     float_in_range("--cycle-length [s]", args.cycle_length, 1e-3, 1e5, unit="s")
     stim, resp = args.stimulus.strip().lower(), args.response.strip().lower()
-    fs, cols, resampled = read_series(args.data, [stim, resp], {stim: ("rad", "m")},
-                                      kinds=trial_kinds(stim, resp, args.length_unit),
-                                      cycle_length=args.cycle_length,
-                                      **recording_options(args))
-    print_resampling(resampled)
+    check_sway_response(args, resp)
+    rec = read_recording(args.data, [stim, resp], {stim: ("rad", "m")},
+                         kinds=trial_kinds(stim, resp, args.length_unit),
+                         cycle_length=args.cycle_length, **recording_options(args))
+    fs, cols = rec.rate, rec.columns
+    if not args.json:
+        print_reading(rec)
     sign = response_sign(args.response_sign)
     x, y, trimmed = whole_cycles(cols[stim], cols[resp], fs, args.cycle_length)
     est = estimate_frf(x, y, fs, args.cycle_length,
@@ -154,7 +160,7 @@ def run(args: argparse.Namespace) -> int:
         for warning in est.warnings:
             print(f"warning: {warning}", file=sys.stderr)
     if args.json:
-        extra = {} if resampled is None else {"resampling": resampled.to_dict()}
+        extra = rec.report_dict()
         print_json({**est.to_dict(), "sign_convention": sign_convention(sign), **extra})
         return 0
     print(f"FRF of {resp} to {stim}, {sign_convention(sign)}: {est.n_cycles} cycles "

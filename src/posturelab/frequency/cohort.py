@@ -33,7 +33,8 @@ import numpy as np
 from ..errors import ParameterError, PostureLabError
 from .fit import check_fit_request
 
-__all__ = ["CohortFit", "SubjectFit", "fit_cohort", "read_frf_file", "max_cohort_workers",
+__all__ = ["CohortFit", "SubjectFit", "fit_cohort", "read_frf_file", "read_trial_frf",
+           "max_cohort_workers",
            "usable_cpus", "csv_text", "MAX_SUBJECTS"]
 
 #: Most subjects one cohort may have. [-]
@@ -74,21 +75,39 @@ def read_frf_file(path, *, stimulus: str | None = None, response: str | None = N
         from .table import read_frf_json
 
         return read_frf_json(path, what)
+    return read_trial_frf(path, stimulus=stimulus, response=response,
+                          cycle_length=cycle_length, discard_cycles=discard_cycles,
+                          response_sign=response_sign, input=input, **recording)[0]
+
+
+def read_trial_frf(path, *, stimulus: str | None = None, response: str | None = None,
+                   cycle_length: float | None = None, discard_cycles: int = 0,
+                   response_sign: int = -1, input: str = "tilt", **recording):
+    """A trial recording's FRF (as :func:`read_frf_file` estimates it) and what reading it
+    did: (:class:`~posturelab.frequency.estimate.FRFEstimate`,
+    :class:`~posturelab.recordings.reading.Recording`); ``recording`` are
+    :func:`~posturelab.recordings.reading.read_recording`'s options.
+
+    Raises
+    ------
+    ParameterError, DataFileError
+    """
     from .._validation import float_in_range
-    from .data import read_series_csv
+    from ..recordings.reading import read_recording
     from .estimate import estimate_frf, whole_cycles
 
     if stimulus is None or response is None or cycle_length is None:
         raise ParameterError("a trial CSV needs --stimulus, --response and --cycle-length")
     float_in_range("--cycle-length [s]", cycle_length, 1e-3, 1e5, unit="s")
     stim, resp = stimulus.strip().lower(), response.strip().lower()
-    fs, cols = read_series_csv(  # recording: read_series_csv's resample/unit options
+    rec = read_recording(
         path, [stim, resp], {stim: ("rad",) if input == "tilt" else ("m",)},
         kinds={stim: "angle" if input == "tilt" else "length", resp: "angle"},
         cycle_length=cycle_length, **recording)
+    fs, cols = rec.rate, rec.columns
     x, y, _ = whole_cycles(cols[stim], cols[resp], fs, cycle_length)
     return estimate_frf(x, y, fs, cycle_length, discard_cycles=discard_cycles,
-                        response_sign=response_sign)
+                        response_sign=response_sign), rec
 
 
 @dataclass(frozen=True)

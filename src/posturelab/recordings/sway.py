@@ -45,13 +45,16 @@ Three methods:
 
 from __future__ import annotations
 
+from dataclasses import dataclass, field
+
 import numpy as np
 
 from ..errors import ParameterError
 from ..model.anthropometry import WINTER_TABLE
 
-__all__ = ["SWAY_METHODS", "com_angle_segments", "com_angle_two_markers", "com_angle_cop",
-           "lower_body_fraction", "LANDMARK_HEIGHTS", "WINTER_SEGMENTS"]
+__all__ = ["SwaySpec", "SWAY_METHODS", "LANDMARKS", "AXES", "com_angle_segments",
+           "com_angle_two_markers", "com_angle_cop", "lower_body_fraction", "LANDMARK_HEIGHTS",
+           "WINTER_SEGMENTS"]
 
 #: The sway methods, with what each needs.
 SWAY_METHODS = {
@@ -59,6 +62,75 @@ SWAY_METHODS = {
     "two-marker": "hip and shoulder markers (ankle marker or its position; Winter 2009)",
     "cop": "a force plate's centre of pressure, height and mass (Caron et al. 1997)",
 }
+
+#: The landmarks a marker may be named for. [-]
+LANDMARKS = ("ankle", "knee", "hip", "shoulder")
+#: The landmarks each method needs. [-]
+NEEDS = {"segments": LANDMARKS, "two-marker": ("hip", "shoulder"), "cop": ()}
+#: Lab axes a marker coordinate may be taken along (a leading - flips it).
+AXES = ("x", "y", "z", "-x", "-y", "-z")
+
+
+@dataclass(frozen=True)
+class SwaySpec:
+    """How ``com_angle`` is computed from a recording's markers or force plate (what
+    ``posturelab convert --sway`` and ``frf --sway`` are given), checked when made.
+
+    Attributes
+    ----------
+    method : str
+        ``segments``, ``two-marker`` or ``cop`` (:data:`SWAY_METHODS`).
+    markers : tuple of (str, str)
+        (landmark, marker label) pairs: ankle, knee, hip, shoulder.
+    plate : int
+        The force plate ``cop`` uses (1-based). [-]
+    forward, up : str
+        The lab axes (x, y, z, a leading - flips) pointing forward and up.
+    height, mass : float or None
+        The subject's height [m] and mass [kg] (``cop``; ``two-marker`` on forward
+        positions only).
+    """
+
+    method: str
+    markers: tuple[tuple[str, str], ...] = field(default=())
+    plate: int = 1
+    forward: str = "x"
+    up: str = "z"
+    height: float | None = None
+    mass: float | None = None
+
+    def __post_init__(self) -> None:
+        if self.method not in SWAY_METHODS:
+            raise ParameterError(f"unknown sway method {self.method!r}; known: "
+                                 + ", ".join(SWAY_METHODS))
+        for a in (self.forward, self.up):
+            if a not in AXES:
+                raise ParameterError(f"an axis must be one of {', '.join(AXES)}, got {a!r}")
+        if self.forward.lstrip("-") == self.up.lstrip("-"):
+            raise ParameterError(f"the forward and up axes must differ, got {self.forward} "
+                                 f"and {self.up}")
+        for k, _ in self.markers:
+            if k not in LANDMARKS:
+                raise ParameterError(f"unknown landmark {k!r} in --markers; known: "
+                                     + ", ".join(LANDMARKS))
+        given = dict(self.markers)
+        missing = [n for n in NEEDS[self.method] if n not in given]
+        if missing:
+            raise ParameterError(f"--sway {self.method} needs the "
+                                 f"{', '.join(NEEDS[self.method])} markers (--markers "
+                                 f"{'=LABEL,'.join(NEEDS[self.method])}=LABEL or "
+                                 f"--{missing[0]}-marker LABEL); {missing[0]} not given")
+        if self.method == "cop" and (self.height is None or self.mass is None):
+            raise ParameterError("--sway cop needs --height [m] and --mass [kg]")
+        if not isinstance(self.plate, int) or self.plate < 1:
+            raise ParameterError(f"the force plate must be a number >= 1, got {self.plate!r}")
+
+    def options(self) -> dict:
+        """:func:`posturelab.recordings.convert.convert_recording`'s sway options."""
+        return {"sway": self.method, "markers": dict(self.markers), "plate": self.plate,
+                "forward": self.forward, "up": self.up, "height": self.height,
+                "mass": self.mass}
+
 
 #: Winter (2009) Table 4.1, from posturelab.model.anthropometry.WINTER_TABLE (stated once
 #: there): per segment, (mass fraction of both sides together [-], centre of mass from the

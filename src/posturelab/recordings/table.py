@@ -1,10 +1,8 @@
-"""Reading the named columns of a recording (a CSV table or a C3D file) in SI units.
+"""Reading the columns of a recording (a CSV table or a C3D file) as stored.
 
-One reader for every command that takes a recording (``frf``, ``fit-frf``, ``fit``,
-``convert``): :func:`read_series` finds the time column and the named columns, converts the
-units the user declared (angles ``deg`` → rad, lengths ``mm`` → m; never guessed), and
-either checks that the time column is uniform or, with ``resample``, puts the recording on
-a uniform grid (:func:`posturelab.recordings.resample.resample_uniform`).
+:func:`read_table` finds the time column [s] and the named columns of a CSV or C3D file;
+:func:`posturelab.recordings.reading.read_recording` (the one reader every command uses)
+builds on it: declared units, resampling, the cut to whole cycles, sway.
 
 A CSV header may declare a column's unit in brackets (``tilt [deg]``). Without a declared
 unit (``angle_unit``/``length_unit``) only SI is read: a column declaring deg or mm is
@@ -14,18 +12,19 @@ refused with a message naming the option that reads it. A ``.c3d`` file is read 
 
 from __future__ import annotations
 
+import io
 import itertools
 import math
+import re
 from pathlib import Path
 
 import numpy as np
 
 from .._files import check_column_unit, column_unit
 from ..errors import DataFileError, ParameterError
-from .resample import ResampleReport, resample_uniform, uniform_step
 
-__all__ = ["read_series", "read_table", "SI_UNITS", "ANGLE_UNITS", "LENGTH_UNITS",
-           "MAX_ROWS", "SCALE"]
+__all__ = ["read_table", "check_time", "SI_UNITS", "ANGLE_UNITS", "LENGTH_UNITS",
+           "TIME_UNITS", "MAX_ROWS", "SCALE"]
 
 #: Most data rows a series file may have. [-]
 MAX_ROWS = 2_000_000  # posturelab._files.MAX_DATA_ROWS
@@ -35,8 +34,10 @@ SI_UNITS = ("rad", "m", "N", "N·m", "N m", "rad/s", "m/s")
 ANGLE_UNITS = ("rad", "deg")
 #: Length units a user may declare (``--length-unit``). [-]
 LENGTH_UNITS = ("m", "mm")
+#: Time units a user may declare for a CSV's time column (``--time-unit``). [-]
+TIME_UNITS = ("s", "ms")
 #: Factor to SI of each declarable unit. [SI unit per unit]
-SCALE = {"rad": 1.0, "deg": math.pi / 180.0, "m": 1.0, "mm": 1e-3}
+SCALE = {"rad": 1.0, "deg": math.pi / 180.0, "m": 1.0, "mm": 1e-3, "s": 1.0, "ms": 1e-3}
 
 
 def _name(header: str) -> str:
@@ -45,7 +46,7 @@ def _name(header: str) -> str:
 
 
 def read_table(path: str | Path, columns: list[str] | None = None, *,
-               skipped: list[str] | None = None
+               skipped: list[str] | None = None, time_unit: str = "s"
                ) -> tuple[np.ndarray, dict[str, np.ndarray], dict[str, str]]:
     """The time column and the named columns of a CSV or C3D recording, as stored.
 
@@ -58,6 +59,9 @@ def read_table(path: str | Path, columns: list[str] | None = None, *,
     skipped : list, optional
         With ``columns`` None, receives the names of the CSV columns left out because their
         first value is not a number (labels, comments).
+    time_unit : str
+        The unit of a CSV's time column, ``s`` or ``ms`` (converted to s); a header that
+        declares another is refused. A C3D file's time comes from its rate.
 
     Returns
     -------
@@ -72,18 +76,50 @@ def read_table(path: str | Path, columns: list[str] | None = None, *,
         that is not a number (line and column named).
     """
     path = Path(path)
+    if time_unit not in TIME_UNITS:
+        raise ParameterError(f"time unit must be one of {', '.join(TIME_UNITS)}, got "
+                             f"{time_unit!r}")
     if path.suffix.lower() == ".c3d":
         from .c3d import read_c3d
 
+        if time_unit != "s":
+            raise ParameterError("--time-unit is for a CSV's time column; a C3D file's time "
+                                 "comes from its frame rate")
         rec = read_c3d(path)
         names = list(rec.columns)
         for c in columns or []:
+            if c in rec.unusable:
+                raise DataFileError(f"{str(path)!r}: column {c!r} cannot be used: "
+                                    f"{rec.unusable[c]}")
             if c not in rec.columns:
                 raise DataFileError(f"{str(path)!r} has no column {c!r}; it has "
                                     f"{_listing(names)}")
         wanted = names if columns is None else list(columns)
         return rec.time, {c: rec.columns[c] for c in wanted}, {c: rec.units[c] for c in wanted}
-    return _read_csv(path, columns, skipped)
+    return _read_csv(path, columns, skipped, time_unit)
+
+
+def _refuse_other_separators(header: list[str], what: str) -> None:
+    """Refuse a header separated by semicolons or tabs (a spreadsheet's export in a locale
+    with decimal commas): posturelab reads comma-separated values with decimal points."""
+    for sep, name in ((";", "semicolons"), ("\t", "tabs")):
+        if len(header) == 1 and sep in header[0] or (
+                sum(sep in h for h in header) >= max(1, len(header) // 2) and sep in
+                "".join(header)):
+            raise DataFileError(f"{what} is separated by {name}; posturelab reads "
+                                "comma-separated values with decimal points: export it as "
+                                "CSV with ',' between columns and '.' in numbers")
+
+
+def _refuse_decimal_commas(text: str, what: str) -> None:
+    """Refuse a file whose first data line has more commas than its header and numbers with
+    a decimal comma (``0,5``): its columns cannot be told apart."""
+    lines = [ln for ln in itertools.islice(io.StringIO(text), 50) if ln.strip()][:2]
+    if len(lines) == 2 and lines[1].count(",") > lines[0].count(",") and re.search(
+            r"\d,\d", lines[1]) and ";" not in lines[0]:
+        raise DataFileError(f"{what}: its first data line has more fields than its header: "
+                            "decimal commas? posturelab reads comma-separated values with decimal "
+                            "points")
 
 
 def _listing(names: list[str], most: int = 12) -> str:
@@ -91,14 +127,18 @@ def _listing(names: list[str], most: int = 12) -> str:
     return shown + (f", … ({len(names)} columns)" if len(names) > most else "")
 
 
-def _read_csv(path: Path, columns: list[str] | None, skipped: list[str] | None = None):
+def _read_csv(path: Path, columns: list[str] | None, skipped: list[str] | None = None,
+              time_unit: str = "s"):
     from .._files import csv_rows, header_words, read_text
 
     what = repr(str(path))
-    rows_in = csv_rows(read_text(path, "data file"), what, max_rows=MAX_ROWS)
+    text = read_text(path, "data file")
+    _refuse_decimal_commas(text, what)
+    rows_in = csv_rows(text, what, max_rows=MAX_ROWS)
     first = next(rows_in, None)
     if first is None:
         raise DataFileError(f"{what} is empty")
+    _refuse_other_separators(first[1], what)
     names = [_name(h) for h in first[1]]
     if "time" not in names:
         raise DataFileError(f"{what} has no time column (named t or time, in s); "
@@ -125,7 +165,11 @@ def _read_csv(path: Path, columns: list[str] | None, skipped: list[str] | None =
             raise DataFileError(f"{what} has no column {c!r}; {header_words(first[1])}")
     wanted = ["time", *wanted_cols]
     index = [names.index(c) for c in wanted]
-    check_column_unit(what, first[1][index[0]], ("s",))
+    time_header = column_unit(first[1][index[0]])
+    if time_header == "ms" and time_unit != "ms":
+        raise DataFileError(f"{what}: the time column is in ms; give --time-unit ms to read "
+                            "it (posturelab converts it to s)")
+    check_column_unit(what, first[1][index[0]], (time_unit,))
     rows = []
     for lineno, row in rows_in:
         values = []
@@ -137,8 +181,10 @@ def _read_csv(path: Path, columns: list[str] | None, skipped: list[str] | None =
             try:
                 v = float(cell)  # type: ignore[arg-type]
             except (TypeError, ValueError):
+                comma = (" (a decimal comma? posturelab reads decimal points)"
+                         if cell and re.fullmatch(r"[-+]?\d+,\d+", cell) else "")
                 raise DataFileError(f"{what} line {lineno}: column {c!r} is not a "
-                                    "number") from None
+                                    f"number{comma}") from None
             if not math.isfinite(v):
                 raise DataFileError(f"{what} line {lineno}: column {c!r} is {v}; NaN and "
                                     "inf are not allowed")
@@ -147,127 +193,19 @@ def _read_csv(path: Path, columns: list[str] | None, skipped: list[str] | None =
     data = np.array(rows, dtype=float).reshape(len(rows), len(wanted))
     units = {c: column_unit(first[1][j]) for c, j in zip(wanted, index, strict=True)}
     units.pop("time")
-    return data[:, 0], {c: data[:, k + 1] for k, c in enumerate(wanted_cols)}, units
+    return (data[:, 0] * SCALE[time_unit],
+            {c: data[:, k + 1] for k, c in enumerate(wanted_cols)}, units)
 
 
-def read_series(path: str | Path, columns: list[str],
-                units: dict[str, tuple[str, ...]] | None = None, *,
-                kinds: dict[str, str] | None = None, angle_unit: str = "rad",
-                length_unit: str = "m", resample: float | None = None,
-                max_gap: float | None = None, start: float | None = None,
-                drop_partial: bool = False, cycle_length: float | None = None
-                ) -> tuple[float, dict[str, np.ndarray], ResampleReport | None]:
-    """The sample rate and the named columns of a recording, in SI, on a uniform grid.
-
-    Parameters
-    ----------
-    path : str or Path
-        A CSV (header row, a ``time`` or ``t`` column [s]) or a ``.c3d``.
-    columns : list of str
-        Columns to read (lower case).
-    units : dict of str -> tuple of str, optional
-        The SI units each column may declare in its header (default :data:`SI_UNITS`).
-    kinds : dict of str -> str, optional
-        ``"angle"`` or ``"length"`` per column: which declared unit applies to it.
-    angle_unit, length_unit : str
-        The unit of the angle (``rad``, ``deg``) and length (``m``, ``mm``) columns, as the
-        user declares it; converted to rad and m. A header that declares another unit is
-        refused.
-    resample : float, optional
-        Put the recording on a uniform grid at this rate [Hz] by a cubic spline (see
-        :func:`~posturelab.recordings.resample.resample_uniform`); without it a non-uniform
-        time column or a missing sample is refused.
-    max_gap : float, optional
-        Longest gap the resampling accepts. [s]
-    start : float, optional
-        Drop the samples before this time (where the stimulus's first cycle starts). [s]
-    drop_partial : bool
-        Drop the samples after the last whole cycle of ``cycle_length`` [s] (a recording
-        that runs on past the stimulus); the cut is said on standard error.
-    cycle_length : float, optional
-        [s]
-
-    Returns
-    -------
-    (float, dict of str -> numpy.ndarray, ResampleReport or None)
-        Sample rate [Hz], each column [SI], and what the resampling did.
-
-    Raises
-    ------
-    DataFileError, ParameterError
-    """
-    if angle_unit not in ANGLE_UNITS:
-        raise ParameterError(f"angle unit must be one of {', '.join(ANGLE_UNITS)}, got "
-                             f"{angle_unit!r}")
-    if length_unit not in LENGTH_UNITS:
-        raise ParameterError(f"length unit must be one of {', '.join(LENGTH_UNITS)}, got "
-                             f"{length_unit!r}")
-    path = Path(path)
-    what = repr(str(path))
-    time, cols, declared = read_table(path, columns)
-    kinds = kinds or {}
-    for c in columns:
-        kind = kinds.get(c)
-        given = {"angle": angle_unit, "length": length_unit}.get(kind or "")
-        header = declared[c]
-        if given is not None and given not in ("rad", "m") and header in ("", given):
-            cols[c] = cols[c] * SCALE[given]  # declared by the user (the header agrees)
-            continue
-        accepted = (units or {}).get(c, SI_UNITS)
-        hint = {("deg", "angle"): "; give --angle-unit deg to read degrees",
-                ("mm", "length"): "; give --length-unit mm to read millimetres"}.get(
-                    (header.lower(), kind or {"deg": "angle", "mm": "length"}.get(
-                        header.lower(), "")), "")
-        if header and header.lower() not in {a.lower() for a in accepted} and hint:
-            raise DataFileError(f"{what}: column {f'{c} [{header}]'!r} is in {header}; "
-                                f"posturelab reads {' or '.join(accepted)}{hint}")
-        check_column_unit(what, f"{c} [{header}]" if header else c, accepted)
-    if start is not None:
-        keep = time >= float(start) - 1e-9
-        if not keep.any():
-            raise DataFileError(f"{what} ends at {time[-1]:g} s, before --start {start:g} s")
-        time, cols = time[keep], {c: v[keep] for c, v in cols.items()}
-    if time.size < 8:
-        raise DataFileError(f"{what} needs at least 8 samples, has {time.size}")
-    report = None
-    if resample is not None:
-        _, cols, report = resample_uniform(time, cols, resample, max_gap=max_gap, what=what)
-        step = 1.0 / report.rate
-    else:
-        step = _uniform_or_refuse(time, cols, columns, what)
-    if drop_partial:
-        if cycle_length is None:
-            raise ParameterError("--drop-partial needs --cycle-length")
-        per = int(round(float(cycle_length) / step))
-        n = next(iter(cols.values())).size
-        whole = (n // per) * per if per > 0 else n
-        if whole == 0:
-            raise DataFileError(f"{what} holds {n * step:g} s, less than one cycle of "
-                                f"{cycle_length:g} s")
-        if whole < n:
-            import sys
-
-            print(f"note: {what}: dropped the last {n - whole} sample(s) "
-                  f"({(n - whole) * step:.4g} s), a partial cycle", file=sys.stderr)
-            cols = {c: v[:whole] for c, v in cols.items()}
-    return 1.0 / step, cols, report
-
-
-def _uniform_or_refuse(time: np.ndarray, cols: dict[str, np.ndarray], columns: list[str],
-                       what: str) -> float:
-    """The step of a uniform time column with no missing sample [s]; else refused."""
-    step = uniform_step(time)
-    if step is None:
-        dt = np.diff(time)
-        med = float(np.median(dt))
-        i = int(np.argmax(np.abs(dt - med)))
-        raise DataFileError(f"{what}: the time column is not uniform (step {med:g} s, but "
-                            f"{dt[i]:g} s at t = {time[i]:g} s); give --resample HZ to "
-                            "interpolate it onto a uniform grid")
-    for c in columns:
-        bad = np.flatnonzero(~np.isfinite(cols[c]))
-        if bad.size:
-            raise DataFileError(f"{what}: column {c!r} is missing at t = {time[bad[0]]:g} s "
-                                f"({bad.size} sample(s)); give --resample HZ to fill short "
-                                "gaps")
-    return step
+def check_time(time: np.ndarray, what: str) -> None:
+    """Refuse a time column that repeats a time stamp or goes backwards (naming where)."""
+    dt = np.diff(time)
+    bad = np.flatnonzero(dt <= 0)
+    if bad.size:
+        i = int(bad[0])
+        if dt[i] == 0:
+            raise DataFileError(f"{what}: the time stamp {time[i]:g} s is repeated (samples "
+                                f"{i + 1} and {i + 2}); drop the duplicated rows")
+        raise DataFileError(f"{what}: the time column goes backwards at sample {i + 2} "
+                            f"({time[i]:g} s, then {time[i + 1]:g} s); sort it or split "
+                            "the recording")
