@@ -52,6 +52,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--level", type=float, default=0.95, metavar="P",
                    help="coverage of the per-band intervals (default 0.95).")
     add_trial_arguments(p)
+    add_recording_flags(p)
     p.add_argument("--json", action="store_true", help="print one JSON object.")
 
 

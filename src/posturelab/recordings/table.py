@@ -112,14 +112,21 @@ def _refuse_other_separators(header: list[str], what: str) -> None:
 
 
 def _refuse_decimal_commas(text: str, what: str) -> None:
-    """Refuse a file whose first data line has more commas than its header and numbers with
+    """Refuse a file whose first data line has more fields than its header and a number with
     a decimal comma (``0,5``): its columns cannot be told apart."""
+    import csv
+
     lines = [ln for ln in itertools.islice(io.StringIO(text), 50) if ln.strip()][:2]
-    if len(lines) == 2 and lines[1].count(",") > lines[0].count(",") and re.search(
-            r"\d,\d", lines[1]) and ";" not in lines[0]:
+    if len(lines) < 2 or ";" in lines[0] or not re.search(r"\d,\d", lines[1]):
+        return
+    try:
+        head, row = list(csv.reader(lines))[:2]
+    except (csv.Error, ValueError):
+        return  # (csv_rows says what is wrong)
+    if len(row) > len(head):
         raise DataFileError(f"{what}: its first data line has more fields than its header: "
-                            "decimal commas? posturelab reads comma-separated values with decimal "
-                            "points")
+                            "decimal commas? posturelab reads comma-separated values with "
+                            "decimal points")
 
 
 def _listing(names: list[str], most: int = 12) -> str:
