@@ -174,8 +174,9 @@ def _read_csv(path: Path, columns: list[str] | None, skipped: list[str] | None =
     index = [names.index(c) for c in wanted]
     time_header = column_unit(first[1][index[0]])
     if time_header == "ms" and time_unit != "ms":
-        raise DataFileError(f"{what}: the time column is in ms; give --time-unit ms to read "
-                            "it (posturelab converts it to s)")
+        raise DataFileError(f"{what}: column {first[1][index[0]].strip()!r} is in ms; "
+                            "posturelab reads time in s: give --time-unit ms to read it "
+                            "(converted to s)")
     check_column_unit(what, first[1][index[0]], (time_unit,))
     rows = []
     for lineno, row in rows_in:
