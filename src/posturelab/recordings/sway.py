@@ -20,10 +20,14 @@ Three methods:
 ``two-marker``
     Hip and shoulder markers only (the common minimal set: sway measured at hip and shoulder
     level): the same table with the knee taken on the ankle–hip line (legs and thighs one
-    segment, centre of mass at the fraction :func:`lower_body_fraction` of ankle–hip). Its
-    error comes from the knee's flexion: on a simulated PRTS trial of a three-link Winter
-    body (knee angle 0.011 rad RMS, sway 0.085 rad RMS) 0.42 % of the sway's RMS
-    (tests/test_recordings.py); it grows with the knee's motion. When only forward
+    segment, centre of mass at the fraction :func:`lower_body_fraction` of ankle–hip).
+    **This reduction is posturelab's own**: searches of the literature (for a hip–shoulder
+    or sacrum-marker estimate of the CoM sway angle with a published error) found no source
+    to cite, so no published error is given; the error below is our measurement. Its error
+    comes from the knee's flexion: on a simulated PRTS trial of a three-link Winter body
+    (knee angle 0.011 rad RMS, sway 0.085 rad RMS) 0.42 % of the sway's RMS
+    (tests/test_recordings.py); it grows with the knee's motion, and is nil for a body
+    straight from ankle to shoulder (tests/test_recordings_hostile.py). When only forward
     positions of hip and shoulder are recorded, their heights above the ankle come from
     the subject's height by Winter's Fig. 4.1 (after Drillis & Contini 1966: greater
     trochanter 0.530 H, shoulder 0.818 H, lateral malleolus 0.039 H).
@@ -59,7 +63,8 @@ __all__ = ["SwaySpec", "SWAY_METHODS", "LANDMARKS", "AXES", "com_angle_segments"
 #: The sway methods, with what each needs.
 SWAY_METHODS = {
     "segments": "ankle, knee, hip and shoulder markers (Winter 2009 Table 4.1)",
-    "two-marker": "hip and shoulder markers (ankle marker or its position; Winter 2009)",
+    "two-marker": "hip and shoulder markers (ankle marker or its position; Winter 2009 "
+                  "reduced by posturelab, no published validation)",
     "cop": "a force plate's centre of pressure, height and mass (Caron et al. 1997)",
 }
 
