@@ -342,3 +342,22 @@ def test_the_cli_sway_choices_are_the_librarys():
     from posturelab.recordings.sway import SWAY_METHODS
 
     assert SWAY_CHOICES == tuple(SWAY_METHODS)
+
+
+def test_a_cohort_says_what_reading_each_trial_did(tmp_path, capsys, trial):
+    """cohort reads trials in worker processes: what was cut comes back with each subject
+    (SubjectFit.reading; "readings" in --json), not printed by the library."""
+    t, tilt, com = trial
+    rows = np.column_stack([t, tilt, com])
+    path = write_csv(tmp_path / "s01.csv", "time,tilt,com_angle",
+                     np.vstack([rows, rows[:30] + [2 * CYCLE, 0, 0]]))
+    code, out, err = run(capsys, "cohort", "--data", path, "--body", "paper-1link",
+                         "--controller", "peterka-2002", "--free", "feedback_delay",
+                         "--stimulus", "tilt", "--response", "com_angle", "--cycle-length",
+                         "20", "--drop-partial", "--workers", "1", "--out",
+                         tmp_path / "c.csv", "--json")
+    assert code == 0, err
+    (item,) = json.loads(out)["readings"]
+    assert item["subject"] == "s01"
+    assert item["reading"] == ["dropped the last 30 sample(s) (0.6 s), a partial cycle of "
+                               "20 s; 2000 sample(s) kept"]

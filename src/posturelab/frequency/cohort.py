@@ -128,6 +128,9 @@ class SubjectFit:
     failed : bool
     reason : str
         Why it failed (empty when it did not).
+    reading : tuple of str
+        What reading the subject's trial recording did (resampled, cut; one line each;
+        empty for an FRF file or a recording read as it was).
     """
 
     subject: str
@@ -139,6 +142,7 @@ class SubjectFit:
     weighting: str = ""
     failed: bool = False
     reason: str = ""
+    reading: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -277,8 +281,12 @@ def _failed(task: _CohortTask, subject: str, reason: str) -> SubjectFit:
 def _fit_one(task: _CohortTask, subject: str, data) -> SubjectFit:
     from .fit import fit_frf
 
+    reading: tuple[str, ...] = ()
     try:
-        if isinstance(data, str | Path):
+        if isinstance(data, str | Path) and not str(data).lower().endswith(".json"):
+            data, rec = read_trial_frf(data, **dict(task.reader))
+            reading = tuple(rec.report_lines())
+        elif isinstance(data, str | Path):
             data = read_frf_file(data, **dict(task.reader))
         fit = fit_frf(task.body, task.muscles, data, list(task.free), **dict(task.options))
     except PostureLabError as exc:
@@ -287,7 +295,8 @@ def _fit_one(task: _CohortTask, subject: str, data) -> SubjectFit:
         return _failed(task, subject, f"{type(exc).__name__}: {exc}"[:300])
     reason = "" if fit.success else f"the optimiser did not converge: {fit.message}"
     return SubjectFit(subject, fit.estimates, fit.standard_errors, fit.confidence_intervals,
-                      fit.determined, fit.fit_error, fit.weighting, not fit.success, reason)
+                      fit.determined, fit.fit_error, fit.weighting, not fit.success, reason,
+                      reading)
 
 
 def _subject_names(subjects, names) -> list[str]:
