@@ -361,3 +361,48 @@ def test_a_cohort_says_what_reading_each_trial_did(tmp_path, capsys, trial):
     assert item["subject"] == "s01"
     assert item["reading"] == ["dropped the last 30 sample(s) (0.6 s), a partial cycle of "
                                "20 s; 2000 sample(s) kept"]
+
+
+def test_sway_on_frf_from_a_lab_csv_equals_convert_then_frf(tmp_path, capsys):
+    """A lab CSV (uneven clock, degrees, forward marker positions in mm): --length-unit is
+    the markers' unit and the stimulus stays an angle (not a translation in mm)."""
+    from posturelab.recordings.example import EXAMPLE_HEIGHT, make_lab_csv
+
+    lab = tmp_path / "lab.csv"
+    make_lab_csv(lab)
+    units = ["--resample", "100", "--angle-unit", "deg", "--length-unit", "mm",
+             "--height", str(EXAMPLE_HEIGHT)]
+    code, out, err = run(capsys, "convert", lab, "--out", tmp_path / "t.csv", *units,
+                         "--angle-columns", "stim_pitch", "--sway", "two-marker",
+                         "--markers", "hip=hip_xpos,shoulder=shld_xpos")
+    assert code == 0, err
+    frf = ["--stimulus", "stim_pitch", "--response", "com_angle", "--cycle-length", "20",
+           "--drop-partial", "--json"]
+    code, out, err = run(capsys, "frf", "--data", tmp_path / "t.csv", *frf)
+    assert code == 0, err
+    want = json.loads(out)
+    code, out, err = run(capsys, "frf", "--data", lab, *frf, *units, "--sway", "two-marker",
+                         "--hip-marker", "hip_xpos", "--shoulder-marker", "shld_xpos")
+    assert code == 0, err
+    got = json.loads(out)
+    np.testing.assert_allclose(got["gain"], want["gain"], rtol=1e-9)
+    np.testing.assert_allclose(got["phase_deg"], want["phase_deg"], atol=1e-7)
+    assert got["trimming"]["dropped_after"] == want["trimming"]["dropped_after"] > 0
+    assert got["resampling"]["rate_hz"] == 100.0
+
+
+def test_crlf_latin1_and_repeated_columns(tmp_path, capsys, trial):
+    t, tilt, com = trial
+    rows = np.column_stack([t, tilt, com])
+    plain = frf_json(capsys, write_csv(tmp_path / "plain.csv", "time,tilt,com_angle", rows))
+    crlf = tmp_path / "crlf.csv"
+    crlf.write_bytes((tmp_path / "plain.csv").read_bytes().replace(b"\n", b"\r\n"))
+    assert frf_json(capsys, crlf)["gain"] == plain["gain"]
+    latin = tmp_path / "latin1.csv"
+    latin.write_bytes("time,tilt [°],com_angle\n0,0,0\n".encode("latin-1"))
+    line = one_line_exit_2(capsys, "frf", "--data", latin, *FRF)
+    assert "not UTF-8 text (byte 0xb0" in line
+    twice = write_csv(tmp_path / "twice.csv", "time,tilt,com_angle,tilt",
+                      np.column_stack([t, tilt, com, tilt]))
+    line = one_line_exit_2(capsys, "frf", "--data", twice, *FRF)
+    assert "names 'tilt' 2 times (columns 2, 4)" in line

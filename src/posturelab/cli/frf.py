@@ -32,7 +32,8 @@ in s, angles in rad, translations in m) and refuses a column in another unit (de
 mm, ...) unless declared with --angle-unit deg / --length-unit mm / --time-unit ms. A .c3d
 is read directly (columns as posturelab convert names them). --sway METHOD with its markers
 (--hip-marker LABEL --shoulder-marker LABEL, ...) computes com_angle from a C3D's or a lab
-CSV's markers as posturelab convert --sway does; then --response com_angle.
+CSV's markers as posturelab convert --sway does; then --response com_angle, --length-unit
+is the markers' unit and the stimulus is read as an angle (a translation stimulus in m).
 --bands peterka (default; the historical name, the same as posturelab-80 and comtest-80)
 averages the 11 bands of the 80-state protocol (COMTEST's analysis; 20 s: 0.05 … 2.20 Hz; for
 another cycle length the same harmonic numbers); --bands peterka-2002-242 the 17 bands
@@ -128,7 +129,8 @@ def run(args: argparse.Namespace) -> int:
     stim, resp = args.stimulus.strip().lower(), args.response.strip().lower()
     check_sway_response(args, resp)
     rec = read_recording(args.data, [stim, resp], {stim: ("rad", "m")},
-                         kinds=trial_kinds(stim, resp, args.length_unit),
+                         kinds=trial_kinds(stim, resp, args.length_unit,
+                                           "tilt" if args.sway else None),
                          cycle_length=args.cycle_length, **recording_options(args))
     fs, cols = rec.rate, rec.columns
     if not args.json:

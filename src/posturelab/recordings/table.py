@@ -167,9 +167,14 @@ def _read_csv(path: Path, columns: list[str] | None, skipped: list[str] | None =
         wanted_cols = list(columns)
     if first_row is not None:
         rows_in = itertools.chain([first_row], rows_in)
-    for c in wanted_cols:
+    for c in ["time", *wanted_cols]:
         if c not in names:
             raise DataFileError(f"{what} has no column {c!r}; {header_words(first[1])}")
+        if names.count(c) > 1:
+            where = [j + 1 for j, n in enumerate(names) if n == c]
+            raise DataFileError(f"{what}: the header names {c!r} {len(where)} times (columns "
+                                f"{', '.join(map(str, where))}); which one is meant is not "
+                                "guessed")
     wanted = ["time", *wanted_cols]
     index = [names.index(c) for c in wanted]
     time_header = column_unit(first[1][index[0]])
