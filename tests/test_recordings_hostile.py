@@ -406,3 +406,15 @@ def test_crlf_latin1_and_repeated_columns(tmp_path, capsys, trial):
                       np.column_stack([t, tilt, com, tilt]))
     line = one_line_exit_2(capsys, "frf", "--data", twice, *FRF)
     assert "names 'tilt' 2 times (columns 2, 4)" in line
+
+
+def test_an_analog_channel_without_samples_is_left_out(tmp_path, capsys):
+    path = tmp_path / "dead.c3d"
+    write_c3d(path, {"a": np.zeros((50, 3))}, 100.0,
+              analogs={"dead": np.full(500, np.nan), "ok": np.ones(500)}, analog_rate=1000.0)
+    rec = read_c3d(path)
+    assert "dead" not in rec.columns and "fewer than 4 valid samples" in rec.unusable["dead"]
+    np.testing.assert_allclose(rec.columns["ok"], 1.0, rtol=1e-12)
+    line = one_line_exit_2(capsys, "frf", "--data", path, "--stimulus", "dead",
+                           "--response", "ok", "--cycle-length", "0.2")
+    assert "'dead' cannot be used" in line

@@ -16,7 +16,8 @@ multiple of it, else by a cubic spline; markers, when the rate differs from thei
 cubic spline. A marker missing in some frames (NaN in ezc3d) is filled by the same spline
 when the gap is at most :data:`posturelab.recordings.resample.MAX_GAP_STEPS` frames, else
 left out of the table (its reason kept in :attr:`C3DRecording.unusable`, said when the
-marker is asked for), as is a marker occluded throughout. Labels are made unique (an
+marker is asked for), as is a marker occluded throughout and an analog channel with
+missing (NaN) samples that cannot be filled. Labels are made unique (an
 empty label becomes ``analogN``/``markerN``, a repeated one gets ``_2``, ``_3``). Time
 starts at 0 at the first frame; a file with fewer than 2 frames is refused, and so is a
 table of more than :data:`MAX_TABLE_SAMPLES` samples per column.
@@ -74,7 +75,8 @@ class C3DRecording:
     notes : tuple of str
         What was done (units scaled, rates changed, samples filled, labels renamed).
     unusable : dict of str -> str
-        Columns left out (markers occluded for longer than the accepted gap) and why.
+        Columns left out (markers occluded for longer than the accepted gap, analog
+        channels with unfillable missing samples) and why.
     """
 
     time: np.ndarray
@@ -261,8 +263,12 @@ def read_c3d(path: str | Path, rate: float | None = None) -> C3DRecording:
     if analogs.size and labels and analog_rate > 0:
         t_an = np.arange(analogs.shape[2]) / analog_rate
         for j, label in enumerate(labels):
-            columns[label] = _to_rate(t_an, analogs[0, j], grid, analog_rate / out_rate,
-                                      what, label)
+            try:
+                columns[label] = _to_rate(t_an, analogs[0, j], grid, analog_rate / out_rate,
+                                          what, label)
+            except DataFileError as e:  # a channel with missing samples: left out
+                unusable[label] = str(e).removeprefix(f"{what}: ")
+                continue
             units[label] = str(analog_units[j]).strip() if j < len(analog_units) else ""
         if analog_rate != out_rate:
             notes.append(f"analog channels from {analog_rate:g} Hz to {out_rate:g} Hz")
