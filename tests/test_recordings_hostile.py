@@ -22,7 +22,7 @@ from posturelab.cli import main
 from posturelab.errors import DataFileError
 from posturelab.model.tilt import PRTSTilt
 from posturelab.recordings.c3d import read_c3d, write_c3d
-from posturelab.recordings.reading import read_recording
+from posturelab.recordings.table import read_recording
 
 CYCLE = 20.0  # the 80-state PRTS cycle [s]
 RATE = 50.0  # [Hz]
@@ -146,12 +146,12 @@ def test_a_constant_stimulus_is_refused(tmp_path, capsys, trial):
 
 
 def test_long_files_are_bounded(tmp_path, capsys, trial, monkeypatch):
-    import posturelab.recordings.table as table
+    import posturelab.recordings.columns as columns
 
     t, tilt, com = trial
     path = write_csv(tmp_path / "trial.csv", "time,tilt,com_angle",
                      np.column_stack([t, tilt, com]))
-    monkeypatch.setattr(table, "MAX_ROWS", 1000)
+    monkeypatch.setattr(columns, "MAX_ROWS", 1000)
     line = one_line_exit_2(capsys, "frf", "--data", path, *FRF)
     assert "more than 1,000 data rows" in line
     monkeypatch.undo()

@@ -129,7 +129,7 @@ def sway_spec(args: argparse.Namespace):
 
 
 def recording_options(args: argparse.Namespace) -> dict:
-    """:func:`posturelab.recordings.reading.read_recording`'s reading options."""
+    """:func:`posturelab.recordings.table.read_recording`'s reading options."""
     given = {"resample": None, "max_gap": None, "angle_unit": "rad", "length_unit": "m",
              "start": None}  # a command without these options reads as before
     out = {k: getattr(args, k, default) for k, default in given.items()}

@@ -77,8 +77,7 @@ def run(args: argparse.Namespace) -> int:
             or args.time_unit != "s" or str(args.data).lower().endswith(".c3d")):
         import numpy as np
 
-        from ..recordings.reading import read_recording
-        from ..recordings.table import read_table
+        from ..recordings.table import read_recording, read_table
         from ._recording import print_reading, recording_options
 
         names = [f"theta{i + 1}" for i in range(sc.body.n_links)]

@@ -136,7 +136,7 @@ def reader_options(args: argparse.Namespace) -> dict:
 
 def _condition(path: str, args: argparse.Namespace, readings: dict | None = None):
     """One FRF from a file (a trial recording or an FRF JSON); what reading a trial did is
-    put in ``readings[path]`` (a :class:`~posturelab.recordings.reading.Recording`)."""
+    put in ``readings[path]`` (a :class:`~posturelab.recordings.table.Recording`)."""
     from ..frequency.cohort import read_frf_file, read_trial_frf
     from ._recording import check_sway_response
 

@@ -120,7 +120,7 @@ def run(args: argparse.Namespace) -> int:
     from .._files import refuse_input_as_output
     from .._validation import float_in_range
     from ..frequency.estimate import estimate_frf, sign_convention, whole_cycles
-    from ..recordings.reading import read_recording
+    from ..recordings.table import read_recording
 
     refuse_input_as_output({"--data": args.data},
                            {"--plot": args.plot, "--plot-cycles": args.plot_cycles})

@@ -85,15 +85,15 @@ def read_trial_frf(path, *, stimulus: str | None = None, response: str | None = 
                    response_sign: int = -1, input: str = "tilt", **recording):
     """A trial recording's FRF (as :func:`read_frf_file` estimates it) and what reading it
     did: (:class:`~posturelab.frequency.estimate.FRFEstimate`,
-    :class:`~posturelab.recordings.reading.Recording`); ``recording`` are
-    :func:`~posturelab.recordings.reading.read_recording`'s options.
+    :class:`~posturelab.recordings.table.Recording`); ``recording`` are
+    :func:`~posturelab.recordings.table.read_recording`'s options.
 
     Raises
     ------
     ParameterError, DataFileError
     """
     from .._validation import float_in_range
-    from ..recordings.reading import read_recording
+    from ..recordings.table import read_recording
     from .estimate import estimate_frf, whole_cycles
 
     if stimulus is None or response is None or cycle_length is None:

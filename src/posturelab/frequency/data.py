@@ -1,6 +1,6 @@
 """Reading the series of an identification experiment from a CSV (or C3D) recording.
 
-The reading itself is :func:`posturelab.recordings.reading.read_series` (declared units,
+The reading itself is :func:`posturelab.recordings.table.read_series` (declared units,
 resampling of an uneven time column, C3D files); this module keeps the frequency package's
 entry point.
 """
@@ -12,8 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from .._files import check_column_unit, column_unit
-from ..recordings.reading import read_series
-from ..recordings.table import MAX_ROWS, SI_UNITS
+from ..recordings.table import MAX_ROWS, SI_UNITS, read_series
 
 __all__ = ["read_series_csv", "column_unit", "check_column_unit", "SI_UNITS", "MAX_ROWS"]
 
@@ -35,8 +34,8 @@ def read_series_csv(path: str | Path, columns: list[str],
     A non-uniform time column is refused unless ``resample`` [Hz] is given
     (:func:`posturelab.recordings.resample.resample_uniform`). ``start`` [s],
     ``drop_partial`` and ``cycle_length`` [s] cut the recording to the stimulus's whole
-    cycles; ``options`` are :func:`posturelab.recordings.reading.read_recording`'s others
-    (``time_unit``, ``sway``). Nothing is printed: :func:`~posturelab.recordings.reading.
+    cycles; ``options`` are :func:`posturelab.recordings.table.read_recording`'s others
+    (``time_unit``, ``sway``). Nothing is printed: :func:`~posturelab.recordings.table.
     read_recording` returns what was resampled and cut.
 
     Returns

@@ -9,9 +9,9 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import DataFileError, ParameterError
+from .columns import ANGLE_UNITS, LENGTH_UNITS, SCALE, check_time
 from .resample import ResampleReport
 from .sway import AXES, SwaySpec
-from .table import ANGLE_UNITS, LENGTH_UNITS, SCALE, check_time
 
 __all__ = ["ConvertedRecording", "convert_recording", "AXES"]
 
@@ -125,8 +125,8 @@ def convert_recording(path: str | Path, *, rate: float | None = None,
     """
     from . import sway as sw
     from .c3d import read_c3d
+    from .columns import read_table
     from .resample import resample_uniform, uniform_step
-    from .table import read_table
 
     path = Path(path)
     what = repr(str(path))
