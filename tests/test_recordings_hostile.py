@@ -117,6 +117,13 @@ def test_a_time_column_in_ms_is_read_when_declared(tmp_path, capsys, trial):
                      np.column_stack([t * 1000, tilt, com]))
     np.testing.assert_allclose(frf_json(capsys, bare, "--time-unit", "ms")["gain"],
                                seconds["gain"], rtol=1e-9)
+    # convert writes it in s
+    code, out, err = run(capsys, "convert", ms, "--out", tmp_path / "out.csv", "--time-unit",
+                         "ms")
+    assert code == 0, err
+    written = np.loadtxt(tmp_path / "out.csv", delimiter=",", skiprows=1)
+    np.testing.assert_allclose(written[:, 0], t, rtol=1e-12, atol=1e-12)
+    assert (tmp_path / "out.csv").read_text().startswith("time [s],")
 
 
 @pytest.mark.parametrize("resample", [[], ["--resample", "50"]])

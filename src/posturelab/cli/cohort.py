@@ -83,6 +83,9 @@ def run(args: argparse.Namespace) -> int:
                              f"got {args.workers}")
     model = model_from_args(args)
     body, muscles, options = model.body, model.muscles, model.options
+    from ._recording import check_sway_response
+
+    check_sway_response(args, args.response)
     free = _names(args.free)
     check_fit_request(muscles, free, (), _bounds(args.bounds))  # before any file is read
     bar = (Progress(len(args.data), label="cohort", unit="subjects")

@@ -19,7 +19,8 @@ fit. The experiment (body, disturbance, initial state) is described exactly as f
 pairs; or --scenario / --builtin). --data is a CSV with columns t [s] and
 theta1..theta3 [rad] (what 'posturelab simulate --out' writes), or a .c3d with those
 columns; --resample HZ puts an uneven time column on a uniform grid, --angle-unit deg
-reads angles in degrees. Reports each
+reads angles in degrees, --time-unit ms a time column in ms (what was resampled or cut:
+stderr, or "resampling"/"trimming" in --json). Reports each
 estimate with its standard error and 95 % confidence interval; by default these
 allow for residuals correlated from sample to sample (a first-order autoregression
 per link, estimated from the residuals), which measured sway always has.

@@ -25,7 +25,11 @@ group means give them), or "frf_se" (standard error of the complex value), "dof"
 in s, a tilt in rad, a translation in m) and refuses a column in another unit. --free
 NAMES (comma separated) are shared by the conditions, --per-condition NAMES take one value
 per condition, NAME#1, NAME#2, … in the order of --data (the output lists the conditions:
-"conditions" in --json, each --data path and its kind, trial or table).
+"conditions" in --json, each --data path and its kind, trial or table, and for a trial
+resampled or cut its "resampling" and "trimming"; without --json one line each on stderr).
+A trial is read with posturelab frf's recording options (--resample, --angle-unit,
+--length-unit, --time-unit, --start, --drop-partial, and --sway with its markers to compute
+com_angle on the fly; --height and --mass are then the body's).
 Names (the parameter table's, as for sweep --vary and fit --free): stiffness:PAIR,
 viscosity:PAIR (intrinsic), active_stiffness:PAIR, active_viscosity:PAIR (:PAIR may be left
 out on a body with one pair), feedback_delay, proprioceptive_weight, torque_feedback_gain,
