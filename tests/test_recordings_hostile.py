@@ -295,7 +295,13 @@ def test_sway_on_frf_equals_convert_then_frf(tmp_path, capsys, trial):
     sway = ["--sway", "two-marker", "--hip-marker", "hip", "--shoulder-marker", "sho",
             "--ankle-marker", "ank"]
     direct = frf_json(capsys, path, *sway)
+    assert direct["reading_notes"][0] == "markers scaled from mm (POINT:UNITS) to m"
     assert direct["reading_notes"][-1].startswith("com_angle by the two-marker method")
+    # a C3D read without --sway says what its reading did too
+    code, out, err = run(capsys, "frf", "--data", path, "--stimulus", "tilt", "--response",
+                         "sho_x", "--cycle-length", "20", "--json")
+    assert code == 0, err
+    assert json.loads(out)["reading_notes"] == ["markers scaled from mm (POINT:UNITS) to m"]
     code, out, err = run(capsys, "convert", path, "--out", tmp_path / "trial.csv", *sway)
     assert code == 0, err
     converted = frf_json(capsys, tmp_path / "trial.csv")

@@ -57,7 +57,7 @@ says when that band's phase lies within 45 deg of +-180 deg with coherence >= 0.
 its stimulus power), "frf_se" (standard error of the complex estimate), "dof",
 "frf_covariance" (of the bands), "response_sign", "sign_convention", "warnings", and with
 --resample "resampling" (what was done), with --start or --drop-partial "trimming" (what
-was cut)}; an undefined number is null. fit-frf reads it back.
+was cut), for a .c3d or --sway "reading_notes"}; an undefined number is null. fit-frf reads it back.
 --ci periodic (default) gives bounds exact for a periodic stimulus; --ci otnes-enochson the
 form Peterka used (wider).
 

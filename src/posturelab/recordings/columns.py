@@ -48,7 +48,8 @@ def _name(header: str) -> str:
 
 
 def read_table(path: str | Path, columns: list[str] | None = None, *,
-               skipped: list[str] | None = None, time_unit: str = "s"
+               skipped: list[str] | None = None, time_unit: str = "s",
+               notes: list[str] | None = None
                ) -> tuple[np.ndarray, dict[str, np.ndarray], dict[str, str]]:
     """The time column and the named columns of a CSV or C3D recording, as stored.
 
@@ -64,6 +65,8 @@ def read_table(path: str | Path, columns: list[str] | None = None, *,
     time_unit : str
         The unit of a CSV's time column, ``s`` or ``ms`` (converted to s); a header that
         declares another is refused. A C3D file's time comes from its rate.
+    notes : list, optional
+        Receives what reading a C3D file did (units scaled, rates changed, samples filled).
 
     Returns
     -------
@@ -88,6 +91,8 @@ def read_table(path: str | Path, columns: list[str] | None = None, *,
             raise ParameterError("--time-unit is for a CSV's time column; a C3D file's time "
                                  "comes from its frame rate")
         rec = read_c3d(path)
+        if notes is not None:
+            notes.extend(rec.notes)
         names = list(rec.columns)
         for c in columns or []:
             if c in rec.unusable:

@@ -214,7 +214,7 @@ def read_recording(path: str | Path, columns: list[str],
         notes = [n for n in conv.notes if n not in said]
         dropped_before = 0 if start is None else conv.dropped_before
     else:
-        time, cols, declared = read_table(path, columns, time_unit=time_unit)
+        time, cols, declared = read_table(path, columns, time_unit=time_unit, notes=notes)
     kinds = kinds or {}
     for c in columns:
         if sway is not None and c == "com_angle":
