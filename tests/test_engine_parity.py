@@ -168,3 +168,25 @@ def test_torque_limit_binds_under_whole_feedback_delay():
         assert np.abs(r.joint_moments[:, 0]).max() <= 80.0 + 1e-6
     free = pl.simulate(body, m, step, 2.0, feedback_delay=0.002, rtol=1e-9)
     assert free.status == "completed" and np.abs(free.joint_moments[:, 0]).max() > 80.0
+
+
+def test_engines_agree_with_a_visual_scene_tilt_on_a_switching_run():
+    """A visual-scene tilt (Peterka 2002's visual channel, W = 0.5, W_v = 0.3) on top of the
+    split feedback, the ankle limit and the knee stop with a surface tilt: the same outcome,
+    switches within 1e-6 s and angles within 1e-6 rad, as the matrix's runs."""
+    from posturelab.model.tilt import SineTilt
+
+    common = dict(feedback_delay=DELAY, torque_limits=[ANKLE_LIMIT, math.inf, math.inf],
+                  knee=pl.KneeModel("stop"), tilt=RaisedCosineTilt(0.05, 0.4),
+                  visual_tilt=SineTilt(0.04, 1.5), proprioceptive_weight=0.5,
+                  visual_weight=0.3, **TOLERANCES)
+    fast, ref = (pl.simulate(pl.paper_body(), muscles("split/two-sided"),
+                             pl.VelocityStep.backward(0.25), 1.0, engine=engine, **common)
+                 for engine in ("compiled", "reference"))
+    assert fast.status == ref.status and len(ref.switch_times) > 0
+    np.testing.assert_allclose(fast.switch_times, ref.switch_times, rtol=0, atol=TIME_TOL)
+    np.testing.assert_allclose(fast.theta, ref.theta, rtol=0, atol=THETA_TOL)
+    without = pl.simulate(pl.paper_body(), muscles("split/two-sided"),
+                          pl.VelocityStep.backward(0.25), 1.0,
+                          **{**common, "visual_weight": 0.0})
+    assert np.abs(without.theta - fast.theta).max() > 100 * THETA_TOL  # the scene matters

@@ -50,6 +50,8 @@ def folder(tmp_path_factory):
         for k in range(300)))
     builtin = resources.files("posturelab.scenarios.builtin") / "paper-backward-case1.toml"
     shutil.copyfile(str(builtin), d / "my-run.toml")
+    subprocess.run([sys.executable, "-m", "posturelab.recordings.example",
+                    str(d / "lab-trial.c3d")], check=True, capture_output=True)
     for name, case in (("other.csv", "3"), ("measured.csv", "1")):
         subprocess.run([sys.executable, "-m", "posturelab", "simulate", "--case", case,
                         "--disturbance", "backward", "--duration", "2", "--sample-rate", "100",

@@ -51,6 +51,7 @@ __all__ = [
     "parse_name",
     "resolve",
     "check_value",
+    "check_weights",
     "quantity",
     "unit",
     "names_for",
@@ -176,6 +177,10 @@ QUANTITIES: dict[str, Quantity] = {q.name: q for q in (
     Quantity("proprioceptive_weight", "-", 0.0, 1.0,
              "W: under a tilt α the active error of pairs spanning the foot is θ + W·α "
              "(1: relative to the foot, 0: to the vertical)", "", 1.0),
+    Quantity("visual_weight", "-", 0.0, 1.0,
+             "W_v: under a visual-scene tilt v the active error of pairs spanning the foot "
+             "gains W_v·v (Peterka 2002's independent channels; W_p + W_v <= 1, the rest "
+             "graviceptive)", "", 1.0),
     Quantity("torque_feedback_gain", "-", 0.0, MAX_TORQUE_FEEDBACK_GAIN,
              "K_t: the active torque fed back positively through K_t/(τ_t s + 1) (Peterka "
              "2002; 0: none; K_t = K_F·K_P of the source's K_F [rad/(N·m)])", "", 3.0),
@@ -348,6 +353,25 @@ def check_value(name: str, value, field: str | None = None) -> float:
             (q.low < v if q.low_open else q.low <= v) and v <= q.high):
         raise ParameterError(f"{label} must be in {q.interval()}, got {value!r}")
     return v
+
+
+def check_weights(proprioceptive_weight, visual_weight,
+                  fields: tuple[str, str] = ("proprioceptive_weight", "visual_weight")) -> float:
+    """The visual weight W_v [-], each weight within its bounds and W_p + W_v <= 1 (the
+    graviceptive weight 1 − W_p − W_v is not negative: Peterka 2002's independent channels);
+    ``fields`` are how a message names the two (a file's keys, the command line's flags).
+
+    Raises
+    ------
+    ParameterError
+        One line naming both weights and their sum when it is over 1.
+    """
+    wp = check_value("proprioceptive_weight", proprioceptive_weight, fields[0])
+    wv = check_value("visual_weight", visual_weight, fields[1])
+    if wp + wv > 1.0 + 1e-12:
+        raise ParameterError(f"{fields[0]} + {fields[1]} [-] must be at most 1 "
+                             f"(the rest is graviceptive), got {wp:g} + {wv:g} = {wp + wv:g}")
+    return wv
 
 
 def names_for(pairs: Sequence[str] = PAPER_PAIRS, joints: Sequence[str] = PAPER_JOINTS,

@@ -89,6 +89,10 @@ def add_muscle_arguments(p: argparse.ArgumentParser, *, require: bool = False,
                     help="W in [0, 1]: the active error of pairs that span the foot is "
                     "θ + W·α under a tilt α (1, the default: relative to the foot; 0: to the "
                     "vertical).")
+    fb.add_argument("--visual-weight", type=float, default=None, metavar="W_V",
+                    help="W_v in [0, 1], with W + W_v <= 1 (the rest graviceptive; Peterka "
+                    "2002's independent channels): the active error gains W_v·v under a "
+                    "visual-scene tilt v (--visual-tilt; default 0).")
 
 
 def add_trial_arguments(p: argparse.ArgumentParser, *,
@@ -121,6 +125,7 @@ MODEL_FLAGS: dict[str, str] = {
     "active_viscosity_ratio": "muscles.active_viscosity_ratio",
     "feedback_delay": "muscles.feedback_delay",
     "proprioceptive_weight": "muscles.proprioceptive_weight",
+    "visual_weight": "muscles.visual_weight",
     "torque_feedback_gain": "muscles.torque_feedback_gain",
     "torque_feedback_time_constant": "muscles.torque_feedback_time_constant",
 }
@@ -301,6 +306,16 @@ def parse_tilt(text: str):
     from ..scenarios._parse import tilt_from_table
 
     return tilt_from_table(tilt_table(text), Path("."), "", FLAG_NAMES)
+
+
+def parse_visual_tilt(text: str):
+    """The Tilt of ``--visual-tilt`` (the specs of ``--tilt``), built by the scenario
+    parser as a file's [visual_tilt] table."""
+    from pathlib import Path
+
+    from ..scenarios._parse import tilt_from_table
+
+    return tilt_from_table(tilt_table(text), Path("."), "", FLAG_NAMES, "visual_tilt")
 
 
 @contextlib.contextmanager

@@ -32,9 +32,14 @@ A trial is read with posturelab frf's recording options (--resample, --angle-uni
 com_angle on the fly; --height and --mass are then the body's).
 Names (the parameter table's, as for sweep --vary and fit --free): stiffness:PAIR,
 viscosity:PAIR (intrinsic), active_stiffness:PAIR, active_viscosity:PAIR (:PAIR may be left
-out on a body with one pair), feedback_delay, proprioceptive_weight, torque_feedback_gain,
-torque_feedback_time_constant (Peterka 2002's torque feedback; starting values from
---torque-feedback-gain and --torque-feedback-time-constant). The body and the
+out on a body with one pair), feedback_delay, proprioceptive_weight, visual_weight,
+torque_feedback_gain, torque_feedback_time_constant (Peterka 2002's torque feedback;
+starting values from --torque-feedback-gain and --torque-feedback-time-constant).
+A dual-stimulus trial (--stimulus tilt,visual_tilt, or a trial CSV with both columns and no
+--stimulus; posturelab.frequency.dual) gives two conditions, its surface-tilt FRF and its
+visual-scene FRF, each fitted with its own model input: --free
+proprioceptive_weight,visual_weight fits W and W_v jointly (Peterka 2002's independent
+channels; W + W_v > 1 is reported as a warning). The body and the
 starting values come from the options below (as in posturelab simulate); --bounds
 NAME=LO:HI,... replaces the defaults (gains 0 … 1e5, delay 0 … {MAX_FEEDBACK_DELAY:g} s,
 W 0 … 1, K_t 0 … 3, τ_t 0.5 … 200 s); each must lie within the table's bounds (docs/parameters.md).
@@ -139,18 +144,57 @@ def reader_options(args: argparse.Namespace) -> dict:
 
 
 def _condition(path: str, args: argparse.Namespace, readings: dict | None = None):
-    """One FRF from a file (a trial recording or an FRF JSON); what reading a trial did is
-    put in ``readings[path]`` (a :class:`~posturelab.recordings.table.Recording`)."""
+    """The one FRF of a --data file (commands that take one condition per file: a
+    dual-stimulus trial needs --stimulus COLUMN there); what reading a trial did is put in
+    ``readings[path]`` (a :class:`~posturelab.recordings.table.Recording`)."""
+    found = _conditions(path, args, readings)
+    if len(found) > 1:
+        raise ParameterError(f"--data {path!r} is a dual-stimulus trial "
+                             f"({', '.join(label for _, _, label in found)}): give "
+                             "--stimulus COLUMN")
+    return found[0][0]
+
+
+def _conditions(path: str, args: argparse.Namespace,
+                readings: dict | None = None) -> list[tuple]:
+    """The conditions of one --data file as (FRF, model input, label): one, or each
+    stimulus of a dual-stimulus trial (--stimulus tilt,visual_tilt, or a trial with both
+    columns and no --stimulus: posturelab.frequency.dual). What reading a one-stimulus
+    trial did is put in ``readings[path]``."""
     from ..frequency.cohort import read_frf_file, read_trial_frf
+    from ..frequency.dual import input_of, read_trial_frfs, stimulus_columns
     from ._recording import check_sway_response
 
     if path.lower().endswith(".json"):
-        return read_frf_file(path, what="--data FRF JSON")
-    check_sway_response(args, args.response)
-    frf, rec = read_trial_frf(path, **reader_options(args))
+        return [(read_frf_file(path, what="--data FRF JSON"), args.input, path)]
+    stimuli = ([s.strip().lower() for s in args.stimulus.split(",") if s.strip()]
+               if args.stimulus else stimulus_columns(path))
+    if len(stimuli) > 1:
+        if args.cycle_length is None:
+            raise ParameterError("a trial CSV needs --cycle-length")
+        from ._recording import recording_options
+
+        options = reader_options(args)
+        _, ests, _ = read_trial_frfs(path, stimuli, args.response or "com_angle",
+                                     args.cycle_length, discard_cycles=args.discard_cycles,
+                                     response_sign=options["response_sign"],
+                                     **recording_options(args))
+        return [(e, input_of(s), f"{path} [{s}]") for s, e in ests.items()]
+    options = reader_options(args)
+    if stimuli and not args.stimulus:  # the trial's one stimulus column
+        options["stimulus"] = stimuli[0]
+    if options["stimulus"] is not None and options["response"] is None:
+        options["response"] = "com_angle"
+    source = args.input  # a visual_tilt column is the scene's (a tilt [rad] to the reader)
+    if options["stimulus"] is not None and input_of(options["stimulus"]) == "visual-tilt":
+        source = "visual-tilt"
+    if options["stimulus"] is None:  # (read_frf_file says what a trial needs)
+        return [(read_frf_file(path, **options), source, path)]
+    check_sway_response(args, options["response"])
+    frf, rec = read_trial_frf(path, **options)
     if readings is not None:
         readings[path] = rec
-    return frf
+    return [(frf, source, path)]
 
 
 def _names(text: str) -> list[str]:
@@ -175,6 +219,8 @@ def _bounds(text: str) -> dict:
 
 
 def run(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
     from .._files import refuse_input_as_output
     from ..frequency.fit import check_fit_request, fit_frf
     from .frf import check_plot_path
@@ -195,35 +241,36 @@ def run(args: argparse.Namespace) -> int:
     else:
         check_fit_request(muscles, free, per, _bounds(args.bounds))
     readings: dict = {}
-    conditions = [_condition(path, args, readings) for path in args.data]
-    fit_options = dict(input=args.input, output=args.output.strip().lower(),
+    found = [c for path in args.data for c in _conditions(path, args, readings)]
+    conditions = [c for c, _, _ in found]
+    names = [label for _, _, label in found]
+    fit_options = dict(input=[source for _, source, _ in found],
+                       output=args.output.strip().lower(),
                        feedback_delay=options.feedback_delay,
                        proprioceptive_weight=options.proprioceptive_weight,
+                       visual_weight=options.visual_weight,
                        torque_feedback_gain=options.torque_feedback_gain,
                        torque_feedback_time_constant=options.torque_feedback_time_constant,
                        bounds=_bounds(args.bounds))
     comparison = None
     if compare is not None:
-        from pathlib import Path
 
         from ..frequency.reweighting import compare_conditions
 
         compare.pop("out"), compare.pop("plot")
         comparison = compare_conditions(body, muscles, conditions, free, per_condition=per,
-                                        labels=[Path(p).name for p in args.data],
+                                        labels=[Path(n).name for n in names],
                                         **compare, **fit_options)
         fit = comparison.general
         _write_comparison(comparison, args)
     else:
         fit = fit_frf(body, muscles, conditions, free, per_condition=per, **fit_options)
     if args.plot:
-        from pathlib import Path
-
         from ..viz.plots import plot_bode, save_figure
 
         labels = [Path(p).name + ("" if getattr(c, "response_sign", None) is None
-                                  else f" (response × {int(c.response_sign):+d})")
-                  for p, c in zip(args.data, conditions, strict=True)]
+                       else f" (response × {int(c.response_sign):+d})")
+                  for p, c in zip(names, conditions, strict=True)]
         curves = [(f, h, f"fit: {label}") for (f, h), label in zip(fit.curves, labels,
                                                                      strict=True)]
         save_figure(plot_bode(conditions, labels, model=curves),
@@ -232,7 +279,7 @@ def run(args: argparse.Namespace) -> int:
                     if getattr(c, "response_sign", None) is not None})
     from ..frequency.estimate import FRFEstimate
 
-    sign_warnings = [f"--data {p!r}: {w}" for p, c in zip(args.data, conditions, strict=True)
+    sign_warnings = [f"--data {p!r}: {w}" for p, c in zip(names, conditions, strict=True)
                      if isinstance(c, FRFEstimate) for w in c.warnings]
     if sign_warnings:
         import sys
@@ -241,7 +288,10 @@ def run(args: argparse.Namespace) -> int:
             print(f"warning: {w}", file=sys.stderr)
     kinds = [{"data": p, "kind": "trial" if isinstance(c, FRFEstimate) else "table",
               **(readings[p].report_dict() if p in readings else {})}
-             for p, c in zip(args.data, conditions, strict=True)]
+             for p, c in zip(names, conditions, strict=True)]
+    if any(source != args.input for _, source, _ in found):  # (a visual tilt among them)
+        for kind, (_, source, _) in zip(kinds, found, strict=True):
+            kind["input"] = source
     if args.json:
         out = fit.to_dict()
         extra = {} if comparison is None else {"reweighting": comparison.to_dict()}

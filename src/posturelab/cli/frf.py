@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import math
 
+from ..errors import ParameterError
 from ._common import FIGURE_SUFFIXES, check_writable, print_json
 from ._recording import (
     add_cycle_trim_argument,
@@ -61,6 +62,14 @@ was cut), for a .c3d or --sway "reading_notes"}; an undefined number is null. fi
 --ci periodic (default) gives bounds exact for a periodic stimulus; --ci otnes-enochson the
 form Peterka used (wider).
 
+Dual-stimulus trials (a surface and a visual-scene tilt at once, posturelab.frequency.dual):
+--stimulus tilt,visual_tilt (the default when the file has both columns: without --stimulus
+the trial's tilt and visual_tilt columns, and com_angle without --response) estimates each
+FRF at its own stimulus's harmonics over the common --cycle-length; the two stimuli must not
+share a harmonic (a PRTS and one of half its cycle: simulate --tilt prts:0.035 --visual-tilt
+prts:0.035:0.125). --json then prints {"tilt": {...}, "visual_tilt": {...}}, one FRF object
+each.
+
 Example: posturelab simulate --controller peterka-2002 --tilt prts:0.035 --duration 120 \\
              --engine compiled --sample-rate 100 --out trial.csv
          posturelab frf --data trial.csv --stimulus tilt --response com_angle \\
@@ -71,8 +80,11 @@ Example: posturelab simulate --controller peterka-2002 --tilt prts:0.035 --durat
 def add_arguments(p: argparse.ArgumentParser) -> None:
     """The options of ``posturelab frf``."""
     p.add_argument("--data", required=True, metavar="FILE.csv|FILE.c3d", help="the trial.")
-    p.add_argument("--stimulus", required=True, metavar="COLUMN", help="stimulus column.")
-    p.add_argument("--response", required=True, metavar="COLUMN", help="response column.")
+    p.add_argument("--stimulus", metavar="COLUMN[,COLUMN]",
+                   help="stimulus column, or two of a dual-stimulus trial (default: the "
+                   "trial's tilt and visual_tilt columns).")
+    p.add_argument("--response", metavar="COLUMN",
+                   help="response column (default com_angle).")
     p.add_argument("--cycle-length", required=True, type=float, metavar="SECONDS",
                    help="stimulus cycle [s] (20 for the 80-state PRTS).")
     p.add_argument("--discard-cycles", type=int, default=0, metavar="N",
@@ -126,16 +138,53 @@ def run(args: argparse.Namespace) -> int:
                            {"--plot": args.plot, "--plot-cycles": args.plot_cycles})
     check_plot_path(args.plot, args.plot_cycles)
     float_in_range("--cycle-length [s]", args.cycle_length, 1e-3, 1e5, unit="s")
-    stim, resp = args.stimulus.strip().lower(), args.response.strip().lower()
+    from ..frequency.dual import estimate_frfs, stimulus_columns
+
+    resp = (args.response or "com_angle").strip().lower()
     check_sway_response(args, resp)
-    rec = read_recording(args.data, [stim, resp], {stim: ("rad", "m")},
-                         kinds=trial_kinds(stim, resp, args.length_unit,
-                                           "tilt" if args.sway else None),
-                         cycle_length=args.cycle_length, **recording_options(args))
+    if args.stimulus:
+        stimuli = [s.strip().lower() for s in args.stimulus.split(",") if s.strip()]
+    elif str(args.data).lower().endswith(".c3d"):
+        raise ParameterError("a .c3d trial needs --stimulus COLUMN (its analog channel)")
+    else:
+        stimuli = stimulus_columns(args.data)
+    if not stimuli:
+        raise ParameterError(f"--data {args.data!r} has no tilt or visual_tilt column: give "
+                             "--stimulus COLUMN")
+    kinds = {k: v for s in stimuli
+             for k, v in trial_kinds(s, resp, args.length_unit,
+                                     "tilt" if args.sway else None).items()}
+    rec = read_recording(args.data, [*stimuli, resp], {s: ("rad", "m") for s in stimuli},
+                         kinds=kinds, cycle_length=args.cycle_length,
+                         **recording_options(args))
     fs, cols = rec.rate, rec.columns
     if not args.json:
         print_reading(rec)
     sign = response_sign(args.response_sign)
+    if len(stimuli) > 1:
+        if args.plot_cycles:
+            raise ParameterError("--plot-cycles draws one stimulus; give --stimulus COLUMN")
+        x, trimmed = {}, False
+        for s in stimuli:
+            x[s], y, trimmed = whole_cycles(cols[s], cols[resp], fs, args.cycle_length)
+        ests = estimate_frfs(x, y, fs, args.cycle_length, discard_cycles=args.discard_cycles,
+                             bands=args.bands, response_sign=sign, ci=args.ci)
+        if args.plot:
+            from ..viz.plots import plot_bode, save_figure
+
+            save_figure(plot_bode(list(ests.values()),
+                                  [f"{'−' if sign < 0 else ''}{resp} / {s}" for s in ests]),
+                        args.plot)
+        if args.json:
+            print_json({**{s: {**e.to_dict(), "sign_convention": sign_convention(sign)}
+                           for s, e in ests.items()}, **rec.report_dict()})
+            return 0
+        for s, e in ests.items():
+            _table(e, s, resp, sign, fs, trimmed)
+        if args.plot:
+            print(f"wrote {args.plot}")
+        return 0
+    stim = stimuli[0]
     x, y, trimmed = whole_cycles(cols[stim], cols[resp], fs, args.cycle_length)
     est = estimate_frf(x, y, fs, args.cycle_length,
                        discard_cycles=args.discard_cycles, bands=args.bands,
@@ -165,6 +214,17 @@ def run(args: argparse.Namespace) -> int:
         extra = rec.report_dict()
         print_json({**est.to_dict(), "sign_convention": sign_convention(sign), **extra})
         return 0
+    _table(est, stim, resp, sign, fs, trimmed)
+    for path in (args.plot, args.plot_cycles):
+        if path:
+            print(f"wrote {path}")
+    return 0
+
+
+def _table(est, stim: str, resp: str, sign: int, fs: float, trimmed: bool) -> None:
+    """Print one FRF as a table, with its warnings."""
+    from ..frequency.estimate import sign_convention
+
     print(f"FRF of {resp} to {stim}, {sign_convention(sign)}: {est.n_cycles} cycles "
           f"of {est.cycle_length:g} s at {fs:g} Hz, {len(est.bands)} bands"
           + (" (the record's end point, one sample past the last cycle, left out)"
@@ -180,7 +240,3 @@ def run(args: argparse.Namespace) -> int:
     if low.any():
         print(f"warning: coherence below 0.5 at {int(low.sum())} band(s): those estimates are "
               "noisy")
-    for path in (args.plot, args.plot_cycles):
-        if path:
-            print(f"wrote {path}")
-    return 0

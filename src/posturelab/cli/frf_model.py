@@ -17,8 +17,11 @@ from .frf import BAND_CHOICES
 DESCRIPTION = """\
 The frequency response function of the model linearised about upright, with the delay as
 e^{−sτ} (no Padé approximation), for any body and controller (the options below, as in
-posturelab simulate). --input tilt (the surface angle, rad) or translation (the platform
-displacement, m); --output com_angle (Σ a_i θ_i / Σ a_i), theta1 … or a joint angle
+posturelab simulate). --input tilt (the surface angle, rad), translation (the platform
+displacement, m) or visual-tilt (the visual scene's angle, rad, positive toes-up like the
+surface; it acts through the active feedback only, weighted by --visual-weight W_v: for one
+link (W_v C)/(J s² − mgh + K_i + L_i s + C), C = (K_a + L_a s) e^{−sτ}; Peterka 2002);
+--output com_angle (Σ a_i θ_i / Σ a_i), theta1 … or a joint angle
 (ankle_angle, knee_angle, hip_angle). Tilt FRFs use the literature's sign: a body that
 follows the surface has gain 1 and phase 0. At --frequencies LIST [Hz] or at the band
 frequencies of the 11 bands of the 80-state protocol (COMTEST; --bands peterka, the
@@ -43,8 +46,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     """The options of ``posturelab frf-model``."""
     add_muscle_arguments(p)
     add_torque_feedback_arguments(p)
-    p.add_argument("--input", choices=["tilt", "translation"], default="tilt",
-                   help="tilt [rad] (default) or platform translation [m].")
+    p.add_argument("--input", choices=["tilt", "translation", "visual-tilt"], default="tilt",
+                   help="tilt [rad] (default), platform translation [m] or visual-tilt "
+                   "[rad].")
     p.add_argument("--output", default="com_angle", metavar="NAME",
                    help="com_angle (default), thetaN or a joint angle (ankle_angle, …).")
     g = p.add_mutually_exclusive_group()
@@ -90,17 +94,20 @@ def run(args: argparse.Namespace) -> int:
                              "--feedback-delay or the torque feedback")
     H = model_frf(body, muscles, f, input=args.input, output=args.output.strip().lower(),
                   feedback_delay=options.feedback_delay,
-                  proprioceptive_weight=options.proprioceptive_weight, **torque_feedback)
+                  proprioceptive_weight=options.proprioceptive_weight,
+                  visual_weight=options.visual_weight, **torque_feedback)
     phase = np.degrees(np.unwrap(np.angle(H)))
     sign = ("−y/α (the literature's tilt sign: a body that follows the surface reads gain 1, "
-            "phase 0)" if args.input == "tilt" else "y/x (as the output is, per metre)")
+            "phase 0)" if args.input == "tilt" else "−y/v (a body that follows the visual "
+            "scene reads gain 1, phase 0)" if args.input == "visual-tilt"
+            else "y/x (as the output is, per metre)")
     if args.json:
         print_json({"frequency": [float(v) for v in f],
                     "frf": [{"re": float(h.real), "im": float(h.imag)} for h in H],
                     "gain": [float(abs(h)) for h in H],
                     "phase_deg": [float(p) for p in phase], "sign_convention": sign})
         return 0
-    unit = "" if args.input == "tilt" else " [rad/m]"
+    unit = " [rad/m]" if args.input == "translation" else ""
     print(f"model FRF of {args.output} to {args.input}{unit}, {sign}")
     print(f"{'f [Hz]':>8} {'gain':>10} {'phase [deg]':>12}")
     for fk, h, p in zip(f, H, phase, strict=True):

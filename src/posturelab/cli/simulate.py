@@ -30,6 +30,7 @@ from ._common import (
     naming_given_options,
     naming_option,
     parse_tilt,
+    parse_visual_tilt,
     print_json,
 )
 
@@ -52,8 +53,9 @@ Output CSV columns: t [s], theta1..3 [rad], omega1..3 [rad/s], M_<pair> [N·m],
 U1..3 [N·m], joint_moment1..3 [N·m], cog_x, cog_y [m], cog_vx, cog_vy [m/s],
 platform_ax, platform_ay [m/s²], platform_vx, platform_vy [m/s], platform_x,
 platform_y [m], cop_x [m] (centre of pressure from the ankle), ground_fx, ground_fy [N]
-(force of the platform on the foot), and with a tilt, tilt and com_angle [rad]. The first
-line printed (outcome in --json) is recovered, not recovered, steady sway, fell or failed.
+(force of the platform on the foot), and with a tilt, tilt and com_angle [rad] (with a
+visual-scene tilt, visual_tilt [rad] before com_angle). The first line printed (outcome
+in --json) is recovered, not recovered, steady sway, fell or failed.
 Settling is counted from the end of the platform motion or tilt (0 for a velocity step). A
 sustained stimulus (a sine or PRTS tilt, a sum of sines, motor noise) has no settling time:
 its outcome is a steady sway, the RMS (about upright) and peak |·| of each θ_i [rad] and of
@@ -143,6 +145,11 @@ def add_experiment_arguments(p: argparse.ArgumentParser) -> None:
                      "sequence), comtest-80 (the Eurobench COMTEST protocol's 80-state one) "
                      "or peterka-2002-242 (Peterka 2002's 242-state, 60.5 s one)). A tilt "
                      "column [rad] in --platform-profile does the same from data.")
+    src.add_argument("--visual-tilt", metavar="SPEC",
+                     help="visual-scene tilt v about the ankle axis, positive toes-up like the "
+                     "surface (the specs of --tilt; e.g. prts:0.035::comtest-80): it acts "
+                     "only through the active feedback, weighted by --visual-weight. With "
+                     "--tilt too, a dual-stimulus trial (CSV columns tilt and visual_tilt).")
     src.add_argument("--tilt-axis-depth", type=float, default=None, metavar="M",
                      help="the tilt axis this far below the ankle [m], in "
                      f"{RUN_SETTINGS['tilt_axis_depth'].interval()} (default 0: "
@@ -228,7 +235,7 @@ def run_options_from_args(args: argparse.Namespace, sc: Scenario,
             fall = fall_from_table(fall_table, "", FLAG_NAMES, base=fall)
     feedback = {attribute: check_value(attribute, getattr(args, attribute),
                                        FLAG_NAMES[f"muscles.{attribute}"])
-                for attribute in ("feedback_delay", "proprioceptive_weight",
+                for attribute in ("feedback_delay", "proprioceptive_weight", "visual_weight",
                                   "torque_feedback_gain", "torque_feedback_time_constant")
                 if getattr(args, attribute, None) is not None}
     description = base.description
@@ -240,6 +247,14 @@ def run_options_from_args(args: argparse.Namespace, sc: Scenario,
         with naming_option("--tilt"):
             tilt = parse_tilt(args.tilt)
         description = f"{description}, {tilt.describe()}"
+    visual_tilt = base.visual_tilt
+    if getattr(args, "visual_tilt", None) is not None:
+        if visual_tilt is not None:
+            raise UsageError(f"{command}: the experiment already has a visual tilt; give "
+                             "--visual-tilt or [visual_tilt], not both")
+        with naming_option("--visual-tilt"):
+            visual_tilt = parse_visual_tilt(args.visual_tilt)
+        description = f"{description}, visual scene: {visual_tilt.describe()}"
     torque_limits = base.torque_limits
     if args.torque_limits:
         torque_limits = torque_limits_from_table(args.torque_limits, n, "", FLAG_NAMES)
@@ -259,7 +274,7 @@ def run_options_from_args(args: argparse.Namespace, sc: Scenario,
             sample_rate=_given(args.sample_rate, base.sample_rate),
             max_steps=_given(args.max_steps, base.max_steps),
             time_limit=_given(args.time_limit, base.time_limit),
-            fall=fall, **feedback, tilt=tilt,
+            fall=fall, **feedback, tilt=tilt, visual_tilt=visual_tilt,
             tilt_axis_depth=_given(args.tilt_axis_depth, base.tilt_axis_depth),
             torque_limits=torque_limits,
             motor_noise=motor_noise, description=description,

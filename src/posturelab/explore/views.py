@@ -117,12 +117,13 @@ CONTROLS: tuple[Control, ...] = (
     _table("viscosity_ratio", "viscosity ratio L/K", 0.25, 1.0, 0.01, "pairs"),
     _table("feedback_delay", "feedback delay τ", 0.0, 0.3, 0.005, "neural"),
     _table("proprioceptive_weight", "proprioceptive weight W", 1.0, 1.0, 0.05, "neural"),
+    _table("visual_weight", "visual weight W_v", 0.0, 1.0, 0.05, "neural"),
     _table("torque_feedback_gain", "torque feedback gain K_t", 0.0, 3.0, 0.05, "neural"),
     Control("torque_feedback_time_constant", "torque feedback time constant τ_t", "s",
             TORQUE_FEEDBACK_TIME_CONSTANT, QUANTITIES["torque_feedback_time_constant"].low,
             QUANTITIES["torque_feedback_time_constant"].high, 0.5, 100.0, 0.5, "neural"),
     Control("perturbation", "perturbation", "", "backward step", group="perturbation",
-            choices=("backward step", "forward step", "tilt")),
+            choices=("backward step", "forward step", "tilt", "visual tilt")),
     Control("step_speed", "step speed", "m/s", 0.3, 0.01, MAX_PLATFORM_SPEED, 0.01, 2.0, 0.01,
             "perturbation"),
     Control("tilt_amplitude", "tilt amplitude", "rad", 0.02, 0.0, MAX_TILT, 0.0, 0.1, 0.002,
@@ -217,6 +218,11 @@ def parse_parameters(fields: dict) -> dict:
         for name in ("feedback_delay", "proprioceptive_weight"):
             if name not in fields:
                 out[name] = float(getattr(preset, name))
+    if out["proprioceptive_weight"] + out["visual_weight"] > 1.0 + 1e-12:
+        raise _field_error("visual_weight", (
+            f"proprioceptive weight W + visual weight W_v must be at most 1 (the rest is "
+            f"graviceptive), got {_number(out['proprioceptive_weight'])} + "
+            f"{_number(out['visual_weight'])}"))
     if out["torque_feedback_time_constant"] <= 0:  # the table's range is open at 0
         raise _field_error("torque_feedback_time_constant", "torque feedback time constant "
                            "τ_t [s] must be > 0, got 0")
@@ -340,7 +346,8 @@ def compute_views(p: dict) -> dict:
         ``poles`` at τ = 0 and ``roots`` (the 2N rightmost characteristic roots at τ) as
         {"re", "im"} [1/s]; ``delay_margin`` [s] (None when unstable without delay, inf
         as None with ``no_margin``);
-        ``frf`` (frequencies [Hz], gain [-], phase [deg]; empty with a ``note`` saying why
+        ``frf`` (frequencies [Hz], gain [-], phase [deg] of the surface tilt's FRF, or of the
+        visual scene's with the perturbation "visual tilt"; empty with a ``note`` saying why
         when the loop is not stable at τ, else ``note`` None); ``run`` (outcome words,
         time [s], link angles [rad], CoG position [m] and velocity [m/s], joint positions
         [m] of the stick figure and the surface tilt [rad] at :data:`FRAME_RATE`).
@@ -355,6 +362,8 @@ def compute_views(p: dict) -> dict:
 
     body, muscles, disturbance, tilt = build_model(p)
     delay, weight = p["feedback_delay"], p["proprioceptive_weight"]
+    visual = p["perturbation"] == "visual tilt"  # the sine tilts the scene, not the surface
+    stimulus = {"visual_tilt" if visual else "tilt": tilt, "visual_weight": p["visual_weight"]}
     torque_feedback = {"torque_feedback_gain": p["torque_feedback_gain"],
                        "torque_feedback_time_constant": p["torque_feedback_time_constant"]}
     lin, margin = _linear(body, muscles)
@@ -372,8 +381,9 @@ def compute_views(p: dict) -> dict:
                               **torque_feedback).poles()[0]
         margin_note = "not computed with torque feedback"
     if status == "stable":
-        frf = model_frf(body, muscles, FRF_FREQUENCIES, input="tilt", output="com_angle",
-                        feedback_delay=delay, proprioceptive_weight=weight, **torque_feedback)
+        frf = model_frf(body, muscles, FRF_FREQUENCIES, input="visual-tilt" if visual else "tilt",
+                        output="com_angle", feedback_delay=delay, proprioceptive_weight=weight,
+                        visual_weight=p["visual_weight"], **torque_feedback)
         frf_view = {"frequency": _rounded(FRF_FREQUENCIES, 9), "gain": _rounded(np.abs(frf), 9),
                     "phase": _rounded(np.degrees(np.unwrap(np.angle(frf))), 4), "note": None}
     else:  # no steady response to measure: say so rather than draw a formula's curve
@@ -383,11 +393,11 @@ def compute_views(p: dict) -> dict:
                     "(the sway grows or never settles), so none is drawn"}
     rate = SAMPLE_RATE if tilt is None else max(SAMPLE_RATE, 40.0 * tilt.frequency)
     run = pl.simulate(body, muscles, disturbance, p["duration"],
-                      feedback_delay=delay, proprioceptive_weight=weight, tilt=tilt,
+                      feedback_delay=delay, proprioceptive_weight=weight, **stimulus,
                       sample_rate=rate, time_limit=TIME_LIMIT, **torque_feedback)
     every = max(1, int(round(rate / FRAME_RATE)))
     frames = joint_positions(body, run.theta[::every])
-    surface = (np.zeros(len(frames)) if tilt is None
+    surface = (np.zeros(len(frames)) if tilt is None or visual
                else np.asarray(tilt.angle_and_rate(run.time[::every])[0], dtype=float))
 
     outcome = run.outcome

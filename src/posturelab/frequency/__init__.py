@@ -4,7 +4,8 @@
 protocol's and others), :mod:`.estimate` estimates an FRF with coherence and 95 % bounds
 from measured series, :mod:`.model` computes
 the linearised model's FRF exactly (the delay as e^{−sτ}), :mod:`.table` holds FRFs given as
-gain and phase (published tables), :mod:`.fit` fits a controller to either.
+gain and phase (published tables), :mod:`.fit` fits a controller to either;
+:mod:`.dual` estimates the surface-tilt and visual-scene FRFs of one dual-stimulus trial.
 """
 
 from .bands import PETERKA_BAND_HARMONICS, band_frequencies, harmonic_bands, peterka_bands

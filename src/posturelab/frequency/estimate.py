@@ -252,7 +252,7 @@ def _trials(values, label: str) -> list[np.ndarray]:
 
 def estimate_frf(stimulus, response, sample_rate: float, cycle_length: float, *,
                  discard_cycles: int = 0, bands="peterka", response_sign: float = 1.0,
-                 ci: str = "periodic") -> FRFEstimate:
+                 ci: str = "periodic", harmonic_step: int = 1) -> FRFEstimate:
     """Estimate the FRF of ``response`` to a periodic ``stimulus`` (module notes).
 
     Parameters
@@ -278,6 +278,11 @@ def estimate_frf(stimulus, response, sample_rate: float, cycle_length: float, *,
         looks opposite to the recording's convention is in the result's ``warnings``. [-]
     ci : {"periodic", "otnes-enochson"}
         The form of the 95 % bounds (module notes).
+    harmonic_step : int
+        m: the stimulus repeats every T/m, so its harmonics are the DFT bins m·(2k − 1) of a
+        cycle T (a dual-stimulus trial analysed over the common cycle T:
+        :mod:`posturelab.frequency.dual`); its bands are numbered in its own odd
+        harmonics. [-]
 
     Returns
     -------
@@ -327,9 +332,14 @@ def estimate_frf(stimulus, response, sample_rate: float, cycle_length: float, *,
     if n_cycles < 2:
         raise ParameterError(f"an FRF needs at least 2 cycles; the record has {n_cycles} "
                              "after discarding")
-    n_odd = L // 4  # odd bins 1, 3, … below the Nyquist bin L/2
+    if isinstance(harmonic_step, bool) or not isinstance(harmonic_step, int | np.integer) \
+            or not 1 <= harmonic_step <= L // 4:
+        raise ParameterError(f"harmonic_step must be an integer in [1, {L // 4}], got "
+                             f"{harmonic_step!r}")
+    step = int(harmonic_step)
+    n_odd = L // (4 * step)  # odd bins step·(1, 3, …) below the Nyquist bin L/2
     chosen = resolve_bands(bands, n_odd)
-    bins = [np.array([2 * k - 1 for k in band]) for band in chosen]
+    bins = [np.array([step * (2 * k - 1) for k in band]) for band in chosen]
     Gxx_h = np.mean(np.abs(X) ** 2, axis=0)
     Gyy_h = np.mean(np.abs(Y) ** 2, axis=0)
     Gxy_h = np.mean(np.conj(X) * Y, axis=0)
@@ -358,7 +368,8 @@ def estimate_frf(stimulus, response, sample_rate: float, cycle_length: float, *,
     gain_ci = np.stack([np.maximum(gain * (1 - r), 0.0), gain * (1 + r)], axis=1)
     half = np.where(r >= 1, 180.0, np.degrees(np.arcsin(np.minimum(r, 1.0))))
     phase_ci = np.stack([phase - half, phase + half], axis=1)
-    est = FRFEstimate(band_frequencies(chosen, T), H, gain, phase, coh, gain_ci, phase_ci,
+    est = FRFEstimate(band_frequencies(chosen, T / step), H, gain, phase, coh, gain_ci,
+                      phase_ci,
                       averages, chosen, int(n_cycles), T,
                       np.concatenate(cx).mean(axis=0), np.concatenate(cy).mean(axis=0),
                       tuple(b / T for b in bins), tuple(Gxx_h[b] for b in bins),

@@ -8,6 +8,7 @@ one pair):
     active_stiffness:PAIR, active_viscosity:PAIR   active (delayed) gains [N·m/rad], [N·m·s/rad]
     feedback_delay                                 τ [s]
     proprioceptive_weight                          W [-]
+    visual_weight                                  W_v [-] (Peterka 2002's visual channel)
     torque_feedback_gain                           K_t [-] (Peterka 2002's torque feedback)
     torque_feedback_time_constant                  τ_t [s]
 
@@ -69,6 +70,7 @@ Bands with coherence below 0.5 raise a warning in ``warnings``.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -95,7 +97,7 @@ __all__ = ["FRFFit", "fit_frf", "check_fit_request", "PARAMETERS", "WEIGHTINGS",
 
 PARAMETERS = ("stiffness", "viscosity", "active_stiffness", "active_viscosity",
               "feedback_delay", "proprioceptive_weight", "torque_feedback_gain",
-              "torque_feedback_time_constant")
+              "torque_feedback_time_constant", "visual_weight")
 #: The lowest τ_t a fit searches by default (the table's range excludes 0). [s]
 _MIN_FIT_TIME_CONSTANT = 0.5
 #: The default search interval of each parameter: the table's lower bound to its fit_high
@@ -297,11 +299,12 @@ def check_fit_request(muscles: MuscleSet, free, per_condition=(), bounds=None) -
     return canon[:len(free)], canon[len(free):], specs, canon, bounds
 
 
-def fit_frf(body: Body, muscles: MuscleSet, data, free, *, input: str = "tilt",
+def fit_frf(body: Body, muscles: MuscleSet, data, free, *, input: str | Sequence[str] = "tilt",
             output: str = "com_angle", feedback_delay: float = 0.0,
             proprioceptive_weight: float = 1.0, per_condition=(), bounds=None,
             model_error: float | None = None, torque_feedback_gain: float = 0.0,
-            torque_feedback_time_constant: float | None = None) -> FRFFit:
+            torque_feedback_time_constant: float | None = None,
+            visual_weight: float = 0.0) -> FRFFit:
     """Fit controller parameters to one or several FRFs (module notes).
 
     Parameters
@@ -314,7 +317,11 @@ def fit_frf(body: Body, muscles: MuscleSet, data, free, *, input: str = "tilt",
         phase, :class:`posturelab.frequency.table.FRFTable`).
     free : sequence of str
         Parameters shared by all conditions.
-    input, output : str
+    input : str or sequence of str
+        As for :func:`posturelab.frequency.model_frf`, or one per condition: the two FRFs
+        of a dual-stimulus trial (:mod:`posturelab.frequency.dual`) are two conditions,
+        ``["tilt", "visual-tilt"]``, fitted jointly for the shared W and W_v.
+    output : str
         As for :func:`posturelab.frequency.model_frf`.
     feedback_delay, proprioceptive_weight : float
         Starting values. [s], [-]
@@ -330,6 +337,8 @@ def fit_frf(body: Body, muscles: MuscleSet, data, free, *, input: str = "tilt",
     torque_feedback_gain, torque_feedback_time_constant : float
         Starting values of the torque feedback (K_t 0: none; τ_t by default the table's
         17.4 s). [-], [s]
+    visual_weight : float
+        Starting W_v. [-]
 
     Raises
     ------
@@ -360,7 +369,12 @@ def fit_frf(body: Body, muscles: MuscleSet, data, free, *, input: str = "tilt",
     torque_feedback_time_constant = check_value(
         "torque_feedback_time_constant", TORQUE_FEEDBACK_TIME_CONSTANT
         if torque_feedback_time_constant is None else torque_feedback_time_constant)
+    inputs = [input] * len(conditions) if isinstance(input, str) else list(input)
+    if len(inputs) != len(conditions):
+        raise ParameterError(f"input gives {len(inputs)} input(s) for {len(conditions)} "
+                             "condition(s)")
     scalars = {"feedback_delay": feedback_delay, "proprioceptive_weight": proprioceptive_weight,
+               "visual_weight": check_value("visual_weight", visual_weight),
                "torque_feedback_gain": torque_feedback_gain,
                "torque_feedback_time_constant": torque_feedback_time_constant}
     targets = [_target(c, k) for k, c in enumerate(conditions)]
@@ -403,12 +417,13 @@ def fit_frf(body: Body, muscles: MuscleSet, data, free, *, input: str = "tilt",
                 else:
                     gains[rows[b], j] = value
 
-            def frf_at(f, gains=gains, v=values):
+            def frf_at(f, gains=gains, v=values, source=inputs[k]):
                 return model_frf_batch(body, muscles, f, gains[0][None], gains[1][None],
                                        gains[2][None] if active else None,
                                        gains[3][None] if active else None,
                                        v["feedback_delay"], v["proprioceptive_weight"],
-                                       input=input, output=output,
+                                       input=source, output=output,
+                                       visual_weight=v["visual_weight"],
                                        torque_feedback_gain=v["torque_feedback_gain"],
                                        torque_feedback_time_constant=v[
                                            "torque_feedback_time_constant"])[0]
@@ -499,6 +514,13 @@ def fit_frf(body: Body, muscles: MuscleSet, data, free, *, input: str = "tilt",
     determined = (seen_col & np.isfinite(se) & (se <= np.abs(p)) & (cond < 1e10)
                   & np.array([side is None for side in sides]))
     ci, clipped = clip_intervals(labels, ci, lo, hi)
+    pair = ("proprioceptive_weight", "visual_weight")
+    fitted = {specs[i][0]: v for (i, c), v in zip(slots, p, strict=True)
+              if c is None and specs[i][0] in pair}
+    total = sum(fitted.get(name, scalars[name]) for name in pair)
+    if fitted and total > 1.0 + 1e-9:
+        warnings.append(f"proprioceptive_weight + visual_weight = {total:.4g} > 1: the "
+                        "graviceptive weight 1 − W − W_v would be negative")
     return FRFFit(tuple(labels), p, se, ci, determined, float(fit_error), bool(sol.success),
                   str(sol.message), tuple(warnings), tuple(model(p, dense=True)), weighting,
                   bool(mismatch), float(delta), systematic, sides,

@@ -11,12 +11,19 @@ with the input u either
 * the surface tilt α [rad]: b(s) = −Eᵀ[f ∘ (k_i + s l_i) + W f ∘ (k_a + s l_a) e^{−sτ}],
   f the pairs that span the foot, W the proprioceptive weight; or
 * the platform displacement x_d [m]: b(s) = −a s² (a the gravity coefficients: the
-  horizontal platform acceleration ẍ_d a).
+  horizontal platform acceleration ẍ_d a); or
+* the visual-scene tilt v [rad] (``visual-tilt``): b(s) = −Eᵀ[W_v f ∘ (k_a + s l_a) e^{−sτ}],
+  W_v the visual weight: the scene acts through the active feedback only (Peterka 2002,
+  J Neurophysiol 88:1097, independent channels). For one link with C(s) = (K_a + s L_a)e^{−sτ}
+  the two tilt FRFs are H_α = (K_i + s L_i + W_p C)/D and H_v = W_v C/D,
+  D = J s² − mgh + K_i + s L_i + C.
 
 The output is y = c·Θ: the centre-of-mass angle Σ a_i θ_i / Σ a_i (``com_angle``), a link
 angle (``theta1`` …) or a joint angle (``ankle_angle`` = θ1, ``knee_angle`` = θ2 − θ1, …).
 Tilt FRFs are reported in the literature's sign, H = −y/α, so that a body that follows the
-surface (θ = −α: perpendicular to it) has H = 1; translation FRFs are H = y/x_d [rad/m].
+surface (θ = −α: perpendicular to it) has H = 1 (and H = −y/v for the scene, positive
+toes-up like the surface: a body that follows the scene has H = 1); translation FRFs are
+H = y/x_d [rad/m].
 The gains split as :func:`posturelab.model.muscles.feedback_gains` states (without active
 gains the whole feedback is delayed, and W applies to it).
 
@@ -35,7 +42,7 @@ from ..errors import ParameterError, UnknownNameError
 from ..linear.system import INPUTS, linear_system
 from ..model.body import Body
 from ..model.muscles import MuscleSet
-from ..parameters import QUANTITIES, check_value
+from ..parameters import QUANTITIES, check_value, check_weights
 
 #: Highest frequency a model FRF is taken at. [Hz]
 MAX_FREQUENCY = 1e4
@@ -77,7 +84,7 @@ def model_frf_batch(body: Body, muscles: MuscleSet, frequencies, stiffness, visc
                     active_stiffness=None, active_viscosity=None, feedback_delay=0.0,
                     proprioceptive_weight=1.0, *, input: str = "tilt",
                     output: str = "com_angle", torque_feedback_gain=0.0,
-                    torque_feedback_time_constant=None) -> np.ndarray:
+                    torque_feedback_time_constant=None, visual_weight=0.0) -> np.ndarray:
     """Model FRFs of M parameter sets at F frequencies (module notes).
 
     Parameters
@@ -95,18 +102,21 @@ def model_frf_batch(body: Body, muscles: MuscleSet, frequencies, stiffness, visc
         τ. [s]
     proprioceptive_weight : float or array_like, shape (M,)
         W. [-]
-    input : {"tilt", "translation"}
+    input : {"tilt", "translation", "visual-tilt"}
     output : str
         :func:`output_names`.
     torque_feedback_gain : float or array_like, shape (M,)
         K_t (module notes; 0: none). [-]
     torque_feedback_time_constant : float or array_like, shape (M,), optional
         τ_t (default: the parameter table's 17.4 s). [s]
+    visual_weight : float or array_like, shape (M,)
+        W_v. Each weight is checked against its range here; W + W_v <= 1 by
+        :func:`model_frf` and by a run (a fit may search beyond it, and says so). [-]
 
     Returns
     -------
     numpy.ndarray of complex, shape (M, F)
-        [-] for tilt, [rad/m] for translation.
+        [-] for the tilts, [rad/m] for translation.
     """
     from ..model.checks import check_model
 
@@ -128,19 +138,21 @@ def model_frf_batch(body: Body, muscles: MuscleSet, frequencies, stiffness, visc
         active_viscosity = _gains("active_viscosity [N·m·s/rad]", active_viscosity, P, M)
     tau = np.broadcast_to(np.asarray(feedback_delay, dtype=float), (M,))
     w = np.broadcast_to(np.asarray(proprioceptive_weight, dtype=float), (M,))
-    for name, values in (("feedback_delay", tau), ("proprioceptive_weight", w)):
+    wv = np.broadcast_to(np.asarray(visual_weight, dtype=float), (M,))
+    for name, values in (("feedback_delay", tau), ("proprioceptive_weight", w),
+                         ("visual_weight", wv)):
         bad = ~((values >= QUANTITIES[name].low) & (values <= QUANTITIES[name].high))
         if np.any(bad):  # the parameter table's bounds (NaN fails too)
             check_value(name, float(values[np.argmax(bad)]))
     system = linear_system(body, muscles, stiffness=k, viscosity=viscosity,
                            active_stiffness=active_stiffness, active_viscosity=active_viscosity,
-                           delay=tau, proprioceptive_weight=w,
+                           delay=tau, proprioceptive_weight=w, visual_weight=wv,
                            torque_feedback_gain=torque_feedback_gain,
                            torque_feedback_time_constant=torque_feedback_time_constant)
     with np.errstate(all="ignore"):
         H = system.frequency_response(f, input, c)
-    if input == "tilt":
-        H = -H  # the literature's sign: H = −y/α
+    if input != "translation":
+        H = -H  # the literature's sign: H = −y/α (−y/v)
     if not np.all(np.isfinite(H)):
         raise ParameterError("the model FRF is not finite at some frequency (a resonance "
                              "exactly at it, or gains beyond what the model can take)")
@@ -163,11 +175,12 @@ def _gains(name: str, value, pairs: int, rows: int | None = None) -> np.ndarray:
 def model_frf(body: Body, muscles: MuscleSet, frequencies, *, input: str = "tilt",
               output: str = "com_angle", feedback_delay: float = 0.0,
               proprioceptive_weight: float = 1.0, torque_feedback_gain: float = 0.0,
-              torque_feedback_time_constant: float | None = None) -> np.ndarray:
+              torque_feedback_time_constant: float | None = None,
+              visual_weight: float = 0.0) -> np.ndarray:
     """The model FRF of one body and muscle set (its own intrinsic and active gains) at
     ``frequencies`` [Hz]; shape (F,). See :func:`model_frf_batch`."""
     check_value("feedback_delay", feedback_delay)
-    check_value("proprioceptive_weight", proprioceptive_weight)
+    check_weights(proprioceptive_weight, visual_weight)
     active = muscles.has_active_feedback
     return model_frf_batch(
         body, muscles, frequencies, muscles.stiffnesses[None], muscles.viscosities[None],
@@ -175,4 +188,5 @@ def model_frf(body: Body, muscles: MuscleSet, frequencies, *, input: str = "tilt
         muscles.active_viscosities[None] if active else None, feedback_delay,
         proprioceptive_weight, input=input, output=output,
         torque_feedback_gain=torque_feedback_gain,
-        torque_feedback_time_constant=torque_feedback_time_constant)[0]
+        torque_feedback_time_constant=torque_feedback_time_constant,
+        visual_weight=visual_weight)[0]

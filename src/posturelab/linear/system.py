@@ -14,7 +14,11 @@ for a positive delay (without active gains the whole pair feedback is the delaye
 with τ = 0, e^{−sτ} = 1 and both parts act at once, as that function sums them). The
 inputs are the surface tilt α [rad] (:func:`posturelab.model.tilt.tilt_pair_gains`: the
 pairs that span the foot feel it, the active part weighted by the proprioceptive weight
-W) and the horizontal platform acceleration ẍ_d [m/s²] (h = −a, the linearised −H(Θ)).
+W) and the horizontal platform acceleration ẍ_d [m/s²] (h = −a, the linearised −H(Θ));
+and the visual-scene tilt v [rad], which acts only through the active part of the pairs that
+span the foot, weighted by the visual weight W_v (:func:`posturelab.model.visual.visual_pair_gains`:
+its moments c0 … c3 on v, v̇, v(t − τ), v̇(t − τ) are those of b with the intrinsic part
+removed and W_v for W; Peterka 2002's independent channels).
 
 Torque feedback (Peterka 2002, J Neurophysiol 88:1097–1118; docs/design.md): the active
 (delayed) torque is fed back positively through the low-pass K_t/(τ_t s + 1), so that the
@@ -54,6 +58,7 @@ from ..model.gains import (
 )
 from ..model.muscles import MuscleSet, feedback_gains
 from ..model.tilt import tilt_pair_gains
+from ..model.visual import visual_pair_gains
 from .body_arrays import BodyArrays
 
 __all__ = ["BodyArrays", "LinearSystem", "linear_system", "sorted_poles", "OneSided",
@@ -61,9 +66,9 @@ __all__ = ["BodyArrays", "LinearSystem", "linear_system", "sorted_poles", "OneSi
 
 OneSided = Literal["active", "inactive"]
 
-#: Inputs of :meth:`LinearSystem.frequency_response`: the surface tilt α [rad] and the
-#: horizontal platform displacement x_d [m].
-INPUTS = ("tilt", "translation")
+#: Inputs of :meth:`LinearSystem.frequency_response`: the surface tilt α [rad], the
+#: horizontal platform displacement x_d [m] and the visual-scene tilt v [rad].
+INPUTS = ("tilt", "translation", "visual-tilt")
 
 #: Sets per evaluation of a frequency response (bounds the memory of one call). [-]
 _FRF_CHUNK = 32_768
@@ -115,6 +120,10 @@ class LinearSystem:
         K_t of the torque feedback (module notes); None for none. [-]
     torque_feedback_time_constant : numpy.ndarray, shape (M or 1,), or None
         τ_t, > 0 (with the gain). [s]
+    visual_input : numpy.ndarray, shape (M or 1, 4, N), or None
+        c0 … c3, the moments on v, v̇, v(t − τ), v̇(t − τ) of the visual-scene tilt (the
+        active part only); None when built without inputs.
+        [N·m/rad], [N·m·s/rad], [N·m/rad], [N·m·s/rad]
     """
 
     inertia: np.ndarray
@@ -127,6 +136,7 @@ class LinearSystem:
     translation_input: np.ndarray
     torque_feedback_gain: np.ndarray | None = None
     torque_feedback_time_constant: np.ndarray | None = None
+    visual_input: np.ndarray | None = None
 
     @property
     def has_torque_feedback(self) -> bool:
@@ -144,7 +154,7 @@ class LinearSystem:
         return _sets(self.inertia, self.stiffness, self.viscosity, self.delayed_stiffness,
                      self.delayed_viscosity, self.delay, self.tilt_input,
                      self.translation_input, self.torque_feedback_gain,
-                     self.torque_feedback_time_constant)
+                     self.torque_feedback_time_constant, self.visual_input)
 
     def __len__(self) -> int:
         return self.n_sets
@@ -156,7 +166,7 @@ class LinearSystem:
         return LinearSystem(*(_pick(getattr(self, f), index) for f in (
             "inertia", "stiffness", "viscosity", "delayed_stiffness", "delayed_viscosity",
             "delay", "tilt_input", "translation_input", "torque_feedback_gain",
-            "torque_feedback_time_constant")))
+            "torque_feedback_time_constant", "visual_input")))
 
     def without_delay(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The system at τ = 0, as the matrices of s² J0 + s L + K:
@@ -287,20 +297,20 @@ class LinearSystem:
         ----------
         frequencies : array_like, shape (F,)
             [Hz]
-        input : {"tilt", "translation"}
-            u: the surface tilt α [rad], or the horizontal platform displacement x_d [m]
-            (the input h ẍ_d = h s² x_d).
+        input : {"tilt", "translation", "visual-tilt"}
+            u: the surface tilt α [rad], the horizontal platform displacement x_d [m]
+            (the input h ẍ_d = h s² x_d), or the visual-scene tilt v [rad].
         output : array_like, shape (N,)
             c. [-]
 
         Returns
         -------
         numpy.ndarray of complex, shape (M, F)
-            [rad/rad] for tilt, [rad/m] for translation.
+            [rad/rad] for the tilts, [rad/m] for translation.
         """
         if input not in INPUTS:
             raise ParameterError(f"input must be one of {', '.join(INPUTS)}, got {input!r}")
-        if input == "tilt" and self.tilt_input is None:
+        if input != "translation" and self.tilt_input is None:
             raise ParameterError("this system was built without its inputs")
         f = np.asarray(frequencies, dtype=float)
         c = np.asarray(output, dtype=float)
@@ -314,8 +324,8 @@ class LinearSystem:
         s = np.broadcast_to((2j * np.pi * f)[None, :], (1, f.size))
         D = self.characteristic_matrix(s)                                  # (M, F, N, N)
         s1 = s[..., None]                                                  # (1, F, 1)
-        if input == "tilt":
-            b = self.tilt_input[:, None]                                   # (M, 1, 4, N)
+        if input != "translation":
+            b = (self.tilt_input if input == "tilt" else self.visual_input)[:, None]  # M,1,4,N
             ex = np.exp(-s * self.delay[:, None])                          # (M, F)
             ex = (ex * self.torque_feedback_factor(s))[..., None]          # (M, F, 1)
             rhs = (b[..., IMMEDIATE_STIFFNESS, :] + s1 * b[..., IMMEDIATE_VISCOSITY, :]
@@ -444,7 +454,7 @@ def _torque_feedback(gain, time_constant) -> tuple[np.ndarray | None, np.ndarray
 def linear_system(body: Body | BodyArrays, muscles: MuscleSet, *, stiffness=None,
                   viscosity=None, viscosity_ratio=None, active_stiffness=None,
                   active_viscosity=None, delay=0.0, proprioceptive_weight=1.0,
-                  one_sided: OneSided = "active", inputs: bool = True,
+                  visual_weight=0.0, one_sided: OneSided = "active", inputs: bool = True,
                   torque_feedback_gain=0.0,
                   torque_feedback_time_constant=None, joint_feedback=None) -> LinearSystem:
     """The chain linearised about upright (module notes), for one or M parameter sets.
@@ -469,10 +479,12 @@ def linear_system(body: Body | BodyArrays, muscles: MuscleSet, *, stiffness=None
         τ, >= 0. [s]
     proprioceptive_weight : float or array_like, shape (M,)
         W, the weight of the tilt in the active part. [-]
+    visual_weight : float or array_like, shape (M,)
+        W_v, the weight of the visual-scene tilt in the active part. [-]
     one_sided : {"active", "inactive"}
         How a one-sided pair is linearised at upright (:func:`posturelab.analyse`).
     inputs : bool
-        Also build the tilt input (a batched map without inputs leaves it out).
+        Also build the tilt inputs (a batched map without inputs leaves them out).
     torque_feedback_gain : float or array_like, shape (M,)
         K_t of the torque feedback (module notes), in the parameter table's range; 0 (every
         set): none. [-]
@@ -538,13 +550,15 @@ def linear_system(body: Body | BodyArrays, muscles: MuscleSet, *, stiffness=None
     index = np.arange(n)
     stiff = np.array(np.broadcast_to(stiff, (max(stiff.shape[0], jac.shape[0]), n, n)))
     stiff[:, index, index] -= gravity_torque
-    tilt = None
+    tilt = visual = None
     if inputs:
         shape = np.broadcast_shapes(*(g.shape for g in split if g is not None))
         gains = np.stack([np.zeros(shape) if g is None else np.broadcast_to(g, shape)
                           for g in split], axis=-2)
         weight = np.atleast_1d(np.asarray(proprioceptive_weight, dtype=float))
         tilt = -tilt_pair_gains(gains, muscles.spans_foot, tau, weight) @ E
+        visual_w = np.atleast_1d(np.asarray(visual_weight, dtype=float))
+        visual = -visual_pair_gains(gains, muscles.spans_foot, tau, visual_w) @ E
     feedback_gain, time_constant = _torque_feedback(torque_feedback_gain,
                                                     torque_feedback_time_constant)
     system = LinearSystem(
@@ -552,7 +566,7 @@ def linear_system(body: Body | BodyArrays, muscles: MuscleSet, *, stiffness=None
         delayed_stiffness=_joint_or_zero(split[DELAYED_STIFFNESS], E),
         delayed_viscosity=_joint_or_zero(split[DELAYED_VISCOSITY], E), delay=tau,
         tilt_input=tilt, translation_input=-coefficients, torque_feedback_gain=feedback_gain,
-        torque_feedback_time_constant=time_constant)
+        torque_feedback_time_constant=time_constant, visual_input=visual)
     system.n_sets  # noqa: B018 (checks that the arrays agree on M)
     return system if joint_feedback is None else with_joint_feedback(system, joint_feedback)
 

@@ -40,35 +40,14 @@ from .options import FallCriteria, KneeModel
 from .platform import Disturbance
 from .tilt import Tilt, axis_acceleration_formula
 
-__all__ = [
-    "SwitchedModel",
-    "EVENT_VALUES",
-    "EVENT_QUANTITIES",
-    "pair_torque_formula",
-    "pull_value_formula",
-    "saturated_moment_formula",
-    "tilt_pair_torque_formula",
-    "torque_feedback_rate_formula",
-    "delayed_pair_torques",
-    "torque_feedback_rate",
-    "model_response",
-    "raw_moments",
-    "saturated_moments",
-    "platform_acceleration",
-    "tilt_pair_torques",
-    "ankle_moment_and_load",
-    "centre_of_pressure_at",
-    "event_value",
-    "pair_gains",
-    "pair_activity_after",
-    "saturation_after",
-    "knee_impact",
-    "apply_switch",
-    "start_activity",
-    "start_moments",
-    "start_saturation",
-    "start_centre_of_pressure",
-]
+__all__ = ["SwitchedModel", "EVENT_VALUES", "EVENT_QUANTITIES", "pair_torque_formula",
+           "pull_value_formula", "saturated_moment_formula", "tilt_pair_torque_formula",
+           "torque_feedback_rate_formula", "delayed_pair_torques", "torque_feedback_rate",
+           "model_response", "raw_moments", "saturated_moments", "platform_acceleration",
+           "tilt_pair_torques", "ankle_moment_and_load", "centre_of_pressure_at",
+           "event_value", "pair_gains", "pair_activity_after", "saturation_after",
+           "knee_impact", "apply_switch", "start_activity", "start_moments",
+           "start_saturation", "start_centre_of_pressure"]
 
 
 # ---------------------------------------------------------------------------
@@ -197,15 +176,14 @@ class SwitchedModel:
         ``inf`` where a joint has none. [N·m]
     feedback_delay : float
         τ. [s]
-    tilt : Tilt or None
-    tilt_gains : numpy.ndarray, shape (4, P), or None
-        Pair gains on α(t), α̇(t), α(t − τ), α̇(t − τ). [N·m/rad], [N·m·s/rad]
-    tilt_axis_depth : float
-        [m]
+    tilt, visual_tilt : Tilt or None
+        The surface's α(t) and the visual scene's v(t). [rad]
+    tilt_gains, visual_gains : numpy.ndarray, shape (4, P), or None
+        Gains on α(t), α̇(t), α(t − τ), α̇(t − τ), and on v (:mod:`.visual`). [N·m/rad], …
+    tilt_axis_depth : float  (the tilt axis's depth below the ankle [m])
     motor_torque : TorqueSeries or None
         Motor noise added to each joint's moment before the limits. [N·m]
-    knee_row : numpy.ndarray, shape (N,), or None
-        The row C of the knee constraint.
+    knee_row : numpy.ndarray, shape (N,), or None  (the row C of the knee constraint)
     knee : KneeModel
     fall : FallCriteria
     torque_feedback_gain : float
@@ -232,6 +210,13 @@ class SwitchedModel:
     torque_feedback_gain: float = 0.0
     torque_feedback_time_constant: float = 17.4
     joint_gains: np.ndarray | None = None
+    visual_tilt: Tilt | None = None
+    visual_gains: np.ndarray | None = None
+
+    def stimuli(self) -> list[tuple[Tilt, np.ndarray]]:
+        """The (profile, pair gains (4, P)) of the surface and the visual tilts present."""
+        both = ((self.tilt, self.tilt_gains), (self.visual_tilt, self.visual_gains))
+        return [(p, g) for p, g in both if p is not None]
 
     @property
     def n_links(self) -> int:
@@ -275,17 +260,16 @@ def tilt_pair_torques(tilt: Tilt, tilt_gains: np.ndarray, delay: float, t) -> np
 def delayed_pair_torques(model: SwitchedModel, t: float, feedback: np.ndarray,
                          active: np.ndarray) -> np.ndarray:
     """P: each pair's delayed (active) torque at ``t`` [s], the delayed gains on
-    ``feedback`` (x(t − τ)) and the tilt's delayed part, what the torque feedback filters
+    ``feedback`` (x(t − τ)) and the tilts' delayed parts, what the torque feedback filters
     (:func:`torque_feedback_rate_formula`). [N·m]"""
     g = model.gains
     E = model.muscles.selection_matrix
     n = model.n_links
     P = (g[DELAYED_STIFFNESS] * (E @ feedback[:n]) + g[DELAYED_VISCOSITY] * (E @ feedback[n:]))
     P = P * np.asarray(active, dtype=float)
-    if model.tilt is not None and model.feedback_delay > 0:
-        a_d, ad_d = model.tilt.angle_and_rate(np.asarray(t - model.feedback_delay, float))
-        P = P + (model.tilt_gains[DELAYED_STIFFNESS] * a_d
-                 + model.tilt_gains[DELAYED_VISCOSITY] * ad_d)
+    for profile, gains in model.stimuli() if model.feedback_delay > 0 else ():
+        a_d, ad_d = profile.angle_and_rate(np.asarray(t - model.feedback_delay, float))
+        P = P + (gains[DELAYED_STIFFNESS] * a_d + gains[DELAYED_VISCOSITY] * ad_d)
     return P
 
 
@@ -306,8 +290,8 @@ def raw_moments(model: SwitchedModel, t: float, x: np.ndarray, feedback: np.ndar
     ``x``, the delayed part on ``feedback`` (x(t − τ)), the tilt's part, the torque feedback
     filters' ``filter_state`` (P,), the joint-space controller's and the motor noise. [N·m]"""
     M = feedback_pair_torques(model.muscles, model.gains, x, feedback, active)
-    if model.tilt is not None:
-        M = M + tilt_pair_torques(model.tilt, model.tilt_gains, model.feedback_delay, t)
+    for profile, gains in model.stimuli():  # the surface's and the visual scene's tilts
+        M = M + tilt_pair_torques(profile, gains, model.feedback_delay, t)
     if filter_state is not None and model.n_filter_states:
         M = M + np.asarray(active, dtype=float) * filter_state
     tau = M @ model.muscles.crossing_matrix

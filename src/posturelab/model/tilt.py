@@ -10,6 +10,8 @@ the foot only; 0: relative to the vertical only). A muscle set without active ga
 its pair gains as the whole (neural) feedback, so W applies to them. The axis is the
 ankle's: the ankle does not move, and the tilt acts on the chain only through the pairs.
 
+A visual-scene tilt v(t) takes the same profiles (:mod:`.visual`: the visual channel).
+
 Profiles (each gives α(t) and α̇(t) for any t; before t = 0 the surface is held at α(0)):
 
 - :class:`SineTilt`: α = A sin(2π f t + φ);

@@ -32,6 +32,8 @@ Schema (every table optional except where noted; units in brackets)::
     active_viscosity = [5 values]        #   pairs = [...], per pair instead [N·m·s/rad]
     active_viscosity_ratio = 0.3         # or the active viscosity as a ratio [s]
     proprioceptive_weight = 1.0          # W of the active error, in [0, 1] [-]
+    visual_weight = 0.0                  # W_v of the visual scene's tilt [-]; W + W_v <= 1
+                                         #   (the rest graviceptive; Peterka 2002)
     torque_feedback_gain = 0.0           # K_t: the active torque fed back positively
                                          #   through K_t/(τ_t s + 1) (Peterka 2002; needs
                                          #   feedback_delay > 0 and --engine reference) [-]
@@ -47,6 +49,11 @@ Schema (every table optional except where noted; units in brackets)::
     #       [1, 1, 0, 0], seed = [1, 0, 0, 0]); state_duration [s]
     # profile: file = "tilt.csv" with columns time [s] and tilt [rad]
     axis_depth = 0.0                     # the tilt axis this far below the ankle [m]
+
+    [visual_tilt]                        # visual-scene tilt about the ankle axis, positive
+    type = "prts"                        #   toes-up like the surface; the [tilt] types
+    sequence = "comtest-80"              #   (no axis_depth): acts only through the
+    amplitude = 0.035                    #   active feedback, weighted by visual_weight
 
     [motor_noise]                        # a seeded random torque on each joint's moment
     standard_deviation = [2.0]           # σ per joint, ankle first [N·m]

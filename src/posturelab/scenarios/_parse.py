@@ -21,16 +21,6 @@ from ..model.controllers import MULTIJOINT_CONTROLLERS
 from ..model.muscles import MusclePair, MuscleSet, paper_muscles
 from ..model.noise import MotorNoise
 from ..model.options import FOOT_FROM_LITERATURE, BaseOfSupport, FallCriteria, KneeModel
-from ..model.platform import (
-    Disturbance,
-    HalfSinePulse,
-    NoDisturbance,
-    RampAndHold,
-    SumOfSines,
-    VelocityStep,
-    combine,
-    read_profile_csv,
-)
 from ..model.tilt import (
     PETERKA_SEED,
     PETERKA_TAPS,
@@ -41,8 +31,9 @@ from ..model.tilt import (
     get_prts_sequence,
     read_tilt_csv,
 )
-from ..parameters import check_value
+from ..parameters import check_value, check_weights
 from ..simulation.options import RunOptions
+from ._disturbance import _reject, disturbance_from_tables
 from ._scenario import SCENARIO_DEFAULTS as DEFAULTS
 from ._scenario import Scenario
 
@@ -50,14 +41,6 @@ __all__ = ["OPTION_KEYS", "parse_tables", "run_options", "body_from_table",
            "muscles_from_table", "tilt_from_table", "disturbance_from_tables",
            "motor_noise_from_table", "fall_from_table", "torque_limits_from_table",
            "number_list"]
-
-
-def _reject(d: dict, allowed, where: str, origin: str) -> None:
-    unknown = [k for k in d if k not in allowed]
-    if unknown:
-        raise ScenarioError(
-            f"{origin}: unknown key {unknown[0]!r} in {where}; allowed: {', '.join(allowed)}"
-        )
 
 
 #: Where each run option is written in a scenario file (its TOML key); a message about an
@@ -70,6 +53,7 @@ OPTION_KEYS: dict[str, str] = {
     "torque_feedback_gain": "muscles.torque_feedback_gain",
     "torque_feedback_time_constant": "muscles.torque_feedback_time_constant", "tilt": "tilt",
     "joint_feedback": "muscles.controller",
+    "visual_weight": "muscles.visual_weight", "visual_tilt": "visual_tilt",
     "tilt_axis_depth": "tilt.axis_depth", "motor_noise": "motor_noise",
     "method": "solver.method", "rtol": "solver.rtol", "atol": "solver.atol",
     "sample_rate": "solver.sample_rate", "max_steps": "solver.max_steps",
@@ -106,8 +90,10 @@ def parse_tables(data: dict, base_dir: Path, origin: str,
     feedback_gain = mt.pop("torque_feedback_gain", DEFAULTS.torque_feedback_gain)
     feedback_lag = mt.pop("torque_feedback_time_constant",
                           DEFAULTS.torque_feedback_time_constant)
+    visual_weight = mt.pop("visual_weight", DEFAULTS.visual_weight)
     for key, value in (("torque_feedback_gain", feedback_gain),
-                       ("torque_feedback_time_constant", feedback_lag)):
+                       ("torque_feedback_time_constant", feedback_lag),
+                       ("visual_weight", visual_weight)):
         try:  # the parameter table's bounds, before the muscles are built
             check_value(key, value, _name(names, f"muscles.{key}"))
         except ParameterError as exc:
@@ -122,8 +108,15 @@ def parse_tables(data: dict, base_dir: Path, origin: str,
     else:
         muscles, case, delay, weight = muscles_from_table(mt, body, origin, names,
                                                           data.get("body", {}))
+    try:
+        check_weights(weight, visual_weight, (_name(names, "muscles.proprioceptive_weight"),
+                                              _name(names, "muscles.visual_weight")))
+    except ParameterError as exc:
+        raise _error(origin, str(exc)) from None
     tilt_table = data.get("tilt", {})
     tilt = tilt_from_table(tilt_table, base_dir, origin, names)
+    visual = tilt_from_table(data.get("visual_tilt", {}), base_dir, origin, names,
+                             "visual_tilt")
     disturbance = disturbance_from_tables(data.get("disturbance"), base_dir, origin, names)
     noise = motor_noise_from_table(data.get("motor_noise", {}), body.n_links, origin, names)
     it = data.get("initial", {})
@@ -152,7 +145,7 @@ def parse_tables(data: dict, base_dir: Path, origin: str,
         torque_limits=torque_limits, feedback_delay=delay, proprioceptive_weight=weight,
         torque_feedback_gain=feedback_gain, torque_feedback_time_constant=feedback_lag,
         tilt=tilt, tilt_axis_depth=tilt_table.get("axis_depth", 0.0), motor_noise=noise,
-        joint_feedback=joint_feedback,
+        joint_feedback=joint_feedback, visual_tilt=visual, visual_weight=visual_weight,
         method=st.get("method"), rtol=st.get("rtol", DEFAULTS.rtol),
         atol=st.get("atol", DEFAULTS.atol),
         sample_rate=st.get("sample_rate", DEFAULTS.sample_rate),
@@ -235,12 +228,13 @@ TILT_KEYS = ("type", "amplitude", "frequency", "phase", "duration", "start", "st
 
 
 def tilt_from_table(tt: dict, base_dir: Path, origin: str = "",
-                    names: Mapping[str, str] | None = None) -> Tilt | None:
+                    names: Mapping[str, str] | None = None, key: str = "tilt") -> Tilt | None:
     """The [tilt] table (module docstring), or None when there is none; the command line's
-    ``--tilt`` as this table too."""
+    ``--tilt`` as this table too; ``key`` "visual_tilt" for the visual scene's table (the
+    same types, without axis_depth)."""
     if not tt:
         return None
-    where = _name(names, "tilt")
+    where = _name(names, key)
     kind = tt.get("type")
     allowed = {"sine": ("amplitude", "frequency", "phase"),
                "raised-cosine": ("amplitude", "duration", "start"),
@@ -248,8 +242,9 @@ def tilt_from_table(tt: dict, base_dir: Path, origin: str = "",
                         "sequence"),
                "profile": ("file",)}
     if kind not in allowed:
-        raise _error(origin, f"tilt.type must be one of {', '.join(allowed)}; got {kind!r}")
-    _reject(tt, ("type", "axis_depth", *allowed[kind]), f"tilt (type {kind})", origin)
+        raise _error(origin, f"{key}.type must be one of {', '.join(allowed)}; got {kind!r}")
+    _reject(tt, ("type", *(("axis_depth",) if key == "tilt" else ()), *allowed[kind]),
+            f"{key} (type {kind})", origin)
     try:
         if kind == "sine":
             return SineTilt(tt.get("amplitude"), tt.get("frequency"), tt.get("phase", 0.0))
@@ -389,6 +384,7 @@ def muscles_from_table(mt: dict, body: Body, origin: str = "",
     [-] (a controller preset's unless the table gives them), each checked against the
     parameter table."""
     mt = dict(mt)
+    mt.pop("visual_weight", None)  # (a run option: parse_tables reads it)
     preset = _controller(mt, body, origin, names, bt or {})
     delay = mt.pop("feedback_delay", 0.0 if preset is None else preset.feedback_delay)
     weight = mt.pop("proprioceptive_weight",
@@ -530,71 +526,3 @@ def motor_noise_from_table(nt: dict, n_joints: int, origin: str = "",
             raise _error(origin, f"{where} [N·m] takes at most {n_joints} values (one per "
                          f"joint), got {len(sigma)}")
     return MotorNoise(sigma, nt.get("cutoff"), nt.get("sample_rate", 100.0), nt.get("seed", 0))
-
-
-DISTURBANCE_KEYS = {
-    "none": (),
-    "velocity-step": ("velocity", "direction", "speed", "axis"),
-    "half-sine": ("peak_acceleration", "duration", "start", "axis"),
-    "ramp-and-hold": ("displacement", "duration", "start", "axis"),
-    "sum-of-sines": ("amplitudes", "frequencies", "phases", "axis"),
-    "profile": ("file",),
-}
-
-
-def disturbance_from_tables(spec, base_dir: Path, origin: str = "",
-                            names: Mapping[str, str] | None = None) -> Disturbance:
-    """The [disturbance] table, or an array of them (their sum); none when absent."""
-    if spec is None:
-        return NoDisturbance()
-    specs = spec if isinstance(spec, list) else [spec]
-    return combine(*[_disturbance(s, base_dir, origin, i) for i, s in enumerate(specs)])
-
-
-def _disturbance(d, base_dir: Path, origin: str, i: int) -> Disturbance:
-    if not isinstance(d, dict):
-        raise ScenarioError(f"{origin}: [disturbance] must be a table")
-    kind = d.get("type")
-    if kind not in DISTURBANCE_KEYS:
-        raise ScenarioError(f"{origin}: disturbance.type must be one of "
-                            f"{', '.join(DISTURBANCE_KEYS)}; got {kind!r}")
-    _reject(d, ("type",) + DISTURBANCE_KEYS[kind], f"[disturbance] of type {kind!r}", origin)
-    axis = d.get("axis", "x")
-    try:
-        if kind == "none":
-            return NoDisturbance()
-        if kind == "velocity-step":
-            if "velocity" in d:
-                if "direction" in d or "speed" in d:
-                    raise ScenarioError(f"{origin}: give velocity, or direction and speed")
-                return VelocityStep(d["velocity"], axis)
-            direction = d.get("direction")
-            speed = d.get("speed", 1.0)
-            if direction == "backward":
-                return VelocityStep.backward(speed)
-            if direction == "forward":
-                return VelocityStep.forward(speed)
-            raise ScenarioError(f"{origin}: velocity-step needs velocity [m/s] or direction "
-                                f"'backward'/'forward'; got direction {direction!r}")
-        if kind == "half-sine":
-            return HalfSinePulse(_need(d, "peak_acceleration", origin),
-                                 _need(d, "duration", origin), d.get("start", 0.0), axis)
-        if kind == "ramp-and-hold":
-            return RampAndHold(_need(d, "displacement", origin), _need(d, "duration", origin),
-                               d.get("start", 0.0), axis)
-        if kind == "sum-of-sines":
-            return SumOfSines(tuple(_need(d, "amplitudes", origin)),
-                              tuple(_need(d, "frequencies", origin)),
-                              None if "phases" not in d else tuple(d["phases"]), axis)
-        file = Path(str(_need(d, "file", origin)))
-        return read_profile_csv(file if file.is_absolute() else base_dir / file)
-    except ParameterError as exc:
-        if not origin:
-            raise
-        raise ScenarioError(f"{origin}: disturbance: {exc}") from None
-
-
-def _need(d: dict, key: str, origin: str):
-    if key not in d:
-        raise ScenarioError(f"{origin}: disturbance of type {d.get('type')!r} lacks {key!r}")
-    return d[key]

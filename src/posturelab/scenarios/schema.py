@@ -75,6 +75,7 @@ class MusclesTable(_Table):
     active_viscosity: list[float] | None = None
     active_viscosity_ratio: float | None = None
     proprioceptive_weight: float | None = None
+    visual_weight: float | None = None
     torque_feedback_gain: float | None = None
     torque_feedback_time_constant: float | None = None
     controller: str | None = None
@@ -195,6 +196,7 @@ class ScenarioFile(_Table):
     limits: LimitsTable | None = None
     solver: SolverTable | None = None
     tilt: TiltTable | None = None
+    visual_tilt: TiltTable | None = None  # the visual scene's (the [tilt] types, no axis_depth)
     motor_noise: MotorNoiseTable | None = None
 
 

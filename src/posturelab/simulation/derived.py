@@ -69,6 +69,8 @@ def derived_series(setup: RunSetup, time: np.ndarray, state: np.ndarray,
         M = np.where(slack, 0.0, M)
     if setup.tilt is not None:
         M = M + tilt_torques(setup.tilt, setup.tilt_gains, setup.feedback_delay, time)
+    if setup.visual_tilt is not None:
+        M = M + tilt_torques(setup.visual_tilt, setup.visual_gains, setup.feedback_delay, time)
     moments = M @ muscles.crossing_matrix
     control = setup.options.joint_feedback is not None
     if control:  # the joint-space controller's moments (posturelab.model.joint_feedback)
@@ -109,4 +111,5 @@ def derived_series(setup: RunSetup, time: np.ndarray, state: np.ndarray,
         angular_acceleration=alpha, ground_reaction=ground, centre_of_pressure=cop,
         com_angle=theta @ body.gravity_coefficients / body.gravity_coefficients.sum(),
         tilt=None if setup.tilt is None else setup.tilt.angle(time),
+        visual_tilt=None if setup.visual_tilt is None else setup.visual_tilt.angle(time),
     )

@@ -30,7 +30,13 @@ from ..model.joint_feedback import JointFeedback
 from ..model.noise import MotorNoise
 from ..model.options import FallCriteria, KneeModel
 from ..model.tilt import Tilt
-from ..parameters import QUANTITIES, RUN_SETTINGS, TORQUE_FEEDBACK_TIME_CONSTANT, check_value
+from ..parameters import (
+    QUANTITIES,
+    RUN_SETTINGS,
+    TORQUE_FEEDBACK_TIME_CONSTANT,
+    check_value,
+    check_weights,
+)
 from .tolerances import DEFAULT_ATOL, DEFAULT_RTOL
 
 __all__ = [
@@ -124,6 +130,13 @@ class RunOptions:
     proprioceptive_weight : float
         W in [0, 1]: the active part's error for pairs that span the foot is θ_hi + W·α
         (1: relative to the foot; 0: to the vertical). [-]
+    visual_weight : float
+        W_v in [0, 1], W_p + W_v <= 1 (the rest, 1 − W_p − W_v, graviceptive): under a
+        visual-scene tilt v the active error of pairs that span the foot gains W_v·v. [-]
+    visual_tilt : Tilt or None
+        Visual-scene tilt v(t) about the ankle axis, positive toes-up like the surface
+        (:mod:`posturelab.model.tilt` profiles); it acts only through the delayed active
+        feedback (no mechanical effect). [rad]
     torque_feedback_gain : float
         K_t of Peterka 2002's torque feedback: each pair's active torque fed back positively
         through K_t/(τ_t s + 1) (docs/design.md; 0, the default: none). Needs a positive
@@ -179,6 +192,8 @@ class RunOptions:
     feedback_delay: float = _option(0.0, QUANTITIES["feedback_delay"].meaning, "s")
     proprioceptive_weight: float = _option(1.0, QUANTITIES["proprioceptive_weight"].meaning,
                                            "-")
+    visual_weight: float = _option(0.0, QUANTITIES["visual_weight"].meaning, "-")
+    visual_tilt: Tilt | None = _option(None, "visual-scene tilt, positive toes-up", "rad")
     torque_feedback_gain: float = _option(0.0, QUANTITIES["torque_feedback_gain"].meaning,
                                           "-")
     torque_feedback_time_constant: float = _option(
@@ -218,6 +233,9 @@ class RunOptions:
         put("feedback_delay", check_value("feedback_delay", self.feedback_delay))
         put("proprioceptive_weight", check_value("proprioceptive_weight",
                                                  self.proprioceptive_weight))
+        put("visual_weight", check_weights(self.proprioceptive_weight, self.visual_weight))
+        if self.visual_tilt is not None:
+            _expect("visual_tilt", self.visual_tilt, Tilt)
         put("torque_feedback_gain", check_value("torque_feedback_gain",
                                                 self.torque_feedback_gain))
         put("torque_feedback_time_constant", check_value("torque_feedback_time_constant",

@@ -86,10 +86,11 @@ class StimulusTiming:
         return start
 
 
-def stimulus_timing(disturbance=None, tilt=None, motor_noise=None) -> StimulusTiming:
+def stimulus_timing(disturbance=None, tilt=None, motor_noise=None,
+                    visual_tilt=None) -> StimulusTiming:
     """The :class:`StimulusTiming` of a run's platform ``disturbance``
-    (:mod:`posturelab.model.platform`), ``tilt`` (:mod:`posturelab.model.tilt`) and
-    ``motor_noise`` (any not None is sustained)."""
+    (:mod:`posturelab.model.platform`), ``tilt`` and ``visual_tilt``
+    (:mod:`posturelab.model.tilt`) and ``motor_noise`` (any not None is sustained)."""
     from ..model import platform as pf
     from ..model import tilt as tl
 
@@ -124,6 +125,9 @@ def stimulus_timing(disturbance=None, tilt=None, motor_noise=None) -> StimulusTi
 
     add(disturbance)
     add(tilt)
+    surface = len(what)
+    add(visual_tilt)
+    what[surface:] = [f"visual-scene {w}" for w in what[surface:]]
     if motor_noise is not None:
         what.append("motor noise")
     if what:

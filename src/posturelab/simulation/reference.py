@@ -344,5 +344,6 @@ def integrate_reference(setup: RunSetup, method: str = "DOP853") -> SimulationRe
         time=time, theta=theta, omega=omega, pair_names=tuple(muscles.names), status=status,
         message=message, fell=fell, fall_time=fall_time, fall_reason=fall_reason,
         switch_times=tuple(switch_times), description=setup.description, derived=derived,
-        stimulus=stimulus_timing(setup.disturbance, setup.tilt, setup.motor_noise),
+        stimulus=stimulus_timing(setup.disturbance, setup.tilt, setup.motor_noise,
+                                 setup.visual_tilt),
     )

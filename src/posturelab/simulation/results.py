@@ -56,6 +56,8 @@ class DerivedSeries:
         Centre-of-mass angle Σ a_i θ_i / Σ a_i. [rad]
     tilt : numpy.ndarray, shape (T,), optional
         The support-surface tilt α, None without one. [rad]
+    visual_tilt : numpy.ndarray, shape (T,), optional
+        The visual-scene tilt v, None without one. [rad]
     """
 
     pair_torques: np.ndarray
@@ -71,6 +73,7 @@ class DerivedSeries:
     centre_of_pressure: np.ndarray | None = None
     com_angle: np.ndarray | None = None
     tilt: np.ndarray | None = None
+    visual_tilt: np.ndarray | None = None
 
 
 def _derived(name: str, doc: str) -> property:
@@ -195,6 +198,8 @@ class SimulationResult:
                                   "Centre of pressure relative to the ankle, (T,). [m]")
     com_angle = _derived("com_angle", "Centre-of-mass angle Σ a_i θ_i / Σ a_i, (T,). [rad]")
     tilt = _derived("tilt", "Support-surface tilt α (positive toes-up), (T,), or None. [rad]")
+    visual_tilt = _derived("visual_tilt",
+                           "Visual-scene tilt v (positive toes-up), (T,), or None. [rad]")
 
     @property
     def n_links(self) -> int:
@@ -319,8 +324,14 @@ class SimulationResult:
             names += ["cop_x", "ground_fx", "ground_fy"]
             cols += [self.centre_of_pressure[:, None], self.ground_reaction]
         if self.tilt is not None:  # (a tilt experiment: the columns an FRF is made of)
-            names += ["tilt", "com_angle"]
-            cols += [self.tilt[:, None], self.com_angle[:, None]]
+            names += ["tilt"]
+            cols += [self.tilt[:, None]]
+        if self.visual_tilt is not None:
+            names += ["visual_tilt"]
+            cols += [self.visual_tilt[:, None]]
+        if self.tilt is not None or self.visual_tilt is not None:
+            names += ["com_angle"]
+            cols += [self.com_angle[:, None]]
         return names, np.concatenate(cols, axis=1)
 
     def to_dataframe(self):

@@ -38,28 +38,16 @@ from ..model.noise import MotorNoise, TorqueSeries, motor_noise_series, torque_a
 from ..model.options import FallCriteria, KneeModel, torque_limit_array
 from ..model.platform import Disturbance, NoDisturbance
 from ..model.tilt import Tilt, axis_translation, tilt_pair_gains
+from ..model.visual import visual_pair_gains
 from ..parameters import MAX_DURATION, MAX_FEEDBACK_DELAY, MAX_STEP_BUDGET, MAX_TIME_LIMIT
 from .messages import outcome_message
 from .options import MAX_OUTPUT_SAMPLES, OPTION_NAMES, RunOptions, default_step_budget
 from .outcome import check_starts_within
 
-__all__ = [
-    "RunSetup",
-    "RunOptions",
-    "RUN_OPTIONS",
-    "prepare_run",
-    "initial_state_for",
-    "model_response",
-    "output_grid",
-    "outcome_message",
-    "DELAY_BREAKPOINT_MULTIPLES",
-    "MAX_FEEDBACK_DELAY",
-    "MAX_DURATION",
-    "MAX_OUTPUT_SAMPLES",
-    "MAX_STEP_BUDGET",
-    "MAX_TIME_LIMIT",
-    "default_step_budget",
-]
+__all__ = ["RunSetup", "RunOptions", "RUN_OPTIONS", "prepare_run", "initial_state_for",
+           "model_response", "output_grid", "outcome_message", "DELAY_BREAKPOINT_MULTIPLES",
+           "MAX_FEEDBACK_DELAY", "MAX_DURATION", "MAX_OUTPUT_SAMPLES", "MAX_STEP_BUDGET",
+           "MAX_TIME_LIMIT", "default_step_budget"]
 
 #: With a feedback delay τ the motion is not smooth at t = kτ (the step at t = 0 reaches
 #: the muscles at τ, its derivative at 2τ, …); every engine ends a step exactly at kτ for
@@ -127,6 +115,9 @@ class RunSetup:
         Pair gains on α(t), α̇(t), α(t − τ), α̇(t − τ)
         (:func:`posturelab.model.tilt.tilt_pair_gains`); None without a tilt.
         [N·m/rad], [N·m·s/rad], [N·m/rad], [N·m·s/rad]
+    visual_gains : numpy.ndarray, shape (4, P), or None
+        Gains on the visual-scene tilt v(t), v̇(t), v(t − τ), v̇(t − τ), as tilt_gains
+        (:func:`posturelab.model.visual.visual_pair_gains`); None without one.
     velocity_jump : (float, float)
         The ankle's velocity change at t = 0: the disturbance's step and the start of a
         tilt about an axis below the ankle. [m/s]
@@ -160,6 +151,7 @@ class RunSetup:
     velocity_jump: tuple[float, float] = (0.0, 0.0)
     motor_torque: TorqueSeries | None = None
     joint_gains: np.ndarray | None = None
+    visual_gains: np.ndarray | None = None
 
     @property
     def n_links(self) -> int:
@@ -180,6 +172,16 @@ class RunSetup:
     def tilt(self) -> Tilt | None:
         """The support-surface tilt α(t), None for none."""
         return self.options.tilt
+
+    @property
+    def visual_tilt(self) -> Tilt | None:
+        """The visual-scene tilt v(t), None for none."""
+        return self.options.visual_tilt
+
+    @property
+    def visual_weight(self) -> float:
+        """W_v of the active part's error for pairs that span the foot. [-]"""
+        return self.options.visual_weight
 
     @property
     def proprioceptive_weight(self) -> float:
@@ -360,11 +362,13 @@ def _prepare(body: Body, muscles: MuscleSet, disturbance: Disturbance,
         raise ParameterError(f"disturbance must be a Disturbance, got "
                              f"{type(disturbance).__name__} {disturbance!r:.60}")
     tilt, depth, delay = options.tilt, options.tilt_axis_depth, options.feedback_delay
-    duration, knee = options.duration, options.knee
-    if tilt is not None and muscles.one_sided_mask.any():
-        raise ParameterError("a platform tilt cannot be combined with one-sided pairs "
-                             "(make them two-sided)")
+    duration, knee, visual = options.duration, options.knee, options.visual_tilt
+    for what, profile in (("platform", tilt), ("visual-scene", visual)):
+        if profile is not None and muscles.one_sided_mask.any():
+            raise ParameterError(f"a {what} tilt cannot be combined with one-sided pairs "
+                                 "(make them two-sided)")
     check_starts_within(disturbance, tilt, duration)
+    check_starts_within(NoDisturbance(), visual, duration)
     noise = options.motor_noise
     motor_torque = None if noise is None else motor_noise_series(noise, duration, body.n_links)
     n = body.n_links
@@ -399,18 +403,26 @@ def _prepare(body: Body, muscles: MuscleSet, disturbance: Disturbance,
                                      options.proprioceptive_weight)
         tilt_gains.setflags(write=False)
     joint_gains = joint_gain_rows(options.joint_feedback, n, delay)
+    visual_gains = None
+    if visual is not None:
+        visual_gains = visual_pair_gains(muscle_set_gains(muscles, 1.0), muscles.spans_foot,
+                                         delay, options.visual_weight)
+        visual_gains.setflags(write=False)
     moments0 = moments_at_start(muscles, x0, before, active0, gains, delay, tilt, tilt_gains,
-                                motor_torque) + joint_feedback_moments(joint_gains, x0, before)
+                                motor_torque, visual, visual_gains) \
+        + joint_feedback_moments(joint_gains, x0, before)
     saturation0 = start_saturation(moments0, limits)
     corners = set(disturbance.breakpoints)
-    if tilt is not None:  # the tilt's corners, and where the delayed part feels them
-        tilt_corners = tilt.breakpoints(duration)
-        corners |= set(tilt_corners) | {b + delay for b in tilt_corners if delay > 0}
+    for profile in (tilt, visual):  # the tilts' corners, and where the delayed part feels them
+        if profile is not None:
+            tilt_corners = profile.breakpoints(duration)
+            corners |= set(tilt_corners) | {b + delay for b in tilt_corners if delay > 0}
     breakpoints = np.array(sorted({b for b in corners if 0.0 < b < duration}), dtype=float)
     delay_bps = np.array([k * delay for k in range(1, DELAY_BREAKPOINT_MULTIPLES + 1)
                           if delay > 0 and k * delay < duration])
     max_step = min(disturbance.max_step, duration, delay if delay > 0 else math.inf,
                    tilt.max_step if tilt is not None else math.inf,
+                   visual.max_step if visual is not None else math.inf,
                    noise.max_step if noise is not None else math.inf)
     for arr in (before, x0, active0, saturation0, breakpoints, delay_bps, gains, joint_gains):
         arr.setflags(write=False)
@@ -422,7 +434,7 @@ def _prepare(body: Body, muscles: MuscleSet, disturbance: Disturbance,
         delay_breakpoints=delay_bps, max_step=max_step, fall_at_start=None, knee_row=knee_row,
         tilt_gains=tilt_gains, velocity_jump=tuple(
             float(a + b) for a, b in zip(disturbance.velocity_change, jump, strict=True)),
-        motor_torque=motor_torque, joint_gains=joint_gains,
+        motor_torque=motor_torque, joint_gains=joint_gains, visual_gains=visual_gains,
     )
     object.__setattr__(setup, "fall_at_start", _fall_at_start(setup))
     return setup
@@ -434,17 +446,22 @@ _prepare_memo = functools.lru_cache(maxsize=128)(_prepare)
 def moments_at_start(muscles: MuscleSet, state: np.ndarray, before: np.ndarray,
                      active: np.ndarray, gains: np.ndarray, delay: float,
                      tilt: Tilt | None = None, tilt_gains: np.ndarray | None = None,
-                     motor_torque: TorqueSeries | None = None) -> np.ndarray:
+                     motor_torque: TorqueSeries | None = None, visual_tilt: Tilt | None = None,
+                     visual_gains: np.ndarray | None = None) -> np.ndarray:
     """Unsaturated joint moments at t = 0 of one run, or of runs that share a delay (a batch):
     the pairs' feedback (:func:`start_moments`, ``state``, ``before`` (..., 2N), ``active``
-    (..., P), ``gains`` (..., 4, P)), the tilt's part with ``tilt_gains`` (..., 4, P) and the
-    motor noise. Returns (..., N). [N·m]
+    (..., P), ``gains`` (..., 4, P)), the tilt's part with ``tilt_gains`` (..., 4, P), the
+    visual-scene tilt's with ``visual_gains`` (..., 4, P) and the motor noise. Returns
+    (..., N). [N·m]
 
     ``delay`` is the runs' feedback delay τ. [s]
     """
     moments = start_moments(muscles, state, before, active, gains)
     if tilt is not None:
         moments = moments + tilt_torques(tilt, tilt_gains, delay, 0.0) @ muscles.crossing_matrix
+    if visual_tilt is not None:
+        moments = moments + (tilt_torques(visual_tilt, visual_gains, delay, 0.0)
+                             @ muscles.crossing_matrix)
     if motor_torque is not None:
         moments = moments + torque_at(motor_torque, 0.0)
     return moments
@@ -470,7 +487,8 @@ def switched_model(setup: RunSetup) -> switched.SwitchedModel:
             knee_row=setup.knee_row, knee=setup.knee, fall=setup.fall,
             torque_feedback_gain=setup.options.torque_feedback_gain,
             torque_feedback_time_constant=setup.options.torque_feedback_time_constant,
-            joint_gains=setup.joint_gains if setup.options.joint_feedback is not None else None)
+            joint_gains=setup.joint_gains if setup.options.joint_feedback is not None else None,
+            visual_tilt=setup.visual_tilt, visual_gains=setup.visual_gains)
         object.__setattr__(setup, "_switched_model", model)
     return model
 

@@ -55,7 +55,7 @@ function enableFields() {
   const ownGains = !(controller in PRESETS);
   const oneLink = body.endsWith("one link") || !ownGains;
   const bodyFree = body.startsWith("height");
-  const tilt = document.getElementById("perturbation").value === "tilt";
+  const tilt = ["tilt", "visual tilt"].includes(document.getElementById("perturbation").value);
   const fields = [["height", bodyFree], ["mass", bodyFree], ["step_speed", !tilt],
                   ["tilt_amplitude", tilt], ["tilt_frequency", tilt],
                   ["viscosity_ratio", ownGains]];

@@ -26,6 +26,7 @@ from ...model.joint_feedback import joint_feedback_moments, joint_gain_rows
 from ...model.muscles import MuscleSet, feedback_gains, paper_muscles
 from ...model.platform import Disturbance
 from ...model.tilt import tilt_pair_gains
+from ...model.visual import visual_pair_gains
 from ..options import OPTION_NAMES, RunOptions
 from ..outcome import StimulusTiming, stimulus_timing
 from ..setup import (
@@ -171,8 +172,10 @@ def _per_run(name: str, value, m: int, width: int | None) -> np.ndarray:
 
 
 def _shared_options(options: RunOptions | None, duration, initial_state,
-                    keywords: dict[str, Any]) -> RunOptions:
-    """The options every run of a batch shares, on the compiled engine."""
+                    keywords: dict[str, Any], weights=None) -> RunOptions:
+    """The options every run of a batch shares, on the compiled engine (with the smallest
+    of the per-run proprioceptive ``weights``, so that the shared visual weight is checked
+    against it here and against each run's later)."""
     unknown = [k for k in keywords if k not in OPTION_NAMES or k in PER_RUN_OPTIONS]
     if unknown:
         shared_names = ", ".join(k for k in OPTION_NAMES if k not in PER_RUN_OPTIONS)
@@ -183,6 +186,11 @@ def _shared_options(options: RunOptions | None, duration, initial_state,
         changes["duration"] = duration
     if initial_state is not None:
         changes["initial_state"] = initial_state
+    if weights is not None and "visual_weight" in changes:
+        try:
+            changes["proprioceptive_weight"] = float(np.min(np.asarray(weights, float)))
+        except (TypeError, ValueError):
+            pass  # (refused with its name by the per-run check)
     shared = (options or RunOptions()).replace(**changes)
     if shared.engine != "compiled":
         raise ParameterError("simulate_batch runs the compiled engine; got engine "
@@ -291,7 +299,7 @@ def simulate_batch(
     BatchResult
     """
     check_model(body, muscles)
-    common = _shared_options(options, duration, initial_state, keywords)
+    common = _shared_options(options, duration, initial_state, keywords, proprioceptive_weight)
     method = common.method
     if method is not None:
         check_method(method)
@@ -398,13 +406,23 @@ def simulate_batch(
     if common.joint_feedback is not None and len({bool(d > 0) for d in delays}) > 1:
         raise ParameterError("a batch with a joint_feedback controller needs every run's "
                              "feedback_delay > 0, or every one 0 (not a mix)")
+    visual_gain_all = enc.readonly(np.zeros((M, len(GAIN_ROWS), n)))
+    visual_pair_gain_all = enc.readonly(np.zeros((M, len(GAIN_ROWS), len(muscles.pairs))))
+    visual_gains = None
+    if base.visual_tilt is not None:  # (the common visual weight, each run's gains and delay)
+        split = feedback_gains(kd_all, ld_all, ka_all, la_all, np.ones(M))
+        visual_gains = visual_pair_gains(split, muscles.spans_foot, delays, base.visual_weight)
+        visual_gain_all = enc.readonly(np.ascontiguousarray(
+            visual_gains @ muscles.crossing_matrix))
+        visual_pair_gain_all = enc.readonly(np.ascontiguousarray(visual_gains))
     moments0 = np.empty((M, n))
     for d in np.unique(delays):
         rows = delays == d
         moments0[rows] = moments_at_start(
             muscles, x0_all[which[rows]], before_all[which[rows]], active_all[which[rows]],
             gains_all[rows], float(d), base.tilt,
-            None if pair_gains is None else pair_gains[rows], base.motor_torque)
+            None if pair_gains is None else pair_gains[rows], base.motor_torque,
+            base.visual_tilt, None if visual_gains is None else visual_gains[rows])
         if common.joint_feedback is not None:  # the controller's moment at the start
             moments0[rows] += joint_feedback_moments(
                 joint_gain_rows(common.joint_feedback, n, float(d)), x0_all[which[rows]],
@@ -448,7 +466,9 @@ def simulate_batch(
                       results=pointer(results),
                       peaks=pointer(peaks), finals=pointer(finals),
                       tilt_gain_all=pointer(tilt_gain_all),
-                      tilt_pair_gain_all=pointer(tilt_pair_gain_all))
+                      tilt_pair_gain_all=pointer(tilt_pair_gain_all),
+                      visual_gain_all=pointer(visual_gain_all),
+                      visual_pair_gain_all=pointer(visual_pair_gain_all))
         _run_rows(batch, todo, parallel, int(chunk))
     if at_start.any():
         results[at_start] = 0.0
@@ -462,7 +482,7 @@ def simulate_batch(
     fall_time = np.where(fell, results[:, R_FALL_TIME], np.nan)
     final_outside = results[:, R_FINAL_OUTSIDE] > 0
     any_outside = results[:, R_ANY_OUTSIDE] > 0
-    timing = stimulus_timing(base.disturbance, base.tilt, base.motor_noise)
+    timing = stimulus_timing(base.disturbance, base.tilt, base.motor_noise, base.visual_tilt)
     # counted from the end of the perturbation (the C engine gives the last time outside)
     # (none when the run ends before its perturbation does: recovery is measured within it)
     cut_short = not timing.sustained and timing.end > base.duration + 1e-9

@@ -51,7 +51,8 @@ class Batch(ctypes.Structure):
                 ("dp_all", _d), ("dp_stride", ctypes.c_int64), ("ipar_all", _i),
                 ("active0_all", _d), ("gains_all", _d), ("lim_all", _d), ("delay_all", _d),
                 ("sat0_all", _d), ("method_all", _i), ("results", _d), ("peaks", _d),
-                ("finals", _d), ("tilt_gain_all", _d), ("tilt_pair_gain_all", _d)]
+                ("finals", _d), ("tilt_gain_all", _d), ("tilt_pair_gain_all", _d),
+                ("visual_gain_all", _d), ("visual_pair_gain_all", _d)]
 
 
 def pointer(arr, kind=_d):

@@ -152,6 +152,7 @@ def options(setup: RunSetup, settle_tolerance: float = 0.01) -> tuple[np.ndarray
     fpar[F_MAX_STEP] = min(  # the C driver caps it at the run's delay itself
         setup.disturbance.max_step, setup.duration,
         setup.tilt.max_step if setup.tilt is not None else math.inf,
+        setup.visual_tilt.max_step if setup.visual_tilt is not None else math.inf,
         setup.motor_noise.max_step if setup.motor_noise is not None else math.inf)
     fpar[F_DURATION] = setup.duration
     fpar[F_SETTLE_TOL] = settle_tolerance

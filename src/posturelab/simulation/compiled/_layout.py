@@ -136,7 +136,8 @@ RUN_FIELDS = ("n:i64", "p:i64", "n_grid:i64", "n_bps:i64", "n_slots:i64", "n_sta
               "ev_offset:*f64", "ev_direction:*i64", "ev_ends:*i64", "tab_A:*f64", "tab_c:*f64",
               "tab_e:*f64", "tab_P:*f64", "tab_error_order:i64", "delay_multiples:i64",
               "tp:*f64", "tilt_gain:*f64", "tilt_depth:f64", "mp:*f64", "n_filters:i64",
-              "filter_gain:f64", "filter_time:f64", "tilt_pair_gain:*f64", "joint_gain:*f64")
+              "filter_gain:f64", "filter_time:f64", "tilt_pair_gain:*f64", "joint_gain:*f64",
+              "vp:*f64", "visual_gain:*f64", "visual_pair_gain:*f64")
 #: The fields of ``pl_out`` (csrc/pl_model.h) and their types: i64, f64, *… arrays.
 OUT_FIELDS = ("samples:*f64", "fb:*f64", "locked:*u8", "switches:*f64", "switch_cap:i64",
               "peak:*f64", "final:*f64", "res:*f64")

@@ -101,6 +101,13 @@ def packed(setup: RunSetup) -> dict:
         "filter_time": float(setup.options.torque_feedback_time_constant),
         "mp": enc.encode_motor_noise(setup.motor_torque),
         "joint_gain": enc.readonly(np.ascontiguousarray(setup.joint_gains)),
+        "vp": enc.encode_tilt(setup.visual_tilt),
+        "visual_gain": enc.readonly(np.ascontiguousarray(
+            setup.visual_gains @ muscles.crossing_matrix if setup.visual_gains is not None
+            else np.zeros((len(GAIN_ROWS), n)))),
+        "visual_pair_gain": enc.readonly(np.ascontiguousarray(
+            setup.visual_gains if setup.visual_gains is not None
+            else np.zeros((len(GAIN_ROWS), len(muscles.pairs))))),
         "bps": enc.readonly(setup.breakpoints.astype(float)), "fpar": fpar, "ipar": ipar,
         "active0": enc.readonly(setup.active0), "slots": slots,
         "ev_offset": ev.EVENT_OFFSET, "ev_direction": ev.EVENT_DIRECTION,
@@ -130,7 +137,8 @@ def base_run_struct(a: dict, method: str) -> Run:
               n_filters=a["n_filters"], filter_gain=a["filter_gain"],
               filter_time=a["filter_time"])
     for name in ("x0", "before", "grid", "bp", "E", "C", "dp", "bps", "fpar", "active0",
-                 "ev_offset", "tp", "tilt_gain", "tilt_pair_gain", "mp", "joint_gain"):
+                 "ev_offset", "tp", "tilt_gain", "tilt_pair_gain", "mp", "joint_gain", "vp",
+                 "visual_gain", "visual_pair_gain"):
         setattr(run, name, pointer(a[name]))
     for name in ("one_sided", "ipar", "ev_direction", "ev_ends"):
         setattr(run, name, pointer(a[name], ctypes_int64))
@@ -240,7 +248,8 @@ def integrate_compiled(setup: RunSetup, method: str | None = None) -> Simulation
         fall_time=fall_time, fall_reason=fall_reason,
         switch_times=tuple(float(v) for v in switches), description=setup.description,
         derived=derive,
-        stimulus=stimulus_timing(setup.disturbance, setup.tilt, setup.motor_noise),
+        stimulus=stimulus_timing(setup.disturbance, setup.tilt, setup.motor_noise,
+                                 setup.visual_tilt),
     )
 
 

@@ -43,12 +43,13 @@ def inputs_pairs() -> str:
 """
 
 
-def inputs_tilt() -> str:
-    """C inside ``pl_inputs_at``'s tilt branch: the tilt's delayed part of each filter's
-    input (:func:`~posturelab.model.switched.tilt_pair_torque_formula` without the parts
-    that act at once)."""
-    g = symbols(f"cx->tilt_pair_gain[{_DK} * cx->p + q]", f"cx->tilt_pair_gain[{_DV} * cx->p + q]")
-    part = switched.tilt_pair_torque_formula(0, 0, *g, 0, 0, *symbols("a_d", "ad_d"))
+def inputs_tilt(gains: str = "tilt_pair_gain", angle: str = "a_d", rate: str = "ad_d") -> str:
+    """C inside ``pl_inputs_at``'s branch of one tilt stimulus (the surface's, or the visual
+    scene's with ``gains="visual_pair_gain"``): its delayed part of each filter's input
+    (:func:`~posturelab.model.switched.tilt_pair_torque_formula` without the parts that act
+    at once), ``angle`` and ``rate`` the C names of the stimulus at t − τ."""
+    g = symbols(f"cx->{gains}[{_DK} * cx->p + q]", f"cx->{gains}[{_DV} * cx->p + q]")
+    part = switched.tilt_pair_torque_formula(0, 0, *g, 0, 0, *symbols(angle, rate))
     return f"""        for (int64_t q = 0; q < cx->md->nf; q++)
             out[2 + n + q] += {c(part)};
 """

@@ -42,6 +42,9 @@ RUN_FIELDS = [
     ("filter_time", "f64", "τ_t of its filter [s]"),
     ("tilt_pair_gain", "*f64", "(4, p) pair torques per α(t), α̇(t), α(t−τ), α̇(t−τ)"),
     ("joint_gain", "*f64", "(4, n, n) joint-space controller's moment gains, rows GAIN_*"),
+    ("vp", "*f64", "packed visual-scene tilt (vp[0] = 0: none)"),
+    ("visual_gain", "*f64", "(4, n) joint moments per v(t), v̇(t), v(t−τ), v̇(t−τ)"),
+    ("visual_pair_gain", "*f64", "(4, p) pair torques per v(t), v̇(t), v(t−τ), v̇(t−τ)"),
 ]
 #: ``pl_out``: where one run's outputs go (any pointer may be NULL where noted).
 OUT_FIELDS = [
@@ -157,6 +160,8 @@ typedef struct {
     int64_t p;
     double *sc_out, *sc_inp, *sc_x, *ys;   /* scratch (m), (2 + n + nf), (m), (m) */
     const double *tilt_pair_gain;          /* (4, p) pair gains on the tilt */
+    const double *vp, *visual_gain;        /* packed visual-scene tilt, (4, n) gains on it */
+    const double *visual_pair_gain;        /* (4, p) pair gains on the visual-scene tilt */
 } pl_ctx;
 """
 

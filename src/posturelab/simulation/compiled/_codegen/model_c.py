@@ -204,9 +204,11 @@ def _inputs() -> str:
     axis_x, axis_y = tilt.axis_acceleration_formula(h, a, ad, add, SYMPY)
     g = symbols(*(f"g[GAIN_{row.upper()} * n + j]" for row in GAIN_ROWS))
     tilt_moment = switched.tilt_pair_torque_formula(*g, a, ad, *symbols("a_d", "ad_d"))
+    visual_moment = switched.tilt_pair_torque_formula(*g, *symbols("v", "vd", "v_d", "vd_d"))
     return f"""
 /* The inputs at t: inp = (ẍ_d, ÿ_d, the moments that do not depend on the state now: the
- * delayed part of the feedback on x(t − τ), the tilt's part, the motor noise). */
+ * delayed part of the feedback on x(t − τ), the tilt's part, the visual scene's part, the
+ * motor noise). */
 void pl_inputs_at(const pl_ctx *cx, double t, double *out)
 {{
     const int64_t n = cx->md->n;
@@ -244,6 +246,15 @@ void pl_inputs_at(const pl_ctx *cx, double t, double *out)
         for (int64_t j = 0; j < n; j++)
             out[2 + j] += {c(tilt_moment)};
 {filters_c.inputs_tilt()}    }}
+    if (cx->vp[0] > 0.0) {{  /* the visual scene's moments: through the active part only */
+        const double *g = cx->visual_gain;
+        double v = 0.0, vd = 0.0, vdd = 0.0, v_d = 0.0, vd_d = 0.0, vdd_d = 0.0;
+        pl_tilt(t, cx->vp, &v, &vd, &vdd);
+        if (cx->delay > 0.0)
+            pl_tilt(t - cx->delay, cx->vp, &v_d, &vd_d, &vdd_d);
+        for (int64_t j = 0; j < n; j++)
+            out[2 + j] += {c(visual_moment)};
+{filters_c.inputs_tilt("visual_pair_gain", "v_d", "vd_d")}    }}
     if (cx->mp[0] > 0.0)  /* the motor noise, on the motor command */
         pl_motor_noise_add(t, cx->mp, n, out + 2);
 }}

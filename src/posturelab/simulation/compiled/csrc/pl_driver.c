@@ -198,7 +198,7 @@ int64_t pl_integrate(const pl_run *run, pl_out *out)
     const double started = timed ? wall_seconds() : 0.0;
     int locked = run->ipar[I_LOCKED0] != 0;
     const int has_inputs = run->dp[0] > 0.0 || delay > 0.0 || run->tp[0] > 0.0
-                           || run->mp[0] > 0.0;
+                           || run->mp[0] > 0.0 || run->vp[0] > 0.0;
     double *res = out->res;
     for (int64_t k = 0; k < N_RESULT; k++)
         res[k] = 0.0;
@@ -235,7 +235,8 @@ int64_t pl_integrate(const pl_run *run, pl_out *out)
                    run->filter_gain, run->filter_time, run->C, b.active, b.fscr};
     pl_ctx cx = {&md, run->E, run->dp, fpar, run->before, run->ev_offset, &hist, delay,
                  run->tp, run->tilt_gain, run->tilt_depth, run->mp, run->gains, run->p,
-                 b.sc_out, b.sc_inp, b.sc_x, b.ys, run->tilt_pair_gain};
+                 b.sc_out, b.sc_inp, b.sc_x, b.ys, run->tilt_pair_gain, run->vp, run->visual_gain,
+                 run->visual_pair_gain};
     double *x = b.x, *y = b.y, *Q = b.Q, *inp = b.inp;
     for (int64_t i = 0; i < n; i++)
         out->peak[i] = 0.0;

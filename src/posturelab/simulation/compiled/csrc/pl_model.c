@@ -131,7 +131,8 @@ void pl_motor_noise_add(double t, const double *mp, int64_t n, double *tau)
 }
 
 /* The inputs at t: inp = (ẍ_d, ÿ_d, the moments that do not depend on the state now: the
- * delayed part of the feedback on x(t − τ), the tilt's part, the motor noise). */
+ * delayed part of the feedback on x(t − τ), the tilt's part, the visual scene's part, the
+ * motor noise). */
 void pl_inputs_at(const pl_ctx *cx, double t, double *out)
 {
     const int64_t n = cx->md->n;
@@ -178,6 +179,17 @@ void pl_inputs_at(const pl_ctx *cx, double t, double *out)
             out[2 + j] += a*g[GAIN_IMMEDIATE_STIFFNESS * n + j] + a_d*g[GAIN_DELAYED_STIFFNESS * n + j] + ad*g[GAIN_IMMEDIATE_VISCOSITY * n + j] + ad_d*g[GAIN_DELAYED_VISCOSITY * n + j];
         for (int64_t q = 0; q < cx->md->nf; q++)
             out[2 + n + q] += a_d*cx->tilt_pair_gain[GAIN_DELAYED_STIFFNESS * cx->p + q] + ad_d*cx->tilt_pair_gain[GAIN_DELAYED_VISCOSITY * cx->p + q];
+    }
+    if (cx->vp[0] > 0.0) {  /* the visual scene's moments: through the active part only */
+        const double *g = cx->visual_gain;
+        double v = 0.0, vd = 0.0, vdd = 0.0, v_d = 0.0, vd_d = 0.0, vdd_d = 0.0;
+        pl_tilt(t, cx->vp, &v, &vd, &vdd);
+        if (cx->delay > 0.0)
+            pl_tilt(t - cx->delay, cx->vp, &v_d, &vd_d, &vdd_d);
+        for (int64_t j = 0; j < n; j++)
+            out[2 + j] += g[GAIN_DELAYED_STIFFNESS * n + j]*v_d + g[GAIN_DELAYED_VISCOSITY * n + j]*vd_d + g[GAIN_IMMEDIATE_STIFFNESS * n + j]*v + g[GAIN_IMMEDIATE_VISCOSITY * n + j]*vd;
+        for (int64_t q = 0; q < cx->md->nf; q++)
+            out[2 + n + q] += cx->visual_pair_gain[GAIN_DELAYED_STIFFNESS * cx->p + q]*v_d + cx->visual_pair_gain[GAIN_DELAYED_VISCOSITY * cx->p + q]*vd_d;
     }
     if (cx->mp[0] > 0.0)  /* the motor noise, on the motor command */
         pl_motor_noise_add(t, cx->mp, n, out + 2);

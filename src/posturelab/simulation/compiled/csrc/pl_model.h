@@ -53,6 +53,9 @@ typedef struct {
     double filter_time;                 /* τ_t of its filter [s] */
     const double *tilt_pair_gain;       /* (4, p) pair torques per α(t), α̇(t), α(t−τ), α̇(t−τ) */
     const double *joint_gain;           /* (4, n, n) joint-space controller's moment gains, rows GAIN_* */
+    const double *vp;                   /* packed visual-scene tilt (vp[0] = 0: none) */
+    const double *visual_gain;          /* (4, n) joint moments per v(t), v̇(t), v(t−τ), v̇(t−τ) */
+    const double *visual_pair_gain;     /* (4, p) pair torques per v(t), v̇(t), v(t−τ), v̇(t−τ) */
 } pl_run;
 
 /* Outputs of one run (any pointer may be NULL where noted). */
@@ -100,6 +103,8 @@ typedef struct {
     int64_t p;
     double *sc_out, *sc_inp, *sc_x, *ys;   /* scratch (m), (2 + n + nf), (m), (m) */
     const double *tilt_pair_gain;          /* (4, p) pair gains on the tilt */
+    const double *vp, *visual_gain;        /* packed visual-scene tilt, (4, n) gains on it */
+    const double *visual_pair_gain;        /* (4, p) pair gains on the visual-scene tilt */
 } pl_ctx;
 
 /* sin θ and cos θ from those of a nearby θ_b by the angle-sum formulas: within a step the

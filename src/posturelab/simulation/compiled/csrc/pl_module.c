@@ -41,6 +41,7 @@ typedef struct {
     const int64_t *method_all;   /* per run: METHOD_RADAU or METHOD_EXPLICIT (the tableau) */
     double *results, *peaks, *finals;
     const double *tilt_gain_all, *tilt_pair_gain_all; /* per run (4, n), (4, p) */
+    const double *visual_gain_all, *visual_pair_gain_all; /* the same on the visual scene */
 } pl_batch;
 
 PL_EXPORT void pl_run_batch(const pl_batch *b, int64_t begin, int64_t end)
@@ -61,6 +62,8 @@ PL_EXPORT void pl_run_batch(const pl_batch *b, int64_t begin, int64_t end)
         run.method = b->method_all[r];
         run.tilt_gain = b->tilt_gain_all + r * 4 * n;
         run.tilt_pair_gain = b->tilt_pair_gain_all + r * 4 * p;
+        run.visual_gain = b->visual_gain_all + r * 4 * n;
+        run.visual_pair_gain = b->visual_pair_gain_all + r * 4 * p;
         pl_out out = {NULL, NULL, NULL, NULL, 0, b->peaks + r * n, b->finals + r * m,
                       b->results + r * N_RESULT};
         pl_integrate(&run, &out);
