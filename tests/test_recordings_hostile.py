@@ -86,6 +86,9 @@ def test_semicolon_and_tab_separated_files_are_refused(tmp_path, capsys, trial, 
                      np.column_stack([t, tilt, com]), sep=sep)
     line = one_line_exit_2(capsys, "frf", "--data", path, *FRF)
     assert f"separated by {word}" in line and "comma-separated" in line
+    # without --stimulus (frf looks for the tilt columns in the header): the same refusal
+    line = one_line_exit_2(capsys, "frf", "--data", path, "--cycle-length", "20")
+    assert f"separated by {word}" in line
 
 
 def test_decimal_commas_are_refused(tmp_path, capsys, trial):

@@ -200,11 +200,13 @@ def stimulus_columns(path) -> list[str]:
     from pathlib import Path
 
     from .._files import csv_rows, read_text
-    from ..recordings.columns import MAX_ROWS, _name
+    from ..recordings.columns import MAX_ROWS, _name, _refuse_other_separators
 
     if Path(path).suffix.lower() == ".c3d":  # (a C3D's channels are named by --stimulus)
         return []
     first = next(csv_rows(read_text(Path(path), "data file"), repr(str(path)),
                           max_rows=MAX_ROWS), None)
+    if first:
+        _refuse_other_separators(first[1], repr(str(path)))
     names = {_name(h) for h in (first[1] if first else [])}
     return [c for c in STIMULUS_INPUTS if c in names]
