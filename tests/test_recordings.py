@@ -19,6 +19,7 @@ from posturelab.recordings.sway import (
     com_angle_segments,
     com_angle_two_markers,
 )
+from posturelab.recordings.table import read_table
 
 
 def run(capsys, *argv):
@@ -104,8 +105,9 @@ def test_resampled_frf_equals_the_uniform_one(tmp_path, capsys, rng, prts_trial)
     assert "not uniform" in line and "--resample" in line
     code, out, err = run(capsys, *args, "--data", uneven, "--resample", "100")
     assert code == 0, err
-    assert "cubic spline" in err
+    assert err == ""  # with --json, what was done is in the object, not on stderr
     got = json.loads(out)
+    assert "cubic spline" in got["resampling"]["interpolation"]
     assert got["resampling"]["rate_hz"] == 100.0
     assert got["resampling"]["step_max_s"] <= 0.0117
     code, out, _ = run(capsys, *args, "--data", uniform)
@@ -377,6 +379,8 @@ def test_fit_reads_an_uneven_recording_in_degrees(tmp_path, capsys, rng):
 
 
 def test_a_marker_missing_for_a_few_frames_is_filled_and_for_long_refused(tmp_path, rng):
+    """A short gap is filled; a long one leaves the marker out of the table (the file's other
+    markers stay usable) and is refused, with its time, when the marker is asked for."""
     m = rng.uniform(size=(100, 3))
     m[10:12] = np.nan  # two frames: within the 3 frames accepted
     write_c3d(tmp_path / "short.c3d", {"a": m}, 100.0)
@@ -385,9 +389,11 @@ def test_a_marker_missing_for_a_few_frames_is_filled_and_for_long_refused(tmp_pa
     assert any("a_x: 2 missing frame(s) filled" in n for n in rec.notes)
     m[10:30] = np.nan
     write_c3d(tmp_path / "long.c3d", {"a": m}, 100.0)
+    rec = read_c3d(tmp_path / "long.c3d")
+    assert "a_x" not in rec.columns and "a_x" in rec.unusable
     with pytest.raises(DataFileError, match=r"'a_x' is missing for 0\.21 s at t = 0\.09 … "
                        r"0\.3 s, longer than the 0\.03 s accepted \(3 frames\)"):
-        read_c3d(tmp_path / "long.c3d")
+        read_table(tmp_path / "long.c3d", ["a_x"])
 
 
 def test_the_sway_tables_are_winters_printed_numbers():

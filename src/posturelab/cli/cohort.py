@@ -27,7 +27,8 @@ determined, fit_error (√(χ²/dof), about 1 when the model explains the data),
 failed and reason. A subject whose file cannot be read or whose fit fails gets rows saying
 why and never stops the others (an optimiser that did not converge keeps its values, marked
 failed). Prints a summary per parameter: subjects fitted, median and quartiles (--json: one
-object, "summary" and the failed subjects); --summary FILE.json writes it, --plot FIG.png
+object, "summary" and the failed subjects, and "readings": what reading each resampled or
+cut trial did); --summary FILE.json writes it, --plot FIG.png
 draws every subject's estimate with its interval over a box of the quartiles. Outputs are
 written only when every fit is done, each atomically (Ctrl-C leaves none half-written).
 Why a command and not fit-frf --each: fit-frf's --data are one subject's conditions; here
@@ -82,6 +83,9 @@ def run(args: argparse.Namespace) -> int:
                              f"got {args.workers}")
     model = model_from_args(args)
     body, muscles, options = model.body, model.muscles, model.options
+    from ._recording import check_sway_response
+
+    check_sway_response(args, args.response)
     free = _names(args.free)
     check_fit_request(muscles, free, (), _bounds(args.bounds))  # before any file is read
     bar = (Progress(len(args.data), label="cohort", unit="subjects")
@@ -98,10 +102,18 @@ def run(args: argparse.Namespace) -> int:
             bar.close()
     summary = cohort.summary()
     _write(cohort, summary, args)
+    readings = [{"subject": s.subject, "reading": list(s.reading)} for s in cohort.subjects
+                if s.reading]
     if args.json:
         print_json({"out": args.out, "summary": summary,
-                    "parameters": list(cohort.parameters)})
+                    "parameters": list(cohort.parameters),
+                    **({"readings": readings} if readings else {})})
         return 0
+    import sys
+
+    for item in readings:
+        for line in item["reading"]:
+            print(f"note: {item['subject']}: {line}", file=sys.stderr)
     failed = summary["failed"]
     print(f"fitted {len(cohort.parameters)} parameter(s) to {len(cohort.subjects)} "
           f"subject(s); {len(failed)} failed")

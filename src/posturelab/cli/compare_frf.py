@@ -26,7 +26,9 @@ this statistic and its sources (Lippi 2025, arXiv:2505.23778 and 2504.20588).
 --json prints one object: {"p_value", "statistic", "statistic_name", "permutations",
 "exact", "n_a", "n_b", "level", "resamples", "seed", "bands": [{"frequency" [Hz],
 "mean_a", "mean_b", "difference" ({"re", "im"}), "re_ci", "im_ci", "excludes_zero"}],
-"a", "b" (the files)}.
+"a", "b" (the files), and "recordings" (per trial file: "resampling", "trimming") when a
+recording was resampled or cut}. The recording options (--resample, --angle-unit,
+--time-unit, --start, --drop-partial, --sway, ...) are those of posturelab frf.
 
 Example: posturelab compare-frf --a ec1.json ec2.json ec3.json --b eo1.json eo2.json \\
              eo3.json --seed 1 --json
@@ -50,15 +52,31 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--level", type=float, default=0.95, metavar="P",
                    help="coverage of the per-band intervals (default 0.95).")
     add_trial_arguments(p)
+    add_recording_flags(p)
     p.add_argument("--json", action="store_true", help="print one JSON object.")
 
 
-def read_frfs(paths: list[str], args: argparse.Namespace) -> list:
+def add_recording_flags(p: argparse.ArgumentParser) -> None:
+    """How a trial recording among the inputs is read (the options ``frf`` takes)."""
+    from ._recording import add_cycle_trim_argument, add_recording_arguments
+
+    add_recording_arguments(p)
+    add_cycle_trim_argument(p)
+
+
+def read_frfs(paths: list[str], args: argparse.Namespace,
+              readings: dict | None = None) -> list:
     """Each file's FRF, read as ``posturelab fit-frf`` reads a condition (a trial CSV or an
-    FRF JSON); FRFs that state different response signs are refused."""
+    FRF JSON); FRFs that state different response signs are refused. What reading each
+    trial did goes in ``readings`` (path → Recording) when given, else on standard error."""
+    from ._recording import print_reading
     from .fit_frf import _condition
 
-    frfs = [_condition(path, args) for path in paths]
+    said: dict = {} if readings is None else readings
+    frfs = [_condition(path, args, said) for path in paths]
+    if readings is None:
+        for path, rec in said.items():
+            print_reading(rec, path)
     one_sign(paths, frfs)
     return frfs
 
@@ -79,13 +97,17 @@ def run(args: argparse.Namespace) -> int:
     from ..frequency.statistics import compare_frf_groups
     from ._common import print_json
 
-    a, b = read_frfs(args.a, args), read_frfs(args.b, args)
+    readings: dict | None = {} if args.json else None
+    a, b = read_frfs(args.a, args, readings), read_frfs(args.b, args, readings)
     one_sign(args.a + args.b, a + b)
     result = compare_frf_groups(a, b,
                                 permutations=args.permutations, resamples=args.resamples,
                                 level=args.level, seed=args.seed)
     if args.json:
-        print_json({**result.to_dict(), "a": list(args.a), "b": list(args.b)})
+        recordings = [{"data": p, **r.report_dict()} for p, r in (readings or {}).items()
+                      if r.report_dict()]
+        print_json({**result.to_dict(), "a": list(args.a), "b": list(args.b),
+                    **({"recordings": recordings} if recordings else {})})
         return 0
     how = ("every split" if result.exact else f"{result.permutations:,} permutations, seed "
            f"{result.seed}")

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 
 from ._common import check_writable
-from ._recording import add_recording_arguments
+from ._recording import add_recording_arguments, add_sway_arguments
 
 DESCRIPTION = """\
 Turn a lab recording into a table posturelab's commands read: a uniform time column [s],
@@ -20,10 +20,13 @@ column. --angle-columns names the angle columns, converted to rad from the unit 
 declare (or --angle-unit); --length-unit is the unit of a CSV's marker columns (--markers).
 
 --sway METHOD writes com_angle: segments (ankle, knee, hip, shoulder markers; Winter 2009
-Table 4.1), two-marker (hip and shoulder; the knee on the ankle–hip line; forward
-positions only need --height), cop (a force plate; the inverted-pendulum low-pass of Caron
-et al. 1997; needs --height and --mass). --markers ankle=LABEL,knee=LABEL,... names them;
---forward and --up the lab axes (default x forward, z up; -x flips).
+Table 4.1), two-marker (hip and shoulder; the knee on the ankle–hip line: posturelab's
+reduction of Winter's table, no published validation; forward positions only need
+--height), cop (a force plate; the inverted-pendulum low-pass of Caron et al. 1997; needs
+--height and --mass). --markers ankle=LABEL,knee=LABEL,... (or --hip-marker LABEL, ...)
+names them; --forward and --up the lab axes (default x forward, z up; -x flips). The same
+--sway options on frf, fit-frf, cohort, likeness and compare-frf compute com_angle on the
+fly, by the same functions.
 
 Example: posturelab convert trial.c3d --out trial.csv --sway segments \\
              --markers ankle=ank,knee=kne,hip=hip,shoulder=sho
@@ -42,45 +45,25 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--angle-columns", default="", metavar="COL,...",
                    help="columns that are angles: converted to rad from the unit they "
                    "declare (ANALOG:UNITS, a CSV header's [deg]) or else --angle-unit.")
-    p.add_argument("--sway", choices=["segments", "two-marker", "cop"],
-                   help="write com_angle by this method (see above).")
-    p.add_argument("--markers", default="", metavar="LANDMARK=LABEL,...",
-                   help="ankle=, knee=, hip=, shoulder= marker labels (or CSV columns).")
-    p.add_argument("--plate", type=int, default=1, metavar="K",
-                   help="the force plate --sway cop uses (default 1).")
-    p.add_argument("--forward", default="x", metavar="AXIS",
-                   help="the lab axis pointing forward: x, y, z, -x, -y, -z (default x).")
-    p.add_argument("--up", default="z", metavar="AXIS", help="the lab axis pointing up "
-                   "(default z).")
-    p.add_argument("--height", type=float, metavar="M", help="the subject's height [m].")
-    p.add_argument("--mass", type=float, metavar="KG", help="the subject's mass [kg].")
-    add_recording_arguments(p)
-
-
-def _mapping(text: str) -> dict[str, str]:
-    from ..errors import ParameterError
-
-    out = {}
-    for item in [i.strip() for i in text.split(",") if i.strip()]:
-        key, eq, value = item.partition("=")
-        if not eq or not value.strip():
-            raise ParameterError(f"--markers must be LANDMARK=LABEL,..., got {item!r}")
-        out[key.strip().lower()] = value.strip()
-    return out
+    add_recording_arguments(p, sway=False)
+    add_sway_arguments(p)
 
 
 def run(args: argparse.Namespace) -> int:
     from .._files import refuse_input_as_output
     from ..recordings.convert import convert_recording
+    from ._recording import marker_mapping, sway_spec
 
     refuse_input_as_output({"FILE": args.recording}, {"--out": args.out})
     check_writable([args.out], {args.out: (".csv", ".parquet")})
+    markers = marker_mapping(args)
+    sway_spec(args)  # the --sway options checked before any reading
     rec = convert_recording(
         args.recording, rate=args.rate, resample=args.resample, max_gap=args.max_gap,
-        angle_unit=args.angle_unit, length_unit=args.length_unit,
+        angle_unit=args.angle_unit, length_unit=args.length_unit, time_unit=args.time_unit,
         angle_columns=tuple(c.strip().lower() for c in args.angle_columns.split(",")
                             if c.strip()),
-        sway=args.sway, markers=_mapping(args.markers), plate=args.plate,
+        sway=args.sway, markers=markers, plate=args.plate,
         forward=args.forward.strip().lower(), up=args.up.strip().lower(),
         height=args.height, mass=args.mass, start=args.start)
     rec.write(args.out)

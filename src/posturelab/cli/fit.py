@@ -19,7 +19,8 @@ fit. The experiment (body, disturbance, initial state) is described exactly as f
 pairs; or --scenario / --builtin). --data is a CSV with columns t [s] and
 theta1..theta3 [rad] (what 'posturelab simulate --out' writes), or a .c3d with those
 columns; --resample HZ puts an uneven time column on a uniform grid, --angle-unit deg
-reads angles in degrees. Reports each
+reads angles in degrees, --time-unit ms a time column in ms (what was resampled or cut:
+stderr, or "resampling"/"trimming" in --json). Reports each
 estimate with its standard error and 95 % confidence interval; by default these
 allow for residuals correlated from sample to sample (a first-order autoregression
 per link, estimated from the residuals), which measured sway always has.
@@ -52,7 +53,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     g.add_argument("--json", action="store_true", help="print one JSON object instead of text.")
     from ._recording import add_recording_arguments
 
-    add_recording_arguments(p)
+    add_recording_arguments(p, sway=False)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -72,19 +73,21 @@ def run(args: argparse.Namespace) -> int:
     free = [s.strip() for s in args.free.split(",") if s.strip()]
     for name in free:  # the names first, before the data are read
         resolve(name, sc.muscles.names, (), accepts=FIT_QUANTITIES)
+    reading = None
     if (args.resample is not None or args.angle_unit != "rad" or args.start is not None
-            or str(args.data).lower().endswith(".c3d")):
+            or args.time_unit != "s" or str(args.data).lower().endswith(".c3d")):
         import numpy as np
 
-        from ..recordings.table import read_series, read_table
-        from ._recording import print_resampling, recording_options
+        from ..recordings.table import read_recording, read_table
+        from ._recording import print_reading, recording_options
 
         names = [f"theta{i + 1}" for i in range(sc.body.n_links)]
-        fs, cols, resampled = read_series(args.data, names, {n: ("rad",) for n in names},
-                                          kinds=dict.fromkeys(names, "angle"),
-                                          **recording_options(args))
-        print_resampling(resampled)
-        times = read_table(args.data, names[:1])[0]
+        rec = read_recording(args.data, names, {n: ("rad",) for n in names},
+                             kinds=dict.fromkeys(names, "angle"), **recording_options(args))
+        fs, cols, reading = rec.rate, rec.columns, rec
+        if not args.json:
+            print_reading(rec)
+        times = read_table(args.data, names[:1], time_unit=args.time_unit)[0]
         start = float(times[times >= (args.start if args.start is not None else -np.inf)
                             - 1e-9][0])
         time = start + np.arange(cols[names[0]].size) / fs
@@ -95,7 +98,7 @@ def run(args: argparse.Namespace) -> int:
     ratio = 0.25 if args.viscosity_ratio is None else args.viscosity_ratio
     fit = fit_stiffness(sc, time, theta, free, viscosity_ratio=ratio,
                         engine=args.engine, residual_model=args.residual_model)
-    summary = fit.to_dict()
+    summary = {**fit.to_dict(), **({} if reading is None else reading.report_dict())}
     if args.report:
         atomic_write_text(args.report, json.dumps(summary, indent=2) + "\n")
     if args.json:

@@ -25,7 +25,11 @@ group means give them), or "frf_se" (standard error of the complex value), "dof"
 in s, a tilt in rad, a translation in m) and refuses a column in another unit. --free
 NAMES (comma separated) are shared by the conditions, --per-condition NAMES take one value
 per condition, NAME#1, NAME#2, … in the order of --data (the output lists the conditions:
-"conditions" in --json, each --data path and its kind, trial or table).
+"conditions" in --json, each --data path and its kind, trial or table, and for a trial
+resampled or cut its "resampling" and "trimming"; without --json one line each on stderr).
+A trial is read with posturelab frf's recording options (--resample, --angle-unit,
+--length-unit, --time-unit, --start, --drop-partial, and --sway with its markers to compute
+com_angle on the fly; --height and --mass are then the body's).
 Names (the parameter table's, as for sweep --vary and fit --free): stiffness:PAIR,
 viscosity:PAIR (intrinsic), active_stiffness:PAIR, active_viscosity:PAIR (:PAIR may be left
 out on a body with one pair), feedback_delay, proprioceptive_weight, visual_weight,
@@ -131,7 +135,7 @@ def add_fit_arguments(p: argparse.ArgumentParser, *, per_condition: bool) -> Non
                    "within the table's ranges.")
     from ._recording import add_cycle_trim_argument, add_recording_arguments
 
-    add_recording_arguments(p)
+    add_recording_arguments(p, subject=False)  # the body's --height and --mass
     add_cycle_trim_argument(p)
 
 
@@ -146,10 +150,11 @@ def reader_options(args: argparse.Namespace) -> dict:
             **recording_options(args)}
 
 
-def _condition(path: str, args: argparse.Namespace):
+def _condition(path: str, args: argparse.Namespace, readings: dict | None = None):
     """The one FRF of a --data file (commands that take one condition per file: a
-    dual-stimulus trial needs --stimulus COLUMN there)."""
-    found = _conditions(path, args)
+    dual-stimulus trial needs --stimulus COLUMN there); what reading a trial did is put in
+    ``readings[path]`` (a :class:`~posturelab.recordings.table.Recording`)."""
+    found = _conditions(path, args, readings)
     if len(found) > 1:
         raise ParameterError(f"--data {path!r} is a dual-stimulus trial "
                              f"({', '.join(label for _, _, label in found)}): give "
@@ -157,12 +162,15 @@ def _condition(path: str, args: argparse.Namespace):
     return found[0][0]
 
 
-def _conditions(path: str, args: argparse.Namespace) -> list[tuple]:
+def _conditions(path: str, args: argparse.Namespace,
+                readings: dict | None = None) -> list[tuple]:
     """The conditions of one --data file as (FRF, model input, label): one, or each
     stimulus of a dual-stimulus trial (--stimulus tilt,visual_tilt, or a trial with both
-    columns and no --stimulus: posturelab.frequency.dual)."""
-    from ..frequency.cohort import read_frf_file
+    columns and no --stimulus: posturelab.frequency.dual). What reading a one-stimulus
+    trial did is put in ``readings[path]``."""
+    from ..frequency.cohort import read_frf_file, read_trial_frf
     from ..frequency.dual import input_of, read_trial_frfs, stimulus_columns
+    from ._recording import check_sway_response
 
     if path.lower().endswith(".json"):
         return [(read_frf_file(path, what="--data FRF JSON"), args.input, path)]
@@ -171,10 +179,13 @@ def _conditions(path: str, args: argparse.Namespace) -> list[tuple]:
     if len(stimuli) > 1:
         if args.cycle_length is None:
             raise ParameterError("a trial CSV needs --cycle-length")
+        from ._recording import recording_options
+
         options = reader_options(args)
         _, ests, _ = read_trial_frfs(path, stimuli, args.response or "com_angle",
                                      args.cycle_length, discard_cycles=args.discard_cycles,
-                                     response_sign=options["response_sign"])
+                                     response_sign=options["response_sign"],
+                                     **recording_options(args))
         return [(e, input_of(s), f"{path} [{s}]") for s, e in ests.items()]
     options = reader_options(args)
     if stimuli and not args.stimulus:  # the trial's one stimulus column
@@ -184,7 +195,13 @@ def _conditions(path: str, args: argparse.Namespace) -> list[tuple]:
     source = args.input  # a visual_tilt column is the scene's (a tilt [rad] to the reader)
     if options["stimulus"] is not None and input_of(options["stimulus"]) == "visual-tilt":
         source = "visual-tilt"
-    return [(read_frf_file(path, **options), source, path)]
+    if options["stimulus"] is None:  # (read_frf_file says what a trial needs)
+        return [(read_frf_file(path, **options), source, path)]
+    check_sway_response(args, options["response"])
+    frf, rec = read_trial_frf(path, **options)
+    if readings is not None:
+        readings[path] = rec
+    return [(frf, source, path)]
 
 
 def _names(text: str) -> list[str]:
@@ -230,7 +247,8 @@ def run(args: argparse.Namespace) -> int:
         check_fit_request(muscles, moved, [compare["parameter"]], _bounds(args.bounds))
     else:
         check_fit_request(muscles, free, per, _bounds(args.bounds))
-    found = [c for path in args.data for c in _conditions(path, args)]
+    readings: dict = {}
+    found = [c for path in args.data for c in _conditions(path, args, readings)]
     conditions = [c for c, _, _ in found]
     names = [label for _, _, label in found]
     fit_options = dict(input=[source for _, source, _ in found],
@@ -275,7 +293,8 @@ def run(args: argparse.Namespace) -> int:
 
         for w in sign_warnings:
             print(f"warning: {w}", file=sys.stderr)
-    kinds = [{"data": p, "kind": "trial" if isinstance(c, FRFEstimate) else "table"}
+    kinds = [{"data": p, "kind": "trial" if isinstance(c, FRFEstimate) else "table",
+              **(readings[p].report_dict() if p in readings else {})}
              for p, c in zip(names, conditions, strict=True)]
     if any(source != args.input for _, source, _ in found):  # (a visual tilt among them)
         for kind, (_, source, _) in zip(kinds, found, strict=True):
@@ -286,6 +305,10 @@ def run(args: argparse.Namespace) -> int:
         print_json({**out, "conditions": kinds, "response_sign": signs,
                     "warnings": sign_warnings + out["warnings"], **extra})
         return 0
+    from ._recording import print_reading
+
+    for path, rec in readings.items():
+        print_reading(rec, path)
     print(f"fitted {len(fit.names)} parameter(s) to {len(conditions)} condition(s); fit error "
           f"{fit.fit_error:.3g} (√(χ²/dof); about 1 when the model explains the data)")
     by_vision = comparison is not None and comparison.grouping == "vision"

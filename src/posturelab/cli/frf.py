@@ -10,7 +10,8 @@ from ._common import FIGURE_SUFFIXES, check_writable, print_json
 from ._recording import (
     add_cycle_trim_argument,
     add_recording_arguments,
-    print_resampling,
+    check_sway_response,
+    print_reading,
     recording_options,
 )
 
@@ -29,8 +30,11 @@ The file has a header row and a uniform time column, t or time [s] (the sample r
 from it); --resample HZ puts an uneven one on a uniform grid (cubic spline; a gap over
 --max-gap refused). A header may declare units, e.g. com [rad]; posturelab reads SI (time
 in s, angles in rad, translations in m) and refuses a column in another unit (deg, ms,
-mm, ...) unless declared with --angle-unit deg / --length-unit mm. A .c3d is read directly
-(columns as posturelab convert names them).
+mm, ...) unless declared with --angle-unit deg / --length-unit mm / --time-unit ms. A .c3d
+is read directly (columns as posturelab convert names them). --sway METHOD with its markers
+(--hip-marker LABEL --shoulder-marker LABEL, ...) computes com_angle from a C3D's or a lab
+CSV's markers as posturelab convert --sway does; then --response com_angle, --length-unit
+is the markers' unit and the stimulus is read as an angle (a translation stimulus in m).
 --bands peterka (default; the historical name, the same as posturelab-80 and comtest-80)
 averages the 11 bands of the 80-state protocol (COMTEST's analysis; 20 s: 0.05 … 2.20 Hz; for
 another cycle length the same harmonic numbers); --bands peterka-2002-242 the 17 bands
@@ -53,7 +57,8 @@ says when that band's phase lies within 45 deg of +-180 deg with coherence >= 0.
 "harmonic_frequency" and "harmonic_weight" (each band's harmonics [Hz] and their share of
 its stimulus power), "frf_se" (standard error of the complex estimate), "dof",
 "frf_covariance" (of the bands), "response_sign", "sign_convention", "warnings", and with
---resample "resampling" (what was done)}; an undefined number is null. fit-frf reads it back.
+--resample "resampling" (what was done), with --start or --drop-partial "trimming" (what
+was cut), for a .c3d or --sway "reading_notes"}; an undefined number is null. fit-frf reads it back.
 --ci periodic (default) gives bounds exact for a periodic stimulus; --ci otnes-enochson the
 form Peterka used (wider).
 
@@ -152,7 +157,7 @@ def run(args: argparse.Namespace) -> int:
     from .._files import refuse_input_as_output
     from .._validation import float_in_range
     from ..frequency.estimate import estimate_frf, sign_convention, whole_cycles
-    from ..recordings.table import read_series
+    from ..recordings.table import read_recording
 
     refuse_input_as_output({"--data": args.data},
                            {"--plot": args.plot, "--plot-cycles": args.plot_cycles})
@@ -162,6 +167,7 @@ def run(args: argparse.Namespace) -> int:
     from ..frequency.dual import estimate_frfs, stimulus_columns
 
     resp = (args.response or "com_angle").strip().lower()
+    check_sway_response(args, resp)
     if args.stimulus:
         stimuli = [s.strip().lower() for s in args.stimulus.split(",") if s.strip()]
     elif str(args.data).lower().endswith(".c3d"):
@@ -172,12 +178,14 @@ def run(args: argparse.Namespace) -> int:
         raise ParameterError(f"--data {args.data!r} has no tilt or visual_tilt column: give "
                              "--stimulus COLUMN")
     kinds = {k: v for s in stimuli
-             for k, v in trial_kinds(s, resp, args.length_unit).items()}
-    fs, cols, resampled = read_series(args.data, [*stimuli, resp],
-                                      {s: ("rad", "m") for s in stimuli}, kinds=kinds,
-                                      cycle_length=args.cycle_length,
-                                      **recording_options(args))
-    print_resampling(resampled)
+             for k, v in trial_kinds(s, resp, args.length_unit,
+                                     "tilt" if args.sway else None).items()}
+    rec = read_recording(args.data, [*stimuli, resp], {s: ("rad", "m") for s in stimuli},
+                         kinds=kinds, cycle_length=args.cycle_length,
+                         **recording_options(args))
+    fs, cols = rec.rate, rec.columns
+    if not args.json:
+        print_reading(rec)
     sign = response_sign(args.response_sign)
     if len(stimuli) > 1:
         if args.plot_cycles or args.bootstrap:
@@ -195,9 +203,8 @@ def run(args: argparse.Namespace) -> int:
                                   [f"{'−' if sign < 0 else ''}{resp} / {s}" for s in ests]),
                         args.plot)
         if args.json:
-            extra = {} if resampled is None else {"resampling": resampled.to_dict()}
             print_json({**{s: {**e.to_dict(), "sign_convention": sign_convention(sign)}
-                           for s, e in ests.items()}, **extra})
+                           for s, e in ests.items()}, **rec.report_dict()})
             return 0
         for s, e in ests.items():
             _table(e, s, resp, sign, fs, trimmed)
@@ -240,7 +247,7 @@ def run(args: argparse.Namespace) -> int:
         for warning in est.warnings:
             print(f"warning: {warning}", file=sys.stderr)
     if args.json:
-        extra = {} if resampled is None else {"resampling": resampled.to_dict()}
+        extra = rec.report_dict()
         if boot is not None:
             extra["bootstrap"] = {k: v for k, v in boot.to_dict().items()
                                   if k not in ("frequency", "frf")}

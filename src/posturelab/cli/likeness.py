@@ -28,7 +28,9 @@ amplitude in the unit of COMTEST's recorded sway (PRTSinfo.m does not state that
 the reference's amplitude; posturelab does not choose A: default 1).
 
 --json prints one object: {"score", "reference", "scale", "difference" (per band, {"re",
-"im"}: A·H − m), "frequency" [Hz], "source", "sign_convention"}.
+"im"}: A·H − m), "frequency" [Hz], "source", "sign_convention", and for a resampled or
+cut trial "resampling", "trimming"}. A trial is read with posturelab frf's recording
+options (--resample, --angle-unit, --time-unit, --start, --drop-partial, --sway, ...).
 
 Example: posturelab frf --data trial.csv --stimulus tilt --response com_angle \\
              --cycle-length 20 --discard-cycles 1 --json > frf.json
@@ -38,7 +40,7 @@ Example: posturelab frf --data trial.csv --stimulus tilt --response com_angle \\
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     """The options of ``posturelab likeness``."""
-    from .compare_frf import add_trial_arguments
+    from .compare_frf import add_recording_flags, add_trial_arguments
 
     p.add_argument("--data", required=True, metavar="FILE",
                    help="the FRF: frf.json (posturelab frf --json) or a trial CSV.")
@@ -50,6 +52,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    "tilt's peak-to-peak amplitude in the unit of the recorded sway; "
                    "default 1).")
     add_trial_arguments(p)
+    add_recording_flags(p)
     p.add_argument("--json", action="store_true", help="print one JSON object.")
 
 
@@ -59,10 +62,12 @@ def run(args: argparse.Namespace) -> int:
     from .compare_frf import read_frfs
 
     reference = likeness_reference(args.reference)  # (an unknown name before any reading)
-    (frf,) = read_frfs([args.data], args)
+    readings: dict | None = {} if args.json else None
+    (frf,) = read_frfs([args.data], args, readings)
     result = likeness(frf, reference, scale=args.scale)
     if args.json:
-        print_json({**result.to_dict(),
+        said = next(iter((readings or {}).values()), None)
+        print_json({**result.to_dict(), **(said.report_dict() if said else {}),
                     "frequency": [float(f) for f in reference.frequency],
                     "source": reference.source, "sign_convention": reference.sign_convention})
         return 0

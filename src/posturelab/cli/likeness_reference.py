@@ -16,7 +16,9 @@ subject of the cohort's population is about χ² with 2B degrees of freedom).
 Σ is invertible only with at least 2B + 1 subjects (23 for the 11 bands); fewer are
 refused, unless --shrinkage λ in (0, 1] is given: Σ_λ = (1 − λ)Σ + λ·diag(Σ), stated in
 the reference ("shrinkage"). Writes JSON (--out, atomically); posturelab likeness
---reference ref.json reads it.
+--reference ref.json reads it. A trial is read with posturelab frf's recording options
+(--resample, --angle-unit, --time-unit, --start, --drop-partial, --sway, ...); what was
+resampled or cut is said on standard error.
 
 Example: posturelab likeness-reference --data s01.json s02.json … s30.json --out ref.json
 """
@@ -24,7 +26,7 @@ Example: posturelab likeness-reference --data s01.json s02.json … s30.json --o
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     """The options of ``posturelab likeness-reference``."""
-    from .compare_frf import add_trial_arguments
+    from .compare_frf import add_recording_flags, add_trial_arguments
 
     p.add_argument("--data", required=True, nargs="+", metavar="FILE",
                    help="the cohort: one FRF file (or trial CSV) per subject.")
@@ -37,6 +39,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    "(default 0: none, and a cohort too small to invert is refused).")
     p.add_argument("--name", default="cohort", help="the reference's name (default cohort).")
     add_trial_arguments(p)
+    add_recording_flags(p)
 
 
 def run(args: argparse.Namespace) -> int:

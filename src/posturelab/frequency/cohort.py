@@ -33,7 +33,8 @@ import numpy as np
 from ..errors import ParameterError, PostureLabError
 from .fit import check_fit_request
 
-__all__ = ["CohortFit", "SubjectFit", "fit_cohort", "read_frf_file", "max_cohort_workers",
+__all__ = ["CohortFit", "SubjectFit", "fit_cohort", "read_frf_file", "read_trial_frf",
+           "max_cohort_workers",
            "usable_cpus", "csv_text", "MAX_SUBJECTS"]
 
 #: Most subjects one cohort may have. [-]
@@ -74,21 +75,39 @@ def read_frf_file(path, *, stimulus: str | None = None, response: str | None = N
         from .table import read_frf_json
 
         return read_frf_json(path, what)
+    return read_trial_frf(path, stimulus=stimulus, response=response,
+                          cycle_length=cycle_length, discard_cycles=discard_cycles,
+                          response_sign=response_sign, input=input, **recording)[0]
+
+
+def read_trial_frf(path, *, stimulus: str | None = None, response: str | None = None,
+                   cycle_length: float | None = None, discard_cycles: int = 0,
+                   response_sign: int = -1, input: str = "tilt", **recording):
+    """A trial recording's FRF (as :func:`read_frf_file` estimates it) and what reading it
+    did: (:class:`~posturelab.frequency.estimate.FRFEstimate`,
+    :class:`~posturelab.recordings.table.Recording`); ``recording`` are
+    :func:`~posturelab.recordings.table.read_recording`'s options.
+
+    Raises
+    ------
+    ParameterError, DataFileError
+    """
     from .._validation import float_in_range
-    from .data import read_series_csv
+    from ..recordings.table import read_recording
     from .estimate import estimate_frf, whole_cycles
 
     if stimulus is None or response is None or cycle_length is None:
         raise ParameterError("a trial CSV needs --stimulus, --response and --cycle-length")
     float_in_range("--cycle-length [s]", cycle_length, 1e-3, 1e5, unit="s")
     stim, resp = stimulus.strip().lower(), response.strip().lower()
-    fs, cols = read_series_csv(  # recording: read_series_csv's resample/unit options
+    rec = read_recording(
         path, [stim, resp], {stim: ("rad",) if input == "tilt" else ("m",)},
         kinds={stim: "angle" if input == "tilt" else "length", resp: "angle"},
         cycle_length=cycle_length, **recording)
+    fs, cols = rec.rate, rec.columns
     x, y, _ = whole_cycles(cols[stim], cols[resp], fs, cycle_length)
     return estimate_frf(x, y, fs, cycle_length, discard_cycles=discard_cycles,
-                        response_sign=response_sign)
+                        response_sign=response_sign), rec
 
 
 @dataclass(frozen=True)
@@ -109,6 +128,9 @@ class SubjectFit:
     failed : bool
     reason : str
         Why it failed (empty when it did not).
+    reading : tuple of str
+        What reading the subject's trial recording did (resampled, cut; one line each;
+        empty for an FRF file or a recording read as it was).
     """
 
     subject: str
@@ -120,6 +142,7 @@ class SubjectFit:
     weighting: str = ""
     failed: bool = False
     reason: str = ""
+    reading: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -258,8 +281,12 @@ def _failed(task: _CohortTask, subject: str, reason: str) -> SubjectFit:
 def _fit_one(task: _CohortTask, subject: str, data) -> SubjectFit:
     from .fit import fit_frf
 
+    reading: tuple[str, ...] = ()
     try:
-        if isinstance(data, str | Path):
+        if isinstance(data, str | Path) and not str(data).lower().endswith(".json"):
+            data, rec = read_trial_frf(data, **dict(task.reader))
+            reading = tuple(rec.report_lines())
+        elif isinstance(data, str | Path):
             data = read_frf_file(data, **dict(task.reader))
         fit = fit_frf(task.body, task.muscles, data, list(task.free), **dict(task.options))
     except PostureLabError as exc:
@@ -268,7 +295,8 @@ def _fit_one(task: _CohortTask, subject: str, data) -> SubjectFit:
         return _failed(task, subject, f"{type(exc).__name__}: {exc}"[:300])
     reason = "" if fit.success else f"the optimiser did not converge: {fit.message}"
     return SubjectFit(subject, fit.estimates, fit.standard_errors, fit.confidence_intervals,
-                      fit.determined, fit.fit_error, fit.weighting, not fit.success, reason)
+                      fit.determined, fit.fit_error, fit.weighting, not fit.success, reason,
+                      reading)
 
 
 def _subject_names(subjects, names) -> list[str]:

@@ -22,8 +22,8 @@ def read_series_csv(path: str | Path, columns: list[str],
                     kinds: dict[str, str] | None = None, angle_unit: str = "rad",
                     length_unit: str = "m", resample: float | None = None,
                     max_gap: float | None = None, start: float | None = None,
-                    drop_partial: bool = False, cycle_length: float | None = None
-                    ) -> tuple[float, dict[str, np.ndarray]]:
+                    drop_partial: bool = False, cycle_length: float | None = None,
+                    **options) -> tuple[float, dict[str, np.ndarray]]:
     """The sample rate and the named columns of a recording with a header row and a
     ``time`` (or ``t``) column [s] (a CSV, or a ``.c3d``).
 
@@ -32,10 +32,11 @@ def read_series_csv(path: str | Path, columns: list[str],
     unless the user declared the angles in deg or the lengths in mm (``angle_unit``,
     ``length_unit``, applying to the columns ``kinds`` names ``"angle"`` or ``"length"``).
     A non-uniform time column is refused unless ``resample`` [Hz] is given
-    (:func:`posturelab.recordings.resample.resample_uniform`; what it did is said on
-    standard error). ``start`` [s], ``drop_partial`` and ``cycle_length`` [s] cut the
-    recording to the stimulus's whole cycles
-    (:func:`posturelab.recordings.table.read_series`).
+    (:func:`posturelab.recordings.resample.resample_uniform`). ``start`` [s],
+    ``drop_partial`` and ``cycle_length`` [s] cut the recording to the stimulus's whole
+    cycles; ``options`` are :func:`posturelab.recordings.table.read_recording`'s others
+    (``time_unit``, ``sway``). Nothing is printed: :func:`~posturelab.recordings.table.
+    read_recording` returns what was resampled and cut.
 
     Returns
     -------
@@ -49,12 +50,8 @@ def read_series_csv(path: str | Path, columns: list[str],
         in another unit, a cell that is not a finite number (line and column named), a
         non-uniform time column (without ``resample``), a gap (with it).
     """
-    fs, cols, report = read_series(path, columns, units, kinds=kinds, angle_unit=angle_unit,
-                                   length_unit=length_unit, resample=resample,
-                                   max_gap=max_gap, start=start, drop_partial=drop_partial,
-                                   cycle_length=cycle_length)
-    if report is not None:
-        import sys
-
-        print(f"note: {report.text()}", file=sys.stderr)
+    fs, cols, _ = read_series(path, columns, units, kinds=kinds, angle_unit=angle_unit,
+                              length_unit=length_unit, resample=resample, max_gap=max_gap,
+                              start=start, drop_partial=drop_partial,
+                              cycle_length=cycle_length, **options)
     return fs, cols

@@ -169,11 +169,14 @@ def dual_prts(surface_amplitude: float, visual_amplitude: float,
 
 def read_trial_frfs(path, stimuli, response: str, cycle_length: float, *,
                     discard_cycles: int = 0, response_sign: int = -1, bands="peterka",
-                    ci: str = "periodic") -> tuple[float, dict[str, FRFEstimate], bool]:
+                    ci: str = "periodic", **recording
+                    ) -> tuple[float, dict[str, FRFEstimate], bool]:
     """Each stimulus column's FRF from one trial CSV (:func:`estimate_frfs`): ``stimuli``
     the column names (tilts [rad]), ``response`` the response column, ``cycle_length`` the
-    common cycle [s]. Returns the sample rate [Hz], the FRFs by column and whether the
-    record's end point (one sample past whole cycles) was left out."""
+    common cycle [s]; ``recording`` are :func:`posturelab.recordings.table.read_recording`'s
+    options (resampling, declared units, the cut to whole cycles). Returns the sample rate
+    [Hz], the FRFs by column and whether the record's end point (one sample past whole
+    cycles) was left out."""
     from .._validation import float_in_range
     from .data import read_series_csv
     from .estimate import whole_cycles
@@ -181,7 +184,9 @@ def read_trial_frfs(path, stimuli, response: str, cycle_length: float, *,
     float_in_range("--cycle-length [s]", cycle_length, 1e-3, 1e5, unit="s")
     names = [s.strip().lower() for s in stimuli]
     resp = response.strip().lower()
-    fs, cols = read_series_csv(path, [*names, resp], {n: ("rad",) for n in names})
+    fs, cols = read_series_csv(path, [*names, resp], {n: ("rad",) for n in names},
+                               kinds={**dict.fromkeys(names, "angle"), resp: "angle"},
+                               cycle_length=cycle_length, **recording)
     x, trimmed = {}, False
     for n in names:
         x[n], y, trimmed = whole_cycles(cols[n], cols[resp], fs, cycle_length)
@@ -195,9 +200,13 @@ def stimulus_columns(path) -> list[str]:
     from pathlib import Path
 
     from .._files import csv_rows, read_text
-    from ..recordings.table import MAX_ROWS, _name
+    from ..recordings.columns import MAX_ROWS, _name, _refuse_other_separators
 
+    if Path(path).suffix.lower() == ".c3d":  # (a C3D's channels are named by --stimulus)
+        return []
     first = next(csv_rows(read_text(Path(path), "data file"), repr(str(path)),
                           max_rows=MAX_ROWS), None)
+    if first:
+        _refuse_other_separators(first[1], repr(str(path)))
     names = {_name(h) for h in (first[1] if first else [])}
     return [c for c in STIMULUS_INPUTS if c in names]

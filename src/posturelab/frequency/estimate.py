@@ -346,8 +346,16 @@ def estimate_frf(stimulus, response, sample_rate: float, cycle_length: float, *,
     Gxx = np.array([Gxx_h[b].mean() for b in bins])
     Gyy = np.array([Gyy_h[b].mean() for b in bins])
     Gxy = np.array([Gxy_h[b].mean() for b in bins])
-    if np.any(Gxx <= 0):
-        raise ParameterError("the stimulus has no power in some band (is it the PRTS?)")
+    # no power: exactly none, or rounding noise (a constant column's DFT off DC is ~1e-16 of
+    # its mean): below 1e-20 of the stimulus's total power per bin, the ratio is meaningless
+    floor = 1e-20 * float(np.sum(Gxx_h))
+    if np.any(Gxx <= floor):
+        k = int(np.argmax(Gxx <= floor))
+        raise ParameterError(f"the stimulus has no power in the band at "
+                             f"{float(np.mean(bins[k])) / T:.4g} Hz"
+                             + (" (it is constant)" if np.all(np.ptp(np.concatenate(cx),
+                                                                     axis=None) == 0) else "")
+                             + "; is it the periodic stimulus of this cycle length?")
     H = Gxy / Gxx
     with np.errstate(invalid="ignore", divide="ignore"):
         coh = np.where(Gyy > 0, np.abs(Gxy) ** 2 / (Gxx * Gyy), 0.0)

@@ -15,7 +15,12 @@ low-pass, Kaiser window, the ends extended by a line) when the analog rate is an
 multiple of it, else by a cubic spline; markers, when the rate differs from theirs, by a
 cubic spline. A marker missing in some frames (NaN in ezc3d) is filled by the same spline
 when the gap is at most :data:`posturelab.recordings.resample.MAX_GAP_STEPS` frames, else
-refused naming the marker and the time. Time starts at 0 at the first frame.
+left out of the table (its reason kept in :attr:`C3DRecording.unusable`, said when the
+marker is asked for), as is a marker occluded throughout and an analog channel with
+missing (NaN) samples that cannot be filled. Labels are made unique (an
+empty label becomes ``analogN``/``markerN``, a repeated one gets ``_2``, ``_3``). Time
+starts at 0 at the first frame; a file with fewer than 2 frames is refused, and so is a
+table of more than :data:`MAX_TABLE_SAMPLES` samples per column.
 
 A truncated file is refused: ezc3d reads as many frames as a cut file holds, so the data
 size the header announces is checked against the file's size first.
@@ -42,6 +47,8 @@ EZC3D_CITATION = ("Michaud B, Begon M (2021) ezc3d: An easy C3D file I/O cross-p
 LENGTH_FACTORS = {"mm": 1e-3, "cm": 1e-2, "m": 1.0}
 #: Largest C3D file read. [bytes]
 MAX_C3D_BYTES = 512 * 2**20
+#: Most samples per column of the table (bounds memory when --rate raises the rate). [-]
+MAX_TABLE_SAMPLES = 2_000_000
 
 
 @dataclass(frozen=True)
@@ -66,7 +73,10 @@ class C3DRecording:
     plates : int
         Force plates read. [-]
     notes : tuple of str
-        What was done (units scaled, rates changed, samples filled).
+        What was done (units scaled, rates changed, samples filled, labels renamed).
+    unusable : dict of str -> str
+        Columns left out (markers occluded for longer than the accepted gap, analog
+        channels with unfillable missing samples) and why.
     """
 
     time: np.ndarray
@@ -79,6 +89,7 @@ class C3DRecording:
     analogs: tuple[str, ...]
     plates: int
     notes: tuple[str, ...] = field(default=())
+    unusable: dict[str, str] = field(default_factory=dict)
 
 
 def _ezc3d():
@@ -91,7 +102,25 @@ def _ezc3d():
 
 
 def _clean(label: str) -> str:
-    return re.sub(r"[^0-9a-z_]", "_", str(label).strip().lower()) or "unnamed"
+    return re.sub(r"[^0-9a-z_]", "_", str(label).strip().lower())
+
+
+def _unique(labels: list[str], empty: str, taken: set[str], notes: list[str]) -> tuple:
+    """Cleaned labels, each unique (and not in ``taken``): an empty one becomes
+    ``{empty}{k}`` (k from 1), a repeated one gets ``_2``, ``_3``; renames said in
+    ``notes``."""
+    out: list[str] = []
+    for k, raw in enumerate(labels, start=1):
+        name = _clean(raw) or f"{empty}{k}"
+        base, n = name, 1
+        while name in taken:
+            n += 1
+            name = f"{base}_{n}"
+        if name != _clean(raw):
+            notes.append(f"{empty} {k} labelled {str(raw).strip()!r} read as {name!r}")
+        taken.add(name)
+        out.append(name)
+    return tuple(out)
 
 
 def _check_size(path: Path, what: str) -> None:
@@ -182,13 +211,18 @@ def read_c3d(path: str | Path, rate: float | None = None) -> C3DRecording:
                                                               unit="Hz")
     t_points = np.arange(n_frames) / point_rate
     n_out = int(np.floor(t_points[-1] * out_rate * (1 + 1e-12))) + 1
+    if n_out > MAX_TABLE_SAMPLES:
+        raise DataFileError(f"{what}: {t_points[-1]:g} s at {out_rate:g} Hz is {n_out:,} "
+                            f"samples per column; at most {MAX_TABLE_SAMPLES:,} are made")
     grid = np.arange(n_out) / out_rate
     columns: dict[str, np.ndarray] = {}
     units: dict[str, str] = {}
     notes: list[str] = []
+    unusable: dict[str, str] = {}
     unit_words = [str(u).strip().lower() for u in params["POINT"].get("UNITS", {}).get(
         "value", [])] or ["mm"]
-    markers = tuple(_clean(x) for x in params["POINT"]["LABELS"]["value"])[:points.shape[1]]
+    markers = _unique(list(params["POINT"]["LABELS"]["value"])[:points.shape[1]], "marker",
+                      set(), notes)
     if markers:
         if unit_words[0] not in LENGTH_FACTORS:
             raise DataFileError(f"{what}: POINT:UNITS is {unit_words[0]!r}; posturelab reads "
@@ -204,25 +238,37 @@ def read_c3d(path: str | Path, rate: float | None = None) -> C3DRecording:
                 name = f"{label}_{axis}"
                 if np.isfinite(v).all() and out_rate == point_rate:
                     columns[name] = v
+                elif not np.isfinite(v).any():
+                    unusable[name] = "the marker is missing (occluded) in every frame"
+                    continue
                 else:
-                    _, filled, report = resample_uniform(
-                        t_points, {name: v}, out_rate, max_gap=gap, what=what,
-                        gap_words=f"{MAX_GAP_STEPS:g} frames")
+                    try:
+                        _, filled, report = resample_uniform(
+                            t_points, {name: v}, out_rate, max_gap=gap, what=what,
+                            gap_words=f"{MAX_GAP_STEPS:g} frames")
+                    except DataFileError as e:
+                        unusable[name] = str(e).removeprefix(f"{what}: ")
+                        continue
                     columns[name] = filled[name][:n_out]
                     if report.filled:
                         notes.append(f"{name}: {report.filled} missing frame(s) filled by a "
                                      "cubic spline")
                 units[name] = "m"
     analogs = np.asarray(c["data"]["analogs"], dtype=float)
-    labels = tuple(_clean(x) for x in params["ANALOG"]["LABELS"]["value"])
+    n_channels = analogs.shape[1] if analogs.ndim == 3 else 0
+    raw = list(params["ANALOG"].get("LABELS", {}).get("value", []))[:n_channels]
+    raw += [""] * (n_channels - len(raw))  # a channel without a label
+    labels = _unique(raw, "analog", {f"{m}_{a}" for m in markers for a in "xyz"}, notes)
     analog_units = list(params["ANALOG"].get("UNITS", {}).get("value", []))
     if analogs.size and labels and analog_rate > 0:
         t_an = np.arange(analogs.shape[2]) / analog_rate
-        for j, label in enumerate(labels[:analogs.shape[1]]):
-            if label in columns:
-                label = f"analog_{label}"
-            columns[label] = _to_rate(t_an, analogs[0, j], grid, analog_rate / out_rate,
-                                      what, label)
+        for j, label in enumerate(labels):
+            try:
+                columns[label] = _to_rate(t_an, analogs[0, j], grid, analog_rate / out_rate,
+                                          what, label)
+            except DataFileError as e:  # a channel with missing samples: left out
+                unusable[label] = str(e).removeprefix(f"{what}: ")
+                continue
             units[label] = str(analog_units[j]).strip() if j < len(analog_units) else ""
         if analog_rate != out_rate:
             notes.append(f"analog channels from {analog_rate:g} Hz to {out_rate:g} Hz")
@@ -244,7 +290,8 @@ def read_c3d(path: str | Path, rate: float | None = None) -> C3DRecording:
     return C3DRecording(time=grid[:n], columns={k: v[:n] for k, v in columns.items()},
                         units=units, rate=out_rate, point_rate=point_rate,
                         analog_rate=analog_rate, markers=markers,
-                        analogs=labels, plates=len(plates), notes=tuple(notes))
+                        analogs=labels, plates=len(plates), notes=tuple(notes),
+                        unusable=unusable)
 
 
 def write_c3d(path: str | Path, markers: dict[str, np.ndarray], point_rate: float, *,

@@ -9,12 +9,11 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import DataFileError, ParameterError
-from .table import ANGLE_UNITS, LENGTH_UNITS, SCALE
+from .columns import ANGLE_UNITS, LENGTH_UNITS, SCALE, check_time
+from .resample import ResampleReport
+from .sway import AXES, SwaySpec
 
 __all__ = ["ConvertedRecording", "convert_recording", "AXES"]
-
-#: Lab axes a marker coordinate may be taken along (a leading - flips it).
-AXES = ("x", "y", "z", "-x", "-y", "-z")
 
 
 @dataclass(frozen=True)
@@ -31,7 +30,11 @@ class ConvertedRecording:
     rate : float
         [Hz]
     notes : tuple of str
-        What was done: units scaled, rates changed, resampling, the sway method.
+        What was done: units scaled, rates changed, resampling, the sway method (last).
+    resampling : ResampleReport or None
+        What the resampling did (None: not resampled).
+    dropped_before : int
+        Samples dropped before ``start``. [-]
     """
 
     time: np.ndarray
@@ -39,6 +42,8 @@ class ConvertedRecording:
     units: dict[str, str]
     rate: float
     notes: tuple[str, ...]
+    resampling: ResampleReport | None = None
+    dropped_before: int = 0
 
     def write(self, path: str | Path) -> None:
         """Write the table (.csv with units in the header, or .parquet with units in the
@@ -59,9 +64,12 @@ class ConvertedRecording:
             atomic_write_bytes(path, table_parquet_bytes(cols, units))
 
 
-def _axis(table: dict, label: str, axis: str, what: str) -> np.ndarray:
+def _axis(table: dict, label: str, axis: str, what: str,
+          unusable: dict[str, str] | None = None) -> np.ndarray:
     sign = -1.0 if axis.startswith("-") else 1.0
     name = f"{label}_{axis.lstrip('-')}"
+    if name in (unusable or {}):
+        raise DataFileError(f"{what}: marker {label!r} cannot be used: {unusable[name]}")
     if name not in table:
         raise DataFileError(f"{what} has no marker {label!r} (column {name!r}); markers: "
                             + ", ".join(sorted({k.rsplit('_', 1)[0] for k in table
@@ -71,7 +79,7 @@ def _axis(table: dict, label: str, axis: str, what: str) -> np.ndarray:
 
 def convert_recording(path: str | Path, *, rate: float | None = None,
                       resample: float | None = None, max_gap: float | None = None,
-                      angle_unit: str = "rad", length_unit: str = "m",
+                      angle_unit: str = "rad", length_unit: str = "m", time_unit: str = "s",
                       angle_columns: tuple[str, ...] = (), sway: str | None = None,
                       markers: dict[str, str] | None = None, plate: int = 1,
                       forward: str = "x", up: str = "z", height: float | None = None,
@@ -92,6 +100,8 @@ def convert_recording(path: str | Path, *, rate: float | None = None,
     angle_unit, length_unit : str
         The unit of ``angle_columns`` that declare none (rad, deg), and (CSV) of the marker
         columns (m, mm); converted to rad and m.
+    time_unit : str
+        The unit of a CSV's time column (s, ms); converted to s.
     angle_columns : tuple of str
         Columns that are angles, converted to rad from the unit they declare (a C3D
         channel's ANALOG:UNITS, a CSV header's brackets) or else ``angle_unit``.
@@ -115,8 +125,8 @@ def convert_recording(path: str | Path, *, rate: float | None = None,
     """
     from . import sway as sw
     from .c3d import read_c3d
+    from .columns import read_table
     from .resample import resample_uniform, uniform_step
-    from .table import read_table
 
     path = Path(path)
     what = repr(str(path))
@@ -126,25 +136,29 @@ def convert_recording(path: str | Path, *, rate: float | None = None,
     for a in (forward, up):
         if a not in AXES:
             raise ParameterError(f"an axis must be one of {', '.join(AXES)}, got {a!r}")
-    if sway is not None and sway not in sw.SWAY_METHODS:
-        raise ParameterError(f"unknown sway method {sway!r}; known: "
-                             + ", ".join(sw.SWAY_METHODS))
     markers = {k.strip().lower(): v.strip().lower() for k, v in (markers or {}).items()}
-    known = ("ankle", "knee", "hip", "shoulder")
-    for k in markers:
-        if k not in known:
-            raise ParameterError(f"unknown landmark {k!r} in --markers; known: "
-                                 + ", ".join(known))
+    if sway is not None:  # checked before any reading
+        SwaySpec(sway, tuple(markers.items()), plate, forward, up, height, mass)
+    else:
+        for k in markers:
+            if k not in sw.LANDMARKS:
+                raise ParameterError(f"unknown landmark {k!r} in --markers; known: "
+                                     + ", ".join(sw.LANDMARKS))
     notes: list[str] = []
+    unusable: dict[str, str] = {}
     if path.suffix.lower() == ".c3d":
+        if time_unit != "s":
+            raise ParameterError("--time-unit is for a CSV's time column; a C3D file's "
+                                 "time comes from its frame rate")
         rec = read_c3d(path, rate=rate)
         time, cols, units = rec.time, dict(rec.columns), dict(rec.units)
         notes += list(rec.notes)
+        unusable = dict(rec.unusable)
     else:
         if rate is not None:
             raise ParameterError("--rate is for C3D files; give --resample HZ for a CSV")
         skipped: list[str] = []
-        time, cols, units = read_table(path, skipped=skipped)
+        time, cols, units = read_table(path, skipped=skipped, time_unit=time_unit)
         if skipped:
             notes.append("left out (not numbers): " + ", ".join(skipped))
         if length_unit == "mm":
@@ -166,13 +180,17 @@ def convert_recording(path: str | Path, *, rate: float | None = None,
             cols[c] = cols[c] * SCALE["deg"]
             notes.append(f"{c} from deg to rad")
         units[c] = "rad"
+    check_time(time, what)
+    dropped = 0
     if start is not None:
         keep = time >= float(start) - 1e-9
         if keep.sum() < 8:
             raise DataFileError(f"{what} has fewer than 8 samples from --start {start:g} s "
                                 f"(it ends at {time[-1]:g} s)")
+        dropped = int((~keep).sum())
         time, cols = time[keep], {c: v[keep] for c, v in cols.items()}
-        notes.append(f"samples before {start:g} s dropped")
+        notes.append(f"{dropped} sample(s) before {start:g} s dropped")
+    report = None
     if resample is not None:
         time, cols, report = resample_uniform(time, cols, resample, max_gap=max_gap,
                                               what=what)
@@ -186,25 +204,20 @@ def convert_recording(path: str | Path, *, rate: float | None = None,
     step = float(np.median(np.diff(time)))
     if sway is not None:
         cols["com_angle"] = _sway(sway, cols, markers, plate, forward, up, height, mass,
-                                  1.0 / step, what)
+                                  1.0 / step, what, unusable)
         units["com_angle"] = "rad"
         notes.append(f"com_angle by the {sway} method: {sw.SWAY_METHODS[sway]}")
+    elif unusable:
+        notes.append("left out: " + "; ".join(f"{k} ({v})" for k, v in unusable.items()))
     return ConvertedRecording(time=time, columns=cols, units=units, rate=1.0 / step,
-                              notes=tuple(notes))
+                              notes=tuple(notes), resampling=report, dropped_before=dropped)
 
 
-def _sway(method, cols, markers, plate, forward, up, height, mass, rate, what):
+def _sway(method, cols, markers, plate, forward, up, height, mass, rate, what, unusable):
     from . import sway as sw
 
-    need = {"segments": ("ankle", "knee", "hip", "shoulder"), "two-marker": ("hip", "shoulder"),
-            "cop": ()}[method]
-    missing = [n for n in need if n not in markers]
-    if missing:
-        raise ParameterError(f"--sway {method} needs --markers {'=LABEL,'.join(need)}=LABEL; "
-                             f"{missing[0]} not given")
+    need = sw.NEEDS[method]
     if method == "cop":
-        if height is None or mass is None:
-            raise ParameterError("--sway cop needs --height [m] and --mass [kg]")
         name = f"fp{plate}_cop{forward.lstrip('-')}"
         if name not in cols:
             raise DataFileError(f"{what} has no force plate {plate} (column {name!r})")
@@ -215,8 +228,8 @@ def _sway(method, cols, markers, plate, forward, up, height, mass, rate, what):
         label = markers[landmark]
         if label in cols:  # a forward position only
             return cols[label]
-        return np.stack([_axis(cols, label, forward, what), _axis(cols, label, up, what)],
-                        axis=1)
+        return np.stack([_axis(cols, label, forward, what, unusable),
+                         _axis(cols, label, up, what, unusable)], axis=1)
 
     if method == "segments":
         return sw.com_angle_segments(*(point(n) for n in need))

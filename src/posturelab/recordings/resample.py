@@ -24,8 +24,8 @@ import numpy as np
 from .._validation import float_in_range
 from ..errors import DataFileError
 
-__all__ = ["ResampleReport", "resample_uniform", "MAX_GAP_STEPS", "INTERPOLATION",
-           "RATE_RANGE", "uniform_step"]
+__all__ = ["ResampleReport", "resample_uniform", "MAX_GAP_STEPS", "MAX_SAMPLES_OUT",
+           "INTERPOLATION", "RATE_RANGE", "uniform_step"]
 
 #: Longest gap accepted by default, in median steps of the time column. [-]
 MAX_GAP_STEPS = 3.0
@@ -33,6 +33,8 @@ MAX_GAP_STEPS = 3.0
 INTERPOLATION = "cubic spline (not-a-knot), scipy.interpolate.CubicSpline"
 #: Sample rates a recording may be resampled to. [Hz]
 RATE_RANGE = (1.0, 100_000.0)
+#: Most samples a resampled column may have (bounds memory: a long file at a high rate). [-]
+MAX_SAMPLES_OUT = 2_000_000
 #: Relative step variation under which a time column counts as uniform. [-]
 UNIFORM_TOLERANCE = 1e-6
 
@@ -129,7 +131,8 @@ def resample_uniform(time: np.ndarray, columns: dict[str, np.ndarray], rate: flo
     ------
     DataFileError
         Times not strictly increasing, a gap longer than ``max_gap`` (its time named), a
-        column with fewer than 4 valid samples.
+        column with fewer than 4 valid samples, more than :data:`MAX_SAMPLES_OUT` samples
+        out.
     """
     from scipy.interpolate import CubicSpline
 
@@ -154,6 +157,9 @@ def resample_uniform(time: np.ndarray, columns: dict[str, np.ndarray], rate: flo
                             f"t = {t[worst]:g} … {t[worst + 1]:g} s, longer than the "
                             f"{limit:.4g} s accepted ({gap_words or _limit_words(max_gap)})")
     n_out = int(np.floor((t[-1] - t[0]) * rate * (1 + 1e-12))) + 1
+    if n_out > MAX_SAMPLES_OUT:
+        raise DataFileError(f"{what}: {t[-1] - t[0]:g} s at {rate:g} Hz is {n_out:,} samples; "
+                            f"at most {MAX_SAMPLES_OUT:,} are made (a lower --resample rate)")
     grid = t[0] + np.arange(n_out) / rate
     out, filled = {}, 0
     for name, values in columns.items():

@@ -20,10 +20,14 @@ Three methods:
 ``two-marker``
     Hip and shoulder markers only (the common minimal set: sway measured at hip and shoulder
     level): the same table with the knee taken on the ankle–hip line (legs and thighs one
-    segment, centre of mass at the fraction :func:`lower_body_fraction` of ankle–hip). Its
-    error comes from the knee's flexion: on a simulated PRTS trial of a three-link Winter
-    body (knee angle 0.011 rad RMS, sway 0.085 rad RMS) 0.42 % of the sway's RMS
-    (tests/test_recordings.py); it grows with the knee's motion. When only forward
+    segment, centre of mass at the fraction :func:`lower_body_fraction` of ankle–hip).
+    **This reduction is posturelab's own**: searches of the literature (for a hip–shoulder
+    or sacrum-marker estimate of the CoM sway angle with a published error) found no source
+    to cite, so no published error is given; the error below is our measurement. Its error
+    comes from the knee's flexion: on a simulated PRTS trial of a three-link Winter body
+    (knee angle 0.011 rad RMS, sway 0.085 rad RMS) 0.42 % of the sway's RMS
+    (tests/test_recordings.py); it grows with the knee's motion, and is nil for a body
+    straight from ankle to shoulder (tests/test_recordings_hostile.py). When only forward
     positions of hip and shoulder are recorded, their heights above the ankle come from
     the subject's height by Winter's Fig. 4.1 (after Drillis & Contini 1966: greater
     trochanter 0.530 H, shoulder 0.818 H, lateral malleolus 0.039 H).
@@ -45,20 +49,93 @@ Three methods:
 
 from __future__ import annotations
 
+from dataclasses import dataclass, field
+
 import numpy as np
 
 from ..errors import ParameterError
 from ..model.anthropometry import WINTER_TABLE
 
-__all__ = ["SWAY_METHODS", "com_angle_segments", "com_angle_two_markers", "com_angle_cop",
-           "lower_body_fraction", "LANDMARK_HEIGHTS", "WINTER_SEGMENTS"]
+__all__ = ["SwaySpec", "SWAY_METHODS", "LANDMARKS", "AXES", "com_angle_segments",
+           "com_angle_two_markers", "com_angle_cop", "lower_body_fraction", "LANDMARK_HEIGHTS",
+           "WINTER_SEGMENTS"]
 
 #: The sway methods, with what each needs.
 SWAY_METHODS = {
     "segments": "ankle, knee, hip and shoulder markers (Winter 2009 Table 4.1)",
-    "two-marker": "hip and shoulder markers (ankle marker or its position; Winter 2009)",
+    "two-marker": "hip and shoulder markers (ankle marker or its position; Winter 2009 "
+                  "reduced by posturelab, no published validation)",
     "cop": "a force plate's centre of pressure, height and mass (Caron et al. 1997)",
 }
+
+#: The landmarks a marker may be named for. [-]
+LANDMARKS = ("ankle", "knee", "hip", "shoulder")
+#: The landmarks each method needs. [-]
+NEEDS = {"segments": LANDMARKS, "two-marker": ("hip", "shoulder"), "cop": ()}
+#: Lab axes a marker coordinate may be taken along (a leading - flips it).
+AXES = ("x", "y", "z", "-x", "-y", "-z")
+
+
+@dataclass(frozen=True)
+class SwaySpec:
+    """How ``com_angle`` is computed from a recording's markers or force plate (what
+    ``posturelab convert --sway`` and ``frf --sway`` are given), checked when made.
+
+    Attributes
+    ----------
+    method : str
+        ``segments``, ``two-marker`` or ``cop`` (:data:`SWAY_METHODS`).
+    markers : tuple of (str, str)
+        (landmark, marker label) pairs: ankle, knee, hip, shoulder.
+    plate : int
+        The force plate ``cop`` uses (1-based). [-]
+    forward, up : str
+        The lab axes (x, y, z, a leading - flips) pointing forward and up.
+    height, mass : float or None
+        The subject's height [m] and mass [kg] (``cop``; ``two-marker`` on forward
+        positions only).
+    """
+
+    method: str
+    markers: tuple[tuple[str, str], ...] = field(default=())
+    plate: int = 1
+    forward: str = "x"
+    up: str = "z"
+    height: float | None = None
+    mass: float | None = None
+
+    def __post_init__(self) -> None:
+        if self.method not in SWAY_METHODS:
+            raise ParameterError(f"unknown sway method {self.method!r}; known: "
+                                 + ", ".join(SWAY_METHODS))
+        for a in (self.forward, self.up):
+            if a not in AXES:
+                raise ParameterError(f"an axis must be one of {', '.join(AXES)}, got {a!r}")
+        if self.forward.lstrip("-") == self.up.lstrip("-"):
+            raise ParameterError(f"the forward and up axes must differ, got {self.forward} "
+                                 f"and {self.up}")
+        for k, _ in self.markers:
+            if k not in LANDMARKS:
+                raise ParameterError(f"unknown landmark {k!r} in --markers; known: "
+                                     + ", ".join(LANDMARKS))
+        given = dict(self.markers)
+        missing = [n for n in NEEDS[self.method] if n not in given]
+        if missing:
+            raise ParameterError(f"--sway {self.method} needs the "
+                                 f"{', '.join(NEEDS[self.method])} markers (--markers "
+                                 f"{'=LABEL,'.join(NEEDS[self.method])}=LABEL or "
+                                 f"--{missing[0]}-marker LABEL); {missing[0]} not given")
+        if self.method == "cop" and (self.height is None or self.mass is None):
+            raise ParameterError("--sway cop needs --height [m] and --mass [kg]")
+        if not isinstance(self.plate, int) or self.plate < 1:
+            raise ParameterError(f"the force plate must be a number >= 1, got {self.plate!r}")
+
+    def options(self) -> dict:
+        """:func:`posturelab.recordings.convert.convert_recording`'s sway options."""
+        return {"sway": self.method, "markers": dict(self.markers), "plate": self.plate,
+                "forward": self.forward, "up": self.up, "height": self.height,
+                "mass": self.mass}
+
 
 #: Winter (2009) Table 4.1, from posturelab.model.anthropometry.WINTER_TABLE (stated once
 #: there): per segment, (mass fraction of both sides together [-], centre of mass from the

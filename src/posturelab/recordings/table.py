@@ -1,168 +1,152 @@
-"""Reading the named columns of a recording (a CSV table or a C3D file) in SI units.
+"""The one reader of recordings: named columns in SI on a uniform grid, and what was done.
 
-One reader for every command that takes a recording (``frf``, ``fit-frf``, ``fit``,
-``convert``): :func:`read_series` finds the time column and the named columns, converts the
-units the user declared (angles ``deg`` → rad, lengths ``mm`` → m; never guessed), and
-either checks that the time column is uniform or, with ``resample``, puts the recording on
-a uniform grid (:func:`posturelab.recordings.resample.resample_uniform`).
-
-A CSV header may declare a column's unit in brackets (``tilt [deg]``). Without a declared
-unit (``angle_unit``/``length_unit``) only SI is read: a column declaring deg or mm is
-refused with a message naming the option that reads it. A ``.c3d`` file is read by
-:func:`posturelab.recordings.c3d.read_c3d` (markers in m, analog channels, force plates).
+Every command that takes a recording (``frf``, ``fit-frf``, ``cohort``, ``fit``,
+``likeness``, ``compare-frf``, ``likeness-reference``) reads it by :func:`read_recording`:
+it finds the time column and the named columns
+(:func:`~posturelab.recordings.columns.read_table`, also importable from here), converts
+the units the user declared (angles ``deg`` → rad, lengths ``mm`` → m, time ``ms`` → s;
+never guessed), refuses a time column that repeats or goes backwards, either checks that
+the time column is uniform or, with ``resample``, puts the recording on a uniform grid
+(:func:`posturelab.recordings.resample.resample_uniform`), cuts it to the stimulus's whole
+cycles, and with ``sway`` computes ``com_angle`` as ``posturelab convert`` does. It prints
+nothing: the returned :class:`Recording` says what was resampled
+(:class:`~posturelab.recordings.resample.ResampleReport`) and cut (:class:`TrimReport`);
+the command line says it (stderr, or ``"resampling"``/``"trimming"`` in ``--json``).
 """
 
 from __future__ import annotations
 
-import itertools
-import math
+from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .._files import check_column_unit, column_unit
+from .._files import check_column_unit
 from ..errors import DataFileError, ParameterError
+from .columns import (
+    ANGLE_UNITS,
+    LENGTH_UNITS,
+    MAX_ROWS,
+    SCALE,
+    SI_UNITS,
+    TIME_UNITS,
+    _listing,
+    check_time,
+    read_table,
+)
 from .resample import ResampleReport, resample_uniform, uniform_step
 
-__all__ = ["read_series", "read_table", "SI_UNITS", "ANGLE_UNITS", "LENGTH_UNITS",
-           "MAX_ROWS", "SCALE"]
+if TYPE_CHECKING:
+    from .sway import SwaySpec
 
-#: Most data rows a series file may have. [-]
-MAX_ROWS = 2_000_000  # posturelab._files.MAX_DATA_ROWS
-#: Units a data column may declare in its header when no other unit is declared. [-]
-SI_UNITS = ("rad", "m", "N", "N·m", "N m", "rad/s", "m/s")
-#: Angle units a user may declare (``--angle-unit``). [-]
-ANGLE_UNITS = ("rad", "deg")
-#: Length units a user may declare (``--length-unit``). [-]
-LENGTH_UNITS = ("m", "mm")
-#: Factor to SI of each declarable unit. [SI unit per unit]
-SCALE = {"rad": 1.0, "deg": math.pi / 180.0, "m": 1.0, "mm": 1e-3}
+__all__ = ["Recording", "TrimReport", "read_recording", "read_series", "read_table",
+           "SI_UNITS", "ANGLE_UNITS", "LENGTH_UNITS", "TIME_UNITS", "MAX_ROWS", "SCALE"]
 
 
-def _name(header: str) -> str:
-    name = header.split("[")[0].strip().lower()
-    return "time" if name == "t" else name
+@dataclass(frozen=True)
+class TrimReport:
+    """What :func:`read_recording` cut from a recording.
 
-
-def read_table(path: str | Path, columns: list[str] | None = None, *,
-               skipped: list[str] | None = None
-               ) -> tuple[np.ndarray, dict[str, np.ndarray], dict[str, str]]:
-    """The time column and the named columns of a CSV or C3D recording, as stored.
-
-    Parameters
+    Attributes
     ----------
-    path : str or Path
-        A CSV with a header row and a ``time`` (or ``t``) column [s], or a ``.c3d``.
-    columns : list of str, optional
-        The columns wanted (default all numeric ones; names are case-insensitive).
-    skipped : list, optional
-        With ``columns`` None, receives the names of the CSV columns left out because their
-        first value is not a number (labels, comments).
-
-    Returns
-    -------
-    (numpy.ndarray, dict of str -> numpy.ndarray, dict of str -> str)
-        Time [s]; each column's values (NaN where a CSV cell is empty); each column's
-        declared unit ("" when none).
-
-    Raises
-    ------
-    DataFileError
-        Unreadable file, no time column, a missing column (the known ones listed), a cell
-        that is not a number (line and column named).
+    start : float or None
+        The time before which samples were dropped (``start``), or None. [s]
+    dropped_before : int
+        Samples dropped before ``start``. [-]
+    dropped_after : int
+        Samples dropped after the last whole cycle (``drop_partial``). [-]
+    dropped_after_duration : float
+        Their duration. [s]
+    cycle_length : float or None
+        The cycle the recording was cut to. [s]
+    samples : int
+        Samples kept. [-]
     """
-    path = Path(path)
-    if path.suffix.lower() == ".c3d":
-        from .c3d import read_c3d
 
-        rec = read_c3d(path)
-        names = list(rec.columns)
-        for c in columns or []:
-            if c not in rec.columns:
-                raise DataFileError(f"{str(path)!r} has no column {c!r}; it has "
-                                    f"{_listing(names)}")
-        wanted = names if columns is None else list(columns)
-        return rec.time, {c: rec.columns[c] for c in wanted}, {c: rec.units[c] for c in wanted}
-    return _read_csv(path, columns, skipped)
+    start: float | None
+    dropped_before: int
+    dropped_after: int
+    dropped_after_duration: float
+    cycle_length: float | None
+    samples: int
 
+    def text(self) -> str:
+        """One line saying what was cut."""
+        parts = []
+        if self.start is not None:
+            parts.append(f"dropped {self.dropped_before} sample(s) before {self.start:g} s")
+        if self.dropped_after:
+            parts.append(f"dropped the last {self.dropped_after} sample(s) "
+                         f"({self.dropped_after_duration:.4g} s), a partial cycle of "
+                         f"{self.cycle_length:g} s")
+        return "; ".join(parts or ["nothing cut"]) + f"; {self.samples} sample(s) kept"
 
-def _listing(names: list[str], most: int = 12) -> str:
-    shown = ", ".join(names[:most])
-    return shown + (f", … ({len(names)} columns)" if len(names) > most else "")
-
-
-def _read_csv(path: Path, columns: list[str] | None, skipped: list[str] | None = None):
-    from .._files import csv_rows, header_words, read_text
-
-    what = repr(str(path))
-    rows_in = csv_rows(read_text(path, "data file"), what, max_rows=MAX_ROWS)
-    first = next(rows_in, None)
-    if first is None:
-        raise DataFileError(f"{what} is empty")
-    names = [_name(h) for h in first[1]]
-    if "time" not in names:
-        raise DataFileError(f"{what} has no time column (named t or time, in s); "
-                            f"{header_words(first[1])}")
-    first_row = next(rows_in, None)
-    if columns is None:  # every column whose first value is a number
-        wanted_cols = []
-        for j, n in enumerate(names):
-            if n == "time" or n in wanted_cols:
-                continue
-            cell = first_row[1][j].strip() if first_row and j < len(first_row[1]) else ""
-            try:
-                float(cell) if cell else None
-                wanted_cols.append(n)
-            except ValueError:
-                if skipped is not None:
-                    skipped.append(n)
-    else:
-        wanted_cols = list(columns)
-    if first_row is not None:
-        rows_in = itertools.chain([first_row], rows_in)
-    for c in wanted_cols:
-        if c not in names:
-            raise DataFileError(f"{what} has no column {c!r}; {header_words(first[1])}")
-    wanted = ["time", *wanted_cols]
-    index = [names.index(c) for c in wanted]
-    check_column_unit(what, first[1][index[0]], ("s",))
-    rows = []
-    for lineno, row in rows_in:
-        values = []
-        for c, j in zip(wanted, index, strict=True):
-            cell = row[j].strip() if j < len(row) else None
-            if cell == "" and c != "time":
-                values.append(math.nan)  # a missing sample: resampling may fill it
-                continue
-            try:
-                v = float(cell)  # type: ignore[arg-type]
-            except (TypeError, ValueError):
-                raise DataFileError(f"{what} line {lineno}: column {c!r} is not a "
-                                    "number") from None
-            if not math.isfinite(v):
-                raise DataFileError(f"{what} line {lineno}: column {c!r} is {v}; NaN and "
-                                    "inf are not allowed")
-            values.append(v)
-        rows.append(values)
-    data = np.array(rows, dtype=float).reshape(len(rows), len(wanted))
-    units = {c: column_unit(first[1][j]) for c, j in zip(wanted, index, strict=True)}
-    units.pop("time")
-    return data[:, 0], {c: data[:, k + 1] for k, c in enumerate(wanted_cols)}, units
+    def to_dict(self) -> dict:
+        """The report as JSON-ready values."""
+        return {"start_s": self.start, "dropped_before": self.dropped_before,
+                "dropped_after": self.dropped_after,
+                "dropped_after_s": self.dropped_after_duration,
+                "cycle_length_s": self.cycle_length, "samples": self.samples}
 
 
-def read_series(path: str | Path, columns: list[str],
-                units: dict[str, tuple[str, ...]] | None = None, *,
-                kinds: dict[str, str] | None = None, angle_unit: str = "rad",
-                length_unit: str = "m", resample: float | None = None,
-                max_gap: float | None = None, start: float | None = None,
-                drop_partial: bool = False, cycle_length: float | None = None
-                ) -> tuple[float, dict[str, np.ndarray], ResampleReport | None]:
-    """The sample rate and the named columns of a recording, in SI, on a uniform grid.
+@dataclass(frozen=True)
+class Recording:
+    """The named columns of a recording in SI on a uniform grid, and what was done to them
+    (:func:`read_recording`).
+
+    Attributes
+    ----------
+    rate : float
+        Sample rate. [Hz]
+    columns : dict of str -> numpy.ndarray
+        Each column. [SI]
+    resampling : ResampleReport or None
+        What the resampling did (None: the time column was uniform).
+    trimming : TrimReport or None
+        What was cut (None: nothing asked).
+    notes : tuple of str
+        Other things done (units scaled, the sway method).
+    """
+
+    rate: float
+    columns: dict[str, np.ndarray]
+    resampling: ResampleReport | None = None
+    trimming: TrimReport | None = None
+    notes: tuple[str, ...] = field(default=())
+
+    def report_lines(self) -> list[str]:
+        """One line per thing done (for standard error)."""
+        lines = [] if self.resampling is None else [self.resampling.text()]
+        lines += [] if self.trimming is None else [self.trimming.text()]
+        return lines + list(self.notes)
+
+    def report_dict(self) -> dict:
+        """``resampling`` and ``trimming`` (when done) and ``notes``, JSON-ready."""
+        out: dict = {}
+        if self.resampling is not None:
+            out["resampling"] = self.resampling.to_dict()
+        if self.trimming is not None:
+            out["trimming"] = self.trimming.to_dict()
+        if self.notes:
+            out["reading_notes"] = list(self.notes)
+        return out
+
+
+def read_recording(path: str | Path, columns: list[str],
+                   units: dict[str, tuple[str, ...]] | None = None, *,
+                   kinds: dict[str, str] | None = None, angle_unit: str = "rad",
+                   length_unit: str = "m", time_unit: str = "s",
+                   resample: float | None = None, max_gap: float | None = None,
+                   start: float | None = None, drop_partial: bool = False,
+                   cycle_length: float | None = None, sway: SwaySpec | None = None
+                   ) -> Recording:
+    """The named columns of a recording, in SI, on a uniform grid, and what was done.
 
     Parameters
     ----------
     path : str or Path
-        A CSV (header row, a ``time`` or ``t`` column [s]) or a ``.c3d``.
+        A CSV (header row, a ``time`` or ``t`` column) or a ``.c3d``.
     columns : list of str
         Columns to read (lower case).
     units : dict of str -> tuple of str, optional
@@ -173,6 +157,8 @@ def read_series(path: str | Path, columns: list[str],
         The unit of the angle (``rad``, ``deg``) and length (``m``, ``mm``) columns, as the
         user declares it; converted to rad and m. A header that declares another unit is
         refused.
+    time_unit : str
+        The unit of a CSV's time column (``s``, ``ms``); converted to s.
     resample : float, optional
         Put the recording on a uniform grid at this rate [Hz] by a cubic spline (see
         :func:`~posturelab.recordings.resample.resample_uniform`); without it a non-uniform
@@ -182,15 +168,18 @@ def read_series(path: str | Path, columns: list[str],
     start : float, optional
         Drop the samples before this time (where the stimulus's first cycle starts). [s]
     drop_partial : bool
-        Drop the samples after the last whole cycle of ``cycle_length`` [s] (a recording
-        that runs on past the stimulus); the cut is said on standard error.
+        Drop the samples after the last whole cycle of ``cycle_length`` (a recording that
+        runs on past the stimulus); said in :attr:`Recording.trimming`.
     cycle_length : float, optional
         [s]
+    sway : SwaySpec, optional
+        Compute ``com_angle`` [rad] from markers or a force plate
+        (:func:`posturelab.recordings.convert.convert_recording`, the same computation as
+        ``posturelab convert --sway``); ``columns`` may then name ``com_angle``.
 
     Returns
     -------
-    (float, dict of str -> numpy.ndarray, ResampleReport or None)
-        Sample rate [Hz], each column [SI], and what the resampling did.
+    Recording
 
     Raises
     ------
@@ -204,53 +193,103 @@ def read_series(path: str | Path, columns: list[str],
                              f"{length_unit!r}")
     path = Path(path)
     what = repr(str(path))
-    time, cols, declared = read_table(path, columns)
+    notes: list[str] = []
+    resampling = None
+    if sway is not None:
+        from .convert import convert_recording
+
+        conv = convert_recording(path, resample=resample, max_gap=max_gap,
+                                 length_unit=length_unit, time_unit=time_unit,
+                                 start=start, **sway.options())
+        missing = [c for c in columns if c not in conv.columns]
+        if missing:
+            raise DataFileError(f"{what} has no column {missing[0]!r}; columns: "
+                                + _listing(list(conv.columns)))
+        time, declared = conv.time, {c: conv.units.get(c, "") for c in columns}
+        cols = {c: np.asarray(conv.columns[c], dtype=float) for c in columns}
+        declared["com_angle"] = ""  # computed in rad
+        resampling = conv.resampling
+        said = {resampling.text() if resampling else "", f"{conv.dropped_before} sample(s) "
+                f"before {start:g} s dropped" if start is not None else ""}
+        notes = [n for n in conv.notes if n not in said]
+        dropped_before = 0 if start is None else conv.dropped_before
+    else:
+        time, cols, declared = read_table(path, columns, time_unit=time_unit, notes=notes)
     kinds = kinds or {}
     for c in columns:
-        kind = kinds.get(c)
-        given = {"angle": angle_unit, "length": length_unit}.get(kind or "")
-        header = declared[c]
-        if given is not None and given not in ("rad", "m") and header in ("", given):
-            cols[c] = cols[c] * SCALE[given]  # declared by the user (the header agrees)
+        if sway is not None and c == "com_angle":
             continue
-        accepted = (units or {}).get(c, SI_UNITS)
-        hint = {("deg", "angle"): "; give --angle-unit deg to read degrees",
-                ("mm", "length"): "; give --length-unit mm to read millimetres"}.get(
-                    (header.lower(), kind or {"deg": "angle", "mm": "length"}.get(
-                        header.lower(), "")), "")
-        if header and header.lower() not in {a.lower() for a in accepted} and hint:
-            raise DataFileError(f"{what}: column {f'{c} [{header}]'!r} is in {header}; "
-                                f"posturelab reads {' or '.join(accepted)}{hint}")
-        check_column_unit(what, f"{c} [{header}]" if header else c, accepted)
-    if start is not None:
-        keep = time >= float(start) - 1e-9
-        if not keep.any():
-            raise DataFileError(f"{what} ends at {time[-1]:g} s, before --start {start:g} s")
-        time, cols = time[keep], {c: v[keep] for c, v in cols.items()}
-    if time.size < 8:
-        raise DataFileError(f"{what} needs at least 8 samples, has {time.size}")
-    report = None
-    if resample is not None:
-        _, cols, report = resample_uniform(time, cols, resample, max_gap=max_gap, what=what)
-        step = 1.0 / report.rate
+        cols[c] = _to_si(what, c, cols[c], declared[c], kinds.get(c), angle_unit,
+                         length_unit, (units or {}).get(c, SI_UNITS))
+    if sway is None:
+        check_time(time, what)
+        dropped_before = 0
+        if start is not None:
+            keep = time >= float(start) - 1e-9
+            if not keep.any():
+                raise DataFileError(f"{what} ends at {time[-1]:g} s, before --start "
+                                    f"{start:g} s")
+            dropped_before = int((~keep).sum())
+            time, cols = time[keep], {c: v[keep] for c, v in cols.items()}
+        if time.size < 8:
+            raise DataFileError(f"{what} needs at least 8 samples, has {time.size}")
+        if resample is not None:
+            _, cols, resampling = resample_uniform(time, cols, resample, max_gap=max_gap,
+                                                   what=what)
+            step = 1.0 / resampling.rate
+        else:
+            step = _uniform_or_refuse(time, cols, columns, what)
     else:
-        step = _uniform_or_refuse(time, cols, columns, what)
+        step = 1.0 / conv.rate
+    n = next(iter(cols.values())).size if cols else time.size
+    dropped_after = 0
     if drop_partial:
         if cycle_length is None:
             raise ParameterError("--drop-partial needs --cycle-length")
         per = int(round(float(cycle_length) / step))
-        n = next(iter(cols.values())).size
         whole = (n // per) * per if per > 0 else n
         if whole == 0:
             raise DataFileError(f"{what} holds {n * step:g} s, less than one cycle of "
                                 f"{cycle_length:g} s")
-        if whole < n:
-            import sys
+        dropped_after, n = n - whole, whole
+        cols = {c: v[:whole] for c, v in cols.items()}
+    trimming = None
+    if start is not None or drop_partial:
+        trimming = TrimReport(start=None if start is None else float(start),
+                              dropped_before=dropped_before, dropped_after=dropped_after,
+                              dropped_after_duration=dropped_after * step,
+                              cycle_length=None if cycle_length is None
+                              else float(cycle_length), samples=n)
+    return Recording(rate=1.0 / step, columns=cols, resampling=resampling,
+                     trimming=trimming, notes=tuple(notes))
 
-            print(f"note: {what}: dropped the last {n - whole} sample(s) "
-                  f"({(n - whole) * step:.4g} s), a partial cycle", file=sys.stderr)
-            cols = {c: v[:whole] for c, v in cols.items()}
-    return 1.0 / step, cols, report
+
+def read_series(path: str | Path, columns: list[str],
+                units: dict[str, tuple[str, ...]] | None = None, **options
+                ) -> tuple[float, dict[str, np.ndarray], ResampleReport | None]:
+    """The sample rate [Hz], the named columns [SI] and what the resampling did (None when
+    the time column was uniform): :func:`read_recording` with the same options, as a tuple.
+    Nothing is printed; :func:`read_recording` also says what was cut."""
+    rec = read_recording(path, columns, units, **options)
+    return rec.rate, rec.columns, rec.resampling
+
+
+def _to_si(what: str, c: str, values: np.ndarray, header: str, kind: str | None,
+           angle_unit: str, length_unit: str, accepted: tuple[str, ...]) -> np.ndarray:
+    """One column in SI: scaled from the unit the user declared (which its header, if it
+    declares one, must agree with), else checked to be in ``accepted``."""
+    given = {"angle": angle_unit, "length": length_unit}.get(kind or "")
+    if given is not None and given not in ("rad", "m") and header in ("", given):
+        return values * SCALE[given]  # declared by the user (the header agrees)
+    hint = {("deg", "angle"): "; give --angle-unit deg to read degrees",
+            ("mm", "length"): "; give --length-unit mm to read millimetres"}.get(
+                (header.lower(), kind or {"deg": "angle", "mm": "length"}.get(
+                    header.lower(), "")), "")
+    if header and header.lower() not in {a.lower() for a in accepted} and hint:
+        raise DataFileError(f"{what}: column {f'{c} [{header}]'!r} is in {header}; "
+                            f"posturelab reads {' or '.join(accepted)}{hint}")
+    check_column_unit(what, f"{c} [{header}]" if header else c, accepted)
+    return values
 
 
 def _uniform_or_refuse(time: np.ndarray, cols: dict[str, np.ndarray], columns: list[str],
