@@ -39,7 +39,7 @@ def add_muscle_arguments(p: argparse.ArgumentParser, *, require: bool = False,
     --feedback-delay and --proprioceptive-weight (``own_case``: the command defines --case
     and --viscosity-ratio itself)."""
     from ..model.body import BODY_PRESETS
-    from ..model.controllers import CONTROLLERS
+    from ..model.controllers import CONTROLLERS, MULTIJOINT_CONTROLLERS
 
     body = p.add_argument_group("body")
     body.add_argument("--body", metavar="PRESET",
@@ -59,12 +59,15 @@ def add_muscle_arguments(p: argparse.ArgumentParser, *, require: bool = False,
                    + ", ".join(PAPER_PAIR_NAMES) + "), one per joint otherwise (one for a "
                    "one-link body). With active gains this is the intrinsic (undelayed) part.")
     g.add_argument("--controller", metavar="NAME",
-                   help="a one-link controller preset after a published model (intrinsic "
+                   help="a controller preset. One-link (after a published model: intrinsic "
                    "and active gains as "
-                   f"fractions of mgh, delay, weight): {', '.join(CONTROLLERS)}. Its body: "
+                   f"fractions of mgh, delay, weight): {', '.join(CONTROLLERS)}; its body: "
                    "the paper's as one link (paper-1link) by default, --height/--mass "
-                   "lumped to one link, or a one-link --body. Which of its numbers come from "
-                   "the source: "
+                   "lumped to one link, or a one-link --body. Multi-joint (an LQR design on "
+                   "the three-link body, knee locked; the commands that take it say so): "
+                   f"{', '.join(MULTIJOINT_CONTROLLERS)}; its body: the paper's, a --body "
+                   "or --height/--mass (three links). Which of the one-link presets' numbers "
+                   "come from the source: "
                    + " ".join(f"{c.name}: {c.provenance_text()}" for c in CONTROLLERS.values()))
     fb.add_argument("--viscosity", metavar="LIST",
                     help="pair viscosities [N·m·s/rad], one per pair (instead of a ratio).")
@@ -190,7 +193,8 @@ def model_from_args(args: argparse.Namespace, tables: dict | None = None, *,
 
 def _note_one_link(args: argparse.Namespace, body) -> None:
     """Say that a one-link controller lumps a body from height and mass to one link."""
-    if getattr(args, "controller", None) is not None and getattr(args, "height", None):
+    if (getattr(args, "controller", None) is not None and getattr(args, "height", None)
+            and body.n_links == 1):
         print(f"posturelab: note: --controller {args.controller} is a one-link controller: "
               f"the body is {body.name}", file=sys.stderr)
 
