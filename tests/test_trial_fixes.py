@@ -10,11 +10,10 @@ import numpy as np
 import pytest
 
 import posturelab as pl
+from _cli import cli
 from posturelab.linear.lqr import knee_basis, multijoint_controller
 from posturelab.linear.system import linear_system
 from posturelab.linear.verdict import upright_verdict
-
-from _cli import cli, one_line_exit_2
 
 MJ = ("simulate", "--controller", "multijoint-default", "--disturbance", "backward",
       "--speed", "0.2", "--initial-posture", "0,0,0")
