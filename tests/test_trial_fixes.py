@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import posturelab as pl
-from _cli import cli
+from _cli import cli, one_line_exit_2
 from posturelab.linear.lqr import knee_basis, multijoint_controller
 from posturelab.linear.system import linear_system
 from posturelab.linear.verdict import upright_verdict
@@ -72,3 +72,22 @@ def test_no_one_link_note_for_the_multijoint_controller_and_the_help_lists_every
         h = " ".join(cli(command, "--help").stdout.split())
         assert "multijoint-default" in h and "peterka-2002" in h, command
         assert "Multi-joint" in h and "One-link" in h, command
+
+
+def test_step_threshold_refuses_an_unstable_upright():
+    # τ = 0.9 s: upright topples by itself (t = 3.46 s); the delay margin is 0.294 s
+    # (measured). Before the fix: "largest translation without a step: 0.2 cm".
+    p = cli("step-threshold", "--height", "1.75", "--mass", "75", "--feedback-delay", "0.9")
+    one_line_exit_2(p, "upright is unstable at feedback_delay 0.9 s", "delay margin 0.294 s")
+
+
+def test_step_threshold_at_the_search_ceiling_is_no_threshold():
+    p = cli("step-threshold", "--height", "1.75", "--mass", "75", "--move-duration", "10",
+            "--ankle-strength", "1e6")
+    assert p.returncode == 0, p.stderr
+    assert "no step needed up to the largest translation searched (60.0 cm)" in p.stdout
+    assert "two SD" not in p.stdout
+    out = json.loads(cli("step-threshold", "--height", "1.75", "--mass", "75", "--move-duration",
+                         "10", "--ankle-strength", "1e6", "--json").stdout)
+    assert out["largest_translation"] is None and out["reached_search_limit"] is True
+    assert out["within_two_sd"] is None and out["largest_searched"] == pytest.approx(0.60)
