@@ -91,3 +91,32 @@ def test_step_threshold_at_the_search_ceiling_is_no_threshold():
                          "10", "--ankle-strength", "1e6", "--json").stdout)
     assert out["largest_translation"] is None and out["reached_search_limit"] is True
     assert out["within_two_sd"] is None and out["largest_searched"] == pytest.approx(0.60)
+
+
+def _fit_delay(tmp_path, start: str) -> dict:
+    model = tmp_path / "model.json"
+    model.write_text(cli("frf-model", "--controller", "peterka-2002", "--json").stdout)
+    p = cli("fit-frf", "--data", str(model), "--controller", "peterka-2002", "--free",
+            "feedback_delay", "--feedback-delay", start, "--json")
+    assert p.returncode == 0, p.stderr
+    return json.loads(p.stdout)
+
+
+def test_fit_frf_flags_an_unstable_start_and_an_unstable_result(tmp_path):
+    # the preset's own model FRF, fitted from τ = 0.9 s (upright unstable): the fit stays in
+    # the unstable region (measured τ = 0.881 s, rightmost root 2.73 1/s). Before the fix
+    # it returned that τ with no word of it.
+    out = _fit_delay(tmp_path, "0.9")
+    assert out["stable"] is False
+    assert any(w.startswith("the fitted loop is unstable") and "not measurable" in w
+               for w in out["warnings"])
+    assert any(w.startswith("the starting loop is unstable") for w in out["warnings"])
+
+
+def test_fit_frf_from_a_stable_start_is_stable_and_recovers_the_delay(tmp_path):
+    from posturelab.model.controllers import CONTROLLERS
+
+    out = _fit_delay(tmp_path, "0.1")
+    assert out["stable"] is True and not any("unstable" in w for w in out["warnings"])
+    tau = CONTROLLERS["peterka-2002"].feedback_delay
+    assert out["parameters"][0]["estimate"] == pytest.approx(tau, rel=1e-4)
