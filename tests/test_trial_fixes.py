@@ -120,3 +120,41 @@ def test_fit_frf_from_a_stable_start_is_stable_and_recovers_the_delay(tmp_path):
     assert out["stable"] is True and not any("unstable" in w for w in out["warnings"])
     tau = CONTROLLERS["peterka-2002"].feedback_delay
     assert out["parameters"][0]["estimate"] == pytest.approx(tau, rel=1e-4)
+
+
+def test_strategy_text_says_fell_and_none_found_and_json_is_null_for_a_fall():
+    p = cli("strategy", "--oscillation", "0.05", "--frequencies", "0.1:1.25:6",
+            "--ankle-torque-limit", "40")
+    assert p.returncode == 0, p.stderr
+    assert "nan" not in p.stdout.lower() and "None" not in p.stdout
+    assert "transition frequency: none found" in p.stdout
+    two = cli("strategy", "--oscillation", "0.05", "--frequencies", "0.1:1.25:6",
+              "--ankle-torque-limits", "40:120:3")
+    assert "nan" not in two.stdout.lower() and "fell" in two.stdout
+    out = json.loads(cli("strategy", "--translation", "backward", "--speeds", "0.3:1.5:2",
+                         "--ankle-torque-limit", "40", "--json").stdout)
+    fell = [r for r in out["runs"] if r["outcome"] == "fell"]
+    assert fell and all(r["hip_fraction"] is None for r in fell)
+
+
+@pytest.mark.parametrize("args, words", [
+    (("--translation", "backward", "--speeds", "0.05:inf:5"), ("--speeds", "finite")),
+    (("--translation", "backward", "--speeds", "0.05:0.5:1"), ("N = 1", "LO = HI")),
+    (("--oscillation", "0.05", "--frequencies", "0.1:1:2", "--speeds", "0.1:0.2:2"),
+     ("--speeds", "--oscillation")),
+    (("--oscillation", "0.05", "--frequencies", "0.1:1:2", "--displacement", "0.1"),
+     ("--displacement", "--oscillation")),
+    (("--translation", "backward", "--speeds", "0.1:0.2:2", "--frequencies", "0.1:1:2"),
+     ("--frequencies", "--translation")),
+])
+def test_strategy_refuses_bad_grids_and_options_that_do_not_apply(args, words):
+    one_line_exit_2(cli("strategy", *args), *words)
+
+
+def test_hip_fraction_of_no_motion_is_undefined():
+    from posturelab.model.kinematics import hip_fraction
+
+    assert np.isnan(hip_fraction(np.zeros((50, 3))))
+    out = json.loads(cli("simulate", "--case", "1", "--disturbance", "none",
+                         "--initial-posture", "0,0,0", "--duration", "0.5", "--json").stdout)
+    assert out["hip_fraction"] is None

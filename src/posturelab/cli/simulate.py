@@ -447,7 +447,9 @@ def run(args: argparse.Namespace) -> int:
         print(f"linear model: {verdict.describe()}")
         print(f"peak |θ| [rad]: {peaks}")
         if sc.body.n_links >= 2:
-            print(f"hip fraction (anti-phase leg–trunk mode): {result.hip_fraction:.3f}")
+            share = result.hip_fraction
+            print("hip fraction (anti-phase leg–trunk mode): "
+                  + (f"{share:.3f}" if share == share else "none (no sway)"))
         print("final state [rad, rad/s]: " + ", ".join(f"{x:.4g}" for x in result.final_state))
         for path in outputs:
             print(f"wrote {path}")
