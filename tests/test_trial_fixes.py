@@ -158,3 +158,21 @@ def test_hip_fraction_of_no_motion_is_undefined():
     out = json.loads(cli("simulate", "--case", "1", "--disturbance", "none",
                          "--initial-posture", "0,0,0", "--duration", "0.5", "--json").stdout)
     assert out["hip_fraction"] is None
+
+
+def test_a_run_option_error_names_the_flags_typed():
+    # before: "posturelab: error: : muscles.torque_feedback_gain > 0 … give a feedback_delay"
+    one_line_exit_2(cli("simulate", "--case", "1", "--disturbance", "backward",
+                        "--torque-feedback-gain", "0.3"),
+                    "error: --torque-feedback-gain > 0 filters the delayed active torque: "
+                    "give a --feedback-delay > 0")
+
+
+def test_torque_feedback_time_constant_alone_is_noted_and_its_lower_bound_is_1_ms():
+    p = cli("simulate", "--case", "1", "--disturbance", "backward", "--duration", "0.2",
+            "--torque-feedback-time-constant", "5")
+    assert p.returncode == 0 and "has no effect without --torque-feedback-gain" in p.stderr
+    one_line_exit_2(cli("simulate", "--controller", "peterka-2002", "--disturbance",
+                        "backward", "--torque-feedback-gain", "0.3",
+                        "--torque-feedback-time-constant", "1e-9"),
+                    "--torque-feedback-time-constant", "[0.001, 1000]")

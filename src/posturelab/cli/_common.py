@@ -188,7 +188,20 @@ def model_from_args(args: argparse.Namespace, tables: dict | None = None, *,
         raise UsageError(f"--controller {args.controller} is a multi-joint controller: "
                          "simulate, sweep, fit and strategy take it, this command does not")
     _note_one_link(args, scenario.body)
+    _note_lag_without_gain(args)
     return scenario
+
+
+def _note_lag_without_gain(args: argparse.Namespace) -> None:
+    """Say that --torque-feedback-time-constant does nothing without a torque feedback gain
+    (unless the command varies or fits the gain)."""
+    if getattr(args, "torque_feedback_time_constant", None) is None or getattr(
+            args, "torque_feedback_gain", None):
+        return
+    varied = " ".join(str(getattr(args, name, None) or "") for name in ("vary", "free", "per"))
+    if "torque_feedback_gain" not in varied:
+        print("posturelab: note: --torque-feedback-time-constant has no effect without "
+              "--torque-feedback-gain > 0 (no torque feedback)", file=sys.stderr)
 
 
 def _note_one_link(args: argparse.Namespace, body) -> None:
