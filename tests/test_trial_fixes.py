@@ -176,3 +176,13 @@ def test_torque_feedback_time_constant_alone_is_noted_and_its_lower_bound_is_1_m
                         "backward", "--torque-feedback-gain", "0.3",
                         "--torque-feedback-time-constant", "1e-9"),
                     "--torque-feedback-time-constant", "[0.001, 1000]")
+
+
+def test_frf_model_of_a_scene_without_weight_is_refused():
+    # before: gain 0 and a made-up phase of −180.0° in every band ("re": -0.0)
+    one_line_exit_2(cli("frf-model", "--controller", "peterka-2002", "--input", "visual-tilt"),
+                    "visual_weight 0", "--visual-weight")
+    p = cli("frf-model", "--controller", "peterka-2002", "--input", "visual-tilt",
+            "--visual-weight", "0.3", "--proprioceptive-weight", "0.7", "--json")
+    out = json.loads(p.stdout)
+    assert all(g > 0 for g in out["gain"]) and None not in out["phase_deg"]
