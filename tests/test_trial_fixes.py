@@ -186,3 +186,24 @@ def test_frf_model_of_a_scene_without_weight_is_refused():
             "--visual-weight", "0.3", "--proprioceptive-weight", "0.7", "--json")
     out = json.loads(p.stdout)
     assert all(g > 0 for g in out["gain"]) and None not in out["phase_deg"]
+
+
+def test_design_refuses_a_stimulus_too_fast_for_its_bands_in_the_users_terms():
+    # 0.001 s states: a 0.08 s cycle, 8 samples at 100 Hz, 2 odd harmonics; the 11 bands need
+    # 25. Before: "band 3 must list odd-harmonic numbers in 1 … 2, got [3, 4]".
+    p = cli("design", "--controller", "peterka-2002", "--free", "active_stiffness:ankle",
+            "--sensor-noise", "0.001", "--tilt", "prts:0.035:0.001")
+    one_line_exit_2(p, "state duration 0.001 s", "0.08 s cycle", "state duration >= 0.02 s")
+    ok = cli("design", "--controller", "peterka-2002", "--free", "active_stiffness:ankle",
+             "--sensor-noise", "0.001", "--tilt", "prts:0.035:0.02", "--json")
+    assert ok.returncode == 0, ok.stderr
+
+
+def test_design_takes_discard_cycles_and_the_old_name():
+    base = ("design", "--controller", "peterka-2002", "--free", "active_stiffness:ankle",
+            "--sensor-noise", "0.001", "--json")
+    new = json.loads(cli(*base, "--discard-cycles", "2").stdout)
+    old = json.loads(cli(*base, "--discard", "2").stdout)
+    assert new == old and new["design"]["discard"] == 2
+    h = cli("design", "--help").stdout
+    assert "--discard-cycles" in h and "--discard " not in h
