@@ -17,7 +17,11 @@ J Biomech 38:1–8; ω0 = √(g/l), l the centre of mass's height) leaves the fo
 the body falls. The platform moves are ramp-and-holds over 0.5 s (posturelab's assumption),
 increased in 1 cm steps and then bisected to 1 mm. Compared with Koushyar et al. 2019
 (PLoS ONE 14:e0210049, PMC6338353): backward, 16.2 ± 2.6 cm (young), 11.8 ± 2.1 cm (older).
-Where each number of a population comes from: --sources.
+Where each number of a population comes from: --sources. An upright that is unstable at the
+feedback delay (it topples without a platform move) is refused: there is no threshold. When
+no translation up to the search's ceiling needs a step, the output says so
+("reached_search_limit": true, "largest_translation": null, "largest_searched" [m]) and
+nothing is compared.
 """
 
 

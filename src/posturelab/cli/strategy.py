@@ -64,8 +64,12 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     """The options of ``posturelab strategy``."""
     p.add_argument("--body", default="paper", metavar="NAME",
                    help="a body preset (default: the paper's three links).")
+    from ..model.controllers import MULTIJOINT_CONTROLLERS
+
     p.add_argument("--controller", default="multijoint-default", metavar="NAME",
-                   help="a multi-joint controller preset (default multijoint-default).")
+                   help="a multi-joint controller preset: "
+                   f"{', '.join(MULTIJOINT_CONTROLLERS)} (default multijoint-default; the "
+                   "one-link presets have no hip).")
     p.add_argument("--joint-feedback-scale", type=float, default=1.0, metavar="S",
                    help="factor on the controller's gain matrices (default 1).")
     family = p.add_mutually_exclusive_group(required=True)
