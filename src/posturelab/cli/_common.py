@@ -46,8 +46,8 @@ def add_muscle_arguments(p: argparse.ArgumentParser, *, require: bool = False,
                       help=f"body preset: {', '.join(BODY_PRESETS)} (default paper).")
     body.add_argument("--height", type=str, metavar="M",
                       help="subject height [m], with --mass: leg, thigh and HAT scaled by "
-                      "Winter's anthropometric table (three links; with --controller, a "
-                      "one-link controller, the same body as one rigid link).")
+                      "Winter's anthropometric table (three links; with a one-link "
+                      "--controller, the same body as one rigid link).")
     body.add_argument("--mass", type=str, metavar="KG", help="subject mass [kg], with --height.")
     fb = p.add_argument_group("feedback (muscle pairs)")
     g = fb.add_mutually_exclusive_group(required=require)
@@ -64,7 +64,7 @@ def add_muscle_arguments(p: argparse.ArgumentParser, *, require: bool = False,
                    f"fractions of mgh, delay, weight): {', '.join(CONTROLLERS)}; its body: "
                    "the paper's as one link (paper-1link) by default, --height/--mass "
                    "lumped to one link, or a one-link --body. Multi-joint (an LQR design on "
-                   "the three-link body, knee locked; the commands that take it say so): "
+                   "the three-link body, knee locked; simulate, sweep, fit and strategy take it): "
                    f"{', '.join(MULTIJOINT_CONTROLLERS)}; its body: the paper's, a --body "
                    "or --height/--mass (three links). Which of the one-link presets' numbers "
                    "come from the source: "
