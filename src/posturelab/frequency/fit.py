@@ -76,7 +76,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .._bounds import at_bound, clip_intervals
-from ..errors import ParameterError
+from ..errors import ParameterError, PostureLabError
 from ..model.body import Body
 from ..model.muscles import MuscleSet
 from ..parameters import (
@@ -430,10 +430,14 @@ def fit_frf(body: Body, muscles: MuscleSet, data, free, *, input: str | Sequence
         return gains, values
 
     def unstable(p: np.ndarray) -> str | None:
-        """The first condition's verdict whose loop is not stable at these values."""
+        """The first condition's verdict whose loop is not stable at these values (None:
+        every one stable; "": not settled, the linear model refusing these values)."""
         for k in range(len(conditions)):
             gains, values = condition_values(p, k)
-            verdict = loop_verdict(body, muscles, gains, active, values)
+            try:
+                verdict = loop_verdict(body, muscles, gains, active, values)
+            except PostureLabError:
+                return ""
             if verdict.side(engaged=True).status != "stable":
                 return verdict.describe()
         return None
@@ -485,7 +489,7 @@ def fit_frf(body: Body, muscles: MuscleSet, data, free, *, input: str | Sequence
     relative = weighting == "relative"
     delta = 0.0 if model_error is None else float_in_range("model_error [-]", model_error,
                                                            0.0, 1e3)
-    if (start_verdict := unstable(x0)) is not None:
+    if start_verdict := unstable(x0):
         warnings.append(f"the starting loop is {start_verdict}: its FRF is not measurable; "
                         "start from stable values (the fit may end on an unstable loop)")
     sol = solve(x0 / scale, delta)
@@ -551,14 +555,14 @@ def fit_frf(body: Body, muscles: MuscleSet, data, free, *, input: str | Sequence
         warnings.append(f"proprioceptive_weight + visual_weight = {total:.4g} > 1: the "
                         "graviceptive weight 1 − W − W_v would be negative")
     end_verdict = unstable(p)
-    if end_verdict is not None:
+    if end_verdict:
         warnings.insert(0, f"the fitted loop is unstable ({end_verdict}): its FRF is not "
                         "measurable, so these estimates describe no experiment")
     return FRFFit(tuple(labels), p, se, ci, determined, float(fit_error), bool(sol.success),
                   str(sol.message), tuple(warnings), tuple(model(p, dense=True)), weighting,
                   bool(mismatch), float(delta), systematic, sides,
                   np.stack([lo, hi], axis=1), clipped, float(u_all @ u_all), float(dof),
-                  float(nu), end_verdict is None)
+                  float(nu), None if end_verdict == "" else end_verdict is None)
 
 
 def _condition_groups(groups, count: int) -> list[int]:
