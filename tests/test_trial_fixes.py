@@ -63,6 +63,7 @@ def test_an_explicit_free_knee_is_honoured_with_the_multijoint_controller():
     assert locked["linear_stability"]["stable"] is True
     assert free["linear_stability"]["stable"] is False
     assert "designed with the knee locked" in p.stderr
+    assert "designed with the knee locked" in free["linear_stability"]["note"]
 
 
 def test_no_one_link_note_for_the_multijoint_controller_and_the_help_lists_every_controller():

@@ -434,9 +434,17 @@ def run(args: argparse.Namespace) -> int:
         torque_feedback_time_constant=sc.options.torque_feedback_time_constant,
         joint_feedback=sc.options.joint_feedback, knee=sc.options.knee.mode)
     outcome = result.outcome
+    knee_note = None
+    if sc.options.joint_feedback is not None and sc.options.knee.mode != "locked":
+        knee_note = (f"the multi-joint controller was designed with the knee locked; this "
+                     f"run's knee is {sc.options.knee.mode} (the linear verdict takes the "
+                     f"{sc.options.knee.mode} knee)")
     if args.json:
+        stability = verdict.to_dict()
+        if knee_note is not None:
+            stability["note"] = knee_note
         print_json({**result.summary(), "engine": args.engine,
-                    "linear_stability": verdict.to_dict()})
+                    "linear_stability": stability})
     else:
         peaks = ", ".join(f"{x:.4f}" for x in result.max_abs_theta)
         print(f"outcome: {outcome.message}")  # first, as the help and README say
@@ -453,10 +461,8 @@ def run(args: argparse.Namespace) -> int:
         print("final state [rad, rad/s]: " + ", ".join(f"{x:.4g}" for x in result.final_state))
         for path in outputs:
             print(f"wrote {path}")
-    if sc.options.joint_feedback is not None and sc.options.knee.mode != "locked":
-        print(f"posturelab: note: the multi-joint controller was designed with the knee "
-              f"locked; this run's knee is {sc.options.knee.mode} (the linear verdict takes "
-              f"the {sc.options.knee.mode} knee)", file=sys.stderr)
+    if knee_note is not None:
+        print(f"posturelab: note: {knee_note}", file=sys.stderr)
     if verdict.status == "depends on the side":
         print("posturelab: warning: upright's linear stability depends on the side of a "
               f"one-sided pair's switch for these gains and this body ({verdict.describe()})",
