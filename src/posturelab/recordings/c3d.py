@@ -36,7 +36,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import DataFileError, PostureLabError
-from .resample import MAX_GAP_STEPS, RATE_RANGE, resample_uniform
+from .resample import MAX_GAP_STEPS, RATE_RANGE, resample_uniform, samples_over
 
 __all__ = ["C3DRecording", "read_c3d", "write_c3d", "EZC3D_CITATION"]
 
@@ -210,10 +210,13 @@ def read_c3d(path: str | Path, rate: float | None = None) -> C3DRecording:
     out_rate = point_rate if rate is None else float_in_range("rate [Hz]", rate, *RATE_RANGE,
                                                               unit="Hz")
     t_points = np.arange(n_frames) / point_rate
-    n_out = int(np.floor(t_points[-1] * out_rate * (1 + 1e-12))) + 1
+    duration = n_frames / point_rate  # each frame stands for 1 / point_rate
+    n_out = samples_over(duration, out_rate)
     if n_out > MAX_TABLE_SAMPLES:
-        raise DataFileError(f"{what}: {t_points[-1]:g} s at {out_rate:g} Hz is {n_out:,} "
-                            f"samples per column; at most {MAX_TABLE_SAMPLES:,} are made")
+        raise DataFileError(f"{what}: {duration:g} s at --rate {out_rate:g} Hz is {n_out:,} "
+                            f"samples per column; at most {MAX_TABLE_SAMPLES:,} are made "
+                            f"(--rate at most {MAX_TABLE_SAMPLES / duration:.6g} Hz for this "
+                            "file)")
     grid = np.arange(n_out) / out_rate
     columns: dict[str, np.ndarray] = {}
     units: dict[str, str] = {}

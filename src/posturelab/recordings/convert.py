@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import DataFileError, ParameterError
-from .columns import ANGLE_UNITS, LENGTH_UNITS, SCALE, check_time
+from .columns import ANGLE_UNITS, LENGTH_UNITS, SCALE, check_start, check_time
 from .resample import ResampleReport
 from .sway import AXES, SwaySpec
 
@@ -130,6 +130,7 @@ def convert_recording(path: str | Path, *, rate: float | None = None,
 
     path = Path(path)
     what = repr(str(path))
+    start = check_start(start)
     if angle_unit not in ANGLE_UNITS or length_unit not in LENGTH_UNITS:
         raise ParameterError(f"angle unit must be one of {', '.join(ANGLE_UNITS)} and length "
                              f"unit one of {', '.join(LENGTH_UNITS)}")
