@@ -207,8 +207,12 @@ def read_c3d(path: str | Path, rate: float | None = None) -> C3DRecording:
     if n_frames < 2 or not point_rate > 0:
         raise DataFileError(f"{what} has {n_frames} frame(s) at {point_rate:g} Hz; needs at "
                             "least 2")
-    out_rate = point_rate if rate is None else float_in_range("rate [Hz]", rate, *RATE_RANGE,
-                                                              unit="Hz")
+    highest = max(point_rate, analog_rate)
+    kind = "analog" if analog_rate > point_rate else "marker"
+    out_rate = point_rate if rate is None else float_in_range(
+        f"--rate [Hz] for {what} (at most its highest rate, {kind} {highest:g} Hz: a rate "
+        "above it adds no information)", rate, RATE_RANGE[0], min(highest, RATE_RANGE[1]),
+        unit="Hz")
     t_points = np.arange(n_frames) / point_rate
     duration = n_frames / point_rate  # each frame stands for 1 / point_rate
     n_out = samples_over(duration, out_rate)

@@ -48,19 +48,19 @@ class ConvertedRecording:
     def write(self, path: str | Path) -> None:
         """Write the table (.csv with units in the header, or .parquet with units in the
         fields' metadata), atomically."""
-        from .._files import atomic_write_text
-        from ..studies._sweep_grid import table_csv_text, table_format, table_parquet_bytes
+        from .._files import atomic_write_csv, check_output_rows
+        from ..studies._sweep_grid import table_format, table_parquet_bytes
 
         cols = [("time", self.time), *self.columns.items()]
         units = {"time": "s", **self.units}
+        fix = "a lower --rate or --resample, or --start"
         if table_format(path) == "csv":
-            text = table_csv_text(cols)
-            head, _, body = text.partition("\n")
-            named = ",".join(f"{n} [{units[n]}]" if units.get(n) else n for n, _ in cols)
-            atomic_write_text(path, named + "\n" + body)
+            named = [f"{n} [{units[n]}]" if units.get(n) else n for n, _ in cols]
+            atomic_write_csv(path, named, [v for _, v in cols], fix=fix)
         else:
             from .._files import atomic_write_bytes
 
+            check_output_rows(self.time.size, f"--out {str(path)!r}", fix)
             atomic_write_bytes(path, table_parquet_bytes(cols, units))
 
 

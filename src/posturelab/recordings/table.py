@@ -125,13 +125,14 @@ class Recording:
         later = [n for n in self.notes if n.startswith("com_angle by")]
         lines = [n for n in self.notes if n not in later]
         trim = self.trimming
-        if trim is not None and trim.start is not None:
+        split = trim is not None and trim.start is not None and self.resampling is not None
+        if split:  # --start cut before the resampling
             lines.append(f"dropped {trim.dropped_before} sample(s) before {trim.start:g} s")
         if self.resampling is not None:
             lines.append(self.resampling.text())
         lines += later
         if trim is not None:
-            lines.append(trim.text(start=False))
+            lines.append(trim.text(start=not split))
         return lines
 
     def report_dict(self) -> dict:
