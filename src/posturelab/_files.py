@@ -248,6 +248,10 @@ def atomic_outputs(paths: Sequence[str | Path], *, suffix: str = ".tmp", what: s
         return error(f"cannot write {what}{str(path)!r}: {exc.strerror or exc}")
 
     try:
+        for given in paths:
+            if str(given).endswith(tuple(filter(None, ("/", os.sep, os.altsep)))):
+                raise error(f"cannot write {what}{str(given)!r}: a file name cannot end in "
+                            f"{str(given)[-1]!r} (a directory's separator)")
         for path in map(Path, paths):
             refuse_non_regular(path, error)
             directory = path.parent if str(path.parent) else Path(".")

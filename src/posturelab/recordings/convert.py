@@ -71,9 +71,15 @@ def _axis(table: dict, label: str, axis: str, what: str,
     if name in (unusable or {}):
         raise DataFileError(f"{what}: marker {label!r} cannot be used: {unusable[name]}")
     if name not in table:
-        raise DataFileError(f"{what} has no marker {label!r} (column {name!r}); markers: "
-                            + ", ".join(sorted({k.rsplit('_', 1)[0] for k in table
-                                                if k.endswith(('_x', '_y', '_z'))}))[:300])
+        known = sorted({k.rsplit("_", 1)[0] for k in table if k.endswith(("_x", "_y", "_z"))})
+        if known:
+            listing = "markers (LABEL_x, LABEL_y, LABEL_z): " + ", ".join(known)
+        else:
+            listing = ("no marker columns (LABEL_x, LABEL_y, LABEL_z); a column holding a "
+                       "marker's forward position may be named instead: "
+                       + (", ".join(k for k in table if k != "time") or "none"))
+        raise DataFileError(f"{what} has no marker {label!r} (column {name!r}); "
+                            + listing[:300])
     return sign * table[name]
 
 
