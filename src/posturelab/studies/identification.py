@@ -501,7 +501,8 @@ def read_trajectory_csv(path: str | Path, n_links: int) -> tuple[np.ndarray, np.
         unit = rows[0][j].partition("[")[2].rstrip("] ").strip().lower()
         if unit == ("ms" if c == clock else "deg"):
             raise DataFileError(f"{str(path)!r}: column {rows[0][j].strip()!r} is in {unit}; "
-                                f"posturelab reads {'s' if c == clock else 'rad'}: "
+                                "posturelab reads "
+                                f"{'time in s' if c == clock else 'angles in rad'}: "
                                 f"{hints[unit]}")
         check_column_unit(repr(str(path)), rows[0][j], ("s",) if c == clock else ("rad",),
                           "angles in rad and time in s")
