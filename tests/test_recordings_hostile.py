@@ -278,7 +278,6 @@ def test_analog_channels_without_labels_get_unique_names(tmp_path):
 
 def test_a_c3d_table_is_bounded(tmp_path, monkeypatch):
     import posturelab.recordings.c3d as c3d
-
     from posturelab.errors import ParameterError
 
     path = tmp_path / "short.c3d"
