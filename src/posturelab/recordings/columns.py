@@ -25,7 +25,7 @@ import numpy as np
 from .._files import check_column_unit, column_unit
 from ..errors import DataFileError, ParameterError
 
-__all__ = ["read_table", "check_time", "SI_UNITS", "ANGLE_UNITS", "LENGTH_UNITS",
+__all__ = ["read_table", "check_time", "check_start", "SI_UNITS", "ANGLE_UNITS", "LENGTH_UNITS",
            "TIME_UNITS", "MAX_ROWS", "SCALE"]
 
 #: Most data rows a series file may have. [-]
@@ -229,3 +229,16 @@ def check_time(time: np.ndarray, what: str) -> None:
         raise DataFileError(f"{what}: the time column goes backwards at sample {i + 2} "
                             f"({time[i]:g} s, then {time[i + 1]:g} s); sort it or split "
                             "the recording")
+
+
+#: Latest --start accepted. [s]
+MAX_START = 1e7
+
+
+def check_start(start: float | None) -> float | None:
+    """``--start`` [s] checked: None, or a finite time in [0, :data:`MAX_START`] s."""
+    if start is None:
+        return None
+    from .._validation import float_in_range
+
+    return float_in_range("--start [s]", start, 0.0, MAX_START, unit="s")
