@@ -9,7 +9,7 @@ counter-rotation about the hip) against the peak speed of a 6 cm backward ramp-a
 (after Horak & Nashner 1986's ramp translations). Right: against the frequency of a 5 cm
 sinusoidal translation, over the steady part. Blue: the ankle moment limited both ways to
 m g x_toe, 121 N·m (the design's τ_max, the default of ``posturelab strategy``); orange:
-limited per side to what the foot carries, m g x_toe toward the toes and m g |x_heel|, 40 N·m,
+limited per side to what the foot carries, m g x_toe toward the toes and m g (−x_heel), 40 N·m,
 toward the heel (:mod:`posturelab.model.limits`, ``--ankle-limit-from-foot``); grey: no
 limit. Filled markers: the ankle saturated; crosses: the run fell.
 

@@ -22,7 +22,9 @@ def cli(*args):
 @pytest.mark.parametrize("args, words", [
     (["--duration", "1e308"], "duration [s] must be in (0, 86400] s, got 1e+308"),
     (["--duration", "1e6"], "duration [s] must be in (0, 86400] s"),
-    (["--duration", "50000"], "gives 50,000,001 output samples; at most 20,000,000"),
+    (["--duration", "50000"], "gives 50,000,001 output samples (floor(duration × "
+     "sample_rate) + 1, both ends); at most 2,000,000"),
+    (["--duration", "2000"], "gives 2,000,001 output samples"),
     (["--speed", "1e300"], "--speed [m/s] must be in (0, 20] (the step's size; "
      "--disturbance gives its direction), got 1e+300"),
 ])

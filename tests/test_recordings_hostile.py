@@ -278,12 +278,20 @@ def test_analog_channels_without_labels_get_unique_names(tmp_path):
 
 def test_a_c3d_table_is_bounded(tmp_path, monkeypatch):
     import posturelab.recordings.c3d as c3d
+    from posturelab.errors import ParameterError
 
     path = tmp_path / "short.c3d"
     write_c3d(path, {"a": np.zeros((50, 3))}, 100.0)
-    monkeypatch.setattr(c3d, "MAX_TABLE_SAMPLES", 1000)
-    with pytest.raises(DataFileError, match="at most 1,000 are made"):
+    # a rate above the file's own adds no information (and would only cost memory)
+    with pytest.raises(ParameterError, match=r"marker 100 Hz.*must be in \[1, 100\] Hz"):
         read_c3d(path, rate=10_000.0)
+    monkeypatch.setattr(c3d, "MAX_TABLE_SAMPLES", 40)  # 50 frames: 0.5 s at 100 Hz
+    with pytest.raises(DataFileError, match="is 50 samples per column; at most 40 are made"):
+        read_c3d(path)
+    monkeypatch.setattr(c3d, "MAX_TABLE_SAMPLES", 1000)
+    monkeypatch.setattr(c3d, "MAX_TABLE_CELLS", 100)  # 50 samples × 3 columns
+    with pytest.raises(DataFileError, match="= 150 values; at most 100 are made"):
+        read_c3d(path)
 
 
 # ---- --sway straight into frf, and the recording flags on likeness and compare-frf ---------
@@ -403,7 +411,10 @@ def test_sway_on_frf_from_a_lab_csv_equals_convert_then_frf(tmp_path, capsys):
     got = json.loads(out)
     np.testing.assert_allclose(got["gain"], want["gain"], rtol=1e-9)
     np.testing.assert_allclose(got["phase_deg"], want["phase_deg"], atol=1e-7)
-    assert got["trimming"]["dropped_after"] == want["trimming"]["dropped_after"] > 0
+    # the example's 3 whole cycles are kept whole: nothing to drop (the resampled grid
+    # covers the last sample's interval)
+    assert got["trimming"]["dropped_after"] == want["trimming"]["dropped_after"] == 0
+    assert got["trimming"]["samples"] == 6000
     assert got["resampling"]["rate_hz"] == 100.0
 
 

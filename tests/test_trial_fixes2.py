@@ -1,4 +1,4 @@
-"""Defects a new-user trial found: the multi-joint controller's verdict with torque feedback,
+"""Defects a new-user trial found (second set): the multi-joint controller's verdict with torque feedback,
 an explicit --knee, the controller texts (one test per defect, the measured numbers in the
 comments)."""
 

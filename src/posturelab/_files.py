@@ -36,7 +36,7 @@ from .errors import DataFileError, ParameterError, PostureLabError
 __all__ = ["MAX_INPUT_BYTES", "MAX_SCENARIO_BYTES", "MAX_DATA_ROWS", "MAX_FIELD_CHARS",
            "read_text", "csv_rows", "refuse_non_regular", "refuse_input_as_output",
            "new_file_mode", "atomic_outputs", "atomic_write_files", "atomic_write_bytes",
-           "atomic_write_text"]
+           "atomic_write_text", "atomic_write_csv", "check_output_rows"]
 
 #: Largest data file read. [bytes]
 MAX_INPUT_BYTES = 512 * 2**20
@@ -248,6 +248,10 @@ def atomic_outputs(paths: Sequence[str | Path], *, suffix: str = ".tmp", what: s
         return error(f"cannot write {what}{str(path)!r}: {exc.strerror or exc}")
 
     try:
+        for given in paths:
+            if str(given).endswith(tuple(filter(None, ("/", os.sep, os.altsep)))):
+                raise error(f"cannot write {what}{str(given)!r}: a file name cannot end in "
+                            f"{str(given)[-1]!r} (a directory's separator)")
         for path in map(Path, paths):
             refuse_non_regular(path, error)
             directory = path.parent if str(path.parent) else Path(".")
@@ -298,3 +302,71 @@ def atomic_write_bytes(path: str | Path, data: bytes) -> None:
 def atomic_write_text(path: str | Path, text: str) -> None:
     """Write ``text`` (UTF-8) to ``path`` through a temporary file and a rename."""
     atomic_write_files({path: text.encode("utf-8")})
+
+
+#: Rows a table is written in, at a time (bounds the text held in memory). [-]
+CSV_CHUNK_ROWS = 20_000
+
+
+def check_output_rows(rows: int, what: str, fix: str) -> None:
+    """Refuse a table of more than :data:`MAX_DATA_ROWS` rows (posturelab could not read it
+    back), in one line naming ``what`` and the ``fix``."""
+    if rows > MAX_DATA_ROWS:
+        raise ParameterError(f"{what} would be {rows:,} rows; at most {MAX_DATA_ROWS:,} are "
+                             f"written (the most posturelab reads back): {fix}")
+
+
+def atomic_write_csv(path: str | Path, header: Sequence[str], columns: Sequence,
+                     cell=None, *, fix: str = "write fewer rows") -> None:
+    """Write a table as CSV, atomically, a block of :data:`CSV_CHUNK_ROWS` rows at a time
+    (memory bounded by the columns, not by their text), refusing a file posturelab could not
+    read back: more than :data:`MAX_DATA_ROWS` rows or :data:`MAX_INPUT_BYTES` bytes.
+
+    Parameters
+    ----------
+    path : path
+    header : sequence of str
+        The column names (with their units, if any).
+    columns : sequence of numpy.ndarray, shape (S,)
+        The values, one array per column (numbers, or booleans written true/false).
+    cell : callable, optional
+        A number to its text (default: 17 significant digits, exact; NaN an empty cell).
+    fix : str
+        What to do instead, in the refusal.
+
+    Raises
+    ------
+    ParameterError
+        Too many rows or bytes (nothing written).
+    """
+    import numpy as np
+
+    if cell is None:
+        def cell(v: float) -> str:
+            return "" if v != v else repr(v)
+    arrays = [np.asarray(c) for c in columns]
+    rows = len(arrays[0]) if arrays else 0
+    check_output_rows(rows, f"--out {str(path)!r}", fix)
+    written = 0
+    with atomic_outputs([path], what="--out ", error=ParameterError) as (tmp,):
+        with open(tmp, "wb") as fh:
+            head = (",".join(header) + "\n").encode("utf-8")
+            fh.write(head)
+            written += len(head)
+            for a in range(0, rows, CSV_CHUNK_ROWS):
+                texts = []
+                for c in arrays:
+                    block = c[a:a + CSV_CHUNK_ROWS]
+                    if block.dtype == bool:
+                        texts.append(["true" if v else "false" for v in block.tolist()])
+                    else:
+                        texts.append([cell(v) for v in block.astype(float).tolist()])
+                data = "".join(",".join(r) + "\n" for r in zip(*texts, strict=True)
+                               ).encode("utf-8")
+                written += len(data)
+                if written > MAX_INPUT_BYTES:
+                    raise ParameterError(
+                        f"--out {str(path)!r} would be more than {MAX_INPUT_BYTES // 2**20} MiB "
+                        f"({rows:,} rows × {len(arrays)} columns; the most posturelab reads "
+                        f"back): {fix}")
+                fh.write(data)

@@ -6,6 +6,11 @@ the command line turns these into one line on standard error and exit code 2.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+from typing import TypeVar
+
+_T = TypeVar("_T")
+
 
 class PostureLabError(Exception):
     """Base class of all errors that posturelab raises on purpose."""
@@ -36,3 +41,14 @@ class DataFileError(PostureLabError, ValueError):
 class UnknownParameterError(UnknownNameError, ParameterError):
     """A parameter name that is not in the parameter table (:mod:`posturelab.parameters`),
     or names a pair or joint the body lacks; the message lists the known ones."""
+
+
+def lookup(registry: Mapping[str, _T], name: object, what: str, known: str = "known") -> _T:
+    """``registry[name]`` (the name trimmed and lower-cased): a named preset. An unknown
+    name raises :class:`UnknownNameError` "unknown {what} 'x'; {known}: a, b, …", listing the
+    registry's names in order."""
+    try:
+        return registry[str(name).strip().lower()]
+    except KeyError:
+        raise UnknownNameError(f"unknown {what} {name!r}; {known}: "
+                               f"{', '.join(registry)}") from None

@@ -429,6 +429,9 @@ def check_writable(paths: list[str], suffixes: dict[str, tuple[str, ...]] | None
 
     seen: dict[str, str] = {}
     for p in paths:
+        if str(p).endswith(tuple(filter(None, ("/", os.sep, os.altsep)))):
+            raise ParameterError(f"cannot write {str(p)!r}: a file name cannot end in "
+                                 f"{str(p)[-1]!r} (a directory's separator)")
         d = Path(p).parent if str(Path(p).parent) else Path(".")
         if not d.is_dir():
             raise ParameterError(f"cannot write {p!r}: directory {str(d)!r} does not exist")

@@ -162,7 +162,7 @@ def print_reading(recording, data: str | None = None) -> None:
 
     where = f"{data}: " if data else ""
     for line in recording.report_lines():
-        print(f"note: {where}{line}", file=sys.stderr)
+        print(f"posturelab: note: {where}{line}", file=sys.stderr)
 
 
 def print_resampling(report) -> None:
@@ -170,4 +170,4 @@ def print_resampling(report) -> None:
     if report is not None:
         import sys
 
-        print(f"note: {report.text()}", file=sys.stderr)
+        print(f"posturelab: note: {report.text()}", file=sys.stderr)

@@ -113,7 +113,7 @@ def run(args: argparse.Namespace) -> int:
 
     for item in readings:
         for line in item["reading"]:
-            print(f"note: {item['subject']}: {line}", file=sys.stderr)
+            print(f"posturelab: note: {item['subject']}: {line}", file=sys.stderr)
     failed = summary["failed"]
     print(f"fitted {len(cohort.parameters)} parameter(s) to {len(cohort.subjects)} "
           f"subject(s); {len(failed)} failed")

@@ -68,7 +68,7 @@ def run(args: argparse.Namespace) -> int:
         height=args.height, mass=args.mass, start=args.start)
     rec.write(args.out)
     print(f"{len(rec.columns)} columns, {rec.time.size} samples at {rec.rate:g} Hz "
-          f"({rec.time[-1] - rec.time[0]:g} s)")
+          f"({rec.time.size / rec.rate:g} s)")
     for note in rec.notes:
         print(f"  {note}")
     print(f"wrote {args.out}")

@@ -75,7 +75,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     """The options of ``posturelab simulate``."""
     add_experiment_arguments(p)
     out = p.add_argument_group("output")
-    out.add_argument("--out", metavar="RUN.csv", help="write the time series as CSV.")
+    out.add_argument("--out", metavar="RUN.csv|RUN.parquet",
+                     help="write the time series as CSV, or Parquet (units in each field's "
+                     "metadata).")
     out.add_argument("--plot", metavar="RUN.png", help="write a 2×2 summary figure (PNG/SVG/PDF).")
     out.add_argument("--animate", metavar="RUN.gif", help="write a stick-figure animation (GIF).")
     out.add_argument("--json", action="store_true",
@@ -401,6 +403,20 @@ def experiment_inputs(args: argparse.Namespace) -> dict[str, str | None]:
     return {"--scenario": args.scenario, "--platform-profile": args.platform_profile}
 
 
+def _write_run(result, path: str) -> None:
+    """--out: the run's time series as CSV, or Parquet with each unit in its field's
+    metadata (as sweep and convert write)."""
+    if not str(path).lower().endswith(".parquet"):
+        result.to_csv(path)
+        return
+    from .._files import atomic_write_bytes
+    from ..studies._sweep_grid import table_parquet_bytes
+
+    names, table = result.columns()
+    atomic_write_bytes(path, table_parquet_bytes(list(zip(names, table.T, strict=True)),
+                                                 result.column_units()))
+
+
 def run(args: argparse.Namespace) -> int:
     from .._files import refuse_input_as_output
 
@@ -408,14 +424,14 @@ def run(args: argparse.Namespace) -> int:
                            {"--out": args.out, "--plot": args.plot, "--animate": args.animate})
     sc = scenario_from_args(args)
     outputs = [p for p in (args.out, args.plot, args.animate) if p]
-    check_writable(outputs, {args.out: (".csv",), args.plot: FIGURE_SUFFIXES,
+    check_writable(outputs, {args.out: (".csv", ".parquet"), args.plot: FIGURE_SUFFIXES,
                              args.animate: (".gif",)})
     if sc.options.time_limit is None:
         sc = sc.replace(time_limit=DEFAULT_TIME_LIMIT)
     with naming_given_options(args):
         result = sc.run(engine=args.engine)
     if args.out:
-        result.to_csv(args.out)
+        _write_run(result, args.out)
     if args.plot:
         from ..viz.plots import plot_run_overview, save_figure
 

@@ -56,7 +56,7 @@ Example: posturelab stability-map --body paper-1link --stiffness 28 --viscosity 
              --feedback-delay 0.15 --out dmap.png
 """
 
-MAX_RESOLUTION = 5000
+MAX_RESOLUTION = 1414  # 1414² = 1,999,396 CSV rows: at most the rows posturelab reads back
 #: Axes of the delayed (D-subdivision) map: one pair's active stiffness [N·m/rad] and
 #: active viscosity [N·m·s/rad].
 DELAYED_AXES = ("active_stiffness", "active_viscosity")

@@ -299,7 +299,20 @@ def _fit_one(task: _CohortTask, subject: str, data) -> SubjectFit:
                       reading)
 
 
+def _refuse_repeated_files(subjects) -> None:
+    """One file given twice would be fitted as two subjects: refused."""
+    seen: dict[Path, str] = {}
+    for s in subjects:
+        if isinstance(s, str | Path):
+            key = Path(s).resolve()
+            if key in seen:
+                raise ParameterError(f"--data names the same file twice ({seen[key]!r} and "
+                                     f"{str(s)!r}); each subject is one file, given once")
+            seen[key] = str(s)
+
+
 def _subject_names(subjects, names) -> list[str]:
+    _refuse_repeated_files(subjects)
     if names is not None:
         names = [str(n) for n in names]
         if len(names) != len(subjects):

@@ -25,7 +25,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from .._validation import float_in_range
-from ..errors import ParameterError, UnknownNameError
+from ..errors import ParameterError, lookup
 from ..parameters import HEIGHT_RANGE, MASS_RANGE
 from .body import Body, BodyPreset, paper_body, register_body_preset
 
@@ -78,11 +78,7 @@ def body_from_anthropometry(height: float, mass: float, table: str = "winter",
     """
     h = float_in_range("height [m]", height, *HEIGHT_RANGE, unit="m")
     m = float_in_range("mass [kg]", mass, *MASS_RANGE, unit="kg")
-    try:
-        rows, citation = ANTHROPOMETRIC_TABLES[table]
-    except KeyError:
-        raise UnknownNameError(f"unknown anthropometric table {table!r}; known: "
-                               f"{', '.join(ANTHROPOMETRIC_TABLES)}") from None
+    rows, citation = lookup(ANTHROPOMETRIC_TABLES, table, "anthropometric table")
     names, masses, lengths, coms, inertias = [], [], [], [], []
     for name, (mass_frac, len_frac, com_frac, rg_frac, count) in rows.items():
         seg_len = len_frac * h

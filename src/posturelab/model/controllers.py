@@ -21,7 +21,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ..errors import ParameterError, UnknownNameError
+from ..errors import ParameterError, lookup
 from .body import Body
 from .muscles import MusclePair, MuscleSet
 
@@ -217,11 +217,7 @@ def get_controller(name: str) -> ControllerPreset:
     UnknownNameError
         Naming the known presets.
     """
-    try:
-        return CONTROLLERS[str(name).strip().lower()]
-    except KeyError:
-        raise UnknownNameError(f"unknown controller {name!r}; known controllers: "
-                               f"{', '.join(CONTROLLERS)}") from None
+    return lookup(CONTROLLERS, name, "controller", "known controllers")
 
 
 @dataclass(frozen=True)
@@ -354,8 +350,4 @@ MULTIJOINT_CONTROLLERS: dict[str, MultiJointPreset] = {
 
 def get_multijoint_controller(name: str) -> MultiJointPreset:
     """The multi-joint preset ``name``; an unknown name lists the known ones."""
-    try:
-        return MULTIJOINT_CONTROLLERS[str(name).strip().lower()]
-    except KeyError:
-        raise UnknownNameError(f"unknown multi-joint controller {name!r}; known: "
-                               f"{', '.join(MULTIJOINT_CONTROLLERS)}") from None
+    return lookup(MULTIJOINT_CONTROLLERS, name, "multi-joint controller")

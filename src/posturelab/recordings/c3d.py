@@ -19,8 +19,11 @@ left out of the table (its reason kept in :attr:`C3DRecording.unusable`, said wh
 marker is asked for), as is a marker occluded throughout and an analog channel with
 missing (NaN) samples that cannot be filled. Labels are made unique (an
 empty label becomes ``analogN``/``markerN``, a repeated one gets ``_2``, ``_3``). Time
-starts at 0 at the first frame; a file with fewer than 2 frames is refused, and so is a
-table of more than :data:`MAX_TABLE_SAMPLES` samples per column.
+starts at 0 at the first frame, and the table covers the whole record: ``F`` frames at
+``f`` Hz are ``F / f`` seconds, ``round(F / f × rate)`` samples. A file with fewer than 2
+frames is refused, and so is a ``rate`` above the file's highest (marker or analog) rate,
+a table of more than :data:`MAX_TABLE_SAMPLES` samples per column or
+:data:`MAX_TABLE_CELLS` values.
 
 A truncated file is refused: ezc3d reads as many frames as a cut file holds, so the data
 size the header announces is checked against the file's size first.
@@ -36,7 +39,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import DataFileError, PostureLabError
-from .resample import MAX_GAP_STEPS, RATE_RANGE, resample_uniform
+from .resample import MAX_GAP_STEPS, RATE_RANGE, resample_uniform, samples_over
 
 __all__ = ["C3DRecording", "read_c3d", "write_c3d", "EZC3D_CITATION"]
 
@@ -49,6 +52,8 @@ LENGTH_FACTORS = {"mm": 1e-3, "cm": 1e-2, "m": 1.0}
 MAX_C3D_BYTES = 512 * 2**20
 #: Most samples per column of the table (bounds memory when --rate raises the rate). [-]
 MAX_TABLE_SAMPLES = 2_000_000
+#: Most values (samples × columns) of the table: 400 MB of float64. [-]
+MAX_TABLE_CELLS = 50_000_000
 
 
 @dataclass(frozen=True)
@@ -207,13 +212,28 @@ def read_c3d(path: str | Path, rate: float | None = None) -> C3DRecording:
     if n_frames < 2 or not point_rate > 0:
         raise DataFileError(f"{what} has {n_frames} frame(s) at {point_rate:g} Hz; needs at "
                             "least 2")
-    out_rate = point_rate if rate is None else float_in_range("rate [Hz]", rate, *RATE_RANGE,
-                                                              unit="Hz")
+    highest = max(point_rate, analog_rate)
+    kind = "analog" if analog_rate > point_rate else "marker"
+    out_rate = point_rate if rate is None else float_in_range(
+        f"--rate [Hz] for {what} (at most its highest rate, {kind} {highest:g} Hz: a rate "
+        "above it adds no information)", rate, RATE_RANGE[0], min(highest, RATE_RANGE[1]),
+        unit="Hz")
     t_points = np.arange(n_frames) / point_rate
-    n_out = int(np.floor(t_points[-1] * out_rate * (1 + 1e-12))) + 1
+    duration = n_frames / point_rate  # each frame stands for 1 / point_rate
+    n_out = samples_over(duration, out_rate)
     if n_out > MAX_TABLE_SAMPLES:
-        raise DataFileError(f"{what}: {t_points[-1]:g} s at {out_rate:g} Hz is {n_out:,} "
-                            f"samples per column; at most {MAX_TABLE_SAMPLES:,} are made")
+        raise DataFileError(f"{what}: {duration:g} s at --rate {out_rate:g} Hz is {n_out:,} "
+                            f"samples per column; at most {MAX_TABLE_SAMPLES:,} are made "
+                            f"(--rate at most {MAX_TABLE_SAMPLES / duration:.6g} Hz for this "
+                            "file)")
+    n_analog = int(np.asarray(c["data"]["analogs"]).shape[1]) if np.asarray(
+        c["data"]["analogs"]).ndim == 3 else 0
+    cells = n_out * (3 * points.shape[1] + n_analog + 6 * len(c["data"].get("platform", [])
+                                                             or []))
+    if cells > MAX_TABLE_CELLS:
+        raise DataFileError(f"{what}: {duration:g} s at {out_rate:g} Hz is {n_out:,} samples "
+                            f"× {cells // n_out} columns = {cells:,} values; at most "
+                            f"{MAX_TABLE_CELLS:,} are made (bounds memory; a lower --rate)")
     grid = np.arange(n_out) / out_rate
     columns: dict[str, np.ndarray] = {}
     units: dict[str, str] = {}

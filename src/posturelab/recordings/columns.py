@@ -25,7 +25,7 @@ import numpy as np
 from .._files import check_column_unit, column_unit
 from ..errors import DataFileError, ParameterError
 
-__all__ = ["read_table", "check_time", "SI_UNITS", "ANGLE_UNITS", "LENGTH_UNITS",
+__all__ = ["read_table", "check_time", "check_start", "SI_UNITS", "ANGLE_UNITS", "LENGTH_UNITS",
            "TIME_UNITS", "MAX_ROWS", "SCALE"]
 
 #: Most data rows a series file may have. [-]
@@ -103,6 +103,8 @@ def read_table(path: str | Path, columns: list[str] | None = None, *,
                                     f"{_listing(names)}")
         wanted = names if columns is None else list(columns)
         return rec.time, {c: rec.columns[c] for c in wanted}, {c: rec.units[c] for c in wanted}
+    if path.suffix.lower() == ".parquet":
+        return _read_parquet(path, columns, skipped, time_unit)
     return _read_csv(path, columns, skipped, time_unit)
 
 
@@ -217,6 +219,70 @@ def _read_csv(path: Path, columns: list[str] | None, skipped: list[str] | None =
             {c: data[:, k + 1] for k, c in enumerate(wanted_cols)}, units)
 
 
+def _read_parquet(path: Path, columns: list[str] | None, skipped: list[str] | None = None,
+                  time_unit: str = "s"):
+    """A Parquet table (as ``convert``, ``simulate`` and ``sweep`` write it: each field's
+    unit in its metadata ``unit``), read like a CSV: a ``time`` or ``t`` column, nulls as
+    NaN (missing samples), NaN or inf values refused."""
+    from .._files import MAX_DATA_ROWS, MAX_INPUT_BYTES
+
+    what = repr(str(path))
+    try:
+        import pyarrow as pa
+        import pyarrow.parquet as pq
+    except ImportError:
+        raise DataFileError(f"reading {what} (Parquet) needs pyarrow: pip install pyarrow, "
+                            "or give a CSV") from None
+    try:
+        size = path.stat().st_size
+        if size > MAX_INPUT_BYTES:
+            raise DataFileError(f"{what} is {size:,} bytes; at most {MAX_INPUT_BYTES:,}")
+        meta = pq.read_metadata(path)
+        if meta.num_rows > MAX_DATA_ROWS:
+            raise DataFileError(f"{what} has {meta.num_rows:,} rows; at most "
+                                f"{MAX_DATA_ROWS:,}")
+        table = pq.read_table(path)
+    except (OSError, pa.ArrowException) as exc:
+        first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+        raise DataFileError(f"cannot read {what} as Parquet: {first}") from None
+    fields = {_name(f.name): f for f in table.schema}
+    if "time" not in fields:
+        raise DataFileError(f"{what} has no time column (named t or time, in s); columns: "
+                            f"{_listing(list(fields))}")
+
+    def numeric(f) -> bool:
+        return pa.types.is_floating(f.type) or pa.types.is_integer(f.type)
+
+    if columns is None:
+        wanted_cols = [n for n, f in fields.items() if n != "time" and numeric(f)]
+        if skipped is not None:
+            skipped.extend(n for n, f in fields.items() if n != "time" and not numeric(f))
+    else:
+        wanted_cols = list(columns)
+    units = {}
+    out = {}
+    for c in ["time", *wanted_cols]:
+        if c not in fields:
+            raise DataFileError(f"{what} has no column {c!r}; columns: "
+                                f"{_listing(list(fields))}")
+        f = fields[c]
+        if not numeric(f):
+            raise DataFileError(f"{what}: column {c!r} is {f.type}, not a number")
+        values = table.column(f.name).to_numpy(zero_copy_only=False).astype(float)
+        bad = np.flatnonzero(np.isinf(values) | (np.isnan(values) & (c == "time")))
+        if bad.size:
+            raise DataFileError(f"{what} row {int(bad[0]) + 1}: column {c!r} is "
+                                f"{values[bad[0]]}; NaN and inf are not allowed")
+        meta_unit = (f.metadata or {}).get(b"unit", b"").decode("utf-8", "replace")
+        units[c], out[c] = meta_unit, values
+    time_declared = units.pop("time")
+    if time_declared and time_declared != time_unit:
+        raise DataFileError(f"{what}: the time column is in {time_declared}; posturelab reads "
+                            f"it in {time_unit}" + (": give --time-unit ms" if
+                                                   time_declared == "ms" else ""))
+    return out.pop("time") * SCALE[time_unit], out, units
+
+
 def check_time(time: np.ndarray, what: str) -> None:
     """Refuse a time column that repeats a time stamp or goes backwards (naming where)."""
     dt = np.diff(time)
@@ -229,3 +295,16 @@ def check_time(time: np.ndarray, what: str) -> None:
         raise DataFileError(f"{what}: the time column goes backwards at sample {i + 2} "
                             f"({time[i]:g} s, then {time[i + 1]:g} s); sort it or split "
                             "the recording")
+
+
+#: Latest --start accepted. [s]
+MAX_START = 1e7
+
+
+def check_start(start: float | None) -> float | None:
+    """``--start`` [s] checked: None, or a finite time in [0, :data:`MAX_START`] s."""
+    if start is None:
+        return None
+    from .._validation import float_in_range
+
+    return float_in_range("--start [s]", start, 0.0, MAX_START, unit="s")

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import DataFileError, ParameterError
-from .columns import ANGLE_UNITS, LENGTH_UNITS, SCALE, check_time
+from .columns import ANGLE_UNITS, LENGTH_UNITS, SCALE, check_start, check_time
 from .resample import ResampleReport
 from .sway import AXES, SwaySpec
 
@@ -48,19 +48,19 @@ class ConvertedRecording:
     def write(self, path: str | Path) -> None:
         """Write the table (.csv with units in the header, or .parquet with units in the
         fields' metadata), atomically."""
-        from .._files import atomic_write_text
-        from ..studies._sweep_grid import table_csv_text, table_format, table_parquet_bytes
+        from .._files import atomic_write_csv, check_output_rows
+        from ..studies._sweep_grid import table_format, table_parquet_bytes
 
         cols = [("time", self.time), *self.columns.items()]
         units = {"time": "s", **self.units}
+        fix = "a lower --rate or --resample, or --start"
         if table_format(path) == "csv":
-            text = table_csv_text(cols)
-            head, _, body = text.partition("\n")
-            named = ",".join(f"{n} [{units[n]}]" if units.get(n) else n for n, _ in cols)
-            atomic_write_text(path, named + "\n" + body)
+            named = [f"{n} [{units[n]}]" if units.get(n) else n for n, _ in cols]
+            atomic_write_csv(path, named, [v for _, v in cols], fix=fix)
         else:
             from .._files import atomic_write_bytes
 
+            check_output_rows(self.time.size, f"--out {str(path)!r}", fix)
             atomic_write_bytes(path, table_parquet_bytes(cols, units))
 
 
@@ -71,9 +71,15 @@ def _axis(table: dict, label: str, axis: str, what: str,
     if name in (unusable or {}):
         raise DataFileError(f"{what}: marker {label!r} cannot be used: {unusable[name]}")
     if name not in table:
-        raise DataFileError(f"{what} has no marker {label!r} (column {name!r}); markers: "
-                            + ", ".join(sorted({k.rsplit('_', 1)[0] for k in table
-                                                if k.endswith(('_x', '_y', '_z'))}))[:300])
+        known = sorted({k.rsplit("_", 1)[0] for k in table if k.endswith(("_x", "_y", "_z"))})
+        if known:
+            listing = "markers (LABEL_x, LABEL_y, LABEL_z): " + ", ".join(known)
+        else:
+            listing = ("no marker columns (LABEL_x, LABEL_y, LABEL_z); a column holding a "
+                       "marker's forward position may be named instead: "
+                       + (", ".join(k for k in table if k != "time") or "none"))
+        raise DataFileError(f"{what} has no marker {label!r} (column {name!r}); "
+                            + listing[:300])
     return sign * table[name]
 
 
@@ -130,6 +136,7 @@ def convert_recording(path: str | Path, *, rate: float | None = None,
 
     path = Path(path)
     what = repr(str(path))
+    start = check_start(start)
     if angle_unit not in ANGLE_UNITS or length_unit not in LENGTH_UNITS:
         raise ParameterError(f"angle unit must be one of {', '.join(ANGLE_UNITS)} and length "
                              f"unit one of {', '.join(LENGTH_UNITS)}")

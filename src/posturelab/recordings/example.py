@@ -77,7 +77,7 @@ def make_lab_csv(path: str | Path, seed: int = 21) -> None:
     rng = np.random.default_rng(seed)
     steps = rng.uniform(0.0107, 0.0117, int(rec.time[-1] / 0.0107) + 2)
     t = np.concatenate([[0.0], np.cumsum(steps)])
-    t = t[t <= rec.time[-1]]
+    t = t[t < rec.time.size / rec.rate]  # the C3D's record: 3 whole cycles, 0 … 60 s
     cols = [t, CubicSpline(rec.time, rec.columns["tilt"])(t),  # ANALOG:UNITS deg
             1000 * CubicSpline(rec.time, rec.columns["hip_x"])(t),
             1000 * CubicSpline(rec.time, rec.columns["sho_x"])(t)]

@@ -9,6 +9,15 @@ step of the time column, or a run of missing (NaN) samples in one column — lon
 ``max_gap`` [s] (default :data:`MAX_GAP_STEPS` median steps), naming where it is. It says
 what it did (:class:`ResampleReport`).
 
+The grid covers the **whole record**: each sample stands for the interval
+``[t_k, t_k + step)`` (``step`` the median step of the time column), so a record of S samples
+spans ``t_0 … t_last + step``, a duration ``D = t_last − t_0 + step``, and is resampled to
+``round(D · rate)`` samples ``t_0 + k / rate`` — a 60 s recording at 50 Hz gives 6,000
+samples at 100 Hz (three whole 20 s cycles), not 5,999. The grid points past ``t_last``
+(fewer than one input step, e.g. one point going from 50 Hz to 100 Hz) are the cubic
+spline's end polynomial continued (its extrapolation over less than one step), counted in
+:attr:`ResampleReport.extrapolated`.
+
 Accuracy (tests/test_recordings.py): a sinusoid of frequency f sampled at f_s with a
 jittered clock is reproduced by the spline with an error of order (2πf/f_s)⁴ of its
 amplitude — at f = 2.2 Hz (the highest band of the 80-state PRTS protocol) and f_s ≈ 90 Hz
@@ -25,7 +34,8 @@ from .._validation import float_in_range
 from ..errors import DataFileError
 
 __all__ = ["ResampleReport", "resample_uniform", "MAX_GAP_STEPS", "MAX_SAMPLES_OUT",
-           "INTERPOLATION", "RATE_RANGE", "uniform_step"]
+           "INTERPOLATION", "RATE_RANGE", "uniform_step", "record_duration",
+           "samples_over"]
 
 #: Longest gap accepted by default, in median steps of the time column. [-]
 MAX_GAP_STEPS = 3.0
@@ -57,6 +67,9 @@ class ResampleReport:
         The longest gap accepted. [s]
     filled : int
         Missing (NaN) samples filled by the interpolation, over all columns. [-]
+    extrapolated : int
+        Output samples past the last input time (within its interval; fewer than one input
+        step), continued by the spline's end polynomial. [-]
     """
 
     rate: float
@@ -68,10 +81,14 @@ class ResampleReport:
     step_max: float
     max_gap: float
     filled: int
+    extrapolated: int = 0
 
     def text(self) -> str:
         """One line saying what was done."""
         filled = f"; {self.filled} missing sample(s) filled" if self.filled else ""
+        if self.extrapolated:
+            filled += (f"; the last {self.extrapolated} sample(s), within the last input "
+                       "sample's interval, continue the spline's end")
         return (f"resampled {self.samples_in} samples (steps {self.step_min:.6g} … "
                 f"{self.step_max:.6g} s, median {self.step_median:.6g} s) to "
                 f"{self.samples_out} at {self.rate:g} Hz by {self.interpolation}; gaps up to "
@@ -83,7 +100,7 @@ class ResampleReport:
                 "samples_in": self.samples_in, "samples_out": self.samples_out,
                 "step_min_s": self.step_min, "step_median_s": self.step_median,
                 "step_max_s": self.step_max, "max_gap_s": self.max_gap,
-                "filled": self.filled}
+                "filled": self.filled, "extrapolated": self.extrapolated}
 
 
 def uniform_step(time: np.ndarray) -> float | None:
@@ -124,8 +141,9 @@ def resample_uniform(time: np.ndarray, columns: dict[str, np.ndarray], rate: flo
     Returns
     -------
     (numpy.ndarray, dict, ResampleReport)
-        The new times ``time[0] + k / rate`` up to ``time[-1]`` [s], each column on them,
-        and what was done.
+        The new times ``time[0] + k / rate``, ``k < round(D · rate)`` with
+        ``D = time[-1] − time[0] + median step`` (the whole record, the last sample's
+        interval included) [s], each column on them, and what was done.
 
     Raises
     ------
@@ -156,11 +174,13 @@ def resample_uniform(time: np.ndarray, columns: dict[str, np.ndarray], rate: flo
         raise DataFileError(f"{what}: a gap of {dt[worst]:.4g} s in the time column at "
                             f"t = {t[worst]:g} … {t[worst + 1]:g} s, longer than the "
                             f"{limit:.4g} s accepted ({gap_words or _limit_words(max_gap)})")
-    n_out = int(np.floor((t[-1] - t[0]) * rate * (1 + 1e-12))) + 1
+    duration = record_duration(t)
+    n_out = samples_over(duration, rate)
     if n_out > MAX_SAMPLES_OUT:
-        raise DataFileError(f"{what}: {t[-1] - t[0]:g} s at {rate:g} Hz is {n_out:,} samples; "
+        raise DataFileError(f"{what}: {duration:g} s at {rate:g} Hz is {n_out:,} samples; "
                             f"at most {MAX_SAMPLES_OUT:,} are made (a lower --resample rate)")
     grid = t[0] + np.arange(n_out) / rate
+    extrapolated = int(np.count_nonzero(grid > t[-1] + 1e-9 * median))
     out, filled = {}, 0
     for name, values in columns.items():
         v = np.asarray(values, dtype=float)
@@ -181,8 +201,21 @@ def resample_uniform(time: np.ndarray, columns: dict[str, np.ndarray], rate: flo
     report = ResampleReport(rate=rate, interpolation=INTERPOLATION, samples_in=int(t.size),
                             samples_out=int(n_out), step_min=float(dt.min()),
                             step_median=median, step_max=float(dt.max()), max_gap=limit,
-                            filled=filled)
+                            filled=filled, extrapolated=extrapolated)
     return grid, out, report
+
+
+def record_duration(time: np.ndarray) -> float:
+    """The duration a record of samples at ``time`` covers [s]: from the first sample to
+    the end of the last one's interval, ``time[-1] − time[0] + median step``."""
+    t = np.asarray(time, dtype=float)
+    return float(t[-1] - t[0] + np.median(np.diff(t)))
+
+
+def samples_over(duration: float, rate: float) -> int:
+    """Samples at ``rate`` [Hz] that cover ``duration`` [s]: ``round(duration · rate)``,
+    at least 1. [-]"""
+    return max(int(round(float(duration) * float(rate))), 1)
 
 
 def _limit_words(max_gap: float | None) -> str:

@@ -218,9 +218,12 @@ def com_angle_two_markers(hip, shoulder, ankle=None, *, height: float | None = N
     """
     hip_a, sh_a = np.asarray(hip, dtype=float), np.asarray(shoulder, dtype=float)
     if hip_a.ndim == 1:
-        if height is None or not 0.5 <= float(height) <= 2.5:
+        if height is None:
+            raise ParameterError("--height is required for --sway two-marker from forward "
+                                 "positions only (the subject's height in 0.5 … 2.5 m)")
+        if not 0.5 <= float(height) <= 2.5:
             raise ParameterError("two-marker sway from forward positions only needs the "
-                                 f"subject's height in 0.5 … 2.5 m, got {height!r}")
+                                 f"subject's height in 0.5 … 2.5 m, got {float(height):g}")
         hgt = float(height)
         ax = np.zeros_like(hip_a) if ankle is None else np.broadcast_to(
             np.asarray(ankle, dtype=float), hip_a.shape)

@@ -71,15 +71,18 @@ class TrimReport:
     cycle_length: float | None
     samples: int
 
-    def text(self) -> str:
-        """One line saying what was cut."""
+    def text(self, start: bool = True) -> str:
+        """One line saying what was cut (``start=False``: leaving out the samples dropped
+        before ``start``, said on their own line)."""
         parts = []
-        if self.start is not None:
+        if start and self.start is not None:
             parts.append(f"dropped {self.dropped_before} sample(s) before {self.start:g} s")
         if self.dropped_after:
             parts.append(f"dropped the last {self.dropped_after} sample(s) "
                          f"({self.dropped_after_duration:.4g} s), a partial cycle of "
                          f"{self.cycle_length:g} s")
+        if not parts and not start and self.start is not None:
+            return f"{self.samples} sample(s) kept"
         return "; ".join(parts or ["nothing cut"]) + f"; {self.samples} sample(s) kept"
 
     def to_dict(self) -> dict:
@@ -116,10 +119,21 @@ class Recording:
     notes: tuple[str, ...] = field(default=())
 
     def report_lines(self) -> list[str]:
-        """One line per thing done (for standard error)."""
-        lines = [] if self.resampling is None else [self.resampling.text()]
-        lines += [] if self.trimming is None else [self.trimming.text()]
-        return lines + list(self.notes)
+        """One line per thing done, in the order it was done (for standard error): reading
+        (units), samples dropped before --start, resampling, com_angle, the partial cycle
+        dropped (or nothing cut) and the samples kept."""
+        later = [n for n in self.notes if n.startswith("com_angle by")]
+        lines = [n for n in self.notes if n not in later]
+        trim = self.trimming
+        split = trim is not None and trim.start is not None and self.resampling is not None
+        if split:  # --start cut before the resampling
+            lines.append(f"dropped {trim.dropped_before} sample(s) before {trim.start:g} s")
+        if self.resampling is not None:
+            lines.append(self.resampling.text())
+        lines += later
+        if trim is not None:
+            lines.append(trim.text(start=not split))
+        return lines
 
     def report_dict(self) -> dict:
         """``resampling`` and ``trimming`` (when done) and ``notes``, JSON-ready."""
@@ -185,6 +199,9 @@ def read_recording(path: str | Path, columns: list[str],
     ------
     DataFileError, ParameterError
     """
+    from .columns import check_start
+
+    start = check_start(start)
     if angle_unit not in ANGLE_UNITS:
         raise ParameterError(f"angle unit must be one of {', '.join(ANGLE_UNITS)}, got "
                              f"{angle_unit!r}")

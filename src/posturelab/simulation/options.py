@@ -65,8 +65,10 @@ ENGINE_DEFAULTS: dict[str, tuple[float, float, str | None]] = {
 COMPILED_METHODS = ("Radau", "RK45", "RK23")
 #: The scipy ``solve_ivp`` methods a scenario file may name for the reference engine.
 REFERENCE_METHODS = ("DOP853", "RK45", "RK23", "Radau", "BDF", "LSODA")
-#: Most output samples of one run (duration × sample_rate + 1). [-]
-MAX_OUTPUT_SAMPLES = 20_000_000
+#: Most output samples of one run: the samples at 0, 1/sample_rate, … up to duration,
+#: floor(duration × sample_rate) + 1 of them, at most the rows posturelab reads back
+#: (posturelab._files.MAX_DATA_ROWS). [-]
+MAX_OUTPUT_SAMPLES = 2_000_000
 #: The step budget of a run when none is given: this many accepted integrator steps … [-]
 BASE_STEP_BUDGET = 1_000_000
 #: … and this many more per simulated second. [1/s]
@@ -274,10 +276,11 @@ class RunOptions:
         put("sample_rate", sample_rate)
         samples = math.floor(duration * sample_rate) + 1
         if samples > MAX_OUTPUT_SAMPLES:
-            raise ParameterError(f"duration [s] × sample_rate [Hz] = {duration:g} × "
-                                 f"{sample_rate:g} gives {samples:,} output samples; at most "
-                                 f"{MAX_OUTPUT_SAMPLES:,} (lower the sample rate or the "
-                                 "duration)")
+            raise ParameterError(f"duration [s] {duration:g} at sample_rate [Hz] "
+                                 f"{sample_rate:g} gives {samples:,} output samples "
+                                 "(floor(duration × sample_rate) + 1, both ends); at most "
+                                 f"{MAX_OUTPUT_SAMPLES:,}, the rows posturelab reads back "
+                                 "(lower the sample rate or the duration)")
         if not _is_integer(self.max_switches) or self.max_switches < 0:
             raise ParameterError(f"max_switches must be an integer >= 0, got "
                                  f"{self.max_switches!r}")

@@ -357,8 +357,30 @@ class SimulationResult:
         return buf.getvalue()
 
     def to_csv(self, path: str | Path) -> None:
-        """Write the CSV atomically (temporary file, then rename)."""
-        atomic_write_text(path, self.to_csv_text())
+        """Write the CSV atomically (temporary file, then rename), a block of rows at a time;
+        refused (nothing written) over the rows or bytes posturelab reads back."""
+        from .._files import atomic_write_csv
+
+        names, table = self.columns()
+        atomic_write_csv(path, names, table.T, cell=lambda v: f"{v:.10g}",
+                         fix="write .parquet, or lower the sample rate or the duration")
+
+    def column_units(self) -> dict[str, str]:
+        """The unit of each column of :meth:`columns`."""
+        names, _ = self.columns()
+        units = {"t": "s", "cog_x": "m", "cog_y": "m", "cog_vx": "m/s", "cog_vy": "m/s",
+                 "platform_ax": "m/s²", "platform_ay": "m/s²", "platform_vx": "m/s",
+                 "platform_vy": "m/s", "platform_x": "m", "platform_y": "m", "cop_x": "m",
+                 "ground_fx": "N", "ground_fy": "N", "tilt": "rad", "visual_tilt": "rad",
+                 "com_angle": "rad"}
+        for n in names:
+            if n.startswith("theta"):
+                units[n] = "rad"
+            elif n.startswith("omega"):
+                units[n] = "rad/s"
+            elif n.startswith(("M_", "U", "joint_moment")):
+                units[n] = "N·m"
+        return {n: units.get(n, "") for n in names}
 
 
 def read_run_csv(path: str | Path) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

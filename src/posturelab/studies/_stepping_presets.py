@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
-from ..errors import UnknownNameError
+from ..errors import lookup
 from ..model.body import Body
 from ..model.controllers import Provenance, get_controller
 from ..model.muscles import MusclePair, MuscleSet
@@ -153,11 +153,7 @@ def get_population(name: str) -> Population:
     UnknownNameError
         Naming the known populations.
     """
-    try:
-        return POPULATIONS[str(name).strip().lower()]
-    except KeyError:
-        raise UnknownNameError(f"unknown population {name!r}; known populations: "
-                               f"{', '.join(POPULATIONS)}") from None
+    return lookup(POPULATIONS, name, "population", "known populations")
 
 
 @dataclass(frozen=True)

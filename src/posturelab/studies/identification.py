@@ -469,7 +469,8 @@ def fit_stiffness(
 
 
 def read_trajectory_csv(path: str | Path, n_links: int) -> tuple[np.ndarray, np.ndarray]:
-    """Read measured link angles: columns ``t`` [s] and ``theta1`` … ``thetaN`` [rad].
+    """Read measured link angles: columns ``t`` (or ``time``) [s] and ``theta1`` …
+    ``thetaN`` [rad].
 
     ``posturelab simulate --out`` writes this format; other columns are ignored.
 
@@ -486,15 +487,24 @@ def read_trajectory_csv(path: str | Path, n_links: int) -> tuple[np.ndarray, np.
     rows = [r for _, r in csv_rows(read_text(path, "trajectory"), repr(str(path)))]
     if len(rows) < 3:
         raise DataFileError(f"{str(path)!r} needs a header row and at least 2 samples")
-    header = [h.split("[")[0].strip() for h in rows[0]]
-    need = ["t"] + [f"theta{i + 1}" for i in range(n_links)]
+    header = [h.split("[")[0].strip().lower() for h in rows[0]]
+    clock = next((c for c in ("t", "time") if c in header), "t")  # as the recordings read
+    need = [clock] + [f"theta{i + 1}" for i in range(n_links)]
     missing = [c for c in need if c not in header]
     if missing:
-        raise DataFileError(f"{str(path)!r} lacks column {missing[0]!r}; needs "
-                            f"{', '.join(need)}")
+        raise DataFileError(f"{str(path)!r} lacks column {missing[0]!r}; needs a time "
+                            f"column (t or time) and {', '.join(need[1:])}")
     idx = [header.index(c) for c in need]
+    hints = {"deg": "give --angle-unit deg to read degrees",
+             "ms": "give --time-unit ms to read milliseconds"}
     for c, j in zip(need, idx, strict=True):
-        check_column_unit(repr(str(path)), rows[0][j], ("s",) if c == "t" else ("rad",),
+        unit = rows[0][j].partition("[")[2].rstrip("] ").strip().lower()
+        if unit == ("ms" if c == clock else "deg"):
+            raise DataFileError(f"{str(path)!r}: column {rows[0][j].strip()!r} is in {unit}; "
+                                "posturelab reads "
+                                f"{'time in s' if c == clock else 'angles in rad'}: "
+                                f"{hints[unit]}")
+        check_column_unit(repr(str(path)), rows[0][j], ("s",) if c == clock else ("rad",),
                           "angles in rad and time in s")
     try:
         data = np.array([[float(r[j]) for j in idx] for r in rows[1:]])
