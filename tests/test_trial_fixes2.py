@@ -1,6 +1,7 @@
-"""Defects a new-user trial found (second set): the multi-joint controller's verdict with torque feedback,
-an explicit --knee, the controller texts (one test per defect, the measured numbers in the
-comments)."""
+"""Defects a new-user trial found (second set): the multi-joint verdict with torque feedback,
+an explicit --knee, controller texts, step-threshold, fit-frf's unstable loops, strategy
+output, run-option messages, frf-model of a weightless scene, design's PRTS check (the
+measured numbers in the comments)."""
 
 from __future__ import annotations
 
