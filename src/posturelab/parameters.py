@@ -76,6 +76,9 @@ MAX_TORQUE_FEEDBACK_GAIN = 5.0
 #: 2018's P18 in balancepy uses the integrator K_t/s, the limit τ_t → ∞); posturelab's
 #: bound. [s]
 MAX_TORQUE_FEEDBACK_TIME_CONSTANT = 1000.0
+#: Smallest τ_t: 1 ms (posturelab's bound, below any physiological filter; τ_t = 1e-9 s
+#: made the integration exhaust its step budget). [s]
+MIN_TORQUE_FEEDBACK_TIME_CONSTANT = 1e-3
 #: The default τ_t: 17.4 s, PMC5664365 Table 1 (τ_F). [s]
 TORQUE_FEEDBACK_TIME_CONSTANT = 17.4
 #: Largest pair stiffness, intrinsic or active: 10⁵ times a standing adult's mgh. [N·m/rad]
@@ -184,9 +187,11 @@ QUANTITIES: dict[str, Quantity] = {q.name: q for q in (
     Quantity("torque_feedback_gain", "-", 0.0, MAX_TORQUE_FEEDBACK_GAIN,
              "K_t: the active torque fed back positively through K_t/(τ_t s + 1) (Peterka "
              "2002; 0: none; K_t = K_F·K_P of the source's K_F [rad/(N·m)])", "", 3.0),
-    Quantity("torque_feedback_time_constant", "s", 0.0, MAX_TORQUE_FEEDBACK_TIME_CONSTANT,
+    Quantity("torque_feedback_time_constant", "s", MIN_TORQUE_FEEDBACK_TIME_CONSTANT,
+             MAX_TORQUE_FEEDBACK_TIME_CONSTANT,
              "τ_t of the torque feedback's low-pass filter (default 17.4 s, PMC5664365 "
-             "Table 1)", "", 200.0, low_open=True),
+             "Table 1; at least 1 ms: a faster filter is no filter and stiffens the "
+             "integration past its step budget)", "", 200.0),
     Quantity("joint_feedback_scale", "-", 0.0, MAX_JOINT_FEEDBACK_SCALE,
              "factor s on a joint-space controller's gain matrices (multijoint-default: "
              "the LQR design at s = 1)", "", 2.0),

@@ -39,15 +39,15 @@ def add_muscle_arguments(p: argparse.ArgumentParser, *, require: bool = False,
     --feedback-delay and --proprioceptive-weight (``own_case``: the command defines --case
     and --viscosity-ratio itself)."""
     from ..model.body import BODY_PRESETS
-    from ..model.controllers import CONTROLLERS
+    from ..model.controllers import CONTROLLERS, MULTIJOINT_CONTROLLERS
 
     body = p.add_argument_group("body")
     body.add_argument("--body", metavar="PRESET",
                       help=f"body preset: {', '.join(BODY_PRESETS)} (default paper).")
     body.add_argument("--height", type=str, metavar="M",
                       help="subject height [m], with --mass: leg, thigh and HAT scaled by "
-                      "Winter's anthropometric table (three links; with --controller, a "
-                      "one-link controller, the same body as one rigid link).")
+                      "Winter's anthropometric table (three links; with a one-link "
+                      "--controller, the same body as one rigid link).")
     body.add_argument("--mass", type=str, metavar="KG", help="subject mass [kg], with --height.")
     fb = p.add_argument_group("feedback (muscle pairs)")
     g = fb.add_mutually_exclusive_group(required=require)
@@ -59,12 +59,15 @@ def add_muscle_arguments(p: argparse.ArgumentParser, *, require: bool = False,
                    + ", ".join(PAPER_PAIR_NAMES) + "), one per joint otherwise (one for a "
                    "one-link body). With active gains this is the intrinsic (undelayed) part.")
     g.add_argument("--controller", metavar="NAME",
-                   help="a one-link controller preset after a published model (intrinsic "
+                   help="a controller preset. One-link (after a published model: intrinsic "
                    "and active gains as "
-                   f"fractions of mgh, delay, weight): {', '.join(CONTROLLERS)}. Its body: "
+                   f"fractions of mgh, delay, weight): {', '.join(CONTROLLERS)}; its body: "
                    "the paper's as one link (paper-1link) by default, --height/--mass "
-                   "lumped to one link, or a one-link --body. Which of its numbers come from "
-                   "the source: "
+                   "lumped to one link, or a one-link --body. Multi-joint (an LQR design on "
+                   "the three-link body, knee locked; simulate, sweep, fit and strategy take it): "
+                   f"{', '.join(MULTIJOINT_CONTROLLERS)}; its body: the paper's, a --body "
+                   "or --height/--mass (three links). Which of the one-link presets' numbers "
+                   "come from the source: "
                    + " ".join(f"{c.name}: {c.provenance_text()}" for c in CONTROLLERS.values()))
     fb.add_argument("--viscosity", metavar="LIST",
                     help="pair viscosities [N·m·s/rad], one per pair (instead of a ratio).")
@@ -185,12 +188,26 @@ def model_from_args(args: argparse.Namespace, tables: dict | None = None, *,
         raise UsageError(f"--controller {args.controller} is a multi-joint controller: "
                          "simulate, sweep, fit and strategy take it, this command does not")
     _note_one_link(args, scenario.body)
+    _note_lag_without_gain(args)
     return scenario
+
+
+def _note_lag_without_gain(args: argparse.Namespace) -> None:
+    """Say that --torque-feedback-time-constant does nothing without a torque feedback gain
+    (unless the command varies or fits the gain)."""
+    if getattr(args, "torque_feedback_time_constant", None) is None or getattr(
+            args, "torque_feedback_gain", None):
+        return
+    varied = " ".join(str(getattr(args, name, None) or "") for name in ("vary", "free", "per"))
+    if "torque_feedback_gain" not in varied:
+        print("posturelab: note: --torque-feedback-time-constant has no effect without "
+              "--torque-feedback-gain > 0 (no torque feedback)", file=sys.stderr)
 
 
 def _note_one_link(args: argparse.Namespace, body) -> None:
     """Say that a one-link controller lumps a body from height and mass to one link."""
-    if getattr(args, "controller", None) is not None and getattr(args, "height", None):
+    if (getattr(args, "controller", None) is not None and getattr(args, "height", None)
+            and body.n_links == 1):
         print(f"posturelab: note: --controller {args.controller} is a one-link controller: "
               f"the body is {body.name}", file=sys.stderr)
 

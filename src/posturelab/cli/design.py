@@ -20,7 +20,7 @@ information of the exact model FRF (the delay as e^{−sτ}) under the stated no
 V⁻¹ D) with D = ∂H/∂θ over the bands (central differences) and V the covariance of the
 estimated band FRFs: white --sensor-noise RAD on the recorded angle, and --motor-noise
 SIGMA[,SIGMA...] N·m per joint (optionally low-passed at --motor-noise-cutoff HZ) through the
-closed loop, for --cycles N analysed cycles (plus --discard, default 1) of --tilt
+closed loop, for --cycles N analysed cycles (plus --discard-cycles, default 1) of --tilt
 prts:AMPLITUDE_RAD[:STATE_DURATION_S][:SEQUENCE] recorded at --sample-rate HZ
 (posturelab.frequency.design states the derivation and its sources;
 posturelab.frequency.design_search the search). The errors fall as
@@ -50,9 +50,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    "prts:0.035: posturelab-80, 0.25 s states, 20 s cycle).")
     p.add_argument("--cycles", type=int, default=5, metavar="N",
                    help="cycles analysed (default 5).")
-    p.add_argument("--discard", type=int, default=1, metavar="N",
+    p.add_argument("--discard-cycles", dest="discard", type=int, default=1, metavar="N",
                    help="cycles run before them, dropped (default 1; they count in the "
                    "duration).")
+    p.add_argument("--discard", dest="discard", type=int, default=argparse.SUPPRESS,
+                   help=argparse.SUPPRESS)  # the former name, kept as an alias
     p.add_argument("--free", required=True, metavar="NAMES",
                    help="the parameters the fit estimates, comma separated (names as "
                    "fit-frf --free: stiffness:PAIR, viscosity:PAIR, active_stiffness:PAIR, "
@@ -111,7 +113,7 @@ def _check_numbers(args: argparse.Namespace) -> None:
     float_in_range("--sensor-noise [rad]", args.sensor_noise, 0.0, 1.0, unit="rad")
     float_in_range("--sample-rate [Hz]", args.sample_rate, 1.0, 1e5, unit="Hz")
     for option, value, least, most in (("--cycles", args.cycles, 2, MAX_CYCLES),
-                                       ("--discard", args.discard, 0, MAX_CYCLES),
+                                       ("--discard-cycles", args.discard, 0, MAX_CYCLES),
                                        ("--grid", args.grid, 2, MAX_GRID)):
         if not least <= value <= most:
             raise ParameterError(f"{option} must be an integer in [{least}, {most}], got "

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 
 from ..errors import ParameterError
+from . import UsageError
 from ._common import (
     add_muscle_arguments,
     add_torque_feedback_arguments,
@@ -72,6 +73,9 @@ def run(args: argparse.Namespace) -> int:
 
     model = model_from_args(args)
     body, muscles, options = model.body, model.muscles, model.options
+    if args.input == "visual-tilt" and options.visual_weight == 0:
+        raise UsageError("frf-model: --input visual-tilt with visual_weight 0: the scene has "
+                         "no effect (gain 0, no phase); give --visual-weight W_v > 0")
     torque_feedback = dict(torque_feedback_gain=options.torque_feedback_gain,
                            torque_feedback_time_constant=options.torque_feedback_time_constant)
     if args.frequencies is not None:
@@ -97,6 +101,7 @@ def run(args: argparse.Namespace) -> int:
                   proprioceptive_weight=options.proprioceptive_weight,
                   visual_weight=options.visual_weight, **torque_feedback)
     phase = np.degrees(np.unwrap(np.angle(H)))
+    phase[np.abs(H) == 0] = np.nan  # a zero response has no phase (null, "—")
     sign = ("−y/α (the literature's tilt sign: a body that follows the surface reads gain 1, "
             "phase 0)" if args.input == "tilt" else "−y/v (a body that follows the visual "
             "scene reads gain 1, phase 0)" if args.input == "visual-tilt"
@@ -111,5 +116,5 @@ def run(args: argparse.Namespace) -> int:
     print(f"model FRF of {args.output} to {args.input}{unit}, {sign}")
     print(f"{'f [Hz]':>8} {'gain':>10} {'phase [deg]':>12}")
     for fk, h, p in zip(f, H, phase, strict=True):
-        print(f"{fk:8.3f} {abs(h):10.4g} {p:12.1f}")
+        print(f"{fk:8.3f} {abs(h):10.4g} " + (f"{p:12.1f}" if p == p else f"{'—':>12}"))
     return 0

@@ -128,9 +128,10 @@ def add_experiment_arguments(p: argparse.ArgumentParser) -> None:
     src.add_argument("--rates-from", choices=["upright", "posture"], default="upright",
                      help="evaluate J⁻¹H for the velocity step at upright (the paper) or at the "
                      "initial posture (exact).")
-    src.add_argument("--knee", choices=["free", "locked", "stop"], default="free",
-                     help="free (the paper), locked (θ2 − θ1 constant), or a hyper-extension stop "
-                     "at θ2 − θ1 = 0.")
+    src.add_argument("--knee", choices=["free", "locked", "stop"], default=None,
+                     help="free (the paper's default), locked (θ2 − θ1 constant), or a "
+                     "hyper-extension stop at θ2 − θ1 = 0; default: the scenario's, or the "
+                     "multi-joint controller's design (locked), else free.")
     src.add_argument("--foot", metavar="none|literature|HEEL,TOE", default="none",
                      help="base of support for the fall test: none (the paper; the foot never "
                      "tips), literature (heel −0.063 m, toe 0.188 m: a 1.65 m person) or "
@@ -293,7 +294,7 @@ def run_options_from_args(args: argparse.Namespace, sc: Scenario,
             tilt_axis_depth=_given(args.tilt_axis_depth, base.tilt_axis_depth),
             torque_limits=torque_limits,
             motor_noise=motor_noise, description=description,
-            knee=KneeModel(args.knee) if args.knee != "free" else base.knee,
+            knee=KneeModel(args.knee) if args.knee is not None else base.knee,
             rates_from=args.rates_from if args.rates_from != "upright" else base.rates_from)
 
 
@@ -449,9 +450,17 @@ def run(args: argparse.Namespace) -> int:
         torque_feedback_time_constant=sc.options.torque_feedback_time_constant,
         joint_feedback=sc.options.joint_feedback, knee=sc.options.knee.mode)
     outcome = result.outcome
+    knee_note = None
+    if sc.options.joint_feedback is not None and sc.options.knee.mode != "locked":
+        knee_note = (f"the multi-joint controller was designed with the knee locked; this "
+                     f"run's knee is {sc.options.knee.mode} (the linear verdict takes the "
+                     f"{sc.options.knee.mode} knee)")
     if args.json:
+        stability = verdict.to_dict()
+        if knee_note is not None:
+            stability["note"] = knee_note
         print_json({**result.summary(), "engine": args.engine,
-                    "linear_stability": verdict.to_dict()})
+                    "linear_stability": stability})
     else:
         peaks = ", ".join(f"{x:.4f}" for x in result.max_abs_theta)
         print(f"outcome: {outcome.message}")  # first, as the help and README say
@@ -462,10 +471,14 @@ def run(args: argparse.Namespace) -> int:
         print(f"linear model: {verdict.describe()}")
         print(f"peak |θ| [rad]: {peaks}")
         if sc.body.n_links >= 2:
-            print(f"hip fraction (anti-phase leg–trunk mode): {result.hip_fraction:.3f}")
+            share = result.hip_fraction
+            print("hip fraction (anti-phase leg–trunk mode): "
+                  + (f"{share:.3f}" if share == share else "none (no sway)"))
         print("final state [rad, rad/s]: " + ", ".join(f"{x:.4g}" for x in result.final_state))
         for path in outputs:
             print(f"wrote {path}")
+    if knee_note is not None:
+        print(f"posturelab: note: {knee_note}", file=sys.stderr)
     if verdict.status == "depends on the side":
         print("posturelab: warning: upright's linear stability depends on the side of a "
               f"one-sided pair's switch for these gains and this body ({verdict.describe()})",

@@ -17,7 +17,11 @@ J Biomech 38:1–8; ω0 = √(g/l), l the centre of mass's height) leaves the fo
 the body falls. The platform moves are ramp-and-holds over 0.5 s (posturelab's assumption),
 increased in 1 cm steps and then bisected to 1 mm. Compared with Koushyar et al. 2019
 (PLoS ONE 14:e0210049, PMC6338353): backward, 16.2 ± 2.6 cm (young), 11.8 ± 2.1 cm (older).
-Where each number of a population comes from: --sources.
+Where each number of a population comes from: --sources. An upright that is unstable at the
+feedback delay (it topples without a platform move) is refused: there is no threshold. When
+no translation up to the search's ceiling needs a step, the output says so
+("reached_search_limit": true, "largest_translation": null, "largest_searched" [m]) and
+nothing is compared.
 """
 
 
@@ -84,10 +88,15 @@ def run(args: argparse.Namespace) -> int:
     cm = 100.0
     print(f"{result.population}, {result.direction}, H = {result.height:g} m, "
           f"M = {result.mass:g} kg")
-    print(f"largest translation without a step: {result.largest_translation * cm:.1f} cm "
-          f"(a step at {result.smallest_stepping * cm:.1f} cm: {result.reason or 'none'})")
+    if result.reached_search_limit:
+        print("no step needed up to the largest translation searched "
+              f"({result.largest_searched * cm:.1f} cm): no threshold found")
+    else:
+        print(f"largest translation without a step: {result.largest_translation * cm:.1f} cm "
+              f"(a step at {result.smallest_stepping * cm:.1f} cm: {result.reason})")
     print(f"  platform move over {result.move_duration:g} s: peak {result.peak_velocity:.2f} "
-          f"m/s, {result.peak_acceleration:.2f} m/s² at the threshold")
+          f"m/s, {result.peak_acceleration:.2f} m/s² at "
+          + ("the largest searched" if result.reached_search_limit else "the threshold"))
     print(f"  τ = {result.feedback_delay * 1000:.0f} ms, ankle strength "
           f"{result.ankle_strength:.0f} N·m (caps: plantarflexion "
           f"{result.ankle_moment_cap:.0f} N·m, dorsiflexion {result.dorsiflexion_cap:.0f} "
@@ -96,7 +105,9 @@ def run(args: argparse.Namespace) -> int:
     if result.cop_overrun > COP_TOLERANCE:
         print(f"  the centre of pressure went {result.cop_overrun * cm:.1f} cm beyond the foot "
               "at the threshold (see the guide)")
-    if result.published_mean is not None:
+    if result.reached_search_limit:
+        print("published: not compared (no threshold within the search)")
+    elif result.published_mean is not None:
         verdict = "within" if result.within_two_sd else "outside"
         print(f"published: {result.published_mean * cm:.1f} ± {result.published_sd * cm:.1f} "
               f"cm ({verdict} two SD); {result.published_source}")

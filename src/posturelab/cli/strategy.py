@@ -28,8 +28,11 @@ heel, what a flat foot carries).
 "peak_hip_angle": rad}], "profile", "ankle_torque_limit" (and, with
 --ankle-limit-from-foot, "ankle_dorsiflexion_limit", its magnitude), "units", "controller",
 "feedback_delay" [s], "delay_margin" [s] and "design_poles" [1/s] of its linear design}.
+A run that fell or failed has "hip_fraction": null (so has one that did not move); a single
+map's "transition_frequency" is a number or null (none found).
 --ankle-torque-limits LO:HI:N  a two-parameter map: the family at each limit [N·m], each
-run with its "ankle_torque_limit" (the sweep does the same with --vary
+run with its "ankle_torque_limit", and "transition_frequencies": [{"ankle_torque_limit",
+"frequency"}] per limit (oscillations) (the sweep does the same with --vary
 torque_limit:ankle=… and --strategy, on Dask with --workers).
 
 Example: posturelab strategy --translation backward --speeds 0.05:0.6:8 --json
@@ -44,9 +47,14 @@ def _grid(text: str, flag: str):
     except (IndexError, ValueError):
         raise UsageError(f"{flag} must be LO:HI:N (numbers, N an integer), got {text!r}") \
             from None
-    if len(parts) != 3 or not (0 < lo <= hi) or not 1 <= n <= 1000:
-        raise UsageError(f"{flag} must be LO:HI:N with 0 < LO <= HI and 1 <= N <= 1000, got "
-                         f"{text!r}")
+    import math
+
+    if (len(parts) != 3 or not (math.isfinite(lo) and math.isfinite(hi))
+            or not (0 < lo <= hi) or not 1 <= n <= 1000):
+        raise UsageError(f"{flag} must be LO:HI:N with finite 0 < LO <= HI and 1 <= N <= 1000, "
+                         f"got {text!r}")
+    if n == 1 and lo != hi:
+        raise UsageError(f"{flag} with N = 1 must have LO = HI (one value), got {text!r}")
     import numpy as np
 
     return np.linspace(lo, hi, n)
@@ -56,8 +64,12 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     """The options of ``posturelab strategy``."""
     p.add_argument("--body", default="paper", metavar="NAME",
                    help="a body preset (default: the paper's three links).")
+    from ..model.controllers import MULTIJOINT_CONTROLLERS
+
     p.add_argument("--controller", default="multijoint-default", metavar="NAME",
-                   help="a multi-joint controller preset (default multijoint-default).")
+                   help="a multi-joint controller preset: "
+                   f"{', '.join(MULTIJOINT_CONTROLLERS)} (default multijoint-default; the "
+                   "one-link presets have no hip).")
     p.add_argument("--joint-feedback-scale", type=float, default=1.0, metavar="S",
                    help="factor on the controller's gain matrices (default 1).")
     family = p.add_mutually_exclusive_group(required=True)
@@ -68,7 +80,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                              "--frequencies).")
     p.add_argument("--speeds", metavar="LO:HI:N", help="peak speeds [m/s].")
     p.add_argument("--frequencies", metavar="LO:HI:N", help="frequencies [Hz].")
-    p.add_argument("--displacement", type=float, default=0.06, metavar="M",
+    p.add_argument("--displacement", type=float, default=None, metavar="M",
                    help="displacement of each transient translation [m] (default 0.06).")
     limit = p.add_mutually_exclusive_group()
     limit.add_argument("--ankle-torque-limit", type=float, metavar="N·m",
@@ -94,6 +106,13 @@ def run(args: argparse.Namespace) -> int:
         raise UsageError("strategy: --translation needs --speeds LO:HI:N")
     if args.oscillation is not None and args.frequencies is None:
         raise UsageError("strategy: --oscillation needs --frequencies LO:HI:N")
+    ignored = ([f for f, v in (("--frequencies", args.frequencies),) if v is not None]
+               if args.translation is not None else
+               [f for f, v in (("--speeds", args.speeds), ("--displacement", args.displacement))
+                if v is not None])
+    if ignored:
+        family = "--translation" if args.translation is not None else "--oscillation"
+        raise UsageError(f"strategy: {ignored[0]} does not apply to {family}; drop it")
     if args.figure:
         from ._common import check_writable
 
@@ -111,7 +130,8 @@ def run(args: argparse.Namespace) -> int:
     if args.translation is not None:
         make = functools.partial(translation_map, body, controller.muscles,
                                  _grid(args.speeds, "--speeds"), direction=args.translation,
-                                 displacement=args.displacement, **common)
+                                 displacement=(0.06 if args.displacement is None
+                                               else args.displacement), **common)
     else:
         make = functools.partial(oscillation_map, body, controller.muscles, args.oscillation,
                                  _grid(args.frequencies, "--frequencies"), **common)
@@ -134,11 +154,21 @@ def run(args: argparse.Namespace) -> int:
              f"{-result.ankle_dorsiflexion_limit:.4g} … {result.ankle_torque_limit:.4g} N·m")
     print(f"{result.profile}; ankle torque limit {shown}; controller {controller.name}")
     for r in result.runs:
-        print(f"  {result.variable} {r.value:8.4g}  hip fraction {r.hip_fraction:6.3f}  "
+        share = "—" if r.outcome != "recovered" else _share(r, "{:6.3f}")
+        print(f"  {result.variable} {r.value:8.4g}  hip fraction {share:>6}  "
               f"{r.outcome}{'  (ankle saturated)' if r.ankle_saturated else ''}")
     if result.kind == "oscillation":
-        print(f"transition frequency: {result.transition_frequency}")
+        found = result.transition_frequency
+        print("transition frequency: " + ("none found (no recovered run with hip fraction "
+                                          "> 0.5)" if found is None else f"{found:.4g} Hz"))
     return 0
+
+
+def _share(run, spec: str) -> str:
+    """A run's hip fraction in words when it has none: "fell", "failed" or "none"."""
+    if run.outcome != "recovered":
+        return run.outcome
+    return "none" if run.hip_fraction != run.hip_fraction else spec.format(run.hip_fraction)
 
 
 def _design(controller) -> dict:
@@ -167,8 +197,12 @@ def _two_parameters(args: argparse.Namespace, controller, maps) -> int:
         return 0
     print(f"{out['profile']}; controller {controller.name}")
     for m in maps:
-        cells = "  ".join(f"{r.hip_fraction:.2f}{'x' if r.outcome != 'recovered' else ''}"
-                          for r in m.runs)
+        cells = "  ".join(f"{_share(r, '{:.2f}'):>6}" for r in m.runs)
         print(f"  ankle limit {m.ankle_torque_limit:8.4g} N·m: {cells}")
-    print("(hip fraction per " + maps[0].variable + "; x: fell or failed)")
+        if maps[0].kind == "oscillation":
+            found = m.transition_frequency
+            print("    transition frequency: "
+                  + ("none found" if found is None else f"{found:.4g} Hz"))
+    print("(hip fraction per " + maps[0].variable + "; fell/failed: the run fell or failed, "
+          "none: no sway)")
     return 0

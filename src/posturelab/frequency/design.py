@@ -187,8 +187,30 @@ def _stimulus_spectrum(tilt, fs: float, L: int, bands) -> tuple[list, np.ndarray
 
     t = np.arange(L) / fs
     X = np.fft.rfft(tilt.angle(t))
-    chosen = resolve_bands(sequence_bands(tilt) if bands is None else bands, L // 4)
+    wanted = sequence_bands(tilt) if bands is None else bands
+    _check_harmonics(tilt, fs, L, wanted)
+    chosen = resolve_bands(wanted, L // 4)
     return chosen, np.abs(X) ** 2
+
+
+def _check_harmonics(tilt, fs: float, L: int, bands) -> None:
+    """Refuse, in the user's terms, a stimulus whose cycle at ``fs`` [Hz] (``L`` samples)
+    has too few odd harmonics below a quarter of the samples for the bands (a band listing
+    a non-number is left to :func:`posturelab.frequency.bands.resolve_bands`)."""
+    try:
+        needed = max(int(k) for band in bands for k in band)
+    except (TypeError, ValueError):
+        return
+    if needed <= L // 4:
+        return
+    states = max(round(tilt.cycle / tilt.state_duration), 1)
+    least = math.ceil(4 * needed / states) / fs  # whole samples per state
+    raise ParameterError(
+        f"the PRTS state duration {tilt.state_duration:g} s makes a {tilt.cycle:g} s cycle, "
+        f"{L} samples at {fs:g} Hz: it resolves {L // 4} odd harmonic(s) (up to "
+        f"{(2 * (L // 4) - 1) / tilt.cycle:.4g} Hz; Nyquist {fs / 2:g} Hz) but the bands "
+        f"need {needed} (up to {(2 * needed - 1) / tilt.cycle:.4g} Hz); give a state duration "
+        f">= {least:.4g} s (or a higher --sample-rate)")
 
 
 def _system(body, muscles, feedback_delay, proprioceptive_weight):

@@ -76,7 +76,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .._bounds import at_bound, clip_intervals
-from ..errors import ParameterError
+from ..errors import ParameterError, PostureLabError
 from ..model.body import Body
 from ..model.muscles import MuscleSet
 from ..parameters import (
@@ -87,6 +87,7 @@ from ..parameters import (
     resolve,
 )
 from ..parameters import unit as parameter_unit
+from ._fit_checks import loop_verdict, systematic_bound
 from ._fit_targets import chi2 as _chi2
 from ._fit_targets import target as _target
 from .estimate import FRFEstimate
@@ -165,6 +166,11 @@ class FRFFit:
     residual_dof, noise_dof : float
         2B − K, and ν, the degrees of freedom of the noise the intervals use (module notes;
         the residual dof for ``"relative"``, ∞ for known standard errors). [-]
+    stable : bool or None
+        Whether the fitted loop of every condition is stable about upright at its delay
+        (:func:`posturelab.linear.verdict.upright_verdict`, the engaged side); False adds a
+        warning: an unstable loop's FRF is not measurable, so the estimates describe no
+        experiment. None when not checked.
     """
 
     names: tuple[str, ...]
@@ -187,6 +193,7 @@ class FRFFit:
     objective: float = math.nan
     residual_dof: float = math.nan
     noise_dof: float = math.inf
+    stable: bool | None = None
 
     def unit(self, name: str) -> str:
         """Unit of a fitted parameter."""
@@ -214,7 +221,7 @@ class FRFFit:
             "weighting_description": self.weighting_text(), "mismatch": bool(self.mismatch),
             "model_error": num(self.model_error),
             "systematic": [num(v) for v in self.systematic],
-            "success": bool(self.success),
+            "success": bool(self.success), "stable": self.stable,
             "message": self.message, "warnings": list(self.warnings)}
 
 
@@ -409,19 +416,36 @@ def fit_frf(body: Body, muscles: MuscleSet, data, free, *, input: str | Sequence
     active = muscles.has_active_feedback or any(
         specs[i][0].startswith("active") for i, _ in slots)
 
+    def condition_values(p: np.ndarray, k: int) -> tuple[np.ndarray, dict]:
+        gains = base.copy()
+        values = dict(scalars)
+        for (i, cond), value in zip(slots, p, strict=True):
+            if cond is not None and cond != group_of[k]:
+                continue
+            b, j = specs[i]
+            if b in values:
+                values[b] = value
+            else:
+                gains[rows[b], j] = value
+        return gains, values
+
+    def unstable(p: np.ndarray) -> str | None:
+        """The first condition's verdict whose loop is not stable at these values (None:
+        every one stable; "": not settled, the linear model refusing these values)."""
+        for k in range(len(conditions)):
+            gains, values = condition_values(p, k)
+            try:
+                verdict = loop_verdict(body, muscles, gains, active, values)
+            except PostureLabError:
+                return ""
+            if verdict.side(engaged=True).status != "stable":
+                return verdict.describe()
+        return None
+
     def model(p: np.ndarray, dense: bool = False) -> list:
         out = []
         for k, c in enumerate(conditions):
-            gains = base.copy()
-            values = dict(scalars)
-            for (i, cond), value in zip(slots, p, strict=True):
-                if cond is not None and cond != group_of[k]:
-                    continue
-                b, j = specs[i]
-                if b in values:
-                    values[b] = value
-                else:
-                    gains[rows[b], j] = value
+            gains, values = condition_values(p, k)
 
             def frf_at(f, gains=gains, v=values, source=inputs[k]):
                 return model_frf_batch(body, muscles, f, gains[0][None], gains[1][None],
@@ -465,6 +489,9 @@ def fit_frf(body: Body, muscles: MuscleSet, data, free, *, input: str | Sequence
     relative = weighting == "relative"
     delta = 0.0 if model_error is None else float_in_range("model_error [-]", model_error,
                                                            0.0, 1e3)
+    if start_verdict := unstable(x0):
+        warnings.append(f"the starting loop is {start_verdict}: its FRF is not measurable; "
+                        "start from stable values (the fit may end on an unstable loop)")
     sol = solve(x0 / scale, delta)
     p = sol.x * scale
     total = chi2_sum(p, 0.0)
@@ -514,7 +541,7 @@ def fit_frf(body: Body, muscles: MuscleSet, data, free, *, input: str | Sequence
     q = float(student.ppf(0.975, nu))
     systematic = np.zeros(K)
     if mismatch and np.isfinite(cond) and seen_col.all():
-        systematic = _systematic_bound(J, targets, delta, seen_col)
+        systematic = systematic_bound(J, targets, delta, seen_col)
     ci = np.stack([p - q * se - systematic, p + q * se + systematic], axis=1)
     sides = at_bound(p, lo, hi)  # an estimate on its search bound is not determined
     determined = (seen_col & np.isfinite(se) & (se <= np.abs(p)) & (cond < 1e10)
@@ -527,11 +554,15 @@ def fit_frf(body: Body, muscles: MuscleSet, data, free, *, input: str | Sequence
     if fitted and total > 1.0 + 1e-9:
         warnings.append(f"proprioceptive_weight + visual_weight = {total:.4g} > 1: the "
                         "graviceptive weight 1 − W − W_v would be negative")
+    end_verdict = unstable(p)
+    if end_verdict:
+        warnings.insert(0, f"the fitted loop is unstable ({end_verdict}): its FRF is not "
+                        "measurable, so these estimates describe no experiment")
     return FRFFit(tuple(labels), p, se, ci, determined, float(fit_error), bool(sol.success),
                   str(sol.message), tuple(warnings), tuple(model(p, dense=True)), weighting,
                   bool(mismatch), float(delta), systematic, sides,
                   np.stack([lo, hi], axis=1), clipped, float(u_all @ u_all), float(dof),
-                  float(nu))
+                  float(nu), None if end_verdict == "" else end_verdict is None)
 
 
 def _condition_groups(groups, count: int) -> list[int]:
@@ -548,27 +579,3 @@ def _condition_groups(groups, count: int) -> list[int]:
                              f"used, got {out}")
     return out
 
-
-def _systematic_bound(J: np.ndarray, targets: list, delta: float, seen: np.ndarray
-                      ) -> np.ndarray:
-    """β_k = δ Σ_b |∂p_k/∂e_b| |Ĥ_b|: the most a model error of at most δ|Ĥ_b| at every band,
-    in any direction, moves each parameter (linearised: ∂p/∂u = −(JᵀJ)⁻¹Jᵀ, u the
-    standardised residuals, ∂u/∂e_b from a small real and imaginary step at band b)."""
-    P = np.linalg.solve(J.T @ J, J.T)  # (K, m)
-    out = np.zeros(J.shape[1])
-    offset = 0
-    for t in targets:
-        base = t.standardised(t.frf, delta).ravel()
-        size = base.size
-        for b in range(t.frf.size):
-            h = 1e-6 * max(abs(t.frf[b]), 1e-300)
-            g = []
-            for step in (h, 1j * h):
-                moved = t.frf.copy()
-                moved[b] += step
-                du = np.zeros(J.shape[0])
-                du[offset:offset + size] = (t.standardised(moved, delta).ravel() - base) / h
-                g.append(P @ du)
-            out += delta * abs(t.frf[b]) * np.hypot(g[0], g[1])
-        offset += size
-    return out

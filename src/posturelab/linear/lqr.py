@@ -73,10 +73,16 @@ def on_knee(system: LinearSystem, knee: str) -> LinearSystem:
     def reduce(m):
         return np.einsum("ji,mjk,kl->mil", T, m, T)
 
+    # the torque feedback's filter acts joint by joint with one scalar gain and lag, so its
+    # states project like the moments (Tᵀ Y) and the reduced system keeps gain and lag
+    visual = None if system.visual_input is None else system.visual_input @ T
     return LinearSystem(reduce(system.inertia), reduce(system.stiffness),
                         reduce(system.viscosity), reduce(system.delayed_stiffness),
                         reduce(system.delayed_viscosity), system.delay, None,
-                        system.translation_input @ T)
+                        system.translation_input @ T,
+                        torque_feedback_gain=system.torque_feedback_gain,
+                        torque_feedback_time_constant=system.torque_feedback_time_constant,
+                        visual_input=visual)
 
 
 def _inputs(n: int, knee: str) -> np.ndarray:

@@ -206,10 +206,11 @@ def strategy_modes(theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def hip_fraction(theta: np.ndarray) -> float:
-    """Σ b² / (Σ a² + Σ b²) of :func:`strategy_modes` [-]; 0 if nothing moves, NaN for N = 1."""
+    """Σ b² / (Σ a² + Σ b²) of :func:`strategy_modes` [-]; NaN if nothing moves (0/0: no
+    sway, no strategy) and for N = 1."""
     theta = np.asarray(theta, dtype=float)
     if theta.ndim == 2 and theta.shape[1] == 1:
         return float("nan")
     a, b = strategy_modes(theta)
     total = float(a @ a + b @ b)
-    return 0.0 if total == 0.0 else float(b @ b) / total
+    return float("nan") if total == 0.0 else float(b @ b) / total

@@ -63,17 +63,24 @@ OPTION_KEYS: dict[str, str] = {
 
 
 
-def run_options(origin: str, **fields) -> RunOptions:
+def run_options(origin: str, names: Mapping[str, str] | None = None, **fields) -> RunOptions:
     """The scenario's :class:`RunOptions`; a bad value raises ScenarioError naming its key
-    (``solver.max_steps must be an integer in [1, …], got 0``)."""
+    (``solver.max_steps must be an integer in [1, …], got 0``), or, from the command line
+    (no ``origin``; ``names`` maps keys to flags), a ParameterError naming the flags."""
+    import re
+
     try:
         return RunOptions(**fields)
     except ParameterError as exc:
         text = str(exc)
         name = next((k for k in OPTION_KEYS if text.startswith(k + " ")), None)
         if name is not None and OPTION_KEYS[name] != name:
-            text = OPTION_KEYS[name] + text[len(name):]
-        raise ScenarioError(f"{origin}: {text}") from None
+            text = _name(names, OPTION_KEYS[name]) + text[len(name):]
+        if names is not None:  # an option named inside the message: its flag too
+            text = re.sub(r"\b(?<![.\-])([a-z]+_[a-z_]+)\b",
+                          lambda m: (_name(names, OPTION_KEYS[m[1]]) if m[1] in OPTION_KEYS
+                                     else m[1]), text)
+        raise _error(origin, text) from None
 
 
 def parse_tables(data: dict, base_dir: Path, origin: str,
@@ -140,7 +147,7 @@ def parse_tables(data: dict, base_dir: Path, origin: str,
                                                  origin, names)
     st = data.get("solver", {})
     options = run_options(
-        origin, duration=duration, initial_state=initial,
+        origin, names, duration=duration, initial_state=initial,
         rates_from=it.get("rates_from", DEFAULTS.rates_from), knee=knee, fall=fall,
         torque_limits=torque_limits, feedback_delay=delay, proprioceptive_weight=weight,
         torque_feedback_gain=feedback_gain, torque_feedback_time_constant=feedback_lag,

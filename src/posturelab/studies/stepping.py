@@ -44,7 +44,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from .._validation import positive_float
-from ..errors import PostureLabError, UnknownNameError
+from ..errors import ParameterError, PostureLabError, UnknownNameError
 from ..parameters import check_value
 from ._stepping_presets import (
     POPULATIONS,
@@ -184,6 +184,9 @@ class StepThreshold:
         The published threshold for this population and direction, if any. [m]
     published_source : str
         Its citation ("" if none).
+    largest_searched : float
+        The search's ceiling when no run needed a step (``reached_search_limit``), else inf.
+        [m]
     """
 
     largest_translation: float
@@ -211,19 +214,33 @@ class StepThreshold:
     published_mean: float | None
     published_sd: float | None
     published_source: str
+    largest_searched: float = math.inf
+
+    @property
+    def reached_search_limit(self) -> bool:
+        """True when no run up to ``largest_searched`` needed a step: ``largest_translation``
+        is then the search's ceiling, not a threshold."""
+        return math.isinf(self.smallest_stepping)
 
     @property
     def within_two_sd(self) -> bool | None:
         """True when ``largest_translation`` is within two published standard deviations of
-        the published mean (None without a published figure)."""
-        if self.published_mean is None or self.published_sd is None:
+        the published mean (None without a published figure, or when the search reached its
+        ceiling without a step: no threshold to compare)."""
+        if (self.published_mean is None or self.published_sd is None
+                or self.reached_search_limit):
             return None
         return abs(self.largest_translation - self.published_mean) <= 2 * self.published_sd
 
     def to_dict(self) -> dict:
-        """The fields (SI units, as documented) and ``within_two_sd``; inf as None."""
+        """The fields (SI units, as documented), ``reached_search_limit`` and
+        ``within_two_sd``; inf as None; ``largest_translation`` None when the search reached
+        its ceiling (``largest_searched``) without a step."""
         out = {k: (None if isinstance(v, float) and math.isinf(v) else v)
                for k, v in asdict(self).items()}
+        out["reached_search_limit"] = self.reached_search_limit
+        if self.reached_search_limit:
+            out["largest_translation"] = None
         out["within_two_sd"] = self.within_two_sd
         return out
 
@@ -235,7 +252,7 @@ UNITS = {"largest_translation": "m", "smallest_stepping": "m", "height": "m", "m
          "dorsiflexion_cap": "N·m",
          "heel": "m", "toe": "m", "com_height": "m", "omega0": "1/s", "minimum_margin": "m",
          "xcom_at_response_onset": "m", "cop_overrun": "m", "published_mean": "m",
-         "published_sd": "m"}
+         "published_sd": "m", "largest_searched": "m"}
 
 
 def step_threshold(height: float, mass: float, population: str | Population = "young",
@@ -304,6 +321,7 @@ def step_threshold(height: float, mass: float, population: str | Population = "y
     com_height = float(body.gravity_coefficients.sum() / body.total_mass)
     omega0 = float(pendulum_frequency(com_height, body.gravity))
     muscles = pop.muscles(body)
+    _check_upright_stable(body, muscles, delay)
     sign = -1.0 if direction == "backward" else 1.0
     count = 0
 
@@ -369,5 +387,22 @@ def step_threshold(height: float, mass: float, population: str | Population = "y
         published_mean=None if published is None else published.mean,
         published_sd=None if published is None else published.sd,
         published_source="" if published is None else published.source,
+        largest_searched=low if math.isinf(high) else math.inf,
     )
+
+
+def _check_upright_stable(body, muscles, delay: float) -> None:
+    """Refuse (ParameterError) a subject whose upright loop is unstable at ``delay`` [s]: it
+    topples with no platform move, so no translation threshold exists."""
+    from ..linear.delay import delay_margin
+    from ..linear.verdict import upright_verdict
+
+    if upright_verdict(body, muscles, delay).stable:
+        return
+    dm = delay_margin(body, muscles)
+    margin = ("unstable without delay" if dm.delay_margin is None
+              else f"delay margin {dm.delay_margin:.3g} s")
+    raise ParameterError(f"upright is unstable at feedback_delay {delay:g} s ({margin}): it "
+                         "topples without a platform move, so there is no threshold; give a "
+                         "smaller --feedback-delay")
 

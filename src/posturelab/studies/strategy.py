@@ -189,7 +189,8 @@ class StrategyRun:
     value : float
         The family's variable: the speed [m/s] or the frequency [Hz].
     hip_fraction : float
-        Over the run (transient) or over its steady part (sinusoidal). [-]
+        Over the run (transient) or over its steady part (sinusoidal); NaN for a run that
+        fell or failed, or that did not move. [-]
     outcome : str
         "recovered", "fell" or "failed".
     peak_ankle_moment : float
@@ -279,8 +280,11 @@ def _run_record(result, value: float, limit: float, start: int = 0,
         (np.isfinite(limit) and moment.max() >= limit * (1 - 1e-9))
         or (np.isfinite(lower) and moment.min() <= -lower * (1 - 1e-9)))
     hip = np.abs(theta[:, -1] - theta[:, 0])
-    steady = theta[start:]  # (a run that fell before its steady part has none: NaN)
-    share = float(hip_fraction(steady)) if steady.shape[0] > 1 else float("nan")
+    steady = theta[start:]
+    # a run that fell (or failed) has no strategy to speak of: NaN (null in JSON), in every
+    # map and in sweep --strategy alike
+    share = (float(hip_fraction(steady)) if outcome == "recovered" and steady.shape[0] > 1
+             else float("nan"))
     return StrategyRun(float(value), share, outcome, peak, saturated,
                        float(hip.max()) if hip.size else 0.0)
 
@@ -401,12 +405,14 @@ def limit_maps(make, limits) -> tuple:
 
 def maps_to_dict(maps) -> dict:
     """Maps over ankle torque limits as one object: every run with its
-    ``ankle_torque_limit`` [N·m], and the transition frequency per limit (sinusoidal)."""
+    ``ankle_torque_limit`` [N·m], and the transition frequency per limit (sinusoidal) as
+    ``transition_frequencies``: [{"ankle_torque_limit", "frequency"}] (a single map's
+    ``transition_frequency`` is one number or None)."""
     first = maps[0].to_dict()
     runs = [{**run, "ankle_torque_limit": m.ankle_torque_limit}
             for m in maps for run in m.to_dict()["runs"]]
     out = {"runs": runs, "profile": first["profile"], "units": first["units"]}
     if maps[0].kind == "oscillation":
-        out["transition_frequency"] = [{"ankle_torque_limit": m.ankle_torque_limit,
+        out["transition_frequencies"] = [{"ankle_torque_limit": m.ankle_torque_limit,
                                         "frequency": m.transition_frequency} for m in maps]
     return out

@@ -127,7 +127,9 @@ class _Task:
 
             from ..model.kinematics import hip_fraction
 
-            share = [hip_fraction(self._row_run(grid, r).theta) for r in range(lo, hi)]
+            runs = (self._row_run(grid, r) for r in range(lo, hi))
+            # a run that fell has no strategy to speak of: NaN (null), as in the maps
+            share = [float("nan") if run.fell else hip_fraction(run.theta) for run in runs]
             result = replace(result, hip_fraction=np.array(share, dtype=float))
         return result
 
