@@ -70,6 +70,17 @@ def check_method(method: str) -> None:
                              f"compiled engine, got {method!r}")
 
 
+def _stimulus_gains(name: str, pair_gains: np.ndarray | None, muscles, n: int) -> dict:
+    """A stimulus's gains as the engine reads them: ``NAME_gain`` (4, n) on the joint
+    moments and ``NAME_pair_gain`` (4, p) on the pair torques (what the torque feedback
+    filters take), zeros without the stimulus."""
+    if pair_gains is None:
+        pair_gains = np.zeros((len(GAIN_ROWS), len(muscles.pairs)))
+    return {f"{name}_gain": enc.readonly(np.ascontiguousarray(
+                pair_gains @ muscles.crossing_matrix)),
+            f"{name}_pair_gain": enc.readonly(np.ascontiguousarray(pair_gains))}
+
+
 @functools.lru_cache(maxsize=64)
 def packed(setup: RunSetup) -> dict:
     """The gain-independent arrays of a run (memoised per set-up object)."""
@@ -89,12 +100,7 @@ def packed(setup: RunSetup) -> dict:
         "E": enc.readonly(muscles.selection_matrix), "C": enc.readonly(muscles.crossing_matrix),
         "one_sided": enc.readonly(muscles.one_sided_mask.astype(np.int64)),
         "dp": enc.encode_disturbance(setup.disturbance), "tp": enc.encode_tilt(setup.tilt),
-        "tilt_gain": enc.readonly(np.ascontiguousarray(
-            setup.tilt_gains @ muscles.crossing_matrix if setup.tilt_gains is not None
-            else np.zeros((len(GAIN_ROWS), n)))),
-        "tilt_pair_gain": enc.readonly(np.ascontiguousarray(
-            setup.tilt_gains if setup.tilt_gains is not None
-            else np.zeros((len(GAIN_ROWS), len(muscles.pairs))))),
+        **_stimulus_gains("tilt", setup.tilt_gains, muscles, n),
         "tilt_depth": float(setup.tilt_axis_depth),
         "n_filters": switched_model(setup).n_filter_states,
         "filter_gain": float(setup.options.torque_feedback_gain),
@@ -102,12 +108,7 @@ def packed(setup: RunSetup) -> dict:
         "mp": enc.encode_motor_noise(setup.motor_torque),
         "joint_gain": enc.readonly(np.ascontiguousarray(setup.joint_gains)),
         "vp": enc.encode_tilt(setup.visual_tilt),
-        "visual_gain": enc.readonly(np.ascontiguousarray(
-            setup.visual_gains @ muscles.crossing_matrix if setup.visual_gains is not None
-            else np.zeros((len(GAIN_ROWS), n)))),
-        "visual_pair_gain": enc.readonly(np.ascontiguousarray(
-            setup.visual_gains if setup.visual_gains is not None
-            else np.zeros((len(GAIN_ROWS), len(muscles.pairs))))),
+        **_stimulus_gains("visual", setup.visual_gains, muscles, n),
         "bps": enc.readonly(setup.breakpoints.astype(float)), "fpar": fpar, "ipar": ipar,
         "active0": enc.readonly(setup.active0), "slots": slots,
         "ev_offset": ev.EVENT_OFFSET, "ev_direction": ev.EVENT_DIRECTION,
