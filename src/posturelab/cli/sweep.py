@@ -41,8 +41,9 @@ active_viscosity:PAIR [N·m·s/rad], a pair's active (delayed) gains; viscosity_
 disturbance_scale [-], a factor on the base experiment's platform motion (velocity-step
 speed, pulse peak, ramp displacement, sine amplitudes, measured accelerations: --vary
 disturbance_scale=0.5:3:26 with a 1 m/s step sweeps 0.5-3 m/s); feedback_delay [s];
-proprioceptive_weight [-]; or torque_limit:JOINT [N·m] ({", ".join(PAPER_JOINTS)} on the
-paper's body), the largest net muscle moment at a joint; repeat --vary for each
+proprioceptive_weight [-]; visual_weight [-] (W_v, with --visual-tilt; every run's
+proprioceptive_weight + visual_weight <= 1); or torque_limit:JOINT [N·m]
+({", ".join(PAPER_JOINTS)} on the paper's body), the largest net muscle moment at a joint; repeat --vary for each
 parameter. Every other gain comes from the base experiment: --case/--stiffness/--controller
 with --disturbance or --tilt (as in posturelab simulate), --scenario FILE.toml or --builtin
 NAME. A pair's viscosity is the varied viscosity:PAIR, else the ratio times its stiffness:
