@@ -46,9 +46,9 @@ proprioceptive_weight + visual_weight <= 1); or torque_limit:JOINT [N·m]
 ({", ".join(PAPER_JOINTS)} on the paper's body), the largest net muscle moment at a joint;
 repeat --vary for each parameter. Every other gain comes from the base experiment:
 --case/--stiffness/--controller with --disturbance or --tilt (as in posturelab simulate),
---scenario FILE.toml or --builtin NAME. A pair's viscosity is the varied viscosity:PAIR, else the ratio times its stiffness:
-the varied viscosity_ratio, else --viscosity-ratio, else the base experiment's (0.25, the
-paper's, for --case); viscosity_ratio and viscosity:PAIR are not varied together.
+--scenario FILE.toml or --builtin NAME. A pair's viscosity is the varied viscosity:PAIR,
+else the ratio times its stiffness: the varied viscosity_ratio, else --viscosity-ratio,
+else the base experiment's (0.25, the paper's, for --case); viscosity_ratio and viscosity:PAIR are not varied together.
 
 Columns: the varied parameters (stiffness:ankle, ...), then
 {", ".join(OUTCOME_COLUMNS)} (one peak_theta
