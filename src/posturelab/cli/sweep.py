@@ -48,7 +48,8 @@ repeat --vary for each parameter. Every other gain comes from the base experimen
 --case/--stiffness/--controller with --disturbance or --tilt (as in posturelab simulate),
 --scenario FILE.toml or --builtin NAME. A pair's viscosity is the varied viscosity:PAIR,
 else the ratio times its stiffness: the varied viscosity_ratio, else --viscosity-ratio,
-else the base experiment's (0.25, the paper's, for --case); viscosity_ratio and viscosity:PAIR are not varied together.
+else the base experiment's (0.25, the paper's, for --case); viscosity_ratio and
+viscosity:PAIR are not varied together.
 
 Columns: the varied parameters (stiffness:ankle, ...), then
 {", ".join(OUTCOME_COLUMNS)} (one peak_theta
