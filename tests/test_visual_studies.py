@@ -114,3 +114,53 @@ def _help_text(command: str) -> str:
     with contextlib.redirect_stdout(buf), contextlib.suppress(SystemExit):
         main([command, "--help"])
     return buf.getvalue()
+
+
+# ---- fit --free visual_weight ---------------------------------------------------------------
+
+
+def test_fit_recovers_the_visual_weight_of_a_noise_free_run():
+    """A 3 s visual-scene sine with W = 0.4, W_v = 0.35: W_v fitted back from 0.1 within 1e-3
+    (noise-free: only the integrator's error, rtol 1e-8, moves it)."""
+    from posturelab.studies.identification import fit_stiffness
+
+    sc = scene_scenario(proprioceptive_weight=0.4, visual_weight=0.1)
+    truth = sc.run(visual_weight=0.35)
+    keep = slice(None, None, 5)
+    fit = fit_stiffness(sc, truth.time[keep], truth.theta[keep], ["visual_weight"])
+    assert fit.parameter_names == ("visual_weight",)
+    assert fit.estimates[0] == pytest.approx(0.35, abs=1e-3)
+
+
+def test_fit_refuses_both_weights_and_a_weight_without_a_scene(tmp_path, capsys):
+    from posturelab.studies.identification import fit_stiffness
+
+    sc = scene_scenario(proprioceptive_weight=0.4)
+    t = np.linspace(0, 1, 11)
+    with pytest.raises(ParameterError, match="not both"):
+        fit_stiffness(sc, t, np.zeros((11, 3)), ["proprioceptive_weight", "visual_weight"])
+    with pytest.raises(ParameterError, match="visual-scene tilt, and it has none"):
+        fit_stiffness(sc.replace(visual_tilt=None), t, np.zeros((11, 3)), ["visual_weight"])
+
+
+def test_the_fit_command_frees_the_visual_weight(tmp_path, capsys):
+    data = tmp_path / "angles.csv"
+    sc = scene_scenario(proprioceptive_weight=0.4)
+    truth = sc.run(visual_weight=0.35, rtol=1e-8, atol=1e-10)
+    rows = ["t,theta1,theta2,theta3"] + [
+        ",".join(f"{v:.17g}" for v in (t, *th)) for t, th in
+        zip(truth.time[::5], truth.theta[::5], strict=True)]
+    data.write_text("\n".join(rows) + "\n", encoding="utf-8")
+    code = main(["fit", "--data", str(data), "--free", "visual_weight",
+                 "--stiffness", ",".join(f"{v:.17g}" for v in sc.muscles.stiffnesses),
+                 "--active-stiffness",
+                 ",".join(f"{v:.17g}" for v in sc.muscles.active_stiffnesses),
+                 "--active-viscosity",
+                 ",".join(f"{v:.17g}" for v in sc.muscles.active_viscosities),
+                 "--feedback-delay", "0.05", "--proprioceptive-weight", "0.4",
+                 "--visual-tilt", "sine:0.03:0.4"])
+    out, err = capsys.readouterr()
+    assert code == 0, err
+    line = next(ln for ln in out.splitlines() if ln.strip().startswith("visual_weight"))
+    assert float(line.split()[1]) == pytest.approx(0.35, abs=1e-3), (out, err)
+    assert "visual_weight" in " ".join(_help_text("fit").split())
