@@ -164,3 +164,62 @@ def test_the_fit_command_frees_the_visual_weight(tmp_path, capsys):
     line = next(ln for ln in out.splitlines() if ln.strip().startswith("visual_weight"))
     assert float(line.split()[1]) == pytest.approx(0.35, abs=1e-3), (out, err)
     assert "visual_weight" in " ".join(_help_text("fit").split())
+
+
+# ---- fit-frf on the two-FRF JSON of a dual trial --------------------------------------------
+
+GAINS = ["--body", "paper-1link", "--stiffness", "113", "--viscosity", "28",
+         "--active-stiffness", "677", "--active-viscosity", "197", "--feedback-delay", "0.12"]
+
+
+def test_fit_frf_reads_the_dual_json_of_frf_as_the_trial(tmp_path, capsys):
+    """simulate a dual trial; frf --json > d.json; fit-frf --data d.json gives the fit of
+    fit-frf --data trial.csv (the same two FRFs, each with its model input)."""
+    import json
+
+    trial, frfs = tmp_path / "trial.csv", tmp_path / "d.json"
+    assert main(["simulate", *GAINS, "--proprioceptive-weight", "0.55",
+                 "--visual-weight", "0.3", "--tilt", "prts:0.035",
+                 "--visual-tilt", "prts:0.035:0.125", "--duration", "60",
+                 "--sample-rate", "100", "--out", str(trial)]) == 0
+    capsys.readouterr()
+    cycles = ["--cycle-length", "20", "--discard-cycles", "1"]
+    assert main(["frf", "--data", str(trial), *cycles, "--json"]) == 0
+    frfs.write_text(capsys.readouterr().out, encoding="utf-8")
+    free = ["--free", "proprioceptive_weight,visual_weight", "--json"]
+    assert main(["fit-frf", "--data", str(trial), *cycles, *GAINS, *free]) == 0
+    by_csv = json.loads(capsys.readouterr().out)
+    assert main(["fit-frf", "--data", str(frfs), *GAINS, *free]) == 0
+    by_json = json.loads(capsys.readouterr().out)
+    assert [c["input"] for c in by_json["conditions"]] == ["tilt", "visual-tilt"]
+    assert [c["kind"] for c in by_json["conditions"]] == ["table", "table"]
+    for a, b in zip(by_csv["parameters"], by_json["parameters"], strict=True):
+        assert a["name"] == b["name"]
+        assert b["estimate"] == pytest.approx(a["estimate"], rel=1e-9, abs=1e-12)
+        assert b["standard_error"] == pytest.approx(a["standard_error"], rel=1e-6)
+    got = {q["name"]: q["estimate"] for q in by_json["parameters"]}
+    assert got["visual_weight"] == pytest.approx(0.3, abs=0.01)
+    # --stimulus picks one of them; an unknown one is refused in one line
+    assert main(["fit-frf", "--data", str(frfs), "--stimulus", "visual_tilt", *GAINS,
+                 "--free", "visual_weight", "--json"]) == 0
+    one = json.loads(capsys.readouterr().out)
+    assert [c["input"] for c in one["conditions"]] == ["visual-tilt"]
+    assert main(["fit-frf", "--data", str(frfs), "--stimulus", "sound", *GAINS,
+                 "--free", "visual_weight"]) == 2
+    err = capsys.readouterr().err
+    assert "'sound' is not in" in err and len(err.strip().splitlines()) == 1
+
+
+def test_a_one_frf_reader_names_a_dual_json(tmp_path):
+    import json
+
+    from posturelab.frequency.table import read_frf_json, read_frf_json_stimuli
+
+    one = {"frequency": [0.1, 0.2], "gain": [1.0, 0.8], "phase_deg": [-10.0, -30.0]}
+    path = tmp_path / "d.json"
+    path.write_text(json.dumps({"tilt": one, "visual_tilt": one}), encoding="utf-8")
+    tables = read_frf_json_stimuli(path)
+    assert list(tables) == ["tilt", "visual_tilt"]
+    np.testing.assert_allclose(abs(tables["visual_tilt"].frf), [1.0, 0.8])
+    with pytest.raises(ParameterError, match=r"one FRF per stimulus \(tilt, visual_tilt\)"):
+        read_frf_json(path)
