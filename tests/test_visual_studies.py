@@ -223,3 +223,49 @@ def test_a_one_frf_reader_names_a_dual_json(tmp_path):
     np.testing.assert_allclose(abs(tables["visual_tilt"].frf), [1.0, 0.8])
     with pytest.raises(ParameterError, match=r"one FRF per stimulus \(tilt, visual_tilt\)"):
         read_frf_json(path)
+
+
+# ---- design --visual-tilt -----------------------------------------------------------------
+
+
+def test_a_scene_design_on_active_gains_is_the_surface_design_with_w_as_w_v():
+    """With active gains only, a scene tilt weighted W_v acts as a surface tilt weighted W
+    = W_v (the surface's mechanical path needs intrinsic gains: test_visual.py checks the
+    engines so); the predicted errors of W_v and the gains then equal those of W."""
+    from posturelab.frequency.design import predict_errors
+    from posturelab.model.muscles import MusclePair, MuscleSet
+
+    body = pl.get_body("paper-1link")
+    mgh = body.load_stiffness
+    muscles = MuscleSet((MusclePair("ankle", 0, 1, 0.0, 0.0, active_stiffness=1.3 * mgh,
+                                    active_viscosity=0.35 * mgh),), 1)
+    common = dict(feedback_delay=0.1, sensor_noise=1e-3, cycles=4)
+    scene = predict_errors(body, muscles, ["visual_weight", "active_stiffness"],
+                           input="visual-tilt", proprioceptive_weight=0.0, visual_weight=0.4,
+                           **common)
+    surface = predict_errors(body, muscles, ["proprioceptive_weight", "active_stiffness"],
+                             proprioceptive_weight=0.4, **common)
+    assert scene.stimulus == "visual-tilt" and scene.to_dict()["design"]["stimulus"] == (
+        "visual-tilt")
+    np.testing.assert_allclose(scene.values, surface.values, rtol=0, atol=0)
+    assert np.all(np.isfinite(scene.standard_errors))
+    np.testing.assert_allclose(scene.standard_errors, surface.standard_errors, rtol=1e-9)
+    with pytest.raises(ParameterError, match=r"proprioceptive_weight \+ visual_weight"):
+        predict_errors(body, muscles, ["visual_weight"], input="visual-tilt",
+                       proprioceptive_weight=0.8, visual_weight=0.4, **common)
+
+
+def test_the_design_command_takes_a_visual_tilt(capsys):
+    import json
+
+    base = ["design", "--controller", "peterka-2002", "--sensor-noise", "0.001"]
+    assert main([*base, "--visual-tilt", "prts:0.035", "--proprioceptive-weight", "0.5",
+                 "--visual-weight", "0.3", "--free", "visual_weight", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["design"]["stimulus"] == "visual-tilt"
+    assert out["parameters"]["visual_weight"]["value"] == 0.3
+    assert out["parameters"]["visual_weight"]["standard_error"] > 0
+    assert main([*base, "--tilt", "prts:0.035", "--visual-tilt", "prts:0.035",
+                 "--free", "visual_weight"]) == 2
+    err = capsys.readouterr().err
+    assert "not both" in err and len(err.strip().splitlines()) == 1
