@@ -269,3 +269,17 @@ def test_the_design_command_takes_a_visual_tilt(capsys):
                  "--free", "visual_weight"]) == 2
     err = capsys.readouterr().err
     assert "not both" in err and len(err.strip().splitlines()) == 1
+
+
+def test_a_prts_experiment_sweep_refuses_the_visual_weight_and_a_scene(tmp_path, capsys):
+    base = ["sweep", "--experiment", "prts", "--case", "1", "--tilt", "prts:0.035",
+            "--out", str(tmp_path / "p.csv")]
+    for extra, words in (
+            (["--vary", "visual_weight=0:0.3:2", "--visual-tilt", "sine:0.01:0.5"],
+             "visual_weight has no effect"),
+            (["--vary", "feedback_delay=0:0.1:2", "--visual-tilt", "sine:0.01:0.5"],
+             "leave out the visual-scene tilt")):
+        assert main([*base, *extra]) == 2
+        err = capsys.readouterr().err
+        assert words in err and len(err.strip().splitlines()) == 1
+    assert not (tmp_path / "p.csv").exists()
