@@ -75,8 +75,8 @@ finished are written and counted (exit 130, 143). Options this kind of sweep doe
 state and integrator options on --experiment prts) are refused.
 
 Everything of the base experiment carries into every run: --torque-limits, --feedback-delay,
-active gains, --tilt and --proprioceptive-weight, --foot with --centre-of-pressure, the
-knee model.
+active gains, --tilt and --proprioceptive-weight, --visual-tilt and --visual-weight, --foot
+with --centre-of-pressure, the knee model.
 
 --experiment prts runs, for every parameter set, the in-silico PRTS identification
 experiment instead of one simulation: the base experiment's --tilt prts:… for
