@@ -154,6 +154,7 @@ def test_sweep_takes_every_name_it_can_vary(tmp_path, leave_out):
         varies += ["--vary", f"{name}={v}:{v}:1"]
     out = tmp_path / "all.csv"
     p = cli("sweep", "--case", "1", "--disturbance", "backward", "--duration", "0.2",
+            "--visual-tilt", "sine:0.01:0.5",  # (visual_weight weighs a scene tilt)
             *varies, "--out", str(out))
     assert p.returncode == 0, p.stderr
     header = next(csv.reader(out.open()))

@@ -45,9 +45,12 @@ Example: posturelab design --controller peterka-2002 --tilt prts:0.035 --cycles 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     """The options of ``posturelab design``."""
     add_muscle_arguments(p)
-    p.add_argument("--tilt", default="prts:0.035", metavar="SPEC",
+    p.add_argument("--tilt", default=None, metavar="SPEC",
                    help="prts:AMPLITUDE_RAD[:STATE_DURATION_S][:SEQUENCE] (default "
                    "prts:0.035: posturelab-80, 0.25 s states, 20 s cycle).")
+    p.add_argument("--visual-tilt", default=None, metavar="SPEC",
+                   help="the PRTS moves the visual scene instead of the surface (as --tilt; "
+                   "its FRF carries --visual-weight, which --free may name).")
     p.add_argument("--cycles", type=int, default=5, metavar="N",
                    help="cycles analysed (default 5).")
     p.add_argument("--discard-cycles", dest="discard", type=int, default=1, metavar="N",
@@ -134,8 +137,12 @@ def run(args: argparse.Namespace) -> int:
 
     model = model_from_args(args)
     body, muscles, options = model.body, model.muscles, model.options
-    with naming_option("--tilt"):
-        tilt = parse_tilt(args.tilt)
+    if args.tilt is not None and args.visual_tilt is not None:
+        raise ParameterError("give --tilt or --visual-tilt, not both (a dual-stimulus design "
+                             "is not predicted)")
+    scene = args.visual_tilt is not None
+    with naming_option("--visual-tilt" if scene else "--tilt"):
+        tilt = parse_tilt(args.visual_tilt if scene else args.tilt or "prts:0.035")
     with naming_option("--motor-noise"):
         noise = motor_noise_from_args(args, body.n_links)
     free = _names(args.free)
@@ -143,7 +150,8 @@ def run(args: argparse.Namespace) -> int:
     common = dict(discard=args.discard, sensor_noise=args.sensor_noise, motor_noise=noise,
                   sample_rate=args.sample_rate, output=args.output.strip().lower(),
                   feedback_delay=options.feedback_delay,
-                  proprioceptive_weight=options.proprioceptive_weight)
+                  proprioceptive_weight=options.proprioceptive_weight,
+                  input="visual-tilt" if scene else "tilt", visual_weight=options.visual_weight)
     if args.optimise:
         if args.budget is None:
             raise ParameterError("--optimise needs --budget SECONDS")
@@ -166,6 +174,7 @@ def run(args: argparse.Namespace) -> int:
         return 0
     p = prediction
     head = "optimised design" if args.optimise else "design"
+    head += " (visual scene)" if scene else ""
     print(f"{head}: PRTS {p.amplitude:.4g} rad peak to peak, {p.state_duration:g} s states "
           f"({p.cycle_length:g} s cycle), {p.cycles} cycles + {p.discard} discarded = "
           f"{p.duration:g} s; sensor noise {p.sensor_noise:g} rad; motor noise: {p.motor_noise}")

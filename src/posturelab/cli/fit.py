@@ -38,7 +38,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    "as sweep --vary and fit-frf --free): stiffness:PAIR, viscosity:PAIR, "
                    "active_stiffness:PAIR, active_viscosity:PAIR (PAIR " + ", ".join(PAPER_PAIRS)
                    + " on the paper's body), viscosity_ratio, feedback_delay, "
-                   "proprioceptive_weight, torque_feedback_gain, torque_feedback_time_constant "
+                   "proprioceptive_weight, visual_weight (with --visual-tilt; one of the two "
+                   "weights at a time), torque_feedback_gain, torque_feedback_time_constant "
                    "(the torque feedback with --engine reference; its starting values from the "
                    "scenario's [muscles]).")
     g.add_argument("--engine", choices=ENGINES, default="compiled",

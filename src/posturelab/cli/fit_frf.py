@@ -36,8 +36,9 @@ out on a body with one pair), feedback_delay, proprioceptive_weight, visual_weig
 torque_feedback_gain, torque_feedback_time_constant (Peterka 2002's torque feedback;
 starting values from --torque-feedback-gain and --torque-feedback-time-constant).
 A dual-stimulus trial (--stimulus tilt,visual_tilt, or a trial CSV with both columns and no
---stimulus; posturelab.frequency.dual) gives two conditions, its surface-tilt FRF and its
-visual-scene FRF, each fitted with its own model input: --free
+--stimulus; posturelab.frequency.dual), or the JSON posturelab frf --json prints for one,
+{{"tilt": {{...}}, "visual_tilt": {{...}}}} (--stimulus picks some), gives two conditions, its
+surface-tilt FRF and its visual-scene FRF, each fitted with its own model input: --free
 proprioceptive_weight,visual_weight fits W and W_v jointly (Peterka 2002's independent
 channels; W + W_v > 1 is reported as a warning). The body and the
 starting values come from the options below (as in posturelab simulate); --bounds
@@ -173,7 +174,19 @@ def _conditions(path: str, args: argparse.Namespace,
     from ._recording import check_sway_response
 
     if path.lower().endswith(".json"):
-        return [(read_frf_file(path, what="--data FRF JSON"), args.input, path)]
+        from ..frequency.table import read_frf_json_stimuli
+
+        tables = read_frf_json_stimuli(path, "--data FRF JSON")
+        if None in tables:
+            return [(tables[None], args.input, path)]
+        if args.stimulus:  # (some of a dual trial's FRFs)
+            wanted = [s.strip().lower() for s in args.stimulus.split(",") if s.strip()]
+            unknown = [s for s in wanted if s not in tables]
+            if unknown:
+                raise ParameterError(f"--stimulus {unknown[0]!r} is not in --data {path!r}; "
+                                     f"it has {', '.join(tables)}")
+            tables = {s: tables[s] for s in wanted}
+        return [(t, input_of(s), f"{path} [{s}]") for s, t in tables.items()]
     stimuli = ([s.strip().lower() for s in args.stimulus.split(",") if s.strip()]
                if args.stimulus else stimulus_columns(path))
     if len(stimuli) > 1:

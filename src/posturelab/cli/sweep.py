@@ -41,13 +41,15 @@ active_viscosity:PAIR [N·m·s/rad], a pair's active (delayed) gains; viscosity_
 disturbance_scale [-], a factor on the base experiment's platform motion (velocity-step
 speed, pulse peak, ramp displacement, sine amplitudes, measured accelerations: --vary
 disturbance_scale=0.5:3:26 with a 1 m/s step sweeps 0.5-3 m/s); feedback_delay [s];
-proprioceptive_weight [-]; or torque_limit:JOINT [N·m] ({", ".join(PAPER_JOINTS)} on the
-paper's body), the largest net muscle moment at a joint; repeat --vary for each
-parameter. Every other gain comes from the base experiment: --case/--stiffness/--controller
-with --disturbance or --tilt (as in posturelab simulate), --scenario FILE.toml or --builtin
-NAME. A pair's viscosity is the varied viscosity:PAIR, else the ratio times its stiffness:
-the varied viscosity_ratio, else --viscosity-ratio, else the base experiment's (0.25, the
-paper's, for --case); viscosity_ratio and viscosity:PAIR are not varied together.
+proprioceptive_weight [-]; visual_weight [-] (W_v, with --visual-tilt; every run's
+proprioceptive_weight + visual_weight <= 1); or torque_limit:JOINT [N·m]
+({", ".join(PAPER_JOINTS)} on the paper's body), the largest net muscle moment at a joint;
+repeat --vary for each parameter. Every other gain comes from the base experiment:
+--case/--stiffness/--controller with --disturbance or --tilt (as in posturelab simulate),
+--scenario FILE.toml or --builtin NAME. A pair's viscosity is the varied viscosity:PAIR,
+else the ratio times its stiffness: the varied viscosity_ratio, else --viscosity-ratio,
+else the base experiment's (0.25, the paper's, for --case); viscosity_ratio and
+viscosity:PAIR are not varied together.
 
 Columns: the varied parameters (stiffness:ankle, ...), then
 {", ".join(OUTCOME_COLUMNS)} (one peak_theta
@@ -73,8 +75,8 @@ finished are written and counted (exit 130, 143). Options this kind of sweep doe
 state and integrator options on --experiment prts) are refused.
 
 Everything of the base experiment carries into every run: --torque-limits, --feedback-delay,
-active gains, --tilt and --proprioceptive-weight, --foot with --centre-of-pressure, the
-knee model.
+active gains, --tilt and --proprioceptive-weight, --visual-tilt and --visual-weight, --foot
+with --centre-of-pressure, the knee model.
 
 --experiment prts runs, for every parameter set, the in-silico PRTS identification
 experiment instead of one simulation: the base experiment's --tilt prts:… for

@@ -85,7 +85,8 @@ MAX_CONDITION = 1e12
 _ROWS = {"stiffness": 0, "viscosity": 1, "active_stiffness": 2, "active_viscosity": 3}
 #: The smallest scale of a parameter's difference step. [its unit]
 _STEP_FLOOR = {"stiffness": 1.0, "viscosity": 1.0, "active_stiffness": 1.0,
-               "active_viscosity": 1.0, "feedback_delay": 1e-3, "proprioceptive_weight": 1e-3}
+               "active_viscosity": 1.0, "feedback_delay": 1e-3, "proprioceptive_weight": 1e-3,
+               "visual_weight": 1e-3}
 
 
 @dataclass(frozen=True)
@@ -118,6 +119,8 @@ class DesignPrediction:
         [rad]
     motor_noise : str
         Its description, or "none".
+    stimulus : {"tilt", "visual-tilt"}
+        What the PRTS moves: the support surface or the visual scene.
     """
 
     names: tuple[str, ...]
@@ -135,6 +138,7 @@ class DesignPrediction:
     duration: float = 0.0
     sensor_noise: float = 0.0
     motor_noise: str = "none"
+    stimulus: str = "tilt"
 
     def to_dict(self) -> dict:
         """Plain-Python summary (JSON-safe: an infinite error is null)."""
@@ -152,7 +156,8 @@ class DesignPrediction:
             "design": {"amplitude": self.amplitude, "state_duration": self.state_duration,
                        "cycle_length": self.cycle_length, "cycles": self.cycles,
                        "discard": self.discard, "duration": self.duration,
-                       "sensor_noise": self.sensor_noise, "motor_noise": self.motor_noise},
+                       "sensor_noise": self.sensor_noise, "motor_noise": self.motor_noise,
+                       "stimulus": self.stimulus},
             "bands": {"frequency": [float(f) for f in self.frequency],
                       "frf_se": [float(math.sqrt(v)) for v in np.diag(self.band_covariance)]},
         }
@@ -351,19 +356,22 @@ def _specs(muscles: MuscleSet, free) -> tuple[list, list]:
     return names, specs
 
 
-def _values(muscles, specs, feedback_delay, proprioceptive_weight) -> np.ndarray:
+def _values(muscles, specs, feedback_delay, proprioceptive_weight,
+            visual_weight: float = 0.0) -> np.ndarray:
     base = np.stack([muscles.stiffnesses, muscles.viscosities, muscles.active_stiffnesses,
                      muscles.active_viscosities])
+    scalars = {"feedback_delay": feedback_delay, "proprioceptive_weight": proprioceptive_weight,
+               "visual_weight": visual_weight}
     out = []
     for b, j in specs:
-        out.append(feedback_delay if b == "feedback_delay" else proprioceptive_weight
-                   if b == "proprioceptive_weight" else float(base[_ROWS[b], j]))
+        out.append(scalars[b] if b in scalars else float(base[_ROWS[b], j]))
     return np.array(out, dtype=float)
 
 
 def model_band_frf(body: Body, muscles: MuscleSet, specs, values, harmonic_frequency,
                    harmonic_weight, *, output: str = "com_angle", feedback_delay: float = 0.0,
-                   proprioceptive_weight: float = 1.0) -> np.ndarray:
+                   proprioceptive_weight: float = 1.0, visual_weight: float = 0.0,
+                   input: str = "tilt") -> np.ndarray:
     """The model's band FRFs for M sets of the parameters ``specs`` (base name, pair index),
     averaged over each band's harmonics with the stimulus's power, as the fit does.
 
@@ -373,6 +381,9 @@ def model_band_frf(body: Body, muscles: MuscleSet, specs, values, harmonic_frequ
         [their units]
     harmonic_frequency, harmonic_weight : sequence of numpy.ndarray
         Per band, its harmonics [Hz] and their stimulus power [rad²].
+    output, feedback_delay, proprioceptive_weight, visual_weight, input
+        As for :func:`posturelab.frequency.model.model_frf_batch` (``input`` "tilt" or
+        "visual-tilt": what the PRTS moves; [s], [-], [-]).
 
     Returns
     -------
@@ -387,18 +398,21 @@ def model_band_frf(body: Body, muscles: MuscleSet, specs, values, harmonic_frequ
                                 muscles.active_viscosities])[None], M, axis=0)
     tau = np.full(M, float(feedback_delay))
     w = np.full(M, float(proprioceptive_weight))
+    wv = np.full(M, float(visual_weight))
     for k, (b, j) in enumerate(specs):
         if b == "feedback_delay":
             tau = values[:, k].copy()
         elif b == "proprioceptive_weight":
             w = values[:, k].copy()
+        elif b == "visual_weight":
+            wv = values[:, k].copy()
         else:
             gains[:, _ROWS[b], j] = values[:, k]
     active = muscles.has_active_feedback or any(b.startswith("active") for b, _ in specs)
     f = np.concatenate(harmonic_frequency)
     H = model_frf_batch(body, muscles, f, gains[:, 0], gains[:, 1],
                         gains[:, 2] if active else None, gains[:, 3] if active else None,
-                        tau, w, output=output)
+                        tau, w, output=output, input=input, visual_weight=wv)
     out, start = [], 0
     for weight in harmonic_weight:
         out.append(H[:, start:start + weight.size] @ weight / weight.sum())
@@ -475,7 +489,8 @@ def predict_errors(body: Body, muscles: MuscleSet, free, *, tilt=None, cycles: i
                    discard: int = 1, sensor_noise: float = 0.0, motor_noise=None,
                    sample_rate: float = 100.0, output: str = "com_angle",
                    feedback_delay: float = 0.0, proprioceptive_weight: float = 1.0,
-                   bands=None) -> DesignPrediction:
+                   bands=None, input: str = "tilt",
+                   visual_weight: float = 0.0) -> DesignPrediction:
     """The standard errors a PRTS experiment will give the ``free`` parameters (module notes).
 
     Parameters
@@ -496,6 +511,11 @@ def predict_errors(body: Body, muscles: MuscleSet, free, *, tilt=None, cycles: i
         [Hz]
     output, feedback_delay, proprioceptive_weight, bands
         As for :func:`posturelab.frequency.experiment.prts_experiment`.
+    input : {"tilt", "visual-tilt"}
+        What ``tilt`` moves: the support surface (default) or the visual scene, whose
+        FRF carries W_v (:mod:`posturelab.model.visual`; the noise's path is the same loop).
+    visual_weight : float
+        W_v, with W + W_v <= 1. [-]
 
     Returns
     -------
@@ -509,17 +529,30 @@ def predict_errors(body: Body, muscles: MuscleSet, free, *, tilt=None, cycles: i
     _check_design(tilt, cycles, discard, sample_rate)
     _check_stable(body, muscles, feedback_delay)
     model = _model_options(feedback_delay, proprioceptive_weight, output)
+    frf_model = {**model, **_input_options(input, proprioceptive_weight, visual_weight)}
     names, specs = _specs(muscles, free)
     noise = band_noise_covariance(body, muscles, tilt, int(cycles), sensor_noise=sensor_noise,
                                   motor_noise=motor_noise, sample_rate=sample_rate,
                                   bands=bands, **model)
-    values = _values(muscles, specs, feedback_delay, proprioceptive_weight)
+    values = _values(muscles, specs, feedback_delay, proprioceptive_weight,
+                     frf_model["visual_weight"])
     hf, hw = noise["harmonic_frequency"], noise["harmonic_weight"]
-    D = frf_derivatives(body, muscles, specs, values, hf, hw, **model)
+    D = frf_derivatives(body, muscles, specs, values, hf, hw, **frf_model)
     fisher = _fisher(D, noise["covariance"])
-    H = model_band_frf(body, muscles, specs, values, hf, hw, **model)[0]
+    H = model_band_frf(body, muscles, specs, values, hf, hw, **frf_model)[0]
     return DesignPrediction(
         tuple(names), values, _errors(fisher), fisher, noise["frequency"], H,
         noise["covariance"], float(tilt.amplitude), float(tilt.state_duration),
         float(tilt.cycle), int(cycles), int(discard), float(tilt.cycle * (cycles + discard)),
-        float(sensor_noise), "none" if motor_noise is None else motor_noise.describe())
+        float(sensor_noise), "none" if motor_noise is None else motor_noise.describe(),
+        frf_model["input"])
+
+
+def _input_options(input: str, proprioceptive_weight, visual_weight) -> dict:
+    """What the PRTS moves and W_v, checked (W + W_v <= 1, naming both)."""
+    from ..parameters import check_weights
+
+    if input not in ("tilt", "visual-tilt"):
+        raise ParameterError(f"input must be tilt or visual-tilt, got {input!r}"[:200])
+    return {"input": input,
+            "visual_weight": check_weights(proprioceptive_weight, visual_weight)}

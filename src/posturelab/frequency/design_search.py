@@ -85,8 +85,8 @@ def optimise_design(body: Body, muscles: MuscleSet, free, *, budget: float, targ
                     sample_rate: float = 100.0, output: str = "com_angle",
                     feedback_delay: float = 0.0, proprioceptive_weight: float = 1.0,
                     amplitude_range=AMPLITUDE_RANGE,
-                    state_duration_range=STATE_DURATION_RANGE, grid: int = 9
-                    ) -> DesignOptimum:
+                    state_duration_range=STATE_DURATION_RANGE, grid: int = 9,
+                    input: str = "tilt", visual_weight: float = 0.0) -> DesignOptimum:
     """The PRTS design (amplitude, state duration, cycles) with the smallest
     Σ (se/|θ|)² over ``targets`` within ``budget`` seconds of recording (module notes).
 
@@ -106,6 +106,9 @@ def optimise_design(body: Body, muscles: MuscleSet, free, *, budget: float, targ
         State durations searched (rounded to whole samples), within [0.01, 10]. [s]
     grid : int
         Values per range, 2 … :data:`MAX_GRID`. [-]
+    input, visual_weight
+        What the PRTS moves ("tilt" or "visual-tilt") and W_v [-], as for
+        :func:`~posturelab.frequency.design.predict_errors`.
     """
     from ..model.tilt import PRTSTilt
 
@@ -123,7 +126,8 @@ def optimise_design(body: Body, muscles: MuscleSet, free, *, budget: float, targ
         raise ParameterError(f"targets must be among the free parameters ({', '.join(names)}), "
                              f"got {', '.join(missing)}")
     index = [names.index(n) for n in chosen]
-    values = _values(muscles, specs, feedback_delay, proprioceptive_weight)
+    values = _values(muscles, specs, feedback_delay, proprioceptive_weight, visual_weight)
+    stimulus = {"input": input, "visual_weight": visual_weight}
     scale = np.array([abs(values[i]) if values[i] else 1.0 for i in index])
     amplitudes = np.geomspace(a_lo, a_hi, grid)
     durations = np.unique(np.round(np.linspace(d_lo, d_hi, grid) * sample_rate) / sample_rate)
@@ -143,7 +147,7 @@ def optimise_design(body: Body, muscles: MuscleSet, free, *, budget: float, targ
                                  sensor_noise=sensor_noise, motor_noise=motor_noise,
                                  sample_rate=sample_rate, output=output,
                                  feedback_delay=feedback_delay,
-                                 proprioceptive_weight=proprioceptive_weight)
+                                 proprioceptive_weight=proprioceptive_weight, **stimulus)
         except ParameterError:  # (this state duration's bands do not fit below Nyquist)
             continue
         # 𝓘 ∝ C A² (module notes): the most cycles and the largest amplitude win at each Δ
@@ -171,7 +175,7 @@ def optimise_design(body: Body, muscles: MuscleSet, free, *, budget: float, targ
                                 discard=discard, sensor_noise=sensor_noise,
                                 motor_noise=motor_noise, sample_rate=sample_rate, output=output,
                                 feedback_delay=feedback_delay,
-                                proprioceptive_weight=proprioceptive_weight)
+                                proprioceptive_weight=proprioceptive_weight, **stimulus)
     searched = {"amplitude": [a_lo, a_hi], "state_duration": [float(durations[0]),
                                                               float(durations[-1])],
                 "grid": grid, "designs": compared}

@@ -265,6 +265,13 @@ def prts_sweep(scenario: Scenario, varies: Sequence, protocol: PRTSProtocol | No
     if any(v.name == "disturbance_scale" for v in varies):
         raise ParameterError("disturbance_scale has no meaning in a PRTS experiment sweep "
                              "(the stimulus is the tilt)")
+    if any(v.name == "visual_weight" for v in varies):
+        raise ParameterError("visual_weight has no effect in a PRTS experiment sweep (its "
+                             "stimulus is the platform tilt; W_v weighs a visual-scene tilt)")
+    if scenario.options.visual_tilt is not None:
+        raise ParameterError("a PRTS experiment sweep runs the platform tilt alone: leave out "
+                             "the visual-scene tilt (a dual-stimulus trial is "
+                             "posturelab simulate, frf and fit-frf)")
     # each fit parameter by its one spelling (the parameter table's; columns fit_NAME)
     protocol = replace(protocol, fit=tuple(_name(n, scenario.muscles) for n in protocol.fit))
     grid = sweep_grid(scenario, varies, viscosity_ratio)

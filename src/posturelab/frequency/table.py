@@ -25,7 +25,8 @@ import numpy as np
 from ..errors import ParameterError
 from .model import MAX_FREQUENCY  # the highest frequency a model FRF is taken at [Hz]
 
-__all__ = ["FRFTable", "frf_table_from_json", "read_frf_json", "MAX_BANDS"]
+__all__ = ["FRFTable", "frf_table_from_json", "read_frf_json", "read_frf_json_stimuli",
+           "MAX_BANDS"]
 
 #: Most bands a table may have. [-]
 MAX_BANDS = 10_000
@@ -171,6 +172,10 @@ def frf_table_from_json(obj, what: str = "FRF JSON") -> FRFTable:
              "sign_convention", "warnings", "harmonic_frequency", "harmonic_weight",
              "frf_covariance"}
     if "frequency" not in obj:
+        if _is_dual(obj):
+            raise ParameterError(f"{what} holds one FRF per stimulus ({', '.join(obj)}): "
+                                 "posturelab fit-frf reads each as a condition; here give "
+                                 "one FRF object")
         raise ParameterError(f"{what} has no 'frequency'; it needs frequency and either frf "
                              "or gain and phase_deg")
     f = _numbers("frequency [Hz]", obj["frequency"], None, 0.0, MAX_FREQUENCY, low_open=True)
@@ -239,6 +244,30 @@ def frf_table_from_json(obj, what: str = "FRF JSON") -> FRFTable:
 
 def read_frf_json(path, what: str = "FRF JSON") -> FRFTable:
     """:func:`frf_table_from_json` of a file (at most 16 MB)."""
+    obj, name = _load_json(path, what)
+    return frf_table_from_json(obj, name)
+
+
+def read_frf_json_stimuli(path, what: str = "FRF JSON") -> dict[str | None, FRFTable]:
+    """The FRFs of a JSON file by stimulus: ``{None: table}`` for one FRF object, or each
+    stimulus column's FRF of a dual-stimulus trial's ``{"tilt": {...}, "visual_tilt": {...}}``
+    (what ``posturelab frf --json`` prints for one: :mod:`posturelab.frequency.dual`), in
+    the file's order; each object as :func:`frf_table_from_json` reads it."""
+    obj, name = _load_json(path, what)
+    if isinstance(obj, dict) and _is_dual(obj):
+        return {str(key): frf_table_from_json(value, f"{name} [{key}]")
+                for key, value in obj.items()}
+    return {None: frf_table_from_json(obj, name)}
+
+
+def _is_dual(obj: dict) -> bool:
+    """Whether a JSON object is one FRF object per stimulus (no frequency of its own)."""
+    return ("frequency" not in obj and 1 <= len(obj) <= 4
+            and all(isinstance(v, dict) and "frequency" in v for v in obj.values()))
+
+
+def _load_json(path, what: str):
+    """The parsed JSON of a file (at most 16 MB) and the name its messages use."""
     import json
 
     from .._files import read_text
@@ -251,7 +280,7 @@ def read_frf_json(path, what: str = "FRF JSON") -> FRFTable:
         raise ParameterError(f"{name} is nested too deeply") from None
     except ValueError as exc:
         raise ParameterError(f"{name} is not valid JSON: {exc}"[:300]) from None
-    return frf_table_from_json(obj, name)
+    return obj, name
 
 
 def _refuse_constant(name: str):

@@ -34,8 +34,8 @@ if TYPE_CHECKING:  # (the engine loads when a sweep runs: posturelab --help stay
 #: The quantities of the parameter table a sweep can vary (all but active_viscosity_ratio).
 SWEEP_QUANTITIES: tuple[str, ...] = (
     "stiffness", "viscosity", "active_stiffness", "active_viscosity", "viscosity_ratio",
-    "feedback_delay", "proprioceptive_weight", "torque_limit", "disturbance_scale",
-    "joint_feedback_scale")
+    "feedback_delay", "proprioceptive_weight", "visual_weight", "torque_limit",
+    "disturbance_scale", "joint_feedback_scale")
 #: The joints whose torque limit a sweep can vary on the paper's body, in joint order.
 TORQUE_LIMIT_PARAMETERS: tuple[str, ...] = tuple(f"torque_limit:{j}" for j in PAPER_JOINTS)
 #: Names a sweep of the paper's body can vary (:data:`SWEEP_QUANTITIES` over its pairs and
@@ -232,6 +232,8 @@ class SweepGrid:
         none is varied. [N·m/rad], [N·m·s/rad]
     proprioceptive_weight : numpy.ndarray, shape (M,), optional
         W per run; None for the base experiment's. [-]
+    visual_weight : numpy.ndarray, shape (M,), optional
+        W_v per run (the visual-scene tilt's weight); None for the base experiment's. [-]
     joint_feedback_scale : numpy.ndarray, shape (M,), optional
         The factor on the base experiment's joint controller per run; None when not varied.
         [-]
@@ -248,6 +250,7 @@ class SweepGrid:
     active_viscosity: np.ndarray | None = None
     proprioceptive_weight: np.ndarray | None = None
     joint_feedback_scale: np.ndarray | None = None
+    visual_weight: np.ndarray | None = None
 
     @property
     def n_runs(self) -> int:
@@ -352,7 +355,7 @@ def sweep_grid(scenario: Scenario, varies: Sequence[VaryRange],
     pairs = list(muscles.names)
     joints = list(joints_of(n))
     varies_active = any(nm.startswith("active_") for nm in names)
-    ka = va = weight = None
+    ka = va = weight = visual = None
     if muscles.has_active_feedback or varies_active:
         ka = np.tile(muscles.active_stiffnesses, (m, 1))
         va = np.tile(muscles.active_viscosities, (m, 1))
@@ -368,6 +371,8 @@ def sweep_grid(scenario: Scenario, varies: Sequence[VaryRange],
             delay = np.ascontiguousarray(column)
         elif quantity == "proprioceptive_weight":
             weight = np.ascontiguousarray(column)
+        elif quantity == "visual_weight":
+            visual = np.ascontiguousarray(column)
         elif quantity == "joint_feedback_scale":
             control = np.ascontiguousarray(column)
         elif quantity == "torque_limit":  # (both ways)
@@ -387,8 +392,34 @@ def sweep_grid(scenario: Scenario, varies: Sequence[VaryRange],
     pair_viscosity = ratios * stiffness
     for j, column in viscosity.items():
         pair_viscosity[:, j] = column
+    _check_weights(scenario, weight, visual, values, names)
     return SweepGrid(tuple(names), values, stiffness, pair_viscosity, scale, delay,
-                     None if np.all(np.isinf(limits)) else limits, ka, va, weight, control)
+                     None if np.all(np.isinf(limits)) else limits, ka, va, weight, control,
+                     visual)
+
+
+def _check_weights(scenario: Scenario, weight: np.ndarray | None, visual: np.ndarray | None,
+                   values: np.ndarray, names: Sequence[str]) -> None:
+    """Every run's W_p + W_v <= 1 (one line naming both and the first run over), and a
+    varied W_v needs the base experiment's visual-scene tilt (it acts on nothing else)."""
+    if visual is not None and scenario.options.visual_tilt is None:
+        raise ParameterError("visual_weight weighs the base experiment's visual-scene tilt, "
+                             "and it has none: give --visual-tilt or a scenario with "
+                             "[visual_tilt]")
+    if weight is None and visual is None:
+        return
+    wp = np.full(values.shape[0], scenario.options.proprioceptive_weight) if weight is None \
+        else weight
+    wv = np.full(values.shape[0], scenario.options.visual_weight) if visual is None else visual
+    over = np.nonzero(wp + wv > 1.0 + 1e-12)[0]
+    if over.size:
+        r = int(over[0])
+        raise ParameterError(
+            f"proprioceptive_weight + visual_weight [-] must be at most 1 (the rest is "
+            f"graviceptive); {over.size:,} runs of the grid exceed it, the first "
+            f"{wp[r]:g} + {wv[r]:g} = {wp[r] + wv[r]:g} (narrow --vary "
+            + " or --vary ".join(n for n in names if n in ("proprioceptive_weight",
+                                                            "visual_weight")) + ")")
 
 
 # ---------------------------------------------------------------------------

@@ -69,10 +69,12 @@ class FitError(PostureLabError):
     budget, a non-finite state, …)."""
 
 VISCOSITY_RATIO = "viscosity_ratio"
+#: The sensory weights W_p, W_v (their sum at most 1).
+WEIGHTS = ("proprioceptive_weight", "visual_weight")
 #: The quantities of the parameter table a time-domain fit can free.
 FIT_QUANTITIES = ("stiffness", "viscosity", "active_stiffness", "active_viscosity",
                   "viscosity_ratio", "feedback_delay", "proprioceptive_weight",
-                  "torque_feedback_gain", "torque_feedback_time_constant",
+                  "visual_weight", "torque_feedback_gain", "torque_feedback_time_constant",
                   "joint_feedback_scale")
 #: How the uncertainty treats the residuals (:func:`fit_stiffness`).
 RESIDUAL_MODELS = ("ar1", "independent")
@@ -252,7 +254,10 @@ def fit_stiffness(
         ``"viscosity:PAIR"`` [N·m·s/rad] (else ratio × stiffness),
         ``"active_stiffness:PAIR"`` [N·m/rad], ``"active_viscosity:PAIR"`` [N·m·s/rad],
         ``"viscosity_ratio"`` [s], ``"feedback_delay"`` [s], ``"proprioceptive_weight"``
-        [-], ``"torque_feedback_gain"`` [-] and ``"torque_feedback_time_constant"`` [s]
+        [-], ``"visual_weight"`` [-] (W_v, under the scenario's visual-scene tilt; searched
+        up to 1 − W, the other weight held: one of the two weights at a time; started at
+        the scenario's W_v, or (1 − W)/2 when that is 0),
+        ``"torque_feedback_gain"`` [-] and ``"torque_feedback_time_constant"`` [s]
         (Peterka 2002's torque feedback, on either engine),
         ``"joint_feedback_scale"`` [-] (the factor on the experiment's joint controller,
         :mod:`posturelab.model.joint_feedback`); a former
@@ -304,6 +309,7 @@ def fit_stiffness(
     if len(set(names)) != len(names):
         raise ParameterError(f"free names must be unique, got {names}")
     control = scenario.options.joint_feedback
+    _check_weight_names(scenario, names)
     if "joint_feedback_scale" in names and control is None:
         raise ParameterError("joint_feedback_scale scales the experiment's joint controller, "
                              "and it has none: give --controller multijoint-default")
@@ -330,6 +336,9 @@ def fit_stiffness(
     special = {VISCOSITY_RATIO: viscosity_ratio,
                "feedback_delay": scenario.options.feedback_delay or 0.1,
                "proprioceptive_weight": scenario.options.proprioceptive_weight,
+               # (from 0 the relative finite-difference step would be lost in the noise)
+               "visual_weight": scenario.options.visual_weight
+               or 0.5 * (1.0 - scenario.options.proprioceptive_weight),
                "torque_feedback_gain": scenario.options.torque_feedback_gain,
                "torque_feedback_time_constant": scenario.options.torque_feedback_time_constant,
                "joint_feedback_scale": 1.0 if control is None else control.scale}
@@ -344,6 +353,14 @@ def fit_stiffness(
     upper = np.array([QUANTITIES[nm].fit_high if nm in special
                       else min(upper_bound, QUANTITIES[nm.partition(":")[0]].high)
                       for nm in names])
+    for k, nm in enumerate(names):  # W_p + W_v <= 1: a weight's box ends at 1 − the other's
+        if nm in WEIGHTS:
+            other = WEIGHTS[1 - WEIGHTS.index(nm)]
+            upper[k] = min(upper[k], 1.0 - getattr(scenario.options, other))
+            if upper[k] <= lower[k]:
+                raise ParameterError(f"{nm} cannot be fitted: {other} is "
+                                     f"{getattr(scenario.options, other):g}, leaving it no "
+                                     "room below 1 (their sum is at most 1)")
     x0 = np.clip(np.asarray(x0, dtype=float), lower + 1e-9, upper)
     sc = scenario.replace(duration=float(t[-1]) if t[-1] > 0 else scenario.options.duration)
     count = [0]
@@ -370,6 +387,7 @@ def fit_stiffness(
             feedback_delay=value.get("feedback_delay", sc.options.feedback_delay),
             proprioceptive_weight=value.get("proprioceptive_weight",
                                             sc.options.proprioceptive_weight),
+            visual_weight=value.get("visual_weight", sc.options.visual_weight),
             torque_feedback_gain=value.get("torque_feedback_gain",
                                            sc.options.torque_feedback_gain),
             torque_feedback_time_constant=value.get("torque_feedback_time_constant",
@@ -515,3 +533,15 @@ def read_trajectory_csv(path: str | Path, n_links: int) -> tuple[np.ndarray, np.
     if np.any(np.diff(data[:, 0]) <= 0):
         raise DataFileError(f"{str(path)!r}: t must be strictly increasing")
     return data[:, 0], data[:, 1:]
+
+
+def _check_weight_names(scenario: Scenario, names: Sequence[str]) -> None:
+    """One line when both weights are free (their sum <= 1 is a constraint the box search
+    cannot keep), or W_v is free with no visual-scene tilt (it would act on nothing)."""
+    if all(w in names for w in WEIGHTS):
+        raise ParameterError("free proprioceptive_weight or visual_weight, not both: their "
+                             "sum <= 1 is a constraint this box search cannot keep (posturelab "
+                             "fit-frf fits both from a dual-stimulus trial)")
+    if "visual_weight" in names and scenario.options.visual_tilt is None:
+        raise ParameterError("visual_weight weighs the experiment's visual-scene tilt, and it "
+                             "has none: give --visual-tilt or a scenario with [visual_tilt]")

@@ -18,8 +18,9 @@ velocity step's speed, a pulse's peak, a ramp's displacement, the sines' amplitu
 measured profile's accelerations; see :meth:`posturelab.model.platform.Disturbance.scaled`),
 so that a sweep over it finds how large a perturbation each gain set absorbs,
 ``feedback_delay`` [s], the neural delay of the muscle feedback,
-``proprioceptive_weight`` [-], and ``torque_limit:JOINT`` [N·m] (ankle, knee, hip), the
-largest net muscle moment at each joint (the others keep the base experiment's
+``proprioceptive_weight`` [-], ``visual_weight`` [-] (W_v, with the base experiment's
+visual-scene tilt; each run's W + W_v <= 1), and ``torque_limit:JOINT`` [N·m] (ankle,
+knee, hip), the largest net muscle moment at each joint (the others keep the base experiment's
 limits; none by default). Every feature of the base experiment (torque limits, a
 delay, centre-of-pressure falls) carries into the sweep. The viscosity of a pair is
 the varied ``viscosity:PAIR``, else the ratio times its stiffness: the varied ratio, else
@@ -158,9 +159,11 @@ class _Task:
         limits = None if grid.torque_limits is None else tuple(grid.torque_limits[r])
         weight = (self.options.proprioceptive_weight if grid.proprioceptive_weight is None
                   else float(grid.proprioceptive_weight[r]))
+        visual = (self.options.visual_weight if grid.visual_weight is None
+                  else float(grid.visual_weight[r]))
         return simulate(sc.body, muscles, disturbance, options=self._options(grid, r).replace(
             torque_limits=limits, feedback_delay=float(grid.feedback_delay[r]),
-            proprioceptive_weight=weight))
+            proprioceptive_weight=weight, visual_weight=visual))
 
     def _with_steady_sway(self, result: BatchResult, grid: SweepGrid, lo: int,
                           hi: int) -> BatchResult:
@@ -212,6 +215,8 @@ class _Task:
             proprioceptive_weight=(self.options.proprioceptive_weight
                                    if grid.proprioceptive_weight is None
                                    else grid.proprioceptive_weight[lo:hi]),
+            visual_weight=(self.options.visual_weight if grid.visual_weight is None
+                           else grid.visual_weight[lo:hi]),
             active_stiffness=_rows(grid.active_stiffness, lo, hi),
             active_viscosity=_rows(grid.active_viscosity, lo, hi),
             disturbance_scale=_rows(grid.disturbance_scale, lo, hi),

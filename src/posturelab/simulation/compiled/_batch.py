@@ -196,10 +196,10 @@ def _batch_limits(value, m: int, n: int, common: RunOptions, body: Body) -> np.n
 
 
 def _shared_options(options: RunOptions | None, duration, initial_state,
-                    keywords: dict[str, Any], weights=None) -> RunOptions:
-    """The options every run of a batch shares, on the compiled engine (with the smallest
-    of the per-run proprioceptive ``weights``, so that the shared visual weight is checked
-    against it here and against each run's later)."""
+                    keywords: dict[str, Any]) -> RunOptions:
+    """The options every run of a batch shares, on the compiled engine (the sensory weights
+    are per run: checked there, and each level is set up with W_v = 0, the batch computing
+    each run's gains on the visual-scene tilt itself)."""
     unknown = [k for k in keywords if k not in OPTION_NAMES or k in PER_RUN_OPTIONS]
     if unknown:
         shared_names = ", ".join(k for k in OPTION_NAMES if k not in PER_RUN_OPTIONS)
@@ -210,11 +210,6 @@ def _shared_options(options: RunOptions | None, duration, initial_state,
         changes["duration"] = duration
     if initial_state is not None:
         changes["initial_state"] = initial_state
-    if weights is not None and "visual_weight" in changes:
-        try:
-            changes["proprioceptive_weight"] = float(np.min(np.asarray(weights, float)))
-        except (TypeError, ValueError):
-            pass  # (refused with its name by the per-run check)
     shared = (options or RunOptions()).replace(**changes)
     if shared.engine != "compiled":
         raise ParameterError("simulate_batch runs the compiled engine; got engine "
@@ -236,7 +231,8 @@ def _gain_array(name: str, value, n_pairs: int) -> np.ndarray:
 
 #: The options each run of a batch may have its own value of (an array, one per run); the
 #: others are shared by every run.
-PER_RUN_OPTIONS = ("feedback_delay", "proprioceptive_weight", "torque_limits")
+PER_RUN_OPTIONS = ("feedback_delay", "proprioceptive_weight", "visual_weight",
+                   "torque_limits")
 
 
 def simulate_batch(
@@ -251,6 +247,7 @@ def simulate_batch(
     options: RunOptions | None = None,
     feedback_delay: float | np.ndarray | None = None,
     proprioceptive_weight: float | np.ndarray | None = None,
+    visual_weight: float | np.ndarray | None = None,
     torque_limits: np.ndarray | tuple[float, ...] | None = None,
     active_stiffness: np.ndarray | None = None,
     active_viscosity: np.ndarray | None = None,
@@ -292,6 +289,9 @@ def simulate_batch(
     proprioceptive_weight : float or array_like, shape (M,), optional
         W of the active part's error for pairs that span the foot, in [0, 1], for every
         run or per run (default ``options.proprioceptive_weight``). [-]
+    visual_weight : float or array_like, shape (M,), optional
+        W_v of the visual-scene tilt (``options.visual_tilt``), in [0, 1] with each run's
+        W + W_v <= 1, for every run or per run (default ``options.visual_weight``). [-]
     torque_limits : array_like, shape (N,), (M, N) or (M, N, 2), or a run's entries, optional
         Largest net muscle moment per joint, both ways, for every run or per run (``inf``
         for none); per run and joint a pair (lower < 0, upper > 0); or a single run's
@@ -325,7 +325,7 @@ def simulate_batch(
     BatchResult
     """
     check_model(body, muscles)
-    common = _shared_options(options, duration, initial_state, keywords, proprioceptive_weight)
+    common = _shared_options(options, duration, initial_state, keywords)
     method = common.method
     if method is not None:
         check_method(method)
@@ -365,10 +365,14 @@ def simulate_batch(
         feedback_delay = common.feedback_delay
     if proprioceptive_weight is None:
         proprioceptive_weight = common.proprioceptive_weight
+    if visual_weight is None:
+        visual_weight = common.visual_weight
     if torque_limits is None:
         torque_limits = common.torque_limits
     delays = _per_run("feedback_delay [s]", feedback_delay, M, None)
     weights = _per_run("proprioceptive_weight [-]", proprioceptive_weight, M, None)
+    visual_weights = _per_run("visual_weight [-]", visual_weight, M, None)
+    common = common.replace(visual_weight=0.0)  # (each run's W_v: visual_weights)
     lims = _batch_limits(torque_limits, M, n, common, body)  # (M, 2, N)
     scale = (np.ones(M) if disturbance_scale is None
              else finite_array("disturbance_scale [-]", disturbance_scale, (M,)))
@@ -379,8 +383,9 @@ def simulate_batch(
         return prepare_run(body, muscles, d, common.replace(
             feedback_delay=delay, torque_limits=limits, proprioceptive_weight=weight))
 
-    for w in np.unique(weights):  # each checked as a single run's would be
-        common.replace(proprioceptive_weight=float(w))
+    # each (W, W_v) checked as a single run's would be (naming both when W + W_v > 1)
+    for w, wv in (np.unique(np.stack([weights, visual_weights], axis=1), axis=0) if M else []):
+        common.replace(proprioceptive_weight=float(w), visual_weight=float(wv))
     weight = float(weights[0]) if M else common.proprioceptive_weight
 
     # every run's delay and limits are checked as a single run's would be
@@ -435,9 +440,9 @@ def simulate_batch(
     visual_gain_all = enc.readonly(np.zeros((M, len(GAIN_ROWS), n)))
     visual_pair_gain_all = enc.readonly(np.zeros((M, len(GAIN_ROWS), len(muscles.pairs))))
     visual_gains = None
-    if base.visual_tilt is not None:  # (the common visual weight, each run's gains and delay)
+    if base.visual_tilt is not None:  # (each run's visual weight, gains and delay)
         split = feedback_gains(kd_all, ld_all, ka_all, la_all, np.ones(M))
-        visual_gains = visual_pair_gains(split, muscles.spans_foot, delays, base.visual_weight)
+        visual_gains = visual_pair_gains(split, muscles.spans_foot, delays, visual_weights)
         visual_gain_all = enc.readonly(np.ascontiguousarray(
             visual_gains @ muscles.crossing_matrix))
         visual_pair_gain_all = enc.readonly(np.ascontiguousarray(visual_gains))
