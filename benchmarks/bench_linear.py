@@ -22,10 +22,11 @@ Everything is measured in this one run on this machine:
   warm, median of 3 after one warm-up run (``--skip-command`` leaves it out), against
   numpy eigvals of the same number of sets (``--command-runs``; ``--compare-source SRC``
   interleaves each run with one of another checkout's ``src`` and compares their outputs
-  byte for byte); and where its time goes: a fresh process
-  that times each phase in turn (start-up, loading the kernels, the map, the CSV,
-  matplotlib and the PNG; the command overlaps the map with matplotlib's import and
-  the CSV with the PNG);
+  byte for byte; ``--command-only`` times just this, against the baseline on
+  ``--baseline-sets``); and where its time goes: a fresh process
+  that times each phase in turn (interpreter start, start-up, loading the kernels, the map,
+  the CSV, matplotlib, the PNG and the interpreter's exit; the command overlaps the map
+  with matplotlib's import and the CSV with the PNG);
 * batched delay margins (``posturelab.linear.batch_delay_margin``: the closed form for
   one link, the delay pencil for three) against the single-set ``delay_margin`` on a
   subset of the same sets (``--margin-baseline-sets``), with the largest relative
@@ -184,13 +185,18 @@ def command_times(runs: int, other_source: str | None = None) -> tuple[list, lis
     return wall, cpu
 
 
-#: A fresh process timing each phase of the stability-map command in turn. [s]
+#: A fresh process timing each phase of the stability-map command in turn, as the command
+#: does them (numba's BLAS probe skipped when loading the kernels, the float32 image, the
+#: collector frozen before exit). [s]
 PHASES = """
-import io, sys, time
+import gc, io, sys, time
+w0 = time.time()
 t0 = time.perf_counter()
 import posturelab.cli.stability_map as command
 from posturelab.linear.batch import stability_map
+from posturelab._jit import skip_blas_probe
 t1 = time.perf_counter()
+skip_blas_probe()
 x, y = ("stiffness:ankle", 0, 2000), ("stiffness:gastrocnemius", 0, 1000)
 stability_map(x, y, 2).write_csv(io.StringIO())
 t2 = time.perf_counter()
@@ -205,10 +211,12 @@ t5 = time.perf_counter()
 with open(sys.argv[1] + ".png", "wb") as stream:
     plot_stability_map(smap).savefig(stream, format="png", dpi=150)
 t6 = time.perf_counter()
-print(t1 - t0, t2 - t1, t3 - t2, t4 - t3, t5 - t4, t6 - t5)
+print(w0, t1 - t0, t2 - t1, t3 - t2, t4 - t3, t5 - t4, t6 - t5, time.time(), flush=True)
+gc.freeze()
 """
-PHASE_NAMES = ("start-up (imports)", "loading the compiled kernels", "the map (10⁶ sets)",
-               "the CSV", "importing matplotlib", "the PNG")
+PHASE_NAMES = ("interpreter start", "start-up (imports)", "loading the compiled kernels",
+               "the map (10⁶ sets)", "the CSV", "importing matplotlib", "the PNG",
+               "exit (interpreter teardown)")
 
 
 def phase_times(runs: int) -> list[list[float]]:
@@ -216,9 +224,12 @@ def phase_times(runs: int) -> list[list[float]]:
     out = []
     with tempfile.TemporaryDirectory(prefix="posturelab-phases-") as folder:
         for _ in range(runs):
+            launched = time.time()
             proc = subprocess.run([sys.executable, "-c", PHASES, os.path.join(folder, "m")],
                                   capture_output=True, text=True, check=True)
-            out.append([float(v) for v in proc.stdout.split()])
+            ended = time.time()
+            w0, *inner, w_end = (float(v) for v in proc.stdout.split())
+            out.append([w0 - launched, *inner, ended - w_end])
     return out
 
 
@@ -296,6 +307,35 @@ def margin_rows(repeats: int, baseline_sets: int) -> None:
               f"{diff:>15.1e}  >= {goal:,.0f}/s: {'ok' if rate >= goal else 'MISSED'}")
 
 
+def command_rows(args, t_base: float) -> None:
+    """Time the whole command (against ``--compare-source`` if given, interleaved) and its
+    phases; ``t_base`` is the numpy baseline's time for ``--sets`` sets. [s]"""
+    if args.compare_source:
+        walls, cpus = command_times(args.command_runs, args.compare_source)
+        this = [w[0] for w in walls]
+        note = (f"  interleaved with {args.compare_source}, {args.command_runs} pairs: "
+                f"wall {statistics.median(this):.3f} s against "
+                f"{statistics.median(w[1] for w in walls):.3f} s (median ratio "
+                f"{statistics.median(w[0] / w[1] for w in walls):.2f}), CPU "
+                f"{statistics.median(c[0] for c in cpus):.3f} s against "
+                f"{statistics.median(c[1] for c in cpus):.3f} s (median ratio "
+                f"{statistics.median(c[0] / c[1] for c in cpus):.2f})")
+    else:
+        this, cpus = command_times(args.command_runs)
+        note = f"  CPU (user + system) median {statistics.median(cpus):.3f} s"
+    t_cmd = statistics.median(this)
+    base_cmd = t_base * COMMAND_SETS / args.sets  # the baseline for as many sets
+    print(f"{'stability-map command, resolution 1000 (warm, whole)':<56}{t_cmd:>11.3f}"
+          f"{1e6 * t_cmd / COMMAND_SETS:>14.3f}{base_cmd / t_cmd:>9.1f}×"
+          f"   (goal 1.5 s: {'ok' if t_cmd <= 1.5 else 'MISSED'})")
+    print(note)
+    phases = np.median(np.array(phase_times(3)), axis=0)
+    print(f"  where it goes (each phase in turn, fresh processes, median of 3; "
+          f"python -c 'import posturelab.cli' alone: {startup_time(3):.2f} s):")
+    for name, t in zip(PHASE_NAMES, phases, strict=True):
+        print(f"    {name:<34}{t:>7.3f} s")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sets", type=int, default=1_000_000)
@@ -310,6 +350,9 @@ def main() -> None:
     parser.add_argument("--margin-baseline-sets", type=int, default=40)
     parser.add_argument("--command-runs", type=int, default=3,
                         help="timed runs of the whole stability-map command (default 3)")
+    parser.add_argument("--command-only", action="store_true",
+                        help="time only the whole stability-map command (and its phases), "
+                        "against the numpy baseline on --baseline-sets")
     parser.add_argument("--compare-source", metavar="SRC",
                         help="the src folder of another checkout (e.g. `git archive REV src | "
                         "tar -x -C DIR`, then DIR/src): its stability-map command is timed "
@@ -318,6 +361,14 @@ def main() -> None:
 
     print(f"machine: {machine()}")
     print(f"load average at start: {', '.join(f'{v:.2f}' for v in os.getloadavg())}")
+
+    if args.command_only:
+        stiffness, ratio = random_sets(args.baseline_sets)
+        medians, _ = median_times({"baseline": lambda: baseline(stiffness, ratio)},
+                                  args.repeats)
+        command_rows(args, medians["baseline"] * args.sets / args.baseline_sets)
+        print(f"load average at end: {', '.join(f'{v:.2f}' for v in os.getloadavg())}")
+        return
 
     if not args.skip_compile:
         with tempfile.TemporaryDirectory(prefix="posturelab-numba-") as cache:
@@ -374,29 +425,7 @@ def main() -> None:
     print(f"{f'stability_map {map_resolution}², roots warm-started':<56}{t_map:>11.3f}"
           f"{1e6 * t_map / map_sets:>14.3f}{t_base * map_sets / args.sets / t_map:>9.1f}×")
     if not args.skip_command:
-        if args.compare_source:
-            walls, cpus = command_times(args.command_runs, args.compare_source)
-            this = [w[0] for w in walls]
-            note = (f"  interleaved with {args.compare_source}, {args.command_runs} pairs: "
-                    f"wall {statistics.median(this):.3f} s against "
-                    f"{statistics.median(w[1] for w in walls):.3f} s (median ratio "
-                    f"{statistics.median(w[0] / w[1] for w in walls):.2f}), CPU "
-                    f"{statistics.median(c[0] for c in cpus):.3f} s against "
-                    f"{statistics.median(c[1] for c in cpus):.3f} s")
-        else:
-            this, cpus = command_times(args.command_runs)
-            note = f"  CPU (user + system) median {statistics.median(cpus):.3f} s"
-        t_cmd = statistics.median(this)
-        base_cmd = t_base * COMMAND_SETS / args.sets  # the baseline for as many sets
-        print(f"{'stability-map command, resolution 1000 (warm, whole)':<56}{t_cmd:>11.3f}"
-              f"{1e6 * t_cmd / COMMAND_SETS:>14.3f}{base_cmd / t_cmd:>9.1f}×"
-              f"   (goal 1.5 s: {'ok' if t_cmd <= 1.5 else 'MISSED'})")
-        print(note)
-        phases = np.median(np.array(phase_times(3)), axis=0)
-        print(f"  where it goes (each phase in turn, fresh processes, median of 3; "
-              f"python -c 'import posturelab.cli' alone: {startup_time(3):.2f} s):")
-        for name, t in zip(PHASE_NAMES, phases, strict=True):
-            print(f"    {name:<34}{t:>7.3f} s")
+        command_rows(args, t_base)
     print()
     print(f"agreement with numpy eigvals on {nb:,} sets:")
     print(f"  poles |Δλ|/max(1,|λ|): max {err.max():.2e}, 99.9th percentile "

@@ -285,3 +285,40 @@ def test_pair_map_of_another_body_refuses_what_it_cannot_map(tmp_path, capsys):
         code, _, err = run(capsys, "stability-map", *argv, "--out", str(tmp_path / "e.png"))
         assert code == 2 and words in err and err.count("\n") == 1, err
     assert list(tmp_path.iterdir()) == []
+
+
+def test_map_image_is_matplotlib_s_own_float32_of_the_rgba_bytes():
+    """The figure hands imshow float32 RGBA = bytes / 255 (what matplotlib makes of uint8
+    RGBA when drawing): the PNG is byte for byte the one the uint8 image gives."""
+    import io
+
+    from posturelab.linear.batch import stability_map
+
+    smap = stability_map(("stiffness:ankle", 0, 2000), ("stiffness:gastrocnemius", 0, 1000), 37)
+    pngs = []
+    for as_uint8 in (False, True):
+        fig = viz_maps.plot_stability_map(smap)  # a fresh figure each (layout as drawn once)
+        image = fig.axes[0].get_images()[0]
+        rgba = image.get_array()
+        assert rgba.dtype == np.float32
+        if as_uint8:
+            as_bytes = np.rint(np.asarray(rgba) * 255).astype(np.uint8)
+            assert np.array_equal(np.divide(as_bytes, 0xff, dtype=np.float32), rgba)
+            image.set_data(as_bytes)
+        stream = io.BytesIO()
+        fig.savefig(stream, format="png", dpi=60)
+        pngs.append(stream.getvalue())
+    assert pngs[0] == pngs[1]
+
+
+def test_main_with_arguments_does_not_freeze_the_collector(tmp_path, capsys):
+    """Only the program itself (main() without arguments, which exits next) freezes the
+    garbage collector; a caller passing argv keeps a normal process."""
+    import gc
+
+    before = gc.get_freeze_count()
+    code = main(["stability-map", "--x", "stiffness:ankle:0:2000", "--y",
+                 "stiffness:gastrocnemius:0:1000", "--resolution", "5", "--out",
+                 str(tmp_path / "m.png")])
+    assert code == 0
+    assert gc.get_freeze_count() == before

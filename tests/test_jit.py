@@ -20,6 +20,8 @@ NON_COMPILING = re.compile(r"^\s*from numba(\.core)? import (event|config)$")
 #: A line that imports the kernel decorator (a module that compiles with it).
 JIT_IMPORT = re.compile(r"^\s*from (\.+|posturelab\.)_jit import|^\s*import posturelab\._jit",
                         re.MULTILINE)
+#: An import of _jit's helper that compiles nothing (the command line's kernel loading).
+NON_COMPILING_JIT = re.compile(r"^\s*from (\.+|posturelab\.)_jit import skip_blas_probe$")
 
 
 def numba_modules(*, compiling: bool = True) -> list[str]:
@@ -29,9 +31,11 @@ def numba_modules(*, compiling: bool = True) -> list[str]:
     for path in sorted(PACKAGE.rglob("*.py")):
         text = path.read_text(encoding="utf-8")
         imports = [m.group(0) for m in NUMBA_IMPORT.finditer(text)]
+        jit = [line for line in text.splitlines() if JIT_IMPORT.match(line)]
         if compiling:
             imports = [line for line in imports if not NON_COMPILING.match(line)]
-        if imports or JIT_IMPORT.search(text):
+            jit = [line for line in jit if not NON_COMPILING_JIT.match(line)]
+        if imports or jit:
             found.append(path.relative_to(PACKAGE).as_posix())
     return found
 
@@ -48,7 +52,8 @@ def test_every_numba_module_is_covered_by_the_digest():
     covered = {p.relative_to(PACKAGE).as_posix() for p in _jit.kernel_files(PACKAGE)}
     modules = numba_modules()
     assert "linear/_batch_kernels.py" in modules and "_jit.py" in modules  # the grep works
-    # cli/_common.py imports numba.core.event only (load_compiled listens for compiles)
+    # cli/_common.py imports numba.core.event and _jit.skip_blas_probe only (load_compiled
+    # listens for compiles)
     assert "cli/_common.py" in numba_modules(compiling=False)
     missing = [m for m in modules if m not in covered]
     assert missing == [], f"modules using numba outside _jit.KERNEL_SOURCES: {missing}"
@@ -120,3 +125,42 @@ def test_internal_kernels_get_no_wrappers(options):
     assert internal["no_cpython_wrapper"] and internal["no_cfunc_wrapper"]
     assert "entry" not in _jit._internal({**options, "entry": True})
     assert "no_cpython_wrapper" not in _jit._internal({**options, "entry": True})
+
+
+#: numpy functions whose compiled form depends on numba's BLAS probe (numba.np.arraymath's
+#: _HAVE_BLAS), which the command line skips (_jit.skip_blas_probe).
+BLAS_PROBED = re.compile(r"\bnp\.(convolve|correlate)\b")
+
+
+def test_no_kernel_depends_on_the_skipped_blas_probe():
+    used = [p.relative_to(PACKAGE).as_posix() for p in _jit.kernel_files(PACKAGE)
+            if p.exists() and BLAS_PROBED.search(p.read_text(encoding="utf-8"))]
+    assert used == []
+
+
+def test_skip_blas_probe_leaves_scipy_linalg_importable():
+    """In a fresh interpreter: the probe is skipped (scipy.linalg not imported, numba's
+    flag False), the kernels give the map, and ``import scipy.linalg`` still works."""
+    import subprocess
+    import sys
+
+    code = (
+        "import sys\n"
+        "from posturelab import _jit\n"
+        "assert _jit.skip_blas_probe() is True\n"
+        "assert 'scipy.linalg' not in sys.modules\n"
+        "import numba.np.arraymath as a\n"
+        "assert a._HAVE_BLAS is False\n"
+        "assert _jit.skip_blas_probe() is False  # once only\n"
+        "from posturelab.linear.batch import stability_map\n"
+        "m = stability_map(('stiffness:ankle', 0, 2000), ('stiffness:gastrocnemius', 0, 1000), 3)\n"
+        "print(repr(m.max_real_part.tolist()))\n"
+        "import scipy.linalg\n"
+        "assert scipy.linalg.cython_blas is not None\n"
+    )
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
+    from posturelab.linear.batch import stability_map
+
+    here = stability_map(("stiffness:ankle", 0, 2000), ("stiffness:gastrocnemius", 0, 1000), 3)
+    assert proc.stdout.strip() == repr(here.max_real_part.tolist())

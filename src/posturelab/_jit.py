@@ -25,7 +25,8 @@ import hashlib
 import types
 from pathlib import Path
 
-__all__ = ["kernel", "specialise", "kernel_files", "SOURCE_HASH", "KERNEL_SOURCES", "CONTRACT"]
+__all__ = ["kernel", "specialise", "kernel_files", "SOURCE_HASH", "KERNEL_SOURCES", "CONTRACT",
+           "skip_blas_probe"]
 
 _ROOT = Path(__file__).resolve().parent
 
@@ -90,6 +91,47 @@ def _renamed(f, name: str, scope: dict):
     copy.__module__ = f.__module__
     copy.__doc__ = f.__doc__
     return copy
+
+
+class _RefuseOnThread:
+    """A meta-path finder that refuses one module name to one thread (see skip_blas_probe)."""
+
+    def __init__(self, name: str, thread: int) -> None:
+        self.name, self.thread = name, thread
+
+    def find_spec(self, name, path=None, target=None):
+        import threading
+
+        if name == self.name and threading.get_ident() == self.thread:
+            raise ImportError(f"{name} is not imported for numba's BLAS probe (posturelab)")
+        return None
+
+
+def skip_blas_probe() -> bool:
+    """Import numba's array-maths lowering without its BLAS probe; True if it was skipped.
+
+    When numba first compiles or loads a kernel it imports ``numba.np.arraymath``, whose
+    module-level ``_check_blas`` imports ``scipy.linalg`` (about 0.2 s) only to decide how
+    compiled ``numpy.convolve``/``numpy.correlate`` compute inner products (BLAS or a
+    loop). posturelab's kernels use neither (``tests/test_jit.py`` checks the kernel
+    sources), and kernels loaded from the cache carry their machine code, so skipping the
+    probe changes no result. It is skipped only when neither module is imported yet, by refusing
+    ``scipy.linalg`` to this thread for the one import; a later ``import scipy.linalg``
+    works as usual. For processes posturelab runs itself (the command line): a program
+    that compiles its own ``numpy.convolve`` in the same process should not call this.
+    """
+    import sys
+    import threading
+
+    if "numba.np.arraymath" in sys.modules or "scipy.linalg" in sys.modules:
+        return False
+    finder = _RefuseOnThread("scipy.linalg", threading.get_ident())
+    sys.meta_path.insert(0, finder)
+    try:
+        import numba.np.arraymath  # noqa: F401
+    finally:
+        sys.meta_path.remove(finder)
+    return True
 
 
 def _internal(options: dict) -> dict:

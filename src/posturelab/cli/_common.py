@@ -524,8 +524,11 @@ def load_compiled(load, what: str, stream=None, notice_after: float = 2.0) -> fl
         def on_end(self, ev) -> None:
             pass
 
+    from .._jit import skip_blas_probe
+
     t0 = time.perf_counter()
     try:
+        skip_blas_probe()  # (scipy.linalg's import: ~0.2 s that the kernels do not need)
         with event.install_listener("numba:compile", CompileStarted()):
             load()
     finally:

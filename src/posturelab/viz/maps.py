@@ -44,9 +44,13 @@ def plot_stability_map(smap) -> Figure:
     fig, ax = new_figure(figsize=(7.5, 5.8))
     # Coloured once here, as RGBA bytes: matplotlib would map the float array through the
     # norm (masked arrays) at every draw; with nearest interpolation the pixels are the same.
+    # Handed over as float32 bytes / 255, the very values matplotlib's resampler makes of
+    # uint8 RGBA (np.divide(A, 0xff, dtype=np.float32)), so the PNG is byte for byte the
+    # same, without that division on a masked array at draw time (0.07 s at 1000², 0.35 s
+    # at 1414² measured).
     colours = ScalarMappable(norm=norm, cmap="RdBu_r")
-    ax.imshow(colours.to_rgba(values, bytes=True), origin="lower", extent=extent,
-              aspect="auto", interpolation="nearest")
+    rgba = np.divide(colours.to_rgba(values, bytes=True), 0xff, dtype=np.float32)
+    ax.imshow(rgba, origin="lower", extent=extent, aspect="auto", interpolation="nearest")
     fig.colorbar(colours, ax=ax, label="largest real part of the poles [1/s]")
     handles = []
     if smap.stable.any() and not smap.stable.all():
