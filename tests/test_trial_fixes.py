@@ -210,3 +210,23 @@ def test_simulate_writes_parquet_with_units(tmp_path, capsys):
     assert units["t"] == "s" and units["theta1"] == "rad" and units["omega1"] == "rad/s"
     assert units["M_ankle"] == "N·m" and units["tilt"] == "rad" and units["cop_x"] == "m"
     assert all(units.values()), units
+
+
+def test_an_unknown_flag_points_to_the_subcommand_help(capsys):
+    """`posturelab frf … --bogus 1`: one line naming the subcommand and its own help."""
+    from posturelab.cli import main
+
+    assert main(["frf", "--data", "x.csv", "--cycle-length", "20", "--bogus", "1"]) == 2
+    err = capsys.readouterr().err
+    assert err.strip() == ("posturelab: error: frf: unrecognized arguments: --bogus 1 "
+                           "(see 'posturelab frf --help')")
+
+
+def test_a_missing_likeness_reference_file_is_named_as_missing(tmp_path, capsys):
+    from posturelab.cli import main
+
+    missing = tmp_path / "ref.json"
+    assert main(["likeness", "--data", str(tmp_path / "a.json"), "--reference",
+                 str(missing)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "no such file" in err and "ref.json" in err

@@ -209,7 +209,12 @@ def _main(argv: Sequence[str] | None) -> int:
         command = next((arg for arg in argv if not arg.startswith("-")), None)
         parser = (build_parser(command) if command in SUBCOMMANDS
                   else build_parser(summary=True))
-        args = parser.parse_args(argv)
+        args, extra = parser.parse_known_args(argv)
+        if extra:  # named with the subcommand's own help, not the top-level one
+            where = f"posturelab {command}" if command in SUBCOMMANDS else "posturelab"
+            prefix = f"{command}: " if command in SUBCOMMANDS else ""
+            raise UsageError(f"{prefix}unrecognized arguments: {' '.join(extra)} "
+                             f"(see '{where} --help')")
         if getattr(args, "_run", None) is None:
             parser.print_help()
             return 2

@@ -50,7 +50,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import ParameterError, UnknownNameError
+from ..errors import DataFileError, ParameterError, UnknownNameError
 
 __all__ = ["LikenessReference", "LikenessResult", "likeness", "likeness_score",
            "likeness_reference", "read_likeness_reference", "read_prtsinfo",
@@ -244,7 +244,9 @@ def likeness_reference(name_or_path) -> LikenessReference:
     text = str(name_or_path)
     if text in LIKENESS_PRESETS:
         return _reference_from_json(json.loads(_preset_text(text)), f"preset {text!r}")
-    if Path(text).suffix.lower() in (".json", ".m") and Path(text).exists():
+    if Path(text).suffix.lower() in (".json", ".m"):
+        if not Path(text).exists():
+            raise DataFileError(f"cannot read likeness reference {text!r}: no such file")
         return read_prtsinfo(text) if text.lower().endswith(".m") \
             else read_likeness_reference(text)
     raise UnknownNameError(f"unknown likeness reference {text!r} (neither a preset nor a "
