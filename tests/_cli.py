@@ -17,3 +17,22 @@ def one_line_exit_2(p: subprocess.CompletedProcess, *words: str) -> None:
     assert len(err.splitlines()) == 1 and "Traceback" not in err, err
     for w in words:
         assert w in err, err
+
+
+def run_main(capsys, *argv) -> tuple[int, str, str]:
+    """``posturelab ARGV`` in this process (``cli.main``): exit code, stdout, stderr."""
+    from posturelab.cli import main
+
+    code = main([str(a) for a in argv])
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def refused_in_one_line(capsys, *argv) -> str:
+    """``posturelab ARGV`` in this process refused: exit 2, nothing on stdout, one line on
+    stderr without a traceback; returns that line."""
+    code, out, err = run_main(capsys, *argv)
+    assert code == 2 and out == "", (out, err)
+    lines = [ln for ln in err.splitlines() if ln.strip()]
+    assert len(lines) == 1 and "Traceback" not in err, err
+    return lines[0]

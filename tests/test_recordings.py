@@ -9,6 +9,8 @@ import numpy as np
 import pytest
 
 import posturelab as pl
+from _cli import refused_in_one_line as one_line_exit_2
+from _cli import run_main as run
 from posturelab.cli import main
 from posturelab.errors import DataFileError
 from posturelab.model.tilt import PRTSTilt
@@ -20,20 +22,6 @@ from posturelab.recordings.sway import (
     com_angle_two_markers,
 )
 from posturelab.recordings.table import read_table
-
-
-def run(capsys, *argv):
-    code = main([str(a) for a in argv])
-    out, err = capsys.readouterr()
-    return code, out, err
-
-
-def one_line_exit_2(capsys, *argv) -> str:
-    code, out, err = run(capsys, *argv)
-    assert code == 2, (out, err)
-    lines = [ln for ln in err.splitlines() if ln.strip()]
-    assert len(lines) == 1 and "Traceback" not in err, err
-    return lines[0]
 
 
 def jittered_times(rng, duration, low=0.0107, high=0.0117):

@@ -18,7 +18,8 @@ import struct
 import numpy as np
 import pytest
 
-from posturelab.cli import main
+from _cli import refused_in_one_line as one_line_exit_2
+from _cli import run_main as run
 from posturelab.errors import DataFileError
 from posturelab.model.tilt import PRTSTilt
 from posturelab.recordings.c3d import read_c3d, write_c3d
@@ -27,20 +28,6 @@ from posturelab.recordings.table import read_recording
 CYCLE = 20.0  # the 80-state PRTS cycle [s]
 RATE = 50.0  # [Hz]
 FRF = ["--stimulus", "tilt", "--response", "com_angle", "--cycle-length", "20", "--json"]
-
-
-def run(capsys, *argv):
-    code = main([str(a) for a in argv])
-    out, err = capsys.readouterr()
-    return code, out, err
-
-
-def one_line_exit_2(capsys, *argv) -> str:
-    code, out, err = run(capsys, *argv)
-    assert code == 2 and out == "", (out, err)
-    lines = [ln for ln in err.splitlines() if ln.strip()]
-    assert len(lines) == 1 and "Traceback" not in err, err
-    return lines[0]
 
 
 @pytest.fixture(scope="module")

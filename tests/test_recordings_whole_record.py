@@ -11,15 +11,9 @@ import numpy as np
 import pytest
 
 import posturelab as pl
-from posturelab.cli import main
+from _cli import run_main as run
 from posturelab.model.tilt import PRTSTilt
 from posturelab.recordings.resample import record_duration, resample_uniform
-
-
-def run(capsys, *argv):
-    code = main([str(a) for a in argv])
-    out, err = capsys.readouterr()
-    return code, out, err
 
 
 @pytest.fixture(scope="module")

@@ -9,22 +9,10 @@ import json
 import numpy as np
 import pytest
 
+from _cli import refused_in_one_line as one_line_exit_2
+from _cli import run_main as run
 from posturelab.cli import main
 from posturelab.recordings.example import EXAMPLE_C3D, EXAMPLE_HEIGHT, make_lab_csv
-
-
-def run(capsys, *argv):
-    code = main([str(a) for a in argv])
-    out, err = capsys.readouterr()
-    return code, out, err
-
-
-def one_line_exit_2(capsys, *argv) -> str:
-    code, out, err = run(capsys, *argv)
-    assert code == 2, (out, err)
-    lines = [ln for ln in err.splitlines() if ln.strip()]
-    assert len(lines) == 1 and "Traceback" not in err, err
-    return lines[0]
 
 
 @pytest.fixture(scope="module")
@@ -214,7 +202,6 @@ def test_simulate_writes_parquet_with_units(tmp_path, capsys):
 
 def test_an_unknown_flag_points_to_the_subcommand_help(capsys):
     """`posturelab frf … --bogus 1`: one line naming the subcommand and its own help."""
-    from posturelab.cli import main
 
     assert main(["frf", "--data", "x.csv", "--cycle-length", "20", "--bogus", "1"]) == 2
     err = capsys.readouterr().err
@@ -223,7 +210,6 @@ def test_an_unknown_flag_points_to_the_subcommand_help(capsys):
 
 
 def test_a_missing_likeness_reference_file_is_named_as_missing(tmp_path, capsys):
-    from posturelab.cli import main
 
     missing = tmp_path / "ref.json"
     assert main(["likeness", "--data", str(tmp_path / "a.json"), "--reference",
