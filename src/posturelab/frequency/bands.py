@@ -146,5 +146,7 @@ def resolve_bands(bands, n_available: int) -> tuple[tuple[int, ...], ...]:
 
 
 def band_frequencies(bands, cycle_length: float) -> np.ndarray:
-    """Mean frequency of each band's harmonics. [Hz]"""
-    return np.array([odd_harmonic_frequency(np.array(b), cycle_length).mean() for b in bands])
+    """Mean frequency of each band's harmonics (the sum of their odd numbers over count × T,
+    one rounding: 0.33 Hz prints as 0.33). [Hz]"""
+    return np.array([float(np.sum(2 * np.asarray(b, dtype=np.int64) - 1))
+                     / (len(b) * float(cycle_length)) for b in bands])
