@@ -36,16 +36,7 @@ PRESET_MUSCLES = PRESET.muscles(ONE_LINK)
 
 #: tests/test_engine_parity.py's strength-2 covering array over (feedback mode and the
 #: gastrocnemius' kind, a torque limit, the knee stop, a tilt, centre-of-pressure falls).
-PAIRWISE = (
-    ("whole/two-sided", False, True, True, True),
-    ("whole/two-sided", True, False, False, False),
-    ("whole/one-sided", False, True, False, False),
-    ("whole/one-sided", True, False, False, True),
-    ("whole/pull-only", False, False, False, False),
-    ("whole/pull-only", True, True, False, True),
-    ("split/two-sided", False, True, False, True),
-    ("split/two-sided", True, False, True, False),
-)
+from test_engine_parity import PAIRWISE  # noqa: E402
 
 
 def seeded_feedback(seed: int) -> dict:

@@ -61,17 +61,6 @@ def test_a_gap_is_refused_naming_its_time(rng):
     assert MAX_GAP_STEPS == 3.0
 
 
-@pytest.fixture(scope="module")
-def prts_trial():
-    """Peterka 2002's one-link controller on a PRTS tilt, 3 cycles of 20 s at 1 kHz."""
-    from posturelab.model.controllers import get_controller
-
-    body = pl.get_body("paper-1link")
-    preset = get_controller("peterka-2002")
-    r = pl.simulate(body, preset.muscles(body), None, 60.0,
-                    tilt=PRTSTilt.named("posturelab-80", 0.035), engine="compiled",
-                    sample_rate=1000.0, rtol=1e-9, atol=1e-11, **preset.run_options())
-    return r.time, r.tilt, r.com_angle
 
 
 def test_resampled_frf_equals_the_uniform_one(tmp_path, capsys, rng, prts_trial):
