@@ -37,6 +37,7 @@ PRESET_MUSCLES = PRESET.muscles(ONE_LINK)
 #: tests/test_engine_parity.py's strength-2 covering array over (feedback mode and the
 #: gastrocnemius' kind, a torque limit, the knee stop, a tilt, centre-of-pressure falls).
 from test_engine_parity import PAIRWISE  # noqa: E402
+from test_engine_parity import muscles as paper_muscles  # noqa: E402  (case 1 by mode)
 
 
 def seeded_feedback(seed: int) -> dict:
@@ -44,21 +45,6 @@ def seeded_feedback(seed: int) -> dict:
     rng = np.random.default_rng(seed)
     return {"torque_feedback_gain": float(rng.uniform(0.1, 0.9)),
             "torque_feedback_time_constant": float(rng.uniform(0.2, 5.0))}
-
-
-def paper_muscles(feedback: str) -> MuscleSet:
-    """Case 1 with the named delay mode and gastrocnemius (as tests/test_engine_parity.py)."""
-    mode, kind = feedback.split("/")
-    m = pl.paper_muscles("1", gastrocnemius="two-sided" if kind == "two-sided" else "one-sided")
-    if kind != "two-sided":
-        m = MuscleSet(tuple(dataclasses.replace(p, pull_only=kind == "pull-only")
-                            if p.one_sided else p for p in m.pairs), m.n_links)
-    if mode == "split":
-        k, v = np.array(m.stiffnesses), np.array(m.viscosities)
-        m = MuscleSet(tuple(dataclasses.replace(p, stiffness=0.6 * p.stiffness,
-                                                viscosity=0.6 * p.viscosity)
-                            for p in m.pairs), m.n_links).with_active_feedback(0.4 * k, 0.4 * v)
-    return m
 
 
 def assert_engines_agree(run_with, theta_tol: float = THETA_TOL) -> pl.SimulationResult:
