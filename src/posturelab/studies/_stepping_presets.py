@@ -11,9 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 from ..errors import lookup
-from ..model.body import Body
-from ..model.controllers import Provenance, get_controller
-from ..model.muscles import MusclePair, MuscleSet
+from ..model.controllers import AnkleController, Provenance, get_controller
 from ..model.platform import RampAndHold
 
 __all__ = ["Population", "POPULATIONS", "get_population", "PlatformProtocol", "PROTOCOL",
@@ -44,58 +42,30 @@ _ICM_NUMBERS = ("intrinsic_stiffness", "intrinsic_viscosity", "active_stiffness"
 
 
 @dataclass(frozen=True)
-class Population:
-    """A group of subjects: the controller, the delay and the strength of its ankles.
+class Population(AnkleController):
+    """A group of subjects: the controller, the delay (the numbers of
+    :class:`~posturelab.model.controllers.AnkleController`, each with its provenance) and the
+    strength of its ankles.
 
     Attributes
     ----------
-    name, description : str
-    intrinsic_stiffness, active_stiffness : float
-        Ankle stiffness / mgh, intrinsic (undelayed) and active (delayed). [-]
-    intrinsic_viscosity, active_viscosity : float
-        Ankle viscosity / mgh. [s]
-    feedback_delay : float
-        τ of the active part. [s]
-    proprioceptive_weight : float
-        W (no effect without a tilt). [-]
+    description : str
     plantarflexion_strength : float
         Maximal isometric plantarflexion moment of one ankle. [N·m]
-    provenance : tuple of (str, Provenance)
-        Where each number above comes from.
     """
 
-    name: str
     description: str
-    intrinsic_stiffness: float
-    intrinsic_viscosity: float
-    active_stiffness: float
-    active_viscosity: float
-    feedback_delay: float
-    proprioceptive_weight: float
     plantarflexion_strength: float
-    provenance: tuple[tuple[str, Provenance], ...] = ()
 
     @property
     def ankle_strength(self) -> float:
         """Plantarflexion strength of both ankles, :data:`LEGS` × one ankle's. [N·m]"""
         return LEGS * self.plantarflexion_strength
 
-    def provenance_of(self, field_name: str) -> Provenance:
-        """The :class:`Provenance` of one numeric field."""
-        return dict(self.provenance)[field_name]
-
     def provenance_text(self) -> str:
         """Where each number comes from, one phrase per number."""
         return "; ".join(self.provenance_of(name).text(name, getattr(self, name))
                          for name, _ in self.provenance) + "."
-
-    def muscles(self, body: Body) -> MuscleSet:
-        """The ankle pair of a one-link ``body``, gains scaled by its mgh [N·m/rad]."""
-        mgh = body.load_stiffness
-        return MuscleSet((MusclePair(
-            "ankle", 0, 1, self.intrinsic_stiffness * mgh, self.intrinsic_viscosity * mgh,
-            active_stiffness=self.active_stiffness * mgh,
-            active_viscosity=self.active_viscosity * mgh),), 1)
 
 
 def _icm(field_name: str) -> Provenance:
