@@ -90,7 +90,7 @@ _STEP_FLOOR = {"stiffness": 1.0, "viscosity": 1.0, "active_stiffness": 1.0,
                "visual_weight": 1e-3}
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # (its arrays: a field-wise == would raise)
 class DesignPrediction:
     """What :func:`predict_errors` predicts.
 
