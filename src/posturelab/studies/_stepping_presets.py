@@ -148,11 +148,11 @@ class PlatformProtocol:
 
     name: str
     citation: str
-    move_duration: float = 0.5
-    settle_time: float = 3.0
-    increment: float = 0.01
-    tolerance: float = 0.001
-    largest: float = 0.6
+    move_duration: float
+    settle_time: float
+    increment: float
+    tolerance: float
+    largest: float
 
     def disturbance(self, displacement: float) -> RampAndHold:
         """The move of ``displacement`` (signed: negative is backward). [m]"""
@@ -170,6 +170,7 @@ PROTOCOL = PlatformProtocol(
     citation=(KOUSHYAR_2019 + "; the move's shape and duration (ramp-and-hold over 0.5 s) "
               "and the 1 cm ascending series are posturelab's assumptions, the paper's "
               "methods not having been available"),
+    move_duration=0.5, settle_time=3.0, increment=0.01, tolerance=0.001, largest=0.6,
 )
 
 
