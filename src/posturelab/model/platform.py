@@ -43,6 +43,7 @@ from .disturbance import (  # the base class and the terms (stated in .disturban
     Disturbance,
     NoDisturbance,
     Primitive,
+    ProfileTerm,
     _axis,
     _check_acceleration,
     sine_formula,
@@ -51,6 +52,7 @@ from .disturbance import (  # the base class and the terms (stated in .disturban
 
 __all__ = [
     "Primitive",
+    "ProfileTerm",
     "Disturbance",
     "NoDisturbance",
     "VelocityStep",

@@ -114,7 +114,7 @@ def cubic_formula(c0, c1, c2, c3, u):
 @dataclass(frozen=True)
 class TiltTerm(ProfileTerm):
     """One term of a tilt profile (the fields of
-    :class:`~posturelab.model.disturbance.ProfileTerm`, amplitude in [rad], and these).
+    :class:`~posturelab.model.platform.ProfileTerm`, amplitude in [rad], and these).
 
     Attributes
     ----------
