@@ -169,7 +169,7 @@ def _table1(symbol: str, value: float, unit: str, per_mgh: bool = True) -> Prove
     return Provenance(f"PMC5664365 Table 1, {symbol}", value, unit, note)
 
 
-def _by_name(*presets):
+def _by_name(*presets) -> dict:
     """The presets keyed by their names."""
     return {p.name: p for p in presets}
 
