@@ -477,6 +477,10 @@ def test_cli_prints_one_json_object_with_the_threshold():
     (("--height", "1.7", "--mass", "75", "--population", "middle"), ("young, older",)),
     (("--height", "1.7", "--mass", "75", "--direction", "up"), ("backward, forward",)),
     (("--height", "1.7"), ("--mass",)),
+    (("--height", "1.75", "--mass", "75", "--ankle-strength", "20"),
+     ("ankle_strength", "20", "51 N·m")),
+    (("--height", "2.5", "--mass", "300"), ("young population's ankle strength", "264")),
+    (("--height", "1.7", "--mass", "75", "--foot", "flat"), ("--foot", "functional")),
 ])
 def test_cli_bad_input_is_one_line_exit_2(args, words):
     one_line_exit_2(cli("step-threshold", *args), *words)

@@ -371,8 +371,12 @@ def step_threshold(height: float, mass: float, population: str | Population = "y
     else:
         foot_bos, tonic = base_of_support_for_height(h), 0.0
     if strength <= tonic:
-        raise ParameterError(f"ankle_strength {strength:g} N·m must exceed the {tonic:.0f} N·m "
-                             "the quiet stance already uses")
+        whose = ("ankle_strength" if ankle_strength is not None
+                 else f"the {pop.name} population's ankle strength")
+        raise ParameterError(f"{whose}, {strength:g} N·m, must exceed the {tonic:.0f} N·m this "
+                             f"subject's quiet stance already uses (m g l sin "
+                             f"{math.degrees(pop.stance_lean):.2f}°); give a larger "
+                             "--ankle-strength")
     cap = ankle_moment_cap(strength - tonic, weight, foot_bos.toe)
     heel_cap = (foot_moment_limits(weight, foot_bos.heel, foot_bos.toe)[0] if heel_limit
                 else -cap)
