@@ -330,7 +330,9 @@ def permutation_statistics(Z: np.ndarray, in_a: np.ndarray) -> np.ndarray:
     dx, dy = d.real, d.imag
     with np.errstate(invalid="ignore", divide="ignore"):
         q = (syy * dx * dx - 2 * sxy * dx * dy + sxx * dy * dy) / det
-    return na * nb / (na + nb) * q.sum(axis=1)
+    # T is a sum of quadratic forms in positive definite matrices: >= 0; rounding can leave
+    # -1e-16 where the means agree (NaN, a singular split, stays NaN)
+    return np.maximum(na * nb / (na + nb) * q.sum(axis=1), 0.0)
 
 
 def _at_least(statistics: np.ndarray, observed: float) -> int:
