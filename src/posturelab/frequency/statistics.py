@@ -336,10 +336,11 @@ def permutation_statistics(Z: np.ndarray, in_a: np.ndarray) -> np.ndarray:
 
 
 def _at_least(statistics: np.ndarray, observed: float) -> int:
-    """How many permuted statistics reach the observed one (to rounding: 1e-12 relative);
-    a split whose pooled covariance is singular (NaN) counts as reaching it, which can only
-    make p larger."""
-    return int(np.sum(~(statistics < observed * (1 - 1e-12))))
+    """How many permuted statistics reach the observed one (to rounding: 1e-12 relative and
+    1e-9 absolute, T being dimensionless and of order one for chance differences, so equal
+    means tie however rounding leaves them); a split whose pooled covariance is singular
+    (NaN) counts as reaching it, which can only make p larger."""
+    return int(np.sum(~(statistics < observed * (1 - 1e-12) - 1e-9)))
 
 
 @dataclass(frozen=True)
