@@ -5,13 +5,14 @@ Beyond the paper.
 
 The largest backward platform translation withstood with the feet in place
 (:func:`posturelab.studies.stepping.step_threshold`: a run needs a step when the
-extrapolated centre of mass x + v/ω0 of Hof, Gazendam & Sinke 2005 leaves the foot, or the
-body falls), for the young and older presets (a 1.75 m, 75 kg subject), against the
-duration T of each ramp-and-hold move, beside the published thresholds of Koushyar et al.
-2019 (PLoS ONE 14:e0210049, PMC6338353): 16.2 ± 2.6 cm (young) and 11.8 ± 2.1 cm (older),
-drawn as bands of ± two standard deviations. The study's protocol assumes T = 0.5 s (the
-paper's profile was not available to posturelab); the curves show how much the comparison
-hangs on it. Each threshold takes 15–40 runs of the compiled engine.
+extrapolated centre of mass x + v/ω0 of Hof, Gazendam & Sinke 2005, with the platform's
+remaining path counted, leaves the population's functional base of support (King, Judge &
+Wolfson 1994), or the body falls), for the young and older presets (a 1.75 m, 75 kg
+subject), against the duration T of each ramp-and-hold move, beside the published thresholds
+of Koushyar et al. 2019 (PLoS ONE 14:e0210049, PMC6338353): 16.2 ± 2.6 cm (young) and 11.8 ±
+2.1 cm (older), drawn as bands of ± two standard deviations. The study's protocol assumes T
+= 0.5 s (the paper's profile was not available to posturelab); the curves show how much the
+comparison hangs on it. Each threshold takes 15–40 runs of the compiled engine.
 
 Writes step_threshold_vs_duration.png: largest translation [cm] against T [s].
 

@@ -110,6 +110,14 @@ def test_few_subjects_enumerate_every_split(rng):
     assert result.p_value == pytest.approx(2 / 20)  # the split and its mirror image
 
 
+def test_a_group_compared_with_itself_gives_t_zero_and_p_one(rng):
+    """The same FRFs in both groups: the means agree, so T is 0 to rounding and never
+    negative (rounding once printed −1e-16), and p = 1."""
+    a = cohort(np.ones(5) + 1j, 4, rng)
+    result = compare_frf_groups(list(a), list(a), permutations=200, resamples=50, seed=1)
+    assert 0.0 <= result.statistic < 1e-20 and result.p_value == 1.0
+
+
 @pytest.mark.parametrize("kwargs, words", [
     ({"permutations": 0}, "permutations must be an integer in [1, 1,000,000]"),
     ({"permutations": 10**7}, "permutations"),

@@ -9,12 +9,17 @@ from ._common import print_json
 DESCRIPTION = """\
 The largest platform translation a subject withstands with the feet in place: a one-link
 body scaled from --height and --mass (Winter's table), an ankle controller with the
-population's gains, feedback delay and ankle strength, on a foot of 0.152 × height; the
-ankle moment limited to min(strength, m g × toe) toward the toes and m g × |heel| toward the
-heel, what a flat foot carries (--symmetric-ankle-cap: the first both ways). A run
-needs a step when the extrapolated centre of mass x + v/ω0 (Hof, Gazendam & Sinke 2005,
-J Biomech 38:1–8; ω0 = √(g/l), l the centre of mass's height) leaves the foot, or when
-the body falls. The platform moves are ramp-and-holds over 0.5 s (posturelab's assumption),
+population's gains, feedback delay and ankle strength. The foot is the population's
+functional base of support (King, Judge & Wolfson 1994: 0.60 of the foot's length under 60
+years, 0.42 at 60 and over, 66 % of it in front of the quiet-standing centre of pressure) on
+a foot of 0.152 × height; --foot anatomical takes the whole foot from the ankle. The ankle
+moment is limited to what that foot carries each way (plantarflexion also by the strength
+left after the quiet stance's tonic moment; --symmetric-ankle-cap: the plantarflexion cap
+both ways). A run needs a step when the extrapolated centre of mass x + v/ω0 (Hof, Gazendam
+& Sinke 2005, J Biomech 38:1–8; ω0 = √(g/l)) leaves the foot once the platform's remaining
+path is counted (--criterion platform-path, the default: the subject stands the whole move;
+platform-velocity: judged as if the platform kept its current velocity), or when the body
+falls. The platform moves are ramp-and-holds over 0.5 s (posturelab's assumption),
 increased in 1 cm steps and then bisected to 1 mm. Compared with Koushyar et al. 2019
 (PLoS ONE 14:e0210049, PMC6338353): backward, 16.2 ± 2.6 cm (young), 11.8 ± 2.1 cm (older).
 Where each number of a population comes from: --sources. An upright that is unstable at the
@@ -51,6 +56,14 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="cap dorsiflexion at the plantarflexion cap (the same both ways, as "
                    "before issue 22) instead of at m g |x_heel|, the foot's: the centre of "
                    "pressure may then pass the heel.")
+    p.add_argument("--foot", choices=("functional", "anatomical"), default="functional",
+                   help="functional (default): the population's functional base of support "
+                   "from the quiet-standing centre of pressure; anatomical: the whole foot "
+                   "from the ankle.")
+    p.add_argument("--criterion", choices=("platform-path", "platform-velocity"),
+                   default="platform-path",
+                   help="platform-path (default): the XCoM with the platform's remaining path "
+                   "counted; platform-velocity: as if the platform kept its current velocity.")
     p.add_argument("--sources", action="store_true",
                    help="also print where each number of the population comes from.")
     p.add_argument("--json", action="store_true", help="print one JSON object instead of text.")
@@ -76,7 +89,8 @@ def run(args: argparse.Namespace) -> int:
                             protocol=protocol, feedback_delay=args.feedback_delay,
                             ankle_strength=args.ankle_strength,
                             cop_criterion=args.cop_criterion,
-                            heel_limit=not args.symmetric_ankle_cap)
+                            heel_limit=not args.symmetric_ankle_cap, foot=args.foot,
+                            criterion=args.criterion)
     out = result.to_dict()
     if args.json:
         out["units"] = UNITS
@@ -100,8 +114,9 @@ def run(args: argparse.Namespace) -> int:
     print(f"  τ = {result.feedback_delay * 1000:.0f} ms, ankle strength "
           f"{result.ankle_strength:.0f} N·m (caps: plantarflexion "
           f"{result.ankle_moment_cap:.0f} N·m, dorsiflexion {result.dorsiflexion_cap:.0f} "
-          "N·m), foot "
-          f"{result.heel * cm:.1f} … {result.toe * cm:.1f} cm, ω0 = {result.omega0:.2f} 1/s")
+          f"N·m), {result.foot} foot "
+          f"{result.heel * cm:.1f} … {result.toe * cm:.1f} cm, ω0 = {result.omega0:.2f} 1/s, "
+          f"criterion {result.criterion}")
     if result.cop_overrun > COP_TOLERANCE:
         print(f"  the centre of pressure went {result.cop_overrun * cm:.1f} cm beyond the foot "
               "at the threshold (see the guide)")

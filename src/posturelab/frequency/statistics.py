@@ -330,14 +330,17 @@ def permutation_statistics(Z: np.ndarray, in_a: np.ndarray) -> np.ndarray:
     dx, dy = d.real, d.imag
     with np.errstate(invalid="ignore", divide="ignore"):
         q = (syy * dx * dx - 2 * sxy * dx * dy + sxx * dy * dy) / det
-    return na * nb / (na + nb) * q.sum(axis=1)
+    # T is a sum of quadratic forms in positive definite matrices: >= 0; rounding can leave
+    # -1e-16 where the means agree (NaN, a singular split, stays NaN)
+    return np.maximum(na * nb / (na + nb) * q.sum(axis=1), 0.0)
 
 
 def _at_least(statistics: np.ndarray, observed: float) -> int:
-    """How many permuted statistics reach the observed one (to rounding: 1e-12 relative);
-    a split whose pooled covariance is singular (NaN) counts as reaching it, which can only
-    make p larger."""
-    return int(np.sum(~(statistics < observed * (1 - 1e-12))))
+    """How many permuted statistics reach the observed one (to rounding: 1e-12 relative and
+    1e-9 absolute, T being dimensionless and of order one for chance differences, so equal
+    means tie however rounding leaves them); a split whose pooled covariance is singular
+    (NaN) counts as reaching it, which can only make p larger."""
+    return int(np.sum(~(statistics < observed * (1 - 1e-12) - 1e-9)))
 
 
 @dataclass(frozen=True)

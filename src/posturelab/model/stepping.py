@@ -18,6 +18,21 @@ ankle moment the foot can react stops the fall: a step is needed.
 
 Positions here are along x (forward), relative to the ankle, in a frame in which the
 foot is at rest. Pure functions over arrays: any leading shape.
+
+**On a moving platform** the foot is not at rest. With the platform (and the foot) at p(t)
+in the lab and the centre of pressure at p + u, u in [heel, toe], the pendulum obeys
+ẍ_lab = ω0² (x_lab − p − u), so ξ_lab = x_lab + ẋ_lab/ω0 obeys ξ̇_lab = ω0 (ξ_lab − p − u)
+and stays bounded only if ξ_lab(t) = ω0 ∫_t^∞ e^{−ω0 (s − t)} (p(s) + u(s)) ds. Some u in
+[heel, toe] does this exactly when
+
+    ξ(t) + Δ(t)  is in [heel, toe],   Δ(t) = ṗ(t)/ω0 − ∫_t^∞ e^{−ω0 (s − t)} ṗ(s) ds    [m]
+
+with ξ = x + v/ω0 taken relative to the foot (x, v relative to the ankle)
+(:func:`platform_path_offset`; posturelab's derivation, the same steps as Hof et al.'s for a
+foot at rest). Δ = 0 while the platform keeps a constant velocity, so the criterion is Hof's
+in the frame moving with the platform; a platform that is going to stop gives Δ of the
+opposite sign to its velocity: its deceleration will push the centre of mass back over the
+foot, so a subject who stands on (rather than steps) is judged by the whole move.
 """
 
 from __future__ import annotations
@@ -27,7 +42,8 @@ import numpy as np
 from .._validation import positive_float
 from ..errors import ParameterError
 
-__all__ = ["pendulum_frequency", "xcom", "margin_of_stability", "ankle_moment_cap"]
+__all__ = ["pendulum_frequency", "xcom", "margin_of_stability", "ankle_moment_cap",
+           "platform_path_offset"]
 
 
 def pendulum_frequency(com_height, gravity=9.81) -> np.ndarray:
@@ -147,3 +163,58 @@ def ankle_moment_cap(strength: float, weight: float, toe: float) -> float:
     """
     return min(positive_float("strength [N·m]", strength),
                positive_float("weight [N]", weight) * positive_float("toe [m]", toe))
+
+
+def platform_path_offset(time, platform_velocity, omega0: float) -> np.ndarray:
+    """Δ(t) = ṗ(t)/ω0 − ∫_t^∞ e^{−ω0 (s − t)} ṗ(s) ds: what the platform's path still to come
+    adds to the extrapolated centre of mass (see the module's text). [m]
+
+    ṗ is taken linear between samples (the integral of each interval is exact for that) and,
+    after the last sample, constant at its last value (the platform keeps moving as it
+    moved): Δ = 0 at the last sample and for any platform at a constant velocity.
+
+    Parameters
+    ----------
+    time : array_like, shape (T,)
+        Increasing sample times. [s]
+    platform_velocity : array_like, shape (..., T)
+        ṗ at those times, in the lab frame. [m/s]
+    omega0 : float
+        ω0 = √(g/l) (:func:`pendulum_frequency`). [1/s]
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., T)
+        Δ. [m]
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from posturelab.model.stepping import platform_path_offset
+    >>> t = np.linspace(0.0, 2.0, 5)
+    >>> [round(float(v), 12) for v in platform_path_offset(t, np.full(5, 0.3), 3.0)]
+    [0.0, 0.0, 0.0, 0.0, 0.0]
+    >>> # moving at 0.3 m/s until it stops at once at t = 1 s: Δ(0) = (0.3/ω0)·e^{−ω0}, more
+    >>> # or less (the step is a ramp between samples here) [m]
+    >>> round(float(platform_path_offset([0, 1, 1 + 1e-9, 3], [0.3, 0.3, 0, 0], 3.0)[0]), 6)
+    0.004979
+    """
+    t = np.asarray(time, dtype=float)
+    v = np.asarray(platform_velocity, dtype=float)
+    w = positive_float("omega0 [1/s]", omega0)
+    if t.ndim != 1 or v.shape[-1:] != t.shape or t.size < 1:
+        raise ParameterError(f"time must be 1-D with one sample per platform_velocity sample, "
+                             f"got shapes {t.shape} and {v.shape}")
+    h = np.diff(t)
+    if not np.all(np.isfinite(t)) or np.any(h <= 0.0) or not np.all(np.isfinite(v)):
+        raise ParameterError("time must be finite and increasing, platform_velocity finite")
+    decay = np.exp(-w * h)
+    # ∫_0^h e^{−ω0 s} ds and ∫_0^h s e^{−ω0 s} ds / h: weights of the interval's ends
+    mean = -np.expm1(-w * h) / w
+    first = (1.0 - decay * (1.0 + w * h)) / (w * w * h)
+    future = np.empty_like(v)
+    future[..., -1] = v[..., -1] / w
+    for k in range(t.size - 2, -1, -1):
+        future[..., k] = (v[..., k] * (mean[k] - first[k]) + v[..., k + 1] * first[k]
+                          + decay[k] * future[..., k + 1])
+    return v / w - future

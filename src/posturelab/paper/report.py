@@ -48,6 +48,7 @@ from ..model.muscles import PAPER_PAIR_NAMES, STIFFNESS_CASES, TABLE_I_CITATION
 from ..simulation.results import atomic_write_bytes, atomic_write_text, new_file_mode
 from . import checks as _checks
 from . import figures as _figures
+from .beyond_ankle import beyond_ankle_finding
 from .checks import (
     FIGURE_CAPTIONS,
     PAPER_SETTLING_CLAIM,
@@ -78,9 +79,9 @@ ProgressCallback = Callable[[int, int, str], None]
 #: The report page's template, in ``templates/`` beside this module.
 TEMPLATE = "report.html.j2"
 
-#: Steps :func:`reproduce_paper` reports: Table II, the runs, the figures, the four searches,
+#: Steps :func:`reproduce_paper` reports: Table II, the runs, the figures, the five searches,
 #: the writing. [-]
-_TOTAL_STEPS = 1 + RUN_STEPS + len(_figures.FIGURE_STEPS) + 4 + 1
+_TOTAL_STEPS = 1 + RUN_STEPS + len(_figures.FIGURE_STEPS) + 5 + 1
 
 
 @dataclass(frozen=True)
@@ -402,6 +403,9 @@ def _build(tmp: Path, progress: ProgressCallback | None) -> tuple[PaperChecks, l
     tick("a delayed controller from the literature, and the hip strategy (beyond the paper)")
     findings.append(_checks.literature_controller_finding(runs.foot))
     findings.append(_checks.strategy_finding(body, runs.foot))
+    tick("the hip strategy under a multi-joint controller, and the step threshold by age "
+         "(beyond the paper)")
+    findings.append(beyond_ankle_finding(body))
     tick("frequency responses to tilt, and a simulated PRTS experiment fitted (beyond the paper)")
     findings.append(_checks.frf_finding())
 

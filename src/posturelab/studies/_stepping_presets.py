@@ -8,6 +8,7 @@ printed, or that it is posturelab's own assumption (and why).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, replace
 
 from ..errors import lookup
@@ -15,7 +16,8 @@ from ..model.controllers import AnkleController, Provenance, get_controller
 from ..model.platform import RampAndHold
 
 __all__ = ["Population", "POPULATIONS", "get_population", "PlatformProtocol", "PROTOCOL",
-           "PublishedThreshold", "PUBLISHED", "KOUSHYAR_2019", "SIMONEAU_2005",
+           "PublishedThreshold", "PUBLISHED", "KOUSHYAR_2019", "SIMONEAU_2005", "KING_1994",
+           "PDS_2017",
            "LIN_WOOLLACOTT_2002", "LEGS"]
 
 #: The study compared with (its abstract is what posturelab could read; see PROTOCOL).
@@ -33,6 +35,20 @@ LIN_WOOLLACOTT_2002 = ("Postural muscle responses following changing balance thr
                        "young, stable older, and unstable older adults. J Mot Behav 2002 "
                        "34(1):37–44, PMID 11880248 (abstract): longer onset latencies in the "
                        "older groups; Lin & Woollacott (authors as posturelab recalls them)")
+#: The functional base of support by age.
+KING_1994 = ("King MB, Judge JO, Wolfson L (1994) Functional base of support decreases with "
+             "age. J Gerontol 49(6):M258–M263 (abstract; journal and pages as posturelab "
+             "recalls them): the anterior–posterior share of the foot's length used in "
+             "maximal sustained forward and backward leaning, 0.60 ± 0.07 under 60 years and "
+             "0.42 ± 0.12 at 60 and over (113 adults, 20–91 y); forward and backward lean 66 % "
+             "and 34 % of it")
+#: A quiet-standing recording: where the centre of gravity stands over the ankle.
+PDS_2017 = ("dos Santos DA, Fukuchi CA, Fukuchi RK, Duarte M (2017) A data set with kinematic "
+            "and ground reaction forces of human balance. PeerJ 5:e3626, "
+            "doi:10.7717/peerj.3626 (CC BY 4.0; one subject's 60 s of quiet standing as "
+            "redistributed in BMClab/BMC data/postureData.txt): the centre of gravity "
+            "4.17 ± 0.27° in front of the lateral malleoli over the 60 s (posturelab's "
+            "computation from the recording)")
 #: The model's ankle is both legs together: strengths measured on one leg are doubled. [-]
 LEGS = 2
 
@@ -52,10 +68,23 @@ class Population(AnkleController):
     description : str
     plantarflexion_strength : float
         Maximal isometric plantarflexion moment of one ankle. [N·m]
+    functional_base_of_support : float
+        F, the share of the foot's length over which the centre of pressure can be held:
+        from the quiet-standing centre of pressure, F × share forward and F × (1 − share)
+        back (:meth:`functional_foot`). [-]
+    forward_share : float
+        The forward part of F. [-]
+    stance_lean : float
+        The centre of gravity's angle in front of the ankle in quiet standing: the tonic
+        plantarflexion moment m g l sin(lean) it needs is not available to the
+        response. [rad]
     """
 
     description: str
     plantarflexion_strength: float
+    functional_base_of_support: float
+    forward_share: float
+    stance_lean: float
 
     @property
     def ankle_strength(self) -> float:
@@ -67,6 +96,15 @@ class Population(AnkleController):
         return "; ".join(self.provenance_of(name).text(name, getattr(self, name))
                          for name, _ in self.provenance) + "."
 
+    def functional_foot(self, height: float) -> tuple[float, float]:
+        """(heel, toe): the functional base of support from the quiet-standing centre of
+        pressure, −F (1 − share) L and F share L, with the foot's length L = 0.152 × height
+        (Winter 2009, :data:`posturelab.model.options.FOOT_LENGTH_FRACTION_OF_HEIGHT`). [m]"""
+        from ..model.options import FOOT_LENGTH_FRACTION_OF_HEIGHT
+
+        span = self.functional_base_of_support * FOOT_LENGTH_FRACTION_OF_HEIGHT * height
+        return -(1.0 - self.forward_share) * span, self.forward_share * span
+
 
 def _icm(field_name: str) -> Provenance:
     """The icm-pmc5664365 preset's provenance of a gain, for both populations."""
@@ -76,14 +114,30 @@ def _icm(field_name: str) -> Provenance:
                       "(posturelab's assumption: no age-specific gains used)")
 
 
+_FORWARD_SHARE = Provenance(
+    "King et al. 1994 abstract, forward lean", 66.0, "% of the functional base of support",
+    "read as the forward lean's distance from the quiet-standing centre of pressure, the "
+    "backward lean's 34 % the rest (posturelab's reading of the abstract); the same at "
+    "every age")
+_STANCE_LEAN = Provenance(
+    "the PDS recording (dos Santos et al. 2017), one subject", 4.17, "°",
+    "the centre of gravity's mean angle in front of the lateral malleoli, taken for both "
+    "populations (posturelab's choice: one subject, not a group mean)")
+
 _YOUNG = Population(
     name="young", description="young adults (20–30 y, as in Koushyar et al. 2019)",
     **{k: getattr(_ICM, k) for k in _ICM_NUMBERS},
     feedback_delay=_ICM.feedback_delay,
     plantarflexion_strength=132.0,
+    functional_base_of_support=0.60, forward_share=0.66, stance_lean=math.radians(4.17),
     provenance=(
         *((k, _icm(k)) for k in _ICM_NUMBERS),
         ("feedback_delay", _ICM.provenance_of("feedback_delay")),
+        ("functional_base_of_support", Provenance(
+            "King et al. 1994 abstract, subjects under 60", 0.60, "of foot length",
+            "the group mean (± 0.07); Koushyar's young were 20–30 y")),
+        ("forward_share", _FORWARD_SHARE),
+        ("stance_lean", _STANCE_LEAN),
         ("plantarflexion_strength", Provenance(
             "HAL inserm-00080421 abstract (Simoneau et al. 2005), young men", 132.0, "N·m",
             f"one ankle's maximal isometric plantarflexion; doubled for the two ankles of the "
@@ -97,9 +151,15 @@ OLDER_EXTRA_DELAY = 0.020
 _OLDER = replace(
     _YOUNG, name="older", description="older adults (70–80 y, as in Koushyar et al. 2019)",
     feedback_delay=_YOUNG.feedback_delay + OLDER_EXTRA_DELAY,
-    plantarflexion_strength=80.0,
+    plantarflexion_strength=80.0, functional_base_of_support=0.42,
     provenance=(
         *((k, _icm(k)) for k in _ICM_NUMBERS),
+        ("functional_base_of_support", Provenance(
+            "King et al. 1994 abstract, subjects 60 and over", 0.42, "of foot length",
+            "the group mean (± 0.12); Koushyar's older were 70–80 y (King: −16 % a decade "
+            "after 60, so a 75-year-old may use less)")),
+        ("forward_share", _FORWARD_SHARE),
+        ("stance_lean", _STANCE_LEAN),
         ("feedback_delay", Provenance(None, note=(
             f"the young delay (PMC5664365 Table 1, τ_D = 0.097 s) plus "
             f"{OLDER_EXTRA_DELAY * 1000:g} ms; older adults' postural responses start later "

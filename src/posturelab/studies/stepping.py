@@ -1,14 +1,32 @@
 """When is a step needed? The largest platform translation withstood with the feet in place.
 
 **Criterion** (Hof, Gazendam & Sinke 2005, J Biomech 38:1–8; :mod:`posturelab.model.stepping`).
-A run *needs a step* when, at any sample, the extrapolated centre of mass ξ = x + v/ω0 leaves
-the foot [heel, toe], or when the run falls (a link past 60°, the centre of gravity off the
-foot). x and v are the centre of mass's position and velocity relative to the ankle, so ξ is
-taken in the frame of the foot; ω0 = √(g/l) with l the centre of mass's height above the ankle.
-The subject does not know when the platform will stop, so at each instant the frame to judge
-in is the one that keeps the platform's current velocity: there the foot is at rest and Hof's
-condition is exact for the linear inverted pendulum (ξ outside the foot: no centre of pressure
-under the foot stops the fall). The platform's later deceleration is not counted on.
+A run *needs a step* when, at any sample, no centre of pressure on the foot could stop the
+centre of mass any more, or when the run falls (a link past 60°, the centre of gravity off the
+foot). For the linear inverted pendulum that is the extrapolated centre of mass
+ξ = x + v/ω0 (x, v relative to the ankle, ω0 = √(g/l), l the centre of mass's height)
+leaving the foot, once the platform's path still to come is counted: ξ + Δ with
+Δ(t) = ṗ(t)/ω0 − ∫_t^∞ e^{−ω0 (s − t)} ṗ(s) ds
+(:func:`~posturelab.model.stepping.platform_path_offset`; Δ = 0 for a platform at rest or at
+a constant velocity, where this is Hof's condition). The subjects compared with were asked not
+to step, so what is measured is whether they could stand the whole move, its deceleration
+included (``criterion="platform-path"``, the default); ``"platform-velocity"`` judges ξ in the
+frame that keeps the platform's current velocity, as if the move never ended (stricter during
+the move).
+
+**The foot** is, by default, the population's *functional* base of support (King, Judge &
+Wolfson 1994): the share of the foot's length over which the centre of pressure can be held,
+measured from the quiet-standing centre of pressure, which the upright model stands on (the
+quiet stance's lean is a shift of the operating point: its tonic ankle moment m g l sin(lean)
+is not available to the response). Its ends bound the ankle moment each way, m g × toe and
+m g × heel (a flat foot cannot press its centre of pressure beyond them; a heel rise or a toe
+lift is not modelled), and the XCoM. ``foot="anatomical"`` takes the whole foot from the ankle
+(0.152 × height, :func:`posturelab.simulation.base_of_support_for_height`) with the centre of
+mass over the ankle. Plantarflexion is also bounded by the strength left after the tonic
+moment (:func:`~posturelab.model.stepping.ankle_moment_cap`); the dorsiflexors' own strength is
+taken not to bind. ``heel_limit=False`` caps dorsiflexion at the plantarflexion cap instead
+(the symmetric cap of posturelab before issue 22), which lets the centre of pressure pass the
+heel.
 
 **The feedback delay** enters through the dynamics: for τ after the platform starts only the
 intrinsic (undelayed) ankle impedance resists; the neural (active) gains act on the state τ
@@ -16,21 +34,10 @@ earlier (:func:`posturelab.simulate`'s ``feedback_delay``). The XCoM is judged a
 delayed trajectory, so what it reaches during the delay counts; the result reports ξ at the
 response onset t = τ.
 
-**Ankle strength and the foot** limit the net ankle moment (``torque_limits``, a pair per
-side, :mod:`posturelab.model.limits`): plantarflexion to the smaller of the plantarflexor
-strength and m g × toe (:func:`~posturelab.model.stepping.ankle_moment_cap`), dorsiflexion to
-m g × |heel|: a flat foot cannot press its centre of pressure in front of its toe nor behind
-its heel (a heel rise or a toe lift is not modelled). The dorsiflexors' own strength is
-taken not to bind (posturelab's assumption: m g |heel| is about 50 N·m for the bodies
-studied). ``heel_limit=False`` caps dorsiflexion at the plantarflexion cap instead (the
-symmetric cap of posturelab before issue 22), which lets the centre of pressure pass the
-heel.
-
 **The body** is a one-link inverted pendulum about the ankle, scaled from height and mass by
-Winter's table (:func:`posturelab.model.anthropometry.one_link`), with the foot of
-:func:`posturelab.simulation.base_of_support_for_height`. **The threshold** is found as an
-experimenter would, by an ascending series (1 cm steps) to the first translation that needs a
-step, then bisected to 1 mm against the last one withstood, on the compiled engine.
+Winter's table (:func:`posturelab.model.anthropometry.one_link`). **The threshold** is found as
+an experimenter would, by an ascending series (1 cm steps) to the first translation that needs
+a step, then bisected to 1 mm against the last one withstood, on the compiled engine.
 The protocol and the published figures compared with are in :data:`PROTOCOL` and
 :data:`PUBLISHED`; the populations, each number with its source, in
 :mod:`posturelab.studies._stepping_presets`.
@@ -63,6 +70,10 @@ __all__ = ["StepThreshold", "RunVerdict", "step_threshold", "step_verdict", "DIR
 #: Platform directions: "backward" moves the feet back (the body sways forward, toward the
 #: toes); "forward" moves them forward (the body sways back, toward the heel).
 DIRECTIONS = ("backward", "forward")
+#: Foot models of :func:`step_threshold`.
+FOOT_MODELS = ("functional", "anatomical")
+#: Step criteria of :func:`step_threshold`.
+CRITERIA = ("platform-path", "platform-velocity")
 #: Output samples per second of each run (the XCoM is judged at these samples). [Hz]
 SAMPLE_RATE = 500.0
 #: How far the centre of pressure may pass an end of the foot before ``cop_criterion`` counts
@@ -159,12 +170,18 @@ class StepThreshold:
     ankle_strength : float
         Plantarflexion strength of both ankles. [N·m]
     ankle_moment_cap : float
-        The plantarflexion cap used, min(strength, m g × toe). [N·m]
+        The plantarflexion cap used, min(strength − stance_moment, m g × toe). [N·m]
     dorsiflexion_cap : float
         The dorsiflexion cap used (its magnitude): m g × |heel|, or ``ankle_moment_cap``
         with ``heel_limit=False``. [N·m]
     heel, toe : float
-        The foot from the ankle. [m]
+        The foot's ends used (from the quiet-standing centre of pressure for the functional
+        foot, from the ankle for the anatomical one). [m]
+    foot, criterion : str
+        The foot model and the step criterion (see :func:`step_threshold`).
+    stance_moment : float
+        The tonic plantarflexion moment of the quiet stance, not available to the response
+        (0 for the anatomical foot). [N·m]
     com_height : float
         l, the centre of mass above the ankle. [m]
     omega0 : float
@@ -205,6 +222,9 @@ class StepThreshold:
     dorsiflexion_cap: float
     heel: float
     toe: float
+    foot: str
+    criterion: str
+    stance_moment: float
     com_height: float
     omega0: float
     minimum_margin: float
@@ -250,7 +270,8 @@ UNITS = {"largest_translation": "m", "smallest_stepping": "m", "height": "m", "m
          "move_duration": "s", "peak_velocity": "m/s", "peak_acceleration": "m/s²",
          "feedback_delay": "s", "ankle_strength": "N·m", "ankle_moment_cap": "N·m",
          "dorsiflexion_cap": "N·m",
-         "heel": "m", "toe": "m", "com_height": "m", "omega0": "1/s", "minimum_margin": "m",
+         "heel": "m", "toe": "m", "stance_moment": "N·m", "com_height": "m", "omega0": "1/s",
+         "minimum_margin": "m",
          "xcom_at_response_onset": "m", "cop_overrun": "m", "published_mean": "m",
          "published_sd": "m", "largest_searched": "m"}
 
@@ -259,6 +280,7 @@ def step_threshold(height: float, mass: float, population: str | Population = "y
                    direction: str = "backward", *, protocol: PlatformProtocol = PROTOCOL,
                    feedback_delay: float | None = None, ankle_strength: float | None = None,
                    cop_criterion: bool = False, heel_limit: bool = True,
+                   foot: str = "functional", criterion: str = "platform-path",
                    engine: str = "compiled") -> StepThreshold:
     """The largest platform translation a subject withstands without stepping.
 
@@ -283,6 +305,20 @@ def step_threshold(height: float, mass: float, population: str | Population = "y
     heel_limit : bool
         Cap dorsiflexion at m g × |heel| (default), or, False, at the plantarflexion cap
         (the same both ways, as before issue 22). [-]
+    foot : {"functional", "anatomical"}
+        ``"functional"`` (default): the population's functional base of support (King et
+        al. 1994), measured from the quiet-standing centre of pressure, which the upright
+        model stands on; its ends bound the ankle moment and the XCoM, and the tonic moment
+        of the population's stance lean is not available to the response. ``"anatomical"``:
+        the whole foot from the ankle (0.152 × height, the ankle at a quarter of it), the
+        upright body's centre of mass over the ankle.
+    criterion : {"platform-path", "platform-velocity"}
+        ``"platform-path"`` (default): a step is needed when no centre of pressure on the
+        foot can stop the centre of mass given how the platform goes on to move (ξ + Δ off
+        the foot, :func:`posturelab.model.stepping.platform_path_offset`): the subject
+        tries not to step, as in the study compared with. ``"platform-velocity"``: ξ judged
+        in the frame moving with the platform's current velocity, as if it would never stop
+        (stricter during the move).
     engine : {"compiled", "reference"}
         The simulator.
 
@@ -299,8 +335,13 @@ def step_threshold(height: float, mass: float, population: str | Population = "y
     """
     from ..model.anthropometry import body_from_anthropometry, one_link
     from ..model.limits import foot_moment_limits
-    from ..model.options import FallCriteria, base_of_support_for_height
-    from ..model.stepping import ankle_moment_cap, pendulum_frequency, xcom
+    from ..model.options import BaseOfSupport, FallCriteria, base_of_support_for_height
+    from ..model.stepping import (
+        ankle_moment_cap,
+        pendulum_frequency,
+        platform_path_offset,
+        xcom,
+    )
     from ..simulation.engines import simulate
 
     h = check_value("height", height)
@@ -313,13 +354,32 @@ def step_threshold(height: float, mass: float, population: str | Population = "y
         "feedback_delay", feedback_delay)
     strength = pop.ankle_strength if ankle_strength is None else positive_float(
         "ankle_strength [N·m]", ankle_strength)
+    if foot not in FOOT_MODELS:
+        raise UnknownNameError(f"unknown foot {foot!r}; known: {', '.join(FOOT_MODELS)}")
+    if criterion not in CRITERIA:
+        raise UnknownNameError(f"unknown criterion {criterion!r}; known: "
+                               f"{', '.join(CRITERIA)}")
     body = one_link(body_from_anthropometry(h, m))
-    foot = base_of_support_for_height(h)
     weight = body.total_mass * body.gravity
-    cap = ankle_moment_cap(strength, weight, foot.toe)
-    heel_cap = foot_moment_limits(weight, foot.heel, foot.toe)[0] if heel_limit else -cap
     com_height = float(body.gravity_coefficients.sum() / body.total_mass)
     omega0 = float(pendulum_frequency(com_height, body.gravity))
+    if foot == "functional":
+        foot_bos = BaseOfSupport(*pop.functional_foot(h), source=(
+            f"the functional base of support of the {pop.name} (King et al. 1994) from the "
+            "quiet-standing centre of pressure"))
+        tonic = weight * com_height * math.sin(pop.stance_lean)
+    else:
+        foot_bos, tonic = base_of_support_for_height(h), 0.0
+    if strength <= tonic:
+        whose = ("ankle_strength" if ankle_strength is not None
+                 else f"the {pop.name} population's ankle strength")
+        raise ParameterError(f"{whose}, {strength:g} N·m, must exceed the {tonic:.0f} N·m this "
+                             f"subject's quiet stance already uses (m g l sin "
+                             f"{math.degrees(pop.stance_lean):.2f}°); give a larger "
+                             "--ankle-strength")
+    cap = ankle_moment_cap(strength - tonic, weight, foot_bos.toe)
+    heel_cap = (foot_moment_limits(weight, foot_bos.heel, foot_bos.toe)[0] if heel_limit
+                else -cap)
     muscles = pop.muscles(body)
     _check_upright_stable(body, muscles, delay)
     sign = -1.0 if direction == "backward" else 1.0
@@ -332,17 +392,19 @@ def step_threshold(height: float, mass: float, population: str | Population = "y
                           duration=protocol.move_duration + protocol.settle_time,
                           feedback_delay=delay, proprioceptive_weight=pop.proprioceptive_weight,
                           torque_limits=((heel_cap, cap),),
-                          fall=FallCriteria(base_of_support=foot),
+                          fall=FallCriteria(base_of_support=foot_bos),
                           sample_rate=SAMPLE_RATE, engine=engine)
         if run.status == "failed":
             raise PostureLabError(f"the run at a {size:g} m translation failed: {run.message}")
         xi = xcom(run.cog_position[:, 0], run.cog_velocity[:, 0], omega0)
-        verdict = step_verdict(run.time, xi, foot.heel, foot.toe, run.fell, run.fall_reason,
-                               run.fall_time)
+        if criterion == "platform-path":
+            xi = xi + platform_path_offset(run.time, run.platform_velocity[:, 0], omega0)
+        verdict = step_verdict(run.time, xi, foot_bos.heel, foot_bos.toe, run.fell,
+                               run.fall_reason, run.fall_time)
         if cop_criterion and not verdict.needs_step:
             cop = run.centre_of_pressure
-            off = np.flatnonzero((cop > foot.toe + COP_TOLERANCE)
-                                 | (cop < foot.heel - COP_TOLERANCE))
+            off = np.flatnonzero((cop > foot_bos.toe + COP_TOLERANCE)
+                                 | (cop < foot_bos.heel - COP_TOLERANCE))
             if off.size:
                 i = int(off[0])
                 verdict = RunVerdict(True, f"the centre of pressure reached {cop[i]:.3f} m, off "
@@ -370,9 +432,10 @@ def step_threshold(height: float, mass: float, population: str | Population = "y
         onset = float(np.interp(delay, run.time, xi))
         margin = verdict.minimum_margin
         cop = run.centre_of_pressure
-        overrun = float(max(0.0, np.nanmax(cop) - foot.toe, foot.heel - np.nanmin(cop)))
+        overrun = float(max(0.0, np.nanmax(cop) - foot_bos.toe,
+                            foot_bos.heel - np.nanmin(cop)))
     else:
-        onset, margin, overrun = 0.0, min(foot.toe, -foot.heel), 0.0
+        onset, margin, overrun = 0.0, min(foot_bos.toe, -foot_bos.heel), 0.0
     published = PUBLISHED.get((pop.name, direction))
     duration = protocol.move_duration
     return StepThreshold(
@@ -381,7 +444,8 @@ def step_threshold(height: float, mass: float, population: str | Population = "y
         move_duration=duration, peak_velocity=2 * low / duration,
         peak_acceleration=2 * math.pi * low / duration**2, feedback_delay=delay,
         ankle_strength=strength, ankle_moment_cap=cap, dorsiflexion_cap=-heel_cap,
-        heel=foot.heel, toe=foot.toe,
+        heel=foot_bos.heel, toe=foot_bos.toe, foot=foot, criterion=criterion,
+        stance_moment=tonic,
         com_height=com_height, omega0=omega0, minimum_margin=margin,
         xcom_at_response_onset=onset, cop_overrun=overrun, n_simulations=count,
         published_mean=None if published is None else published.mean,
