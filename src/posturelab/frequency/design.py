@@ -68,6 +68,7 @@ from .._validation import float_in_range
 from ..errors import ParameterError
 from ..model.body import Body
 from ..model.muscles import MuscleSet
+from ..model.tilt import PRTSTilt
 
 __all__ = ["DesignPrediction", "predict_errors", "band_noise_covariance", "model_band_frf",
            "frf_derivatives", "motor_noise_gain", "MAX_CYCLES",
@@ -89,7 +90,7 @@ _STEP_FLOOR = {"stiffness": 1.0, "viscosity": 1.0, "active_stiffness": 1.0,
                "visual_weight": 1e-3}
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # (its arrays: a field-wise == would raise)
 class DesignPrediction:
     """What :func:`predict_errors` predicts.
 
@@ -109,12 +110,11 @@ class DesignPrediction:
         The model's band FRF. [-]
     band_covariance : numpy.ndarray, shape (B, B)
         V, E[(Ĥ_a − H_a)(Ĥ_b − H_b)*]. [-]
-    amplitude, state_duration, cycle_length : float
-        The tilt's peak-to-peak amplitude [rad], state duration and cycle [s].
+    tilt : PRTSTilt
+        The stimulus: its ``amplitude`` (peak to peak) [rad], ``state_duration`` and
+        ``cycle_length`` [s] read through the prediction.
     cycles, discard : int
         Cycles analysed and run before them. [-]
-    duration : float
-        (cycles + discard) × cycle length. [s]
     sensor_noise : float
         [rad]
     motor_noise : str
@@ -130,15 +130,32 @@ class DesignPrediction:
     frequency: np.ndarray = field(repr=False)
     frf: np.ndarray = field(repr=False)
     band_covariance: np.ndarray = field(repr=False)
-    amplitude: float = 0.0
-    state_duration: float = 0.0
-    cycle_length: float = 0.0
-    cycles: int = 0
-    discard: int = 0
-    duration: float = 0.0
-    sensor_noise: float = 0.0
-    motor_noise: str = "none"
-    stimulus: str = "tilt"
+    tilt: PRTSTilt
+    cycles: int
+    discard: int
+    sensor_noise: float
+    motor_noise: str
+    stimulus: str
+
+    @property
+    def amplitude(self) -> float:
+        """The tilt's peak-to-peak amplitude. [rad]"""
+        return float(self.tilt.amplitude)
+
+    @property
+    def state_duration(self) -> float:
+        """The tilt's state duration. [s]"""
+        return float(self.tilt.state_duration)
+
+    @property
+    def cycle_length(self) -> float:
+        """The tilt's cycle. [s]"""
+        return float(self.tilt.cycle)
+
+    @property
+    def duration(self) -> float:
+        """(cycles + discard) × cycle length. [s]"""
+        return self.cycle_length * (self.cycles + self.discard)
 
     def to_dict(self) -> dict:
         """Plain-Python summary (JSON-safe: an infinite error is null)."""
@@ -164,8 +181,6 @@ class DesignPrediction:
 
 
 def _check_design(tilt, cycles: int, discard: int, sample_rate: float):
-    from ..model.tilt import PRTSTilt
-
     if not isinstance(tilt, PRTSTilt):
         raise ParameterError("the tilt must be a PRTS (a periodic stimulus: prts:AMPLITUDE_RAD"
                              "[:STATE_DURATION_S][:SEQUENCE])")
@@ -521,8 +536,6 @@ def predict_errors(body: Body, muscles: MuscleSet, free, *, tilt=None, cycles: i
     -------
     DesignPrediction
     """
-    from ..model.tilt import PRTSTilt
-
     if not isinstance(body, Body) or not isinstance(muscles, MuscleSet):
         raise ParameterError("predict_errors needs a Body and a MuscleSet")
     tilt = PRTSTilt.named("posturelab-80", 0.035) if tilt is None else tilt
@@ -542,10 +555,8 @@ def predict_errors(body: Body, muscles: MuscleSet, free, *, tilt=None, cycles: i
     H = model_band_frf(body, muscles, specs, values, hf, hw, **frf_model)[0]
     return DesignPrediction(
         tuple(names), values, _errors(fisher), fisher, noise["frequency"], H,
-        noise["covariance"], float(tilt.amplitude), float(tilt.state_duration),
-        float(tilt.cycle), int(cycles), int(discard), float(tilt.cycle * (cycles + discard)),
-        float(sensor_noise), "none" if motor_noise is None else motor_noise.describe(),
-        frf_model["input"])
+        noise["covariance"], tilt, int(cycles), int(discard), float(sensor_noise),
+        "none" if motor_noise is None else motor_noise.describe(), frf_model["input"])
 
 
 def _input_options(input: str, proprioceptive_weight, visual_weight) -> dict:

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
+from inspect import signature
 from pathlib import Path
 from typing import Any
 
@@ -33,7 +34,11 @@ import numpy as np
 from ..errors import ParameterError
 from ..scenarios import Scenario
 from ..simulation.options import RunOptions
-from .experiment import MAX_RECORD_RATE, MAX_SENSOR_NOISE  # (the one experiment's bounds)
+from .experiment import (  # (the one experiment: its bounds and defaults)
+    MAX_RECORD_RATE,
+    MAX_SENSOR_NOISE,
+    prts_experiment,
+)
 
 __all__ = ["PRTSProtocol", "PRTSSweepResult", "prts_sweep", "MAX_EXPERIMENTS"]
 
@@ -41,9 +46,15 @@ __all__ = ["PRTSProtocol", "PRTSSweepResult", "prts_sweep", "MAX_EXPERIMENTS"]
 MAX_EXPERIMENTS = 100_000
 
 
+#: One experiment's defaults, stated once (in :func:`prts_experiment`'s signature); a
+#: :class:`PRTSProtocol` takes them, all but ``bands``.
+_EXPERIMENT = {name: p.default for name, p in signature(prts_experiment).parameters.items()}
+
+
 @dataclass(frozen=True)
 class PRTSProtocol:
-    """What each run of :func:`prts_sweep` does.
+    """What each run of :func:`prts_sweep` does; by default what
+    :func:`~posturelab.frequency.experiment.prts_experiment` does, but for ``bands``.
 
     Parameters
     ----------
@@ -67,12 +78,12 @@ class PRTSProtocol:
         no fit.
     """
 
-    cycles: int = 5
-    discard: int = 1
-    sensor_noise: float = 0.0
-    seed: int = 0
-    sample_rate: float = 100.0
-    output: str = "com_angle"
+    cycles: int = _EXPERIMENT["cycles"]
+    discard: int = _EXPERIMENT["discard"]
+    sensor_noise: float = _EXPERIMENT["sensor_noise"]
+    seed: int = _EXPERIMENT["seed"]
+    sample_rate: float = _EXPERIMENT["sample_rate"]
+    output: str = _EXPERIMENT["output"]
     bands: Any = "peterka"
     fit: tuple[str, ...] = ()
 
@@ -107,7 +118,6 @@ class _ExperimentTask:
     protocol: PRTSProtocol
 
     def run(self, grid, lo: int, hi: int, parallel: bool) -> list[tuple]:
-        from .experiment import prts_experiment
         from .fit import fit_frf
 
         sc, pr = self.scenario, self.protocol

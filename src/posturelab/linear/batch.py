@@ -69,6 +69,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import TypedDict, Unpack
 
 import numpy as np
 
@@ -100,6 +101,7 @@ __all__ = [
     "ParameterGrid",
     "StabilityMap",
     "characteristic_polynomials",
+    "SetKeywords",
     "batch_stable",
     "batch_analyse",
     "parameter_grid",
@@ -175,7 +177,7 @@ def _body_rows(body: BodyArrays, lo: int, hi: int) -> BodyArrays:
         body.gravity[lo:hi] if body.gravity.ndim == 1 else body.gravity)
 
 
-def _systems(pair_stiffness, viscosity_ratio, pair_viscosity, body, muscles):
+def _systems(pair_stiffness, viscosity_ratio, pair_viscosity=None, body=None, muscles=None):
     """The checked inputs as linear systems of blocks of at most _BLOCK sets:
     (M, [(lo, hi, LinearSystem), ...])."""
     body, muscles, k, v, ratio = _gains(pair_stiffness, viscosity_ratio, pair_viscosity,
@@ -240,6 +242,28 @@ _FILLED = {
 # ---------------------------------------------------------------------------
 
 
+class SetKeywords(TypedDict, total=False):
+    """The keywords that, beside the pair stiffness and the viscosity ratio, give the M
+    parameter sets of :func:`characteristic_polynomials`, :func:`batch_stable` and
+    :func:`batch_analyse`.
+
+    Attributes
+    ----------
+    pair_viscosity : array_like, shape (M, P)
+        Per-pair viscosity instead of a ratio. [N·m·s/rad]
+    body : Body or BodyArrays
+        The chain (one body, or per-set parameters); the paper's body by default.
+    muscles : MuscleSet
+        Gives the pair spans (the matrix E) only; its own gains are ignored.
+        The paper's five pairs by default.
+    """
+
+    pair_viscosity: np.ndarray | None
+    body: Body | BodyArrays | None
+    muscles: MuscleSet | None
+
+
+
 @dataclass(frozen=True)
 class BatchLinearAnalysis:
     """Linear stability of M parameter sets about upright.
@@ -266,14 +290,9 @@ class BatchLinearAnalysis:
         return int(self.stable.shape[0])
 
 
-def characteristic_polynomials(
-    pair_stiffness: np.ndarray,
-    viscosity_ratio: float | np.ndarray | None = None,
-    *,
-    pair_viscosity: np.ndarray | None = None,
-    body: Body | BodyArrays | None = None,
-    muscles: MuscleSet | None = None,
-) -> np.ndarray:
+def characteristic_polynomials(pair_stiffness: np.ndarray,
+                               viscosity_ratio: float | np.ndarray | None = None,
+                               **sets: Unpack[SetKeywords]) -> np.ndarray:
     """Coefficients of p(s) = det(s² J0 + s L + K − g diag(a)) for each set.
 
     Parameters
@@ -283,13 +302,8 @@ def characteristic_polynomials(
     viscosity_ratio : float or array_like, shape (M,), optional
         Pair viscosity = ratio × pair stiffness; 0.25 (the paper's) when
         neither this nor ``pair_viscosity`` is given. [s]
-    pair_viscosity : array_like, shape (M, P), optional
-        Per-pair viscosity instead of a ratio. [N·m·s/rad]
-    body : Body or BodyArrays, optional
-        The chain (one body, or per-set parameters); the paper's body by default.
-    muscles : MuscleSet, optional
-        Gives the pair spans (the matrix E) only; its own gains are ignored.
-        The paper's five pairs by default.
+    **sets
+        ``pair_viscosity`` [N·m·s/rad], ``body``, ``muscles``: :class:`SetKeywords`.
 
     Returns
     -------
@@ -297,24 +311,14 @@ def characteristic_polynomials(
         ``c[:, j]`` multiplies s^j (ascending powers); ``c[:, 2N] = det J0``.
         Units: [(N·m/rad)^N · s^j] (a determinant of N×N torque-per-angle entries).
     """
-    m, blocks = _systems(pair_stiffness, viscosity_ratio, pair_viscosity, body, muscles)
+    m, blocks = _systems(pair_stiffness, viscosity_ratio, **sets)
     return _blocks(m, blocks, _kernels.MODE_COEFFICIENTS)["coefficients"]
 
 
-def batch_stable(
-    pair_stiffness: np.ndarray,
-    viscosity_ratio: float | np.ndarray | None = None,
-    *,
-    pair_viscosity: np.ndarray | None = None,
-    body: Body | BodyArrays | None = None,
-    muscles: MuscleSet | None = None,
-) -> np.ndarray:
-    """Stable flags of M parameter sets by the Routh–Hurwitz test (fastest path).
-
-    Parameters
-    ----------
-    pair_stiffness, viscosity_ratio, pair_viscosity, body, muscles
-        As in :func:`characteristic_polynomials`: [N·m/rad], [s], [N·m·s/rad].
+def batch_stable(pair_stiffness: np.ndarray, viscosity_ratio: float | np.ndarray | None = None,
+                 **sets: Unpack[SetKeywords]) -> np.ndarray:
+    """Stable flags of M parameter sets by the Routh–Hurwitz test (fastest path); the
+    arguments as for :func:`characteristic_polynomials` ([N·m/rad], [s], [N·m·s/rad]).
 
     Returns
     -------
@@ -322,26 +326,18 @@ def batch_stable(
         True when every pole has real part < −δ (module notes); equal to
         ``batch_analyse(...).stable`` except within rounding of that boundary.
     """
-    m, blocks = _systems(pair_stiffness, viscosity_ratio, pair_viscosity, body, muscles)
+    m, blocks = _systems(pair_stiffness, viscosity_ratio, **sets)
     return _blocks(m, blocks, _kernels.MODE_FLAGS)["stable"]
 
 
-def batch_analyse(
-    pair_stiffness: np.ndarray,
-    viscosity_ratio: float | np.ndarray | None = None,
-    *,
-    pair_viscosity: np.ndarray | None = None,
-    body: Body | BodyArrays | None = None,
-    muscles: MuscleSet | None = None,
-    keep_poles: bool = False,
-    _max_iterations: int = _MAX_ITERATIONS,
-) -> BatchLinearAnalysis:
-    """Poles, largest real part and stable flag of M parameter sets.
+def batch_analyse(pair_stiffness: np.ndarray, viscosity_ratio: float | np.ndarray | None = None,
+                  *, keep_poles: bool = False, _max_iterations: int = _MAX_ITERATIONS,
+                  **sets: Unpack[SetKeywords]) -> BatchLinearAnalysis:
+    """Poles, largest real part and stable flag of M parameter sets; the sets as for
+    :func:`characteristic_polynomials` ([N·m/rad], [s], [N·m·s/rad]).
 
     Parameters
     ----------
-    pair_stiffness, viscosity_ratio, pair_viscosity, body, muscles
-        As in :func:`characteristic_polynomials`: [N·m/rad], [s], [N·m·s/rad].
     keep_poles : bool, optional
         Also return all 2N poles of every set, shape (M, 2N) [1/s] (32·N bytes
         per set).
@@ -350,7 +346,7 @@ def batch_analyse(
     -------
     BatchLinearAnalysis
     """
-    m, blocks = _systems(pair_stiffness, viscosity_ratio, pair_viscosity, body, muscles)
+    m, blocks = _systems(pair_stiffness, viscosity_ratio, **sets)
     parts = [_analyse(system, keep_poles=keep_poles, max_iterations=_max_iterations)
              for _, _, system in blocks]
     if len(parts) == 1:

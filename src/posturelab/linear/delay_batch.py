@@ -164,7 +164,7 @@ def batch_delay_stable(body: Body, muscles: MuscleSet, stiffness, viscosity,
     return r.real < -1e-9 * np.maximum(1.0, np.abs(r))
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # (its arrays: a field-wise == would raise)
 class DelayStabilityMap:
     """Delayed stability over active stiffness × active viscosity of one pair.
 

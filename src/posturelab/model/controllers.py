@@ -19,13 +19,13 @@ posturelab's own assumption. :meth:`ControllerPreset.provenance_text` says it in
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from ..errors import ParameterError, lookup
 from .body import Body
 from .muscles import MusclePair, MuscleSet
 
-__all__ = ["ControllerPreset", "Provenance", "CONTROLLERS", "get_controller",
+__all__ = ["AnkleController", "ControllerPreset", "Provenance", "CONTROLLERS", "get_controller",
            "MultiJointPreset", "MULTIJOINT_CONTROLLERS", "get_multijoint_controller"]
 
 
@@ -74,56 +74,42 @@ class Provenance:
 
 
 @dataclass(frozen=True)
-class ControllerPreset:
-    """A one-link ankle controller from the literature.
+class AnkleController:
+    """A named one-link ankle controller: its gains as fractions of the body's load stiffness
+    mgh, its delay and proprioceptive weight, each number with its :class:`Provenance`
+    (:class:`ControllerPreset`; the stepping study's populations).
 
     Attributes
     ----------
     name : str
-    citation : str
     intrinsic_stiffness : float
-        Intrinsic ankle stiffness / mgh. [-]
+        Intrinsic (undelayed) ankle stiffness / mgh. [-]
     intrinsic_viscosity : float
         Intrinsic ankle viscosity / mgh. [s]
     active_stiffness : float
-        Active (neural) stiffness K_P / mgh. [-]
+        Active (neural, delayed) stiffness K_P / mgh. [-]
     active_viscosity : float
         Active viscosity K_D / mgh. [s]
     feedback_delay : float
-        τ. [s]
+        τ of the active part. [s]
     proprioceptive_weight : float
-        W. [-]
-    omitted : str
-        What of the published model is not modelled here.
+        W (no effect without a tilt). [-]
     provenance : tuple of (str, Provenance)
-        For each numeric field (:data:`PRESET_NUMBERS`), where it comes from.
+        For each numeric field, where it comes from (a keyword).
     """
 
     name: str
-    citation: str
     intrinsic_stiffness: float
     intrinsic_viscosity: float
     active_stiffness: float
     active_viscosity: float
     feedback_delay: float
     proprioceptive_weight: float
-    omitted: str = ""
-    provenance: tuple[tuple[str, Provenance], ...] = ()
+    provenance: tuple[tuple[str, Provenance], ...] = field(default=(), kw_only=True)
 
     def provenance_of(self, field_name: str) -> Provenance:
         """The :class:`Provenance` of one numeric field."""
         return dict(self.provenance)[field_name]
-
-    def provenance_text(self) -> str:
-        """Which numbers come from the source (and where) and which are posturelab's, in
-        words (one sentence per number)."""
-        return "; ".join(self.provenance_of(name).text(symbol, getattr(self, name))
-                         for name, symbol in PRESET_NUMBERS) + "."
-
-    def assumed(self) -> tuple[str, ...]:
-        """The symbols of the numbers that are posturelab's assumptions."""
-        return tuple(symbol for name, symbol in PRESET_NUMBERS
-                     if not self.provenance_of(name).from_source)
 
     def muscles(self, body: Body) -> MuscleSet:
         """The ankle pair for ``body`` (one link), gains scaled by its mgh [N·m/rad]."""
@@ -145,6 +131,33 @@ class ControllerPreset:
                 "proprioceptive_weight": self.proprioceptive_weight}
 
 
+@dataclass(frozen=True)
+class ControllerPreset(AnkleController):
+    """A one-link ankle controller from the literature (the numbers of
+    :class:`AnkleController`).
+
+    Attributes
+    ----------
+    citation : str
+    omitted : str
+        What of the published model is not modelled here.
+    """
+
+    citation: str
+    omitted: str = ""
+
+    def provenance_text(self) -> str:
+        """Which numbers come from the source (and where) and which are posturelab's, in
+        words (one sentence per number)."""
+        return "; ".join(self.provenance_of(name).text(symbol, getattr(self, name))
+                         for name, symbol in PRESET_NUMBERS) + "."
+
+    def assumed(self) -> tuple[str, ...]:
+        """The symbols of the numbers that are posturelab's assumptions."""
+        return tuple(symbol for name, symbol in PRESET_NUMBERS
+                     if not self.provenance_of(name).from_source)
+
+
 #: The body of PMC5664365 Table 1 (after Fonteyn et al. 2010): m [kg], h [m], g [m/s²].
 PMC5664365_BODY = (75.0, 0.83, 9.81)
 _MGH = PMC5664365_BODY[0] * PMC5664365_BODY[2] * PMC5664365_BODY[1]  # [N·m/rad]
@@ -156,16 +169,23 @@ def _table1(symbol: str, value: float, unit: str, per_mgh: bool = True) -> Prove
     return Provenance(f"PMC5664365 Table 1, {symbol}", value, unit, note)
 
 
+def _by_name(*presets) -> dict:
+    """The presets keyed by their names."""
+    return {p.name: p for p in presets}
+
+
+#: The paper the round values of the Peterka 2002 / 2018 models are after.
+_PETERKA_2002 = ("Peterka RJ (2002) Sensorimotor integration in human postural control. "
+                 "J Neurophysiol 88:1097–1118")
 #: A round value summarised for the Peterka 2002 / 2018 models that posturelab has not found
-#: in a table of Peterka 2002 (J Neurophysiol 88:1097–1118): posturelab's reading.
+#: in a table of :data:`_PETERKA_2002`: posturelab's reading.
 _PETERKA_ROUND = "a round value after Peterka 2002, not found in its tables"
 
 #: The presets by name.
-CONTROLLERS: dict[str, ControllerPreset] = {
-    "peterka-2002": ControllerPreset(
+CONTROLLERS: dict[str, ControllerPreset] = _by_name(
+    ControllerPreset(
         name="peterka-2002",
-        citation=("Peterka RJ (2002) Sensorimotor integration in human postural control. "
-                  "J Neurophysiol 88:1097–1118; independent-channel model, round values "
+        citation=(_PETERKA_2002 + "; independent-channel model, round values "
                   "K_P ≈ 1.35 mgh, K_D ≈ 0.47 mgh·s, τ ≈ 0.15 s as summarised for the "
                   "Peterka 2002 / 2018 models (not checked against the paper's tables); "
                   "W = 1 and no intrinsic impedance are posturelab's choices"),
@@ -185,7 +205,7 @@ CONTROLLERS: dict[str, ControllerPreset] = {
                 "source's weights depend on the stimulus amplitude and condition")),
         ),
     ),
-    "icm-pmc5664365": ControllerPreset(
+    ControllerPreset(
         name="icm-pmc5664365",
         citation=("Default parameters of the independent-channel stance model, PMC5664365 "
                   "Table 1 (body J = 66 kg·m², m = 75 kg, h = 0.83 m after Fonteyn et al. "
@@ -206,17 +226,11 @@ CONTROLLERS: dict[str, ControllerPreset] = {
             ("proprioceptive_weight", _table1("W_P", 0.8, "", per_mgh=False)),
         ),
     ),
-}
+)
 
 
 def get_controller(name: str) -> ControllerPreset:
-    """The preset ``name``.
-
-    Raises
-    ------
-    UnknownNameError
-        Naming the known presets.
-    """
+    """The preset ``name``; an unknown name raises UnknownNameError listing the known ones."""
     return lookup(CONTROLLERS, name, "controller", "known controllers")
 
 
@@ -311,8 +325,8 @@ class MultiJointPreset:
 _OURS = "posturelab's choice"
 
 #: Multi-joint presets by name.
-MULTIJOINT_CONTROLLERS: dict[str, MultiJointPreset] = {
-    "multijoint-default": MultiJointPreset(
+MULTIJOINT_CONTROLLERS: dict[str, MultiJointPreset] = _by_name(
+    MultiJointPreset(
         name="multijoint-default",
         citation=("LQR full-state feedback of the chain about upright after Kuo AD (1995) An "
                   "optimal control model for analyzing human postural balance, IEEE Trans "
@@ -345,7 +359,7 @@ MULTIJOINT_CONTROLLERS: dict[str, MultiJointPreset] = {
                                           "delay margin")),
         ),
     ),
-}
+)
 
 
 def get_multijoint_controller(name: str) -> MultiJointPreset:

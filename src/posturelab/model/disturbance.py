@@ -1,6 +1,7 @@
 """The base of every platform disturbance: :class:`Disturbance`, the terms the compiled engine
-evaluates (:class:`Primitive`) and their formulas, and the platform's bounds. The
-disturbances themselves are in :mod:`.platform`.
+evaluates (:class:`Primitive`; :class:`ProfileTerm`, the fields it shares with a tilt's terms)
+and their formulas, and the platform's bounds. The disturbances themselves are in
+:mod:`.platform`.
 """
 
 from __future__ import annotations
@@ -13,7 +14,7 @@ import numpy as np
 from .._validation import finite_float
 from ..errors import ParameterError
 
-__all__ = ["Primitive", "Disturbance", "NoDisturbance", "windowed_sine_formula",
+__all__ = ["ProfileTerm", "Primitive", "Disturbance", "NoDisturbance", "windowed_sine_formula",
            "sine_formula", "MAX_PLATFORM_ACCELERATION", "MIN_PROFILE_SPACING"]
 
 def _axis(axis: str) -> int:
@@ -41,8 +42,37 @@ def _check_acceleration(name: str, peak: float) -> None:
 
 
 @dataclass(frozen=True)
-class Primitive:
-    """One term of a platform acceleration, in the form the compiled engine evaluates.
+class ProfileTerm:
+    """What a term of a platform acceleration (:class:`Primitive`) and a term of a tilt
+    (:class:`~posturelab.model.tilt.TiltTerm`) share, in the form the engines evaluate: its
+    kind, a sine's amplitude, frequency and phase, a window's start and duration.
+
+    Attributes
+    ----------
+    kind : str
+        The term's formula (each subclass lists its kinds).
+    amplitude : float
+        [m/s²] for a platform term, [rad] for a tilt term.
+    frequency : float
+        [Hz]
+    phase : float
+        [rad]
+    start, duration : float
+        The window of a windowed sine, or the ramp of a raised cosine. [s]
+    """
+
+    kind: str
+    amplitude: float = 0.0
+    frequency: float = 0.0
+    phase: float = 0.0
+    start: float = 0.0
+    duration: float = 0.0
+
+
+@dataclass(frozen=True)
+class Primitive(ProfileTerm):
+    """One term of a platform acceleration (the fields of :class:`ProfileTerm`, amplitude in
+    [m/s²], and these).
 
     Attributes
     ----------
@@ -53,28 +83,14 @@ class Primitive:
         interpolation of (time, x, y), zero outside.
     axis : int
         0 horizontal (x), 1 vertical (y); unused for samples (both axes). [-]
-    amplitude : float
-        [m/s²]
-    duration, start : float
-        The window of a windowed sine. [s]
     cycles : float
         Sine cycles within the window (½ a half-sine, 1 a ramp-and-hold). [-]
-    frequency : float
-        [Hz]
-    phase : float
-        [rad]
     samples : tuple of numpy.ndarray, optional
         (time [s], x acceleration [m/s²], y acceleration [m/s²]).
     """
 
-    kind: str
     axis: int = 0
-    amplitude: float = 0.0
-    duration: float = 0.0
-    start: float = 0.0
     cycles: float = 0.0
-    frequency: float = 0.0
-    phase: float = 0.0
     samples: tuple | None = None
 
 

@@ -43,6 +43,7 @@ from .disturbance import (  # the base class and the terms (stated in .disturban
     Disturbance,
     NoDisturbance,
     Primitive,
+    ProfileTerm,
     _axis,
     _check_acceleration,
     sine_formula,
@@ -51,6 +52,7 @@ from .disturbance import (  # the base class and the terms (stated in .disturban
 
 __all__ = [
     "Primitive",
+    "ProfileTerm",
     "Disturbance",
     "NoDisturbance",
     "VelocityStep",
@@ -148,8 +150,8 @@ class _SinePulse(Disturbance):
         return (self.start, self.start + self.duration)
 
     def primitives(self) -> tuple[Primitive, ...]:
-        return (Primitive("windowed-sine", _axis(self.axis), self.peak_acceleration,
-                          duration=self.duration, start=self.start, cycles=self._cycles),)
+        return (Primitive("windowed-sine", self.peak_acceleration, start=self.start,
+                          duration=self.duration, axis=_axis(self.axis), cycles=self._cycles),)
 
     def acceleration(self, t):
         t = np.asarray(t, dtype=float)
@@ -274,7 +276,7 @@ class SumOfSines(Disturbance):
         return replace(self, amplitudes=tuple(a * f for a in self.amplitudes))
 
     def primitives(self) -> tuple[Primitive, ...]:
-        return tuple(Primitive("sine", _axis(self.axis), a, frequency=f, phase=ph)
+        return tuple(Primitive("sine", a, f, ph, axis=_axis(self.axis))
                      for a, f, ph in zip(self.amplitudes, self.frequencies, self.phases,
                                          strict=True))
 

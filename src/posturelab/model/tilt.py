@@ -39,6 +39,7 @@ import numpy as np
 from .._validation import finite_array, finite_float, float_in_range
 from ..errors import ParameterError
 from ..parameters import MAX_AXIS_DEPTH, MAX_TILT
+from .disturbance import ProfileTerm
 from .prts import (  # the sequences (stated in .prts)
     DEFAULT_PRTS,
     PETERKA_2002_CITATION,
@@ -111,8 +112,9 @@ def cubic_formula(c0, c1, c2, c3, u):
 
 
 @dataclass(frozen=True)
-class TiltTerm:
-    """One term of a tilt profile, in the form the engines evaluate.
+class TiltTerm(ProfileTerm):
+    """One term of a tilt profile (the fields of
+    :class:`~posturelab.model.platform.ProfileTerm`, amplitude in [rad], and these).
 
     Attributes
     ----------
@@ -123,14 +125,6 @@ class TiltTerm:
         piecewise cubic on ``knots`` with ``coefficients`` (c0, c1, c2, c3) per interval in
         powers of (t − knot), held at its end values outside, repeated with ``period``
         when that is > 0.
-    amplitude : float
-        [rad]
-    frequency : float
-        [Hz]
-    phase : float
-        [rad]
-    start, duration : float
-        The ramp of a raised cosine. [s]
     knots : numpy.ndarray, shape (K + 1,), optional
         [s]
     coefficients : numpy.ndarray, shape (K, 4), optional
@@ -139,12 +133,6 @@ class TiltTerm:
         0 for a profile that is not repeated. [s]
     """
 
-    kind: str
-    amplitude: float = 0.0
-    frequency: float = 0.0
-    phase: float = 0.0
-    start: float = 0.0
-    duration: float = 0.0
     knots: np.ndarray | None = None
     coefficients: np.ndarray | None = None
     period: float = 0.0

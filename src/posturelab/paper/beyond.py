@@ -175,9 +175,8 @@ def literature_controller_finding(foot: BaseOfSupport, name: str = "peterka-2002
         return largest_recoverable(run, 0.01, 1.0, tolerance=1e-3).estimate
 
     return LiteratureControllerFinding(
-        preset.name, preset.citation, preset.feedback_delay,
-        float(delay_margin(body, muscles).delay_margin), RECOVERY_RAMP_DURATION,
-        search(True), search(False), preset.provenance_text())
+        ramp_duration=RECOVERY_RAMP_DURATION, by_cop=search(True), by_cog=search(False),
+        preset=preset, delay_margin=float(delay_margin(body, muscles).delay_margin))
 
 
 def strategy_finding(body: Body, foot: BaseOfSupport, ankle_torque_limit: float = 60.0

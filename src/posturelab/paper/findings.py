@@ -11,6 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..model.controllers import ControllerPreset
 from ..model.options import BaseOfSupport
 from ..simulation.results import SimulationResult
 
@@ -326,37 +327,45 @@ class DelayFinding:
 
 
 @dataclass(frozen=True)
-class LiteratureControllerFinding:
+class LiteratureControllerFinding(RecoveryFinding):
     """A published delayed controller on the paper's body (as one link): its delay margin
-    and the largest backward translation it recovers, against the human range.
+    and the largest backward translation it recovers (the numbers of
+    :class:`RecoveryFinding`: ``by_cop`` is the bound compared with people; ``by_cog``, the
+    centre of pressure allowed past the toe, a foot that cannot tip, is not), against the
+    human range.
 
     Attributes
     ----------
-    controller : str
-        Preset name (:mod:`posturelab.model.controllers`).
-    citation : str
-    feedback_delay : float
-        The preset's τ. [s]
+    preset : ControllerPreset
+        The controller (:mod:`posturelab.model.controllers`): its name (``controller``),
+        ``citation``, ``feedback_delay`` τ [s] and the ``provenance`` of its numbers, in
+        words, read through the finding.
     delay_margin : float
         Of the linearised model. [s]
-    ramp_duration : float
-        The backward ramp-and-hold's duration. [s]
-    by_cop : float
-        Largest recoverable displacement before the foot tips (the centre of pressure leaves
-        the foot): the bound compared with people. [m]
-    by_cog : float
-        Largest before the centre of gravity leaves the foot, the centre of pressure allowed
-        past the toe (a foot that cannot tip); not compared with people. [m]
     """
 
-    controller: str
-    citation: str
-    feedback_delay: float
+    preset: ControllerPreset
     delay_margin: float
-    ramp_duration: float
-    by_cop: float
-    by_cog: float
-    provenance: str = ""
+
+    @property
+    def controller(self) -> str:
+        """The preset's name."""
+        return self.preset.name
+
+    @property
+    def citation(self) -> str:
+        """The preset's citation."""
+        return self.preset.citation
+
+    @property
+    def feedback_delay(self) -> float:
+        """The preset's τ. [s]"""
+        return self.preset.feedback_delay
+
+    @property
+    def provenance(self) -> str:
+        """Where each of the preset's numbers comes from, in words."""
+        return self.preset.provenance_text()
 
     @property
     def text(self) -> str:

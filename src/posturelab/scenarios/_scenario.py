@@ -56,8 +56,8 @@ class Scenario:
     body: Body
     muscles: MuscleSet
     disturbance: Disturbance
-    options: RunOptions = SCENARIO_DEFAULTS
-    case: str | None = None
+    options: RunOptions  # (the defaults of these two are __init__'s: init=False)
+    case: str | None
 
     def __init__(self, name: str, source: str, body: Body, muscles: MuscleSet,
                  disturbance: Disturbance, options: RunOptions | None = None,

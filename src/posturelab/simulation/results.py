@@ -20,45 +20,48 @@ from .._files import (  # (re-exported: the writers keep this public path)
 from ..errors import PostureLabError
 from .outcome import StimulusTiming
 
-__all__ = ["SimulationResult", "DerivedSeries", "atomic_write_text", "atomic_write_bytes",
-           "atomic_write_files", "new_file_mode", "read_run_csv"]
+__all__ = ["SimulationResult", "DerivedSeries", "DERIVED_SERIES", "atomic_write_text",
+           "atomic_write_bytes", "atomic_write_files", "new_file_mode", "read_run_csv"]
+
+
+#: Each series a run derives from its states, time first: its name, shape and meaning [unit].
+#: The fields of :class:`DerivedSeries` and the properties of :class:`SimulationResult` of
+#: the same names, in this order; a DerivedSeries may hold None from ``angular_acceleration``
+#: on.
+DERIVED_SERIES: tuple[tuple[str, str, str], ...] = (
+    ("pair_torques", "(T, P)",
+     "Muscle-pair torques M (zero while a one-sided pair is slack). [N·m]"),
+    ("joint_torques", "(T, N)", "Generalised torques U = −EᵀM on the link angles. [N·m]"),
+    ("joint_moments", "(T, N)", "Net muscle moment at the ankle, knee, hip, …: the sum of "
+     "the torques of the pairs that cross each joint. [N·m]"),
+    ("cog_position", "(T, 2)", "Centre of gravity (x_c, y_c) relative to the ankle. [m]"),
+    ("cog_velocity", "(T, 2)", "Its velocity relative to the ankle (ẋ_c, ẏ_c). [m/s]"),
+    ("platform_acceleration", "(T, 2)", "Platform acceleration (ẍ_d, ÿ_d). [m/s²]"),
+    ("platform_velocity", "(T, 2)",
+     "Platform velocity (ẋ_d, ẏ_d), including any velocity step at t = 0. [m/s]"),
+    ("platform_position", "(T, 2)", "Platform position (x_d, y_d) from 0 at t = 0. [m]"),
+    ("angular_acceleration", "(T, N)", "Link angular accelerations. [rad/s²]"),
+    ("ground_reaction", "(T, 2)",
+     "Horizontal and vertical force of the platform on the foot (F_x, F_y). [N]"),
+    ("centre_of_pressure", "(T,)", "Centre of pressure under the massless foot, x_p = "
+     "τ_ankle / F_y, relative to the ankle. [m]"),
+    ("com_angle", "(T,)", "Centre-of-mass angle Σ a_i θ_i / Σ a_i. [rad]"),
+    ("tilt", "(T,)", "Support-surface tilt α (positive toes-up), None without one. [rad]"),
+    ("visual_tilt", "(T,)", "Visual-scene tilt v (positive toes-up), None without one. [rad]"),
+)
+
+
+def _series_doc(head: str) -> str:
+    """``head`` and a numpydoc Attributes entry per row of :data:`DERIVED_SERIES`."""
+    return head + "\n\n    Attributes\n    ----------\n" + "".join(
+        f"    {name} : numpy.ndarray, shape {shape}\n        {meaning}\n"
+        for name, shape, meaning in DERIVED_SERIES)
 
 
 @dataclass(frozen=True)
 class DerivedSeries:
-    """The series a :class:`SimulationResult` derives from its states (time first).
-
-    Attributes
-    ----------
-    pair_torques : numpy.ndarray, shape (T, P)
-        Muscle-pair torques M. [N·m]
-    joint_torques : numpy.ndarray, shape (T, N)
-        Generalised torques U = −EᵀM. [N·m]
-    joint_moments : numpy.ndarray, shape (T, N)
-        Net muscle moment per joint. [N·m]
-    cog_position : numpy.ndarray, shape (T, 2)
-        Centre of gravity relative to the ankle. [m]
-    cog_velocity : numpy.ndarray, shape (T, 2)
-        Its velocity. [m/s]
-    platform_acceleration : numpy.ndarray, shape (T, 2)
-        (ẍ_d, ÿ_d). [m/s²]
-    platform_velocity : numpy.ndarray, shape (T, 2)
-        (ẋ_d, ẏ_d). [m/s]
-    platform_position : numpy.ndarray, shape (T, 2)
-        (x_d, y_d). [m]
-    angular_acceleration : numpy.ndarray, shape (T, N), optional
-        Link angular accelerations. [rad/s²]
-    ground_reaction : numpy.ndarray, shape (T, 2), optional
-        Force of the platform on the foot. [N]
-    centre_of_pressure : numpy.ndarray, shape (T,), optional
-        Centre of pressure relative to the ankle. [m]
-    com_angle : numpy.ndarray, shape (T,), optional
-        Centre-of-mass angle Σ a_i θ_i / Σ a_i. [rad]
-    tilt : numpy.ndarray, shape (T,), optional
-        The support-surface tilt α, None without one. [rad]
-    visual_tilt : numpy.ndarray, shape (T,), optional
-        The visual-scene tilt v, None without one. [rad]
-    """
+    __doc__ = _series_doc("The series a :class:`SimulationResult` derives from its states "
+                          "(:data:`DERIVED_SERIES`).")
 
     pair_torques: np.ndarray
     joint_torques: np.ndarray
@@ -89,12 +92,11 @@ class SimulationResult:
     """The outcome of one nonlinear simulation; arrays have time as the first axis.
 
     The states (``time``, ``theta``, ``omega``) and the outcome are stored; the
-    series derived from them (``pair_torques`` to ``platform_position``,
-    ``angular_acceleration``, ``ground_reaction``, ``centre_of_pressure``) come
-    from ``derived``: a :class:`DerivedSeries`, or a function that computes one,
-    called on the first access of any of them and then kept. The compiled
-    simulator defers them this way, so that a run whose angles are all that is
-    read (a sweep, a fit, a bisection) does not pay for them.
+    series derived from them (properties, one per row of :data:`DERIVED_SERIES`:
+    ``pair_torques`` … ``visual_tilt``) come from ``derived``: a :class:`DerivedSeries`,
+    or a function that computes one, called on the first access of any of them and then
+    kept. The compiled simulator defers them this way, so that a run whose angles are all
+    that is read (a sweep, a fit, a bisection) does not pay for them.
 
     Attributes
     ----------
@@ -104,23 +106,6 @@ class SimulationResult:
         Absolute link angles, forward positive. [rad]
     omega : numpy.ndarray, shape (T, N)
         Link angular rates. [rad/s]
-    pair_torques : numpy.ndarray, shape (T, P)
-        Muscle-pair torques M (zero while a one-sided pair is slack). [N·m]
-    joint_torques : numpy.ndarray, shape (T, N)
-        Generalised torques U = −EᵀM on the link angles. [N·m]
-    joint_moments : numpy.ndarray, shape (T, N)
-        Net muscle moment at the ankle, knee, hip, …: the sum of the torques of
-        the pairs that cross each joint. [N·m]
-    cog_position : numpy.ndarray, shape (T, 2)
-        Centre of gravity (x_c, y_c) relative to the ankle. [m]
-    cog_velocity : numpy.ndarray, shape (T, 2)
-        Its velocity relative to the ankle (ẋ_c, ẏ_c). [m/s]
-    platform_acceleration : numpy.ndarray, shape (T, 2)
-        (ẍ_d, ÿ_d). [m/s²]
-    platform_velocity : numpy.ndarray, shape (T, 2)
-        (ẋ_d, ẏ_d), including any velocity step at t = 0. [m/s]
-    platform_position : numpy.ndarray, shape (T, 2)
-        (x_d, y_d) from 0 at t = 0. [m]
     pair_names : tuple of str
         Names of the pairs, in column order of ``pair_torques``.
     status : str
@@ -138,13 +123,6 @@ class SimulationResult:
         Times at which a one-sided pair or the knee stop switched. [s]
     description : str
         The run's set-up in words (body, muscles, disturbance).
-    angular_acceleration : numpy.ndarray, shape (T, N), optional
-        Link angular accelerations. [rad/s²]
-    ground_reaction : numpy.ndarray, shape (T, 2), optional
-        Horizontal and vertical force of the platform on the foot. [N]
-    centre_of_pressure : numpy.ndarray, shape (T,), optional
-        Centre of pressure under the massless foot, x_p = τ_ankle / F_y,
-        relative to the ankle. [m]
     derived : DerivedSeries or callable returning one
         Where the derived series come from (see above).
     stimulus : StimulusTiming or None
@@ -178,28 +156,6 @@ class SimulationResult:
             raise PostureLabError(f"derived series must be a DerivedSeries, got "
                                   f"{type(series).__name__}")
         return series
-
-    pair_torques = _derived("pair_torques", "Muscle-pair torques M, shape (T, P). [N·m]")
-    joint_torques = _derived("joint_torques", "Generalised torques U = −EᵀM, (T, N). [N·m]")
-    joint_moments = _derived("joint_moments", "Net muscle moment per joint, (T, N). [N·m]")
-    cog_position = _derived("cog_position", "Centre of gravity (x_c, y_c), (T, 2). [m]")
-    cog_velocity = _derived("cog_velocity", "Its velocity (ẋ_c, ẏ_c), (T, 2). [m/s]")
-    platform_acceleration = _derived("platform_acceleration",
-                                     "Platform acceleration (ẍ_d, ÿ_d), (T, 2). [m/s²]")
-    platform_velocity = _derived("platform_velocity",
-                                 "Platform velocity (ẋ_d, ẏ_d), (T, 2). [m/s]")
-    platform_position = _derived("platform_position",
-                                 "Platform position (x_d, y_d), (T, 2). [m]")
-    angular_acceleration = _derived("angular_acceleration",
-                                    "Link angular accelerations, (T, N). [rad/s²]")
-    ground_reaction = _derived("ground_reaction",
-                               "Force of the platform on the foot (F_x, F_y), (T, 2). [N]")
-    centre_of_pressure = _derived("centre_of_pressure",
-                                  "Centre of pressure relative to the ankle, (T,). [m]")
-    com_angle = _derived("com_angle", "Centre-of-mass angle Σ a_i θ_i / Σ a_i, (T,). [rad]")
-    tilt = _derived("tilt", "Support-surface tilt α (positive toes-up), (T,), or None. [rad]")
-    visual_tilt = _derived("visual_tilt",
-                           "Visual-scene tilt v (positive toes-up), (T,), or None. [rad]")
 
     @property
     def n_links(self) -> int:
@@ -381,6 +337,12 @@ class SimulationResult:
             elif n.startswith(("M_", "U", "joint_moment")):
                 units[n] = "N·m"
         return {n: units.get(n, "") for n in names}
+
+
+# the derived series read through the result (its ``_series``), one property per row
+for _name, _shape, _meaning in DERIVED_SERIES:
+    setattr(SimulationResult, _name, _derived(_name, f"Shape {_shape}. {_meaning}"))
+del _name, _shape, _meaning
 
 
 def read_run_csv(path: str | Path) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -12,9 +12,7 @@ import math
 from dataclasses import dataclass, replace
 
 from ..errors import lookup
-from ..model.body import Body
-from ..model.controllers import Provenance, get_controller
-from ..model.muscles import MusclePair, MuscleSet
+from ..model.controllers import AnkleController, Provenance, get_controller
 from ..model.platform import RampAndHold
 
 __all__ = ["Population", "POPULATIONS", "get_population", "PlatformProtocol", "PROTOCOL",
@@ -60,20 +58,14 @@ _ICM_NUMBERS = ("intrinsic_stiffness", "intrinsic_viscosity", "active_stiffness"
 
 
 @dataclass(frozen=True)
-class Population:
-    """A group of subjects: the controller, the delay and the strength of its ankles.
+class Population(AnkleController):
+    """A group of subjects: the controller, the delay (the numbers of
+    :class:`~posturelab.model.controllers.AnkleController`, each with its provenance) and the
+    strength of its ankles.
 
     Attributes
     ----------
-    name, description : str
-    intrinsic_stiffness, active_stiffness : float
-        Ankle stiffness / mgh, intrinsic (undelayed) and active (delayed). [-]
-    intrinsic_viscosity, active_viscosity : float
-        Ankle viscosity / mgh. [s]
-    feedback_delay : float
-        τ of the active part. [s]
-    proprioceptive_weight : float
-        W (no effect without a tilt). [-]
+    description : str
     plantarflexion_strength : float
         Maximal isometric plantarflexion moment of one ankle. [N·m]
     functional_base_of_support : float
@@ -86,32 +78,18 @@ class Population:
         The centre of gravity's angle in front of the ankle in quiet standing: the tonic
         plantarflexion moment m g l sin(lean) it needs is not available to the
         response. [rad]
-    provenance : tuple of (str, Provenance)
-        Where each number above comes from.
     """
 
-    name: str
     description: str
-    intrinsic_stiffness: float
-    intrinsic_viscosity: float
-    active_stiffness: float
-    active_viscosity: float
-    feedback_delay: float
-    proprioceptive_weight: float
     plantarflexion_strength: float
     functional_base_of_support: float
     forward_share: float
     stance_lean: float
-    provenance: tuple[tuple[str, Provenance], ...] = ()
 
     @property
     def ankle_strength(self) -> float:
         """Plantarflexion strength of both ankles, :data:`LEGS` × one ankle's. [N·m]"""
         return LEGS * self.plantarflexion_strength
-
-    def provenance_of(self, field_name: str) -> Provenance:
-        """The :class:`Provenance` of one numeric field."""
-        return dict(self.provenance)[field_name]
 
     def provenance_text(self) -> str:
         """Where each number comes from, one phrase per number."""
@@ -126,14 +104,6 @@ class Population:
 
         span = self.functional_base_of_support * FOOT_LENGTH_FRACTION_OF_HEIGHT * height
         return -(1.0 - self.forward_share) * span, self.forward_share * span
-
-    def muscles(self, body: Body) -> MuscleSet:
-        """The ankle pair of a one-link ``body``, gains scaled by its mgh [N·m/rad]."""
-        mgh = body.load_stiffness
-        return MuscleSet((MusclePair(
-            "ankle", 0, 1, self.intrinsic_stiffness * mgh, self.intrinsic_viscosity * mgh,
-            active_stiffness=self.active_stiffness * mgh,
-            active_viscosity=self.active_viscosity * mgh),), 1)
 
 
 def _icm(field_name: str) -> Provenance:
@@ -238,11 +208,11 @@ class PlatformProtocol:
 
     name: str
     citation: str
-    move_duration: float = 0.5
-    settle_time: float = 3.0
-    increment: float = 0.01
-    tolerance: float = 0.001
-    largest: float = 0.6
+    move_duration: float
+    settle_time: float
+    increment: float
+    tolerance: float
+    largest: float
 
     def disturbance(self, displacement: float) -> RampAndHold:
         """The move of ``displacement`` (signed: negative is backward). [m]"""
@@ -260,6 +230,7 @@ PROTOCOL = PlatformProtocol(
     citation=(KOUSHYAR_2019 + "; the move's shape and duration (ramp-and-hold over 0.5 s) "
               "and the 1 cm ascending series are posturelab's assumptions, the paper's "
               "methods not having been available"),
+    move_duration=0.5, settle_time=3.0, increment=0.01, tolerance=0.001, largest=0.6,
 )
 
 
