@@ -69,7 +69,11 @@ SHARED: dict[str, dict] = {
 MODEL_OUTPUTS = ", thetaN or a joint angle (ankle_angle, knee_angle, hip_angle)"
 
 
-def add_flag(p, flag: str, detail: str | None = None, *, former: tuple[str, ...] = (),
+#: A parser or an argument group (each has ``add_argument``).
+Parser = argparse._ActionsContainer
+
+
+def add_flag(p: Parser, flag: str, detail: str | None = None, *, former: tuple[str, ...] = (),
              **changes) -> argparse.Action:
     """Add the shared ``flag`` (:data:`SHARED`) to the parser or group ``p``.
 
@@ -78,6 +82,8 @@ def add_flag(p, flag: str, detail: str | None = None, *, former: tuple[str, ...]
     replace keywords of the declaration (a default, ``required``, a ``dest``) but never
     its help.
     """
+    if "help" in changes:
+        raise TypeError(f"{flag}: its help is the shared one (give a detail)")
     spec = dict(SHARED[flag])
     template = spec.pop("help")
     if ("{}" in template) != (detail is not None):
@@ -89,13 +95,13 @@ def add_flag(p, flag: str, detail: str | None = None, *, former: tuple[str, ...]
     return p.add_argument(flag, *former, **{**spec, **changes, "help": text})
 
 
-def add_flags(p, *flags: str) -> None:
+def add_flags(p: Parser, *flags: str) -> None:
     """Add each shared flag of ``flags`` whose help has nothing of the subcommand's own."""
     for flag in flags:
         add_flag(p, flag)
 
 
-def add_options(p, table: dict[str, str | tuple[str, str]], **common) -> None:
+def add_options(p: Parser, table: dict[str, str | tuple[str, str]], **common) -> None:
     """Add a subcommand's own flags from ``table``, flag -> help or (metavar, help), each
     with the ``add_argument`` keywords ``common`` (``action="store_true"``,
     ``type=float``, …)."""
