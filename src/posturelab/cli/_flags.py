@@ -3,10 +3,11 @@
 A concept has one flag, one metavar and one help text in every subcommand that takes it
 (:data:`SHARED`, added by :func:`add_flag`); where a subcommand says something of its own
 about it (what ``--plot`` draws, what ``--seed`` seeds), the shared help has one ``{}`` that
-the subcommand fills. A former spelling stays accepted as an alias listed after the flag,
-and the help says so. A run of a subcommand's own flags that differ only in name, metavar
-and help is declared as a table (:func:`add_options`). Nothing here imports more than
-argparse: ``--help`` stays instant.
+the subcommand fills. A former spelling stays accepted as an alias listed after the flag;
+the flag's help names it, the option list shows the flag alone (:class:`HelpFormatter`). A
+run of a subcommand's own flags that differ only in name, metavar and help is declared as a
+table (:func:`add_options`). Nothing here imports more than argparse: ``--help`` stays
+instant.
 """
 
 from __future__ import annotations
@@ -78,7 +79,7 @@ def add_flag(p: Parser, flag: str, detail: str | None = None, *, former: tuple[s
     """Add the shared ``flag`` (:data:`SHARED`) to the parser or group ``p``.
 
     ``detail`` fills the help's ``{}`` (the subcommand's own words); ``former``, spellings
-    the flag had before, stay accepted as aliases (and the help names them); ``changes``
+    the flag had before, stay accepted as aliases (the help says "formerly …"); ``changes``
     replace keywords of the declaration (a default, ``required``, a ``dest``) but never
     its help.
     """
@@ -90,9 +91,25 @@ def add_flag(p: Parser, flag: str, detail: str | None = None, *, former: tuple[s
         raise TypeError(f"{flag}: detail {'needed' if detail is None else 'not taken'}")
     text = template.format(detail) if detail is not None else template
     if former:
-        said = "is its former name" if len(former) == 1 else "are its former names"
-        text = text.removesuffix(".") + f"; {' and '.join(former)} {said}."
-    return p.add_argument(flag, *former, **{**spec, **changes, "help": text})
+        text = text.removesuffix(".") + f" (formerly {', '.join(former)})."
+    action = p.add_argument(flag, *former, **{**spec, **changes, "help": text})
+    action.former = former  # (listed by HelpFormatter under the flag's help only)
+    return action
+
+
+class HelpFormatter(argparse.RawDescriptionHelpFormatter):
+    """The subcommands' help: the description as written, and each flag under its one
+    name (a former spelling, still accepted, is named in the flag's help only)."""
+
+    def _format_action_invocation(self, action: argparse.Action) -> str:
+        former = getattr(action, "former", ())
+        if not former:
+            return super()._format_action_invocation(action)
+        import copy
+
+        shown = copy.copy(action)
+        shown.option_strings = [s for s in action.option_strings if s not in former]
+        return super()._format_action_invocation(shown)
 
 
 def add_flags(p: Parser, *flags: str) -> None:
