@@ -132,9 +132,10 @@ def build_parser(command: str | None = None, *, summary: bool = False) -> OneLin
             if exc.name == f"{__name__}.{module_name}":
                 continue
             raise
+        from ._flags import HelpFormatter
+
         p = sub.add_parser(name, help=SUBCOMMAND_HELP[name], description=module.DESCRIPTION,
-                           epilog=CONVENTIONS_EPILOG,
-                           formatter_class=argparse.RawDescriptionHelpFormatter)
+                           epilog=CONVENTIONS_EPILOG, formatter_class=HelpFormatter)
         module.add_arguments(p)
         p.set_defaults(_run=module.run)
     return parser

@@ -11,6 +11,7 @@ import sys
 from ..errors import ParameterError
 from ..model.muscles import PAPER_PAIR_NAMES, STIFFNESS_CASES
 from ..parameters import MAX_FEEDBACK_DELAY
+from ._flags import add_flag, add_options
 
 GASTROCNEMIUS_HELP = (
     "two-sided (default): the paper's artificial antagonist added, the gastrocnemius pair "
@@ -69,48 +70,45 @@ def add_muscle_arguments(p: argparse.ArgumentParser, *, require: bool = False,
                    "or --height/--mass (three links). Which of the one-link presets' numbers "
                    "come from the source: "
                    + " ".join(f"{c.name}: {c.provenance_text()}" for c in CONTROLLERS.values()))
-    fb.add_argument("--viscosity", metavar="LIST",
-                    help="pair viscosities [N·m·s/rad], one per pair (instead of a ratio).")
-    if not own_case:
-        fb.add_argument("--viscosity-ratio", type=float, default=None, metavar="R",
-                        help="pair viscosity = R × pair stiffness [s] (default 0.25, the "
-                        "paper's).")
+    add_options(fb, {
+        "--viscosity": "pair viscosities [N·m·s/rad], one per pair (instead of a ratio).",
+        "--active-stiffness": "active (neural) pair stiffnesses [N·m/rad], delayed by "
+                              "--feedback-delay; one per pair.",
+        "--active-viscosity": "active pair viscosities [N·m·s/rad], one per pair.",
+    }, metavar="LIST")
     fb.add_argument("--gastrocnemius", choices=GASTROCNEMIUS_CHOICES, default="two-sided",
                     help=GASTROCNEMIUS_HELP)
-    fb.add_argument("--active-stiffness", metavar="LIST",
-                    help="active (neural) pair stiffnesses [N·m/rad], delayed by "
-                    "--feedback-delay; one per pair.")
-    fb.add_argument("--active-viscosity", metavar="LIST",
-                    help="active pair viscosities [N·m·s/rad], one per pair.")
-    fb.add_argument("--active-viscosity-ratio", type=float, default=None, metavar="R",
-                    help="active viscosity = R × active stiffness [s] (default 0).")
-    fb.add_argument("--feedback-delay", type=float, default=None, metavar="SECONDS",
-                    help=f"neural delay τ [s], in [0, {MAX_FEEDBACK_DELAY:g}]. With active gains "
-                    "it delays their part only (the intrinsic gains act at once); without any, it "
-                    "delays every pair's whole feedback (the paper's gains read as neural).")
-    fb.add_argument("--proprioceptive-weight", type=float, default=None, metavar="W",
-                    help="W in [0, 1]: the active error of pairs that span the foot is "
-                    "θ + W·α under a tilt α (1, the default: relative to the foot; 0: to the "
-                    "vertical).")
-    fb.add_argument("--visual-weight", type=float, default=None, metavar="W_V",
-                    help="W_v in [0, 1], with W + W_v <= 1 (the rest graviceptive; Peterka "
-                    "2002's independent channels): the active error gains W_v·v under a "
-                    "visual-scene tilt v (--visual-tilt; default 0).")
+    numbers = {  # (None when not given: a scenario's or a preset's value then stands)
+        "--viscosity-ratio": ("R", "pair viscosity = R × pair stiffness [s] (default 0.25, "
+                              "the paper's)."),
+        "--active-viscosity-ratio": ("R", "active viscosity = R × active stiffness [s] "
+                                     "(default 0)."),
+        "--feedback-delay": ("SECONDS", f"neural delay τ [s], in [0, {MAX_FEEDBACK_DELAY:g}]. "
+                             "With active gains it delays their part only (the intrinsic "
+                             "gains act at once); without any, it delays every pair's whole "
+                             "feedback (the paper's gains read as neural)."),
+        "--proprioceptive-weight": ("W", "W in [0, 1]: the active error of pairs that span "
+                                    "the foot is θ + W·α under a tilt α (1, the default: "
+                                    "relative to the foot; 0: to the vertical)."),
+        "--visual-weight": ("W_V", "W_v in [0, 1], with W + W_v <= 1 (the rest graviceptive; "
+                            "Peterka 2002's independent channels): the active error gains "
+                            "W_v·v under a visual-scene tilt v (--visual-tilt; default 0)."),
+    }
+    if own_case:  # (the command defines --viscosity-ratio itself)
+        del numbers["--viscosity-ratio"]
+    add_options(fb, numbers, type=float, default=None)
 
 
 def add_trial_arguments(p: argparse.ArgumentParser, *,
                         input_help: str = "what a trial's stimulus is: tilt [rad] (default) "
                         "or translation [m].") -> None:
-    """How a trial CSV among the inputs is estimated (``fit-frf``, ``cohort``, ``likeness``
-    and this command share them)."""
-    p.add_argument("--stimulus", metavar="COLUMN", help="stimulus column of a trial CSV.")
-    p.add_argument("--response", metavar="COLUMN", help="response column of a trial CSV.")
-    p.add_argument("--cycle-length", type=float, metavar="SECONDS", help="of a trial CSV [s].")
-    p.add_argument("--discard-cycles", type=int, default=0, metavar="N",
-                   help="leading cycles of a trial CSV to drop (the transient; default 0).")
-    p.add_argument("--response-sign", choices=["-1", "+1", "1"], default="-1",
-                   help="multiply a trial's response by this (default -1: posturelab's tilt "
-                   "convention, as posturelab frf).")
+    """How a trial CSV among the inputs is estimated (``fit-frf``, ``cohort``, ``likeness``,
+    ``likeness-reference`` and ``compare-frf``; ``frf`` takes the same shared flags)."""
+    add_flag(p, "--stimulus", " CSV (or two of a dual-stimulus trial)")
+    add_flag(p, "--response")
+    add_flag(p, "--cycle-length", " of a trial CSV")
+    add_flag(p, "--discard-cycles", "0")
+    add_flag(p, "--response-sign", ", as posturelab frf")
     p.add_argument("--input", choices=["tilt", "translation"], default="tilt",
                    help=input_help)
 
@@ -316,23 +314,15 @@ def tilt_table(text: str) -> dict:
     return table
 
 
-def parse_tilt(text: str):
-    """The Tilt of ``--tilt`` (:func:`tilt_table`), built by the scenario parser."""
+def parse_tilt(text: str, table: str = "tilt"):
+    """The Tilt of ``--tilt`` (:func:`tilt_table`), or with ``table="visual_tilt"`` of
+    ``--visual-tilt`` (the same specs), built by the scenario parser as a file's [tilt] or
+    [visual_tilt] table."""
     from pathlib import Path
 
     from ..scenarios._parse import tilt_from_table
 
-    return tilt_from_table(tilt_table(text), Path("."), "", FLAG_NAMES)
-
-
-def parse_visual_tilt(text: str):
-    """The Tilt of ``--visual-tilt`` (the specs of ``--tilt``), built by the scenario
-    parser as a file's [visual_tilt] table."""
-    from pathlib import Path
-
-    from ..scenarios._parse import tilt_from_table
-
-    return tilt_from_table(tilt_table(text), Path("."), "", FLAG_NAMES, "visual_tilt")
+    return tilt_from_table(tilt_table(text), Path("."), "", FLAG_NAMES, table)
 
 
 @contextlib.contextmanager

@@ -11,6 +11,7 @@ from ._common import (
     model_from_args,
     print_json,
 )
+from ._flags import add_flag, add_flags
 from .fit_frf import _bounds, _names, add_fit_arguments, reader_options
 
 DESCRIPTION = """\
@@ -50,14 +51,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="the table: one row per subject and parameter (.csv or .parquet).")
     p.add_argument("--summary", metavar="SUMMARY.json",
                    help="write the summary (median, quartiles per parameter) as JSON.")
-    p.add_argument("--plot", metavar="FIG.png",
-                   help="draw each parameter's distribution over the subjects (PNG/SVG/PDF).")
+    add_flag(p, "--plot", "each parameter's distribution over the subjects")
     p.add_argument("--workers", type=int, default=None, metavar="N",
                    help="worker processes (default: one per CPU; at most four per CPU).")
-    p.add_argument("--progress", action="store_true",
-                   help="draw a progress bar on standard error even when it is not a "
-                   "terminal.")
-    p.add_argument("--json", action="store_true", help="print one JSON object.")
+    add_flags(p, "--progress", "--json")
     add_muscle_arguments(p)
 
 

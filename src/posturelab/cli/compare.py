@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 
 from ._common import FIGURE_SUFFIXES, check_writable, print_json
+from ._flags import add_flag, add_flags
 
 DESCRIPTION = """\
 Read runs written by posturelab simulate --out (columns t, theta1..N, omega1..N), print for
@@ -56,9 +57,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     """The options of ``posturelab compare``."""
     p.add_argument("runs", nargs="+", metavar="RUN.csv", help="runs saved by simulate --out.")
     p.add_argument("--labels", metavar="A,B,...", help="one label per run.")
-    p.add_argument("--plot", metavar="FILE.png", help="write the overlay (PNG/SVG/PDF).")
+    add_flag(p, "--plot", "the overlay")
     p.add_argument("--rates", action="store_true", help="plot the rates, not the angles.")
-    p.add_argument("--json", action="store_true", help="print one JSON object.")
+    add_flags(p, "--json")
 
 
 def run(args: argparse.Namespace) -> int:

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 
 from ._common import add_trial_arguments  # (likeness and likeness-reference import it here)
+from ._flags import add_flag, add_flags
 
 DESCRIPTION = """\
 Compare two groups of FRFs (patients and controls, eyes open and closed, two amplitudes):
@@ -41,8 +42,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="group A: trial CSVs or FRF JSON files, one per subject.")
     p.add_argument("--b", required=True, nargs="+", metavar="FILE",
                    help="group B, as --a.")
-    p.add_argument("--seed", type=int, default=0, metavar="N",
-                   help="seed of the permutations and the bootstrap (default 0).")
+    add_flag(p, "--seed", "the permutations and the bootstrap")
     p.add_argument("--permutations", type=int, default=10_000, metavar="N",
                    help="permutations of the global test, 1 … 1,000,000 (default 10,000; "
                    "frequency.statistics.MAX_PERMUTATIONS).")
@@ -53,7 +53,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="coverage of the per-band intervals (default 0.95).")
     add_trial_arguments(p)
     add_recording_flags(p)
-    p.add_argument("--json", action="store_true", help="print one JSON object.")
+    add_flags(p, "--json")
 
 
 def add_recording_flags(p: argparse.ArgumentParser) -> None:

@@ -12,6 +12,7 @@ from ._common import (
     model_from_args,
     print_json,
 )
+from ._flags import add_flags
 
 DESCRIPTION = """\
 The delay margin of the chain linearised about upright: the smallest feedback delay τ at
@@ -54,7 +55,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     """The options of ``posturelab delay-margin``."""
     add_muscle_arguments(p)
     add_torque_feedback_arguments(p)
-    p.add_argument("--json", action="store_true", help="print one JSON object instead of text.")
+    add_flags(p, "--json")
 
 
 def run(args: argparse.Namespace) -> int:

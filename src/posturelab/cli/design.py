@@ -11,6 +11,7 @@ from ._common import (
     parse_float_list,
     print_json,
 )
+from ._flags import MODEL_OUTPUTS, add_flag, add_flags, add_options
 
 DESCRIPTION = """\
 Predict, before the experiment, the standard error of each --free parameter that a fit of
@@ -45,49 +46,37 @@ Example: posturelab design --controller peterka-2002 --tilt prts:0.035 --cycles 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     """The options of ``posturelab design``."""
     add_muscle_arguments(p)
-    p.add_argument("--tilt", default=None, metavar="SPEC",
-                   help="prts:AMPLITUDE_RAD[:STATE_DURATION_S][:SEQUENCE] (default "
-                   "prts:0.035: posturelab-80, 0.25 s states, 20 s cycle).")
-    p.add_argument("--visual-tilt", default=None, metavar="SPEC",
-                   help="the PRTS moves the visual scene instead of the surface (as --tilt; "
-                   "its FRF carries --visual-weight, which --free may name).")
-    p.add_argument("--cycles", type=int, default=5, metavar="N",
-                   help="cycles analysed (default 5).")
-    p.add_argument("--discard-cycles", dest="discard", type=int, default=1, metavar="N",
-                   help="cycles run before them, dropped (default 1; they count in the "
-                   "duration).")
-    p.add_argument("--discard", dest="discard", type=int, default=argparse.SUPPRESS,
-                   help=argparse.SUPPRESS)  # the former name, kept as an alias
+    add_flag(p, "--tilt", "prts:AMPLITUDE_RAD[:STATE_DURATION_S][:SEQUENCE] (default "
+             "prts:0.035: posturelab-80, 0.25 s states, 20 s cycle).")
+    add_flag(p, "--visual-tilt", "; the PRTS then moves the visual scene instead of the "
+             "surface (--free may name visual_weight)")
+    add_flag(p, "--cycles", default=5)
+    add_flag(p, "--discard-cycles", "1; run before the analysed ones, they count in the "
+             "duration", former=("--discard",), dest="discard", default=1)
     p.add_argument("--free", required=True, metavar="NAMES",
                    help="the parameters the fit estimates, comma separated (names as "
                    "fit-frf --free: stiffness:PAIR, viscosity:PAIR, active_stiffness:PAIR, "
                    "active_viscosity:PAIR, feedback_delay, proprioceptive_weight).")
-    p.add_argument("--sensor-noise", type=float, default=0.0, metavar="RAD",
-                   help="standard deviation of white noise on the recorded angle [rad].")
-    p.add_argument("--motor-noise", metavar="SIGMA[,SIGMA...]",
-                   help="standard deviation of a random torque per joint [N·m], ankle first.")
-    p.add_argument("--motor-noise-cutoff", type=float, default=None, metavar="HZ",
-                   help="low-pass the motor noise at HZ (first order; default: white at "
-                   "100 Hz samples).")
-    p.add_argument("--sample-rate", type=float, default=100.0, metavar="HZ",
-                   help="record rate [Hz] (default 100).")
-    p.add_argument("--output", default="com_angle", metavar="NAME",
-                   help="the angle recorded (default com_angle).")
-    p.add_argument("--optimise", action="store_true",
-                   help="search state duration, amplitude and cycles within --budget.")
-    p.add_argument("--budget", type=float, default=None, metavar="SECONDS",
-                   help="total recording time for --optimise [s].")
-    p.add_argument("--targets", default=None, metavar="NAMES",
-                   help="the parameters whose errors --optimise minimises (default: all "
-                   "--free).")
-    p.add_argument("--amplitudes", default=None, metavar="LO:HI",
-                   help="peak-to-peak amplitudes --optimise searches [rad] (default "
-                   "0.005:0.07).")
-    p.add_argument("--state-durations", default=None, metavar="LO:HI",
-                   help="state durations --optimise searches [s] (default 0.1:0.5).")
-    p.add_argument("--grid", type=int, default=9, metavar="N",
-                   help="values per range for --optimise (2 … 41, default 9).")
-    p.add_argument("--json", action="store_true", help="print one JSON object.")
+    add_flag(p, "--sensor-noise", default=0.0)
+    add_flags(p, "--motor-noise", "--motor-noise-cutoff")
+    add_flag(p, "--sample-rate", "100", default=100.0)
+    add_flag(p, "--output", MODEL_OUTPUTS)
+    search = p.add_argument_group("searching the design (--optimise)")
+    search.add_argument("--optimise", action="store_true",
+                        help="search state duration, amplitude and cycles within --budget.")
+    search.add_argument("--budget", type=float, default=None, metavar="SECONDS",
+                        help="total recording time for --optimise [s].")
+    add_options(search, {
+        "--targets": ("NAMES", "the parameters whose errors --optimise minimises (default: "
+                      "all --free)."),
+        "--amplitudes": ("LO:HI", "peak-to-peak amplitudes --optimise searches [rad] "
+                         "(default 0.005:0.07)."),
+        "--state-durations": ("LO:HI", "state durations --optimise searches [s] (default "
+                              "0.1:0.5)."),
+    }, default=None)
+    search.add_argument("--grid", type=int, default=9, metavar="N",
+                        help="values per range for --optimise (2 … 41, default 9).")
+    add_flags(p, "--json")
     p.set_defaults(seed=None)
 
 

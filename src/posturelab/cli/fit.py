@@ -9,6 +9,7 @@ from ..parameters import unit as parameter_unit
 from ..studies.identification import ENGINES, FIT_QUANTITIES, RESIDUAL_MODELS
 from . import UsageError
 from ._common import check_writable, print_json
+from ._flags import add_flag, add_flags
 from .simulate import add_experiment_arguments, experiment_inputs, scenario_from_args
 
 DESCRIPTION = """\
@@ -42,16 +43,14 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    "weights at a time), torque_feedback_gain, torque_feedback_time_constant "
                    "(the torque feedback with --engine reference; its starting values from the "
                    "scenario's [muscles]).")
-    g.add_argument("--engine", choices=ENGINES, default="compiled",
-                   help="engine inside the fit: compiled (default) or reference (scipy); "
-                   "either at the scenario's tolerances and solver.method; fast is a "
-                   "former name of compiled.")
+    add_flag(g, "--engine", ", run inside the fit at the scenario's tolerances and "
+             "solver.method (fast: a former name of compiled)", choices=ENGINES)
     g.add_argument("--residual-model", choices=RESIDUAL_MODELS, default="ar1",
                    help="residuals of the standard errors: ar1 (default: correlated from "
                    "sample to sample, estimated per link) or independent (the textbook "
                    "s²(JᵀJ)⁻¹, too narrow when the residuals are correlated).")
     g.add_argument("--report", metavar="FIT.json", help="also write the JSON summary to a file.")
-    g.add_argument("--json", action="store_true", help="print one JSON object instead of text.")
+    add_flags(g, "--json")
     from ._recording import add_recording_arguments
 
     add_recording_arguments(p, sway=False)

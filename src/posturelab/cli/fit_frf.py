@@ -13,6 +13,7 @@ from ._common import (
     model_from_args,
     print_json,
 )
+from ._flags import MODEL_OUTPUTS, add_flag, add_flags, add_options
 
 DESCRIPTION = f"""\
 Fit the linearised model's FRF to one or several measured FRFs. Each --data is a condition:
@@ -87,30 +88,28 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--data", required=True, action="append", metavar="FILE",
                    help="a condition: trial.csv or frf.json (repeat for several).")
     add_fit_arguments(p, per_condition=True)
-    p.add_argument("--json", action="store_true", help="print one JSON object.")
-    p.add_argument("--plot", metavar="BODE.png",
-                   help="write a Bode plot of every condition with its fitted model (PNG/SVG/"
-                   "PDF).")
-    p.add_argument("--compare", metavar="NAME",
-                   help="fit NAME per condition and shared, and test the difference (a "
-                   "likelihood-ratio test: \"reweighting\" in --json, with its p_value); "
-                   "e.g. proprioceptive_weight.")
-    p.add_argument("--amplitudes", metavar="A1,A2,...",
-                   help="with --compare: each condition's stimulus amplitude, peak to peak "
-                   "[rad for a tilt, m for a translation] (default: a trial's measured, a "
-                   "table's unknown).")
-    p.add_argument("--vision", metavar="open|closed,...",
-                   help="with --compare: each condition's vision, open or closed (or - for "
-                   "not given).")
-    p.add_argument("--compare-by", choices=["condition", "vision"], default=None,
-                   help="with --compare: one value of NAME per condition (default) or per "
-                   "vision label (eyes open against closed; needs --vision).")
-    p.add_argument("--compare-out", metavar="TABLE.json|.csv",
-                   help="with --compare: write the per-condition table (and the test, in "
-                   "JSON).")
-    p.add_argument("--compare-plot", metavar="FIG.png",
-                   help="with --compare: draw NAME against the stimulus amplitude with its "
-                   "intervals (PNG/SVG/PDF).")
+    add_flags(p, "--json")
+    add_flag(p, "--plot", "a Bode plot of every condition with its fitted model",
+             metavar="BODE.png")
+    compare = p.add_argument_group("comparing the conditions (--compare)")
+    compare.add_argument("--compare", metavar="NAME",
+                         help="fit NAME per condition and shared, and test the difference (a "
+                         "likelihood-ratio test: \"reweighting\" in --json, with its "
+                         "p_value); e.g. proprioceptive_weight.")
+    add_options(compare, {  # (each with --compare only)
+        "--amplitudes": ("A1,A2,...", "with --compare: each condition's stimulus amplitude, "
+                         "peak to peak [rad for a tilt, m for a translation] (default: a "
+                         "trial's measured, a table's unknown)."),
+        "--vision": ("open|closed,...", "with --compare: each condition's vision, open or "
+                     "closed (or - for not given)."),
+        "--compare-out": ("TABLE.json|.csv", "with --compare: write the per-condition table "
+                          "(and the test, in JSON)."),
+        "--compare-plot": ("FIG.png", "with --compare: draw NAME against the stimulus "
+                           "amplitude with its intervals (PNG, SVG or PDF, by the suffix)."),
+    })
+    compare.add_argument("--compare-by", choices=["condition", "vision"], default=None,
+                         help="with --compare: one value of NAME per condition (default) or "
+                         "per vision label (eyes open against closed; needs --vision).")
     add_muscle_arguments(p)
     add_torque_feedback_arguments(p)
 
@@ -119,8 +118,7 @@ def add_fit_arguments(p: argparse.ArgumentParser, *, per_condition: bool) -> Non
     """How a trial CSV is read and what is fitted (``fit-frf`` and ``cohort`` share them)."""
     add_trial_arguments(p, input_help="what the stimulus is: tilt [rad] (default) or "
                         "platform translation [m].")
-    p.add_argument("--output", default="com_angle", metavar="NAME",
-                   help="the model output the response is (default com_angle).")
+    add_flag(p, "--output", MODEL_OUTPUTS)
     p.add_argument("--free", required=True, metavar="NAMES",
                    help="parameters shared by the conditions, comma separated, from "
                    "stiffness:PAIR, viscosity:PAIR, active_stiffness:PAIR, "

@@ -7,6 +7,7 @@ import math
 
 from ..errors import ParameterError
 from ._common import FIGURE_SUFFIXES, check_writable, print_json
+from ._flags import add_flag, add_flags
 from ._recording import (
     add_cycle_trim_argument,
     add_recording_arguments,
@@ -88,35 +89,28 @@ Example: posturelab simulate --controller peterka-2002 --tilt prts:0.035 --durat
 def add_arguments(p: argparse.ArgumentParser) -> None:
     """The options of ``posturelab frf``."""
     p.add_argument("--data", required=True, metavar="FILE.csv|FILE.c3d", help="the trial.")
-    p.add_argument("--stimulus", metavar="COLUMN[,COLUMN]",
-                   help="stimulus column, or two of a dual-stimulus trial (default: the "
-                   "trial's tilt and visual_tilt columns).")
-    p.add_argument("--response", metavar="COLUMN",
-                   help="response column (default com_angle).")
-    p.add_argument("--cycle-length", required=True, type=float, metavar="SECONDS",
-                   help="stimulus cycle [s] (20 for the 80-state PRTS).")
-    p.add_argument("--discard-cycles", type=int, default=0, metavar="N",
-                   help="leading cycles to drop (the transient; default 0).")
+    add_flag(p, "--stimulus", ", or two of a dual-stimulus trial (default: the trial's tilt "
+             "and visual_tilt columns)", metavar="COLUMN[,COLUMN]")
+    add_flag(p, "--response")
+    add_flag(p, "--cycle-length", " (20 for the 80-state PRTS)", required=True)
+    add_flag(p, "--discard-cycles", "0")
     p.add_argument("--bands", choices=BAND_CHOICES + ["harmonics"], default="peterka",
                    help="frequency bands (default peterka, the historical name of the 11 "
                    "bands of the 80-state protocol (COMTEST), the same as posturelab-80 and "
                    "comtest-80; peterka-2002-242: 17 bands for Peterka 2002's 242-state "
                    "sequence, posturelab's placement; harmonics: every odd harmonic).")
-    p.add_argument("--response-sign", choices=["-1", "+1", "1"], default="-1",
-                   help="multiply the response by this (default -1: posturelab's tilt "
-                   "convention; see above).")
+    add_flag(p, "--response-sign", "; see above")
     p.add_argument("--ci", choices=["periodic", "otnes-enochson"], default="periodic",
                    help="form of the 95 %% bounds (default periodic).")
     p.add_argument("--bootstrap", type=int, default=None, metavar="N",
                    help="also bootstrap 95 %% bands over the cycles, N resamples "
                    "(1 … 100,000; see above).")
-    p.add_argument("--seed", type=int, default=0, metavar="SEED",
-                   help="of the bootstrap's resampling (default 0).")
-    p.add_argument("--json", action="store_true", help="print one JSON object.")
-    p.add_argument("--plot", metavar="BODE.png", help="write a Bode plot (PNG/SVG/PDF).")
+    add_flag(p, "--seed", "the bootstrap's resampling")
+    add_flags(p, "--json")
+    add_flag(p, "--plot", "a Bode plot", metavar="BODE.png")
     p.add_argument("--plot-cycles", metavar="CYCLES.png",
                    help="write the stimulus over one cycle and the cycle-averaged response "
-                   "(PNG/SVG/PDF).")
+                   "(PNG, SVG or PDF, by the suffix).")
     add_recording_arguments(p)
     add_cycle_trim_argument(p)
 

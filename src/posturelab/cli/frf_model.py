@@ -13,6 +13,7 @@ from ._common import (
     parse_float_list,
     print_json,
 )
+from ._flags import MODEL_OUTPUTS, add_flag, add_flags
 from .frf import BAND_CHOICES
 
 DESCRIPTION = """\
@@ -50,18 +51,15 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--input", choices=["tilt", "translation", "visual-tilt"], default="tilt",
                    help="tilt [rad] (default), platform translation [m] or visual-tilt "
                    "[rad].")
-    p.add_argument("--output", default="com_angle", metavar="NAME",
-                   help="com_angle (default), thetaN or a joint angle (ankle_angle, …).")
+    add_flag(p, "--output", MODEL_OUTPUTS)
     g = p.add_mutually_exclusive_group()
     g.add_argument("--frequencies", metavar="LIST", help="frequencies [Hz], > 0.")
     g.add_argument("--bands", choices=BAND_CHOICES,
                    help="the band frequencies of the 80-state protocol (COMTEST; peterka, "
                    "its historical name, posturelab-80 and comtest-80: the same 11 bands) or "
                    "of Peterka 2002's 242-state sequence (17 bands).")
-    p.add_argument("--cycle-length", type=float, default=None, metavar="SECONDS",
-                   help="stimulus cycle for --bands [s] (default 20; 60.5 for "
-                   "peterka-2002-242).")
-    p.add_argument("--json", action="store_true", help="print one JSON object.")
+    add_flag(p, "--cycle-length", " of --bands (default 20; 60.5 for peterka-2002-242)")
+    add_flags(p, "--json")
 
 
 def run(args: argparse.Namespace) -> int:

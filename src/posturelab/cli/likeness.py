@@ -40,6 +40,7 @@ Example: posturelab frf --data trial.csv --stimulus tilt --response com_angle \\
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     """The options of ``posturelab likeness``."""
+    from ._flags import add_flags
     from .compare_frf import add_recording_flags, add_trial_arguments
 
     p.add_argument("--data", required=True, metavar="FILE",
@@ -53,7 +54,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    "default 1).")
     add_trial_arguments(p)
     add_recording_flags(p)
-    p.add_argument("--json", action="store_true", help="print one JSON object.")
+    add_flags(p, "--json")
 
 
 def run(args: argparse.Namespace) -> int:

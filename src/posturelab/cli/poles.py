@@ -10,6 +10,7 @@ from ._common import (
     model_from_args,
     print_json,
 )
+from ._flags import add_flags
 
 DESCRIPTION = """\
 Poles [1/s] of the paper's three-link biped (Appendix A; or any --body, --height/--mass)
@@ -42,7 +43,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     add_muscle_arguments(p)
     p.add_argument("--all", action="store_true",
                    help="Table II: every case as printed beside what we compute, errata flagged.")
-    p.add_argument("--json", action="store_true", help="print one JSON object instead of text.")
+    add_flags(p, "--json")
 
 
 def _ratio(args: argparse.Namespace) -> float:

@@ -7,6 +7,7 @@ import math
 
 from ..errors import ParameterError
 from ._common import parse_float_list, print_json
+from ._flags import add_flags
 
 DESCRIPTION = """\
 J(Θ)⁻¹H(Θ) [rad/m] for the paper's three-link body: the change of each link's rate
@@ -24,7 +25,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--posture", metavar="T1,T2,T3", default="0,0,0",
                    help="link angles θ1,θ2,θ3 [rad] from the vertical, forward positive, each "
                    "within ±π/2 (default 0,0,0).")
-    p.add_argument("--json", action="store_true", help="print one JSON object instead of text.")
+    add_flags(p, "--json")
 
 
 def run(args: argparse.Namespace) -> int:

@@ -30,9 +30,9 @@ from ._common import (
     naming_given_options,
     naming_option,
     parse_tilt,
-    parse_visual_tilt,
     print_json,
 )
+from ._flags import add_flag, add_flags
 
 DESCRIPTION = """\
 Simulate the paper's three-link biped (or a scenario file) under muscle-pair feedback
@@ -78,7 +78,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     out.add_argument("--out", metavar="RUN.csv|RUN.parquet",
                      help="write the time series as CSV, or Parquet (units in each field's "
                      "metadata).")
-    out.add_argument("--plot", metavar="RUN.png", help="write a 2×2 summary figure (PNG/SVG/PDF).")
+    add_flag(out, "--plot", "a 2×2 summary figure", metavar="RUN.png")
     out.add_argument("--animate", metavar="RUN.gif", help="write a stick-figure animation (GIF).")
     out.add_argument("--json", action="store_true",
                      help='print one JSON summary: {"outcome" (recovered, not recovered, '
@@ -94,12 +94,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                      'switch, "stable", "rightmost_root" [1/s], "feedback_delay" [s], '
                      '"sides", ...})}; hip_fraction [-] is the share of the anti-phase (hip) '
                      'mode of leg and trunk, null for one link.')
-    p.add_argument("--engine", choices=["compiled", "reference"], default="compiled",
-                   help="compiled (default): the C engine, hundreds of times faster (Radau, "
-                   "or RK45 with a feedback delay); reference: the numpy model integrated by "
-                   "scipy (DOP853), the independent check. Either runs at the tolerances of "
-                   "--rtol/--atol (default: the scenario's, 1e-8 and 1e-10) and with the "
-                   "scenario's solver.method if it names one.")
+    add_flag(p, "--engine", ". Either runs at the tolerances of --rtol/--atol (default: "
+             "the scenario's, 1e-8 and 1e-10) and with the scenario's solver.method if it "
+             "names one")
 
 
 def add_experiment_arguments(p: argparse.ArgumentParser) -> None:
@@ -139,44 +136,32 @@ def add_experiment_arguments(p: argparse.ArgumentParser) -> None:
     src.add_argument("--centre-of-pressure", action="store_true",
                      help="with --foot, also fall when the centre of pressure leaves the foot "
                      "(the foot tips), not only the centre of gravity.")
-    src.add_argument("--tilt", metavar="SPEC",
-                     help="support-surface tilt α, positive toes-up, about the ankle: "
-                     "sine:AMPLITUDE_RAD:FREQUENCY_HZ[:PHASE_RAD], "
-                     "raised-cosine:AMPLITUDE_RAD:DURATION_S[:START_S] (a smooth ramp, then "
-                     "held), prts:AMPLITUDE_RAD[:STATE_DURATION_S][:SEQUENCE] (peak to peak; "
-                     "SEQUENCE posturelab-80 (default: posturelab's own 80-state, 20 s "
-                     "sequence), comtest-80 (the Eurobench COMTEST protocol's 80-state one) "
-                     "or peterka-2002-242 (Peterka 2002's 242-state, 60.5 s one)). A tilt "
-                     "column [rad] in --platform-profile does the same from data.")
-    src.add_argument("--visual-tilt", metavar="SPEC",
-                     help="visual-scene tilt v about the ankle axis, positive toes-up like the "
-                     "surface (the specs of --tilt; e.g. prts:0.035::comtest-80): it acts "
-                     "only through the active feedback, weighted by --visual-weight. With "
-                     "--tilt too, a dual-stimulus trial (CSV columns tilt and visual_tilt).")
+    add_flag(src, "--tilt",
+             "sine:AMPLITUDE_RAD:FREQUENCY_HZ[:PHASE_RAD], "
+             "raised-cosine:AMPLITUDE_RAD:DURATION_S[:START_S] (a smooth ramp, then "
+             "held), prts:AMPLITUDE_RAD[:STATE_DURATION_S][:SEQUENCE] (peak to peak; "
+             "SEQUENCE posturelab-80 (default: posturelab's own 80-state, 20 s "
+             "sequence), comtest-80 (the Eurobench COMTEST protocol's 80-state one) "
+             "or peterka-2002-242 (Peterka 2002's 242-state, 60.5 s one)). A tilt "
+             "column [rad] in --platform-profile does the same from data.")
+    add_flag(src, "--visual-tilt", ". With --tilt too, a dual-stimulus trial (CSV columns "
+             "tilt and visual_tilt)")
     src.add_argument("--tilt-axis-depth", type=float, default=None, metavar="M",
                      help="the tilt axis this far below the ankle [m], in "
                      f"{RUN_SETTINGS['tilt_axis_depth'].interval()} (default 0: "
                      "about the ankle; then the ankle moves with the surface). Needs a tilt "
                      "without rate jumps (not prts).")
-    src.add_argument("--motor-noise", metavar="SIGMA[,SIGMA...]",
-                     help="motor noise: a seeded random torque added to each joint's net "
-                     "moment, standard deviation per joint [N·m], ankle first (one value: "
-                     "the ankle only).")
-    src.add_argument("--motor-noise-cutoff", type=float, default=None, metavar="HZ",
-                     help="low-pass the motor noise at HZ (first order; default: white at "
-                     "100 Hz samples).")
-    src.add_argument("--seed", type=int, default=None, metavar="N",
-                     help="seed of the motor noise (default 0); with sweep --experiment prts, "
-                     "of the measurement noise too.")
+    add_flags(src, "--motor-noise", "--motor-noise-cutoff")
+    add_flag(src, "--seed", "the motor noise (and with sweep --experiment prts, of the "
+             "measurement noise)", default=None)
     src.add_argument("--torque-limits", metavar="ANKLE,KNEE,HIP",
                      help="largest net muscle moment at each joint [N·m], each > 0 ('inf' for "
                      "none); or LO:HI, the moment kept in [LO, HI], LO < 0 < HI (at the ankle "
                      "HI is plantarflexion, pressing toward the toes, LO dorsiflexion, toward "
                      "the heel); or 'foot' for the ankle: LO = m g x_heel, HI = m g x_toe "
                      "from the body's weight and --foot.")
-    src.add_argument("--ankle-limit-from-foot", action="store_true",
-                     help="limit the ankle to what the foot can carry, m g x_heel : m g x_toe "
-                     "(the same as 'foot' as the first --torque-limits entry; needs --foot).")
+    add_flag(src, "--ankle-limit-from-foot", "of --foot, which it needs (the same as 'foot' "
+             "as the first --torque-limits entry)")
     src.add_argument("--max-link-angle", type=float, default=None, metavar="RAD",
                      help="fall when any |θ_i| exceeds this [rad] (default π/3).")
     run = p.add_argument_group("integration")
@@ -188,9 +173,7 @@ def add_experiment_arguments(p: argparse.ArgumentParser) -> None:
     run.add_argument("--atol", type=float, default=None,
                      help="absolute tolerance [rad, rad/s] (default: the scenario's, 1e-10 "
                      "unless it says otherwise; sweep: 1e-9).")
-    run.add_argument("--sample-rate", type=float, default=None,
-                     help="output samples per second [Hz] (default "
-                     f"{SCENARIO_DEFAULTS.sample_rate:g}).")
+    add_flag(run, "--sample-rate", f"{SCENARIO_DEFAULTS.sample_rate:g}")
     run.add_argument("--max-steps", type=int, default=None, metavar="N",
                      help="step budget of each run: after N accepted integrator steps it "
                      "stops as failed (default 1e6 + 1e4 per simulated second).")
@@ -248,22 +231,9 @@ def run_options_from_args(args: argparse.Namespace, sc: Scenario,
                                   "torque_feedback_gain", "torque_feedback_time_constant")
                 if getattr(args, attribute, None) is not None}
     description = base.description
-    tilt = base.tilt
-    if args.tilt is not None:
-        if tilt is not None:
-            raise UsageError(f"{command}: the experiment already has a tilt; give --tilt or "
-                             "a tilt column, not both")
-        with naming_option("--tilt"):
-            tilt = parse_tilt(args.tilt)
-        description = f"{description}, {tilt.describe()}"
-    visual_tilt = base.visual_tilt
-    if getattr(args, "visual_tilt", None) is not None:
-        if visual_tilt is not None:
-            raise UsageError(f"{command}: the experiment already has a visual tilt; give "
-                             "--visual-tilt or [visual_tilt], not both")
-        with naming_option("--visual-tilt"):
-            visual_tilt = parse_visual_tilt(args.visual_tilt)
-        description = f"{description}, visual scene: {visual_tilt.describe()}"
+    tilt, description = _tilt_from_flag(args, "tilt", base.tilt, description, command)
+    visual_tilt, description = _tilt_from_flag(args, "visual_tilt", base.visual_tilt,
+                                               description, command)
     torque_limits = base.torque_limits
     if args.torque_limits:
         torque_limits = torque_limits_from_table(args.torque_limits, n, "", FLAG_NAMES)
@@ -296,6 +266,29 @@ def run_options_from_args(args: argparse.Namespace, sc: Scenario,
             motor_noise=motor_noise, description=description,
             knee=KneeModel(args.knee) if args.knee is not None else base.knee,
             rates_from=args.rates_from if args.rates_from != "upright" else base.rates_from)
+
+
+#: What --tilt and --visual-tilt set: the ``args`` attribute (and scenario table) -> the
+#: experiment's other source of it, and the words before its description.
+TILT_FLAGS = {"tilt": ("a tilt column", ""),
+              "visual_tilt": ("[visual_tilt]", "visual scene: ")}
+
+
+def _tilt_from_flag(args: argparse.Namespace, attribute: str, given, description: str,
+                    command: str):
+    """(the Tilt, the description with it) of the flag of ``attribute`` (--tilt or
+    --visual-tilt), or (``given``, ``description``) when the flag is not given; refused when
+    the experiment has that tilt already (``given``)."""
+    spec = getattr(args, attribute, None)
+    if spec is None:
+        return given, description
+    option, (other, words) = "--" + attribute.replace("_", "-"), TILT_FLAGS[attribute]
+    if given is not None:
+        raise UsageError(f"{command}: the experiment already has a {attribute.replace('_', ' ')}"
+                         f"; give {option} or {other}, not both")
+    with naming_option(option):
+        tilt = parse_tilt(spec, attribute)
+    return tilt, f"{description}, {words}{tilt.describe()}"
 
 
 def _given(value: T | None, default: T) -> T:

@@ -64,6 +64,9 @@ DELAYED_AXES = ("active_stiffness", "active_viscosity")
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     """The options of ``posturelab stability-map``."""
+    from ._common import add_muscle_arguments, add_torque_feedback_arguments
+    from ._flags import add_flags
+
     p.add_argument("--x", required=True, metavar="NAME:LO:HI",
                    help="horizontal axis: parameter name and range (e.g. stiffness:ankle:0:2000).")
     p.add_argument("--y", required=True, metavar="NAME:LO:HI",
@@ -79,13 +82,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--viscosity-ratio", default=None, metavar="R",
                    help="pair viscosity = R × pair stiffness [s] when viscosity_ratio is not "
                    "an axis (default 0.25, as in the paper).")
-    p.add_argument("--progress", action="store_true",
-                   help="show a progress bar on standard error even when it is not a terminal.")
+    add_flags(p, "--progress")
     p.add_argument("--pair", metavar="NAME",
                    help="former option: the pair is now part of the axis names "
                    "(active_stiffness:PAIR:LO:HI).")
-    from ._common import add_muscle_arguments, add_torque_feedback_arguments
-
     add_muscle_arguments(p, own_case=True)
     add_torque_feedback_arguments(p)
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 
 from ._common import print_json
+from ._flags import add_flag, add_flags, add_options
 
 DESCRIPTION = """\
 The largest platform translation a subject withstands with the feet in place: a one-link
@@ -32,30 +33,28 @@ nothing is compared.
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     """The options of ``posturelab step-threshold``."""
-    p.add_argument("--height", type=float, required=True, metavar="M",
-                   help="standing height [m] (0.5–2.5).")
-    p.add_argument("--mass", type=float, required=True, metavar="KG",
-                   help="body mass [kg] (10–300).")
+    add_options(p, {"--height": ("M", "standing height [m] (0.5–2.5)."),
+                    "--mass": ("KG", "body mass [kg] (10–300).")}, type=float, required=True)
     p.add_argument("--population", default="young", metavar="NAME",
                    help="young or older (default young): the controller, delay and ankle "
                    "strength.")
-    p.add_argument("--direction", default="backward", metavar="WAY",
-                   help="backward (default; the body sways forward) or forward.")
-    p.add_argument("--feedback-delay", type=float, default=None, metavar="S",
-                   help="feedback delay τ [s] in place of the population's.")
-    p.add_argument("--ankle-strength", type=float, default=None, metavar="NM",
-                   help="plantarflexion strength of both ankles [N·m] in place of the "
-                   "population's.")
-    p.add_argument("--move-duration", type=float, default=None, metavar="S",
-                   help="duration T [s] of each platform move in place of the protocol's 0.5 s "
-                   "(posturelab's assumption).")
-    p.add_argument("--cop-criterion", action="store_true",
-                   help="also count a step when the centre of pressure leaves the foot (the "
-                   "heel would rise or the toes lift).")
-    p.add_argument("--symmetric-ankle-cap", action="store_true",
-                   help="cap dorsiflexion at the plantarflexion cap (the same both ways, as "
-                   "before issue 22) instead of at m g |x_heel|, the foot's: the centre of "
-                   "pressure may then pass the heel.")
+    add_flag(p, "--translation", " (default backward)", former=("--direction",),
+             default="backward", choices=None, metavar="WAY")
+    add_options(p, {  # each in place of the population's (or the protocol's) value
+        "--feedback-delay": ("SECONDS", "feedback delay τ [s] in place of the population's."),
+        "--ankle-strength": ("N·m", "plantarflexion strength of both ankles [N·m] in place "
+                             "of the population's."),
+        "--move-duration": ("SECONDS", "duration T [s] of each platform move in place of "
+                            "the protocol's 0.5 s (posturelab's assumption)."),
+    }, type=float, default=None)
+    add_options(p, {
+        "--cop-criterion": "also count a step when the centre of pressure leaves the foot "
+                           "(the heel would rise or the toes lift).",
+        "--symmetric-ankle-cap": "cap dorsiflexion at the plantarflexion cap (the same both "
+                                 "ways, as before issue 22) instead of at m g |x_heel|, the "
+                                 "foot's: the centre of pressure may then pass the heel.",
+        "--sources": "also print where each number of the population comes from.",
+    }, action="store_true")
     p.add_argument("--foot", choices=("functional", "anatomical"), default="functional",
                    help="functional (default): the population's functional base of support "
                    "from the quiet-standing centre of pressure; anatomical: the whole foot "
@@ -64,9 +63,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    default="platform-path",
                    help="platform-path (default): the XCoM with the platform's remaining path "
                    "counted; platform-velocity: as if the platform kept its current velocity.")
-    p.add_argument("--sources", action="store_true",
-                   help="also print where each number of the population comes from.")
-    p.add_argument("--json", action="store_true", help="print one JSON object instead of text.")
+    add_flags(p, "--json")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -85,7 +82,7 @@ def run(args: argparse.Namespace) -> int:
     protocol = PROTOCOL if args.move_duration is None else replace(
         PROTOCOL, move_duration=float_in_range("--move-duration [s]", args.move_duration,
                                                0.05, 10.0, unit="s"))
-    result = step_threshold(args.height, args.mass, population, args.direction,
+    result = step_threshold(args.height, args.mass, population, args.translation,
                             protocol=protocol, feedback_delay=args.feedback_delay,
                             ankle_strength=args.ankle_strength,
                             cop_criterion=args.cop_criterion,

@@ -7,6 +7,7 @@ import functools
 
 from . import UsageError
 from ._common import print_json
+from ._flags import add_flag, add_flags, add_options
 
 DESCRIPTION = """\
 Strategy maps: how much of the sway is the hip (anti-phase) mode of leg and trunk, the hip
@@ -36,7 +37,7 @@ run with its "ankle_torque_limit", and "transition_frequencies": [{"ankle_torque
 torque_limit:ankle=… and --strategy, on Dask with --workers).
 
 Example: posturelab strategy --translation backward --speeds 0.05:0.6:8 --json
-         posturelab strategy --oscillation 0.05 --frequencies 0.1:1.25:6 --figure map.png
+         posturelab strategy --oscillation 0.05 --frequencies 0.1:1.25:6 --plot map.png
 """
 
 
@@ -62,8 +63,8 @@ def _grid(text: str, flag: str):
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     """The options of ``posturelab strategy``."""
-    p.add_argument("--body", default="paper", metavar="NAME",
-                   help="a body preset (default: the paper's three links).")
+    p.add_argument("--body", default="paper", metavar="PRESET",
+                   help="body preset (default paper: the paper's three links).")
     from ..model.controllers import MULTIJOINT_CONTROLLERS
 
     p.add_argument("--controller", default="multijoint-default", metavar="NAME",
@@ -73,28 +74,26 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--joint-feedback-scale", type=float, default=1.0, metavar="S",
                    help="factor on the controller's gain matrices (default 1).")
     family = p.add_mutually_exclusive_group(required=True)
-    family.add_argument("--translation", choices=("backward", "forward"),
-                        help="transient translations in this direction (with --speeds).")
+    add_flag(family, "--translation", ": transient translations in this direction (with "
+             "--speeds)")
     family.add_argument("--oscillation", type=float, metavar="AMPLITUDE",
                         help="sinusoidal translations of this amplitude [m] (with "
                              "--frequencies).")
-    p.add_argument("--speeds", metavar="LO:HI:N", help="peak speeds [m/s].")
-    p.add_argument("--frequencies", metavar="LO:HI:N", help="frequencies [Hz].")
+    add_options(p, {"--speeds": ("LO:HI:N", "peak speeds [m/s]."),
+                    "--frequencies": ("LO:HI:N", "frequencies [Hz].")})
     p.add_argument("--displacement", type=float, default=None, metavar="M",
                    help="displacement of each transient translation [m] (default 0.06).")
     limit = p.add_mutually_exclusive_group()
     limit.add_argument("--ankle-torque-limit", type=float, metavar="N·m",
                        help="the ankle's torque limit (default: m g x_toe, the foot's).")
-    limit.add_argument("--ankle-limit-from-foot", action="store_true",
-                       help="limit the ankle both ways to what the foot can carry: "
-                            "plantarflexion m g x_toe, dorsiflexion m g |x_heel| (the foot of "
-                            "0.152 × 1.65 m, ankle at a quarter from the heel).")
+    add_flag(limit, "--ankle-limit-from-foot", "of the literature's foot (0.152 × 1.65 m, "
+             "the ankle a quarter of it from the heel)")
     limit.add_argument("--ankle-torque-limits", metavar="LO:HI:N",
                        help="a two-parameter map: the family at each of these ankle torque "
                             "limits [N·m] (each run then carries its ankle_torque_limit).")
-    p.add_argument("--engine", choices=("compiled", "reference"), default="compiled")
-    p.add_argument("--figure", metavar="PATH", help="also draw the map (PNG, SVG or PDF).")
-    p.add_argument("--json", action="store_true", help="print one JSON object.")
+    add_flag(p, "--engine", "")
+    add_flag(p, "--plot", "the map", former=("--figure",), metavar="MAP.png")
+    add_flags(p, "--json")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -113,10 +112,10 @@ def run(args: argparse.Namespace) -> int:
     if ignored:
         family = "--translation" if args.translation is not None else "--oscillation"
         raise UsageError(f"strategy: {ignored[0]} does not apply to {family}; drop it")
-    if args.figure:
-        from ._common import check_writable
+    if args.plot:
+        from ._common import FIGURE_SUFFIXES, check_writable
 
-        check_writable([args.figure])
+        check_writable([args.plot], {args.plot: FIGURE_SUFFIXES})
     body = get_body(args.body)
     controller = multijoint_controller(body, args.controller, args.joint_feedback_scale)
     limit = (controller.effort_limits[0] if args.ankle_torque_limit is None
@@ -140,11 +139,11 @@ def run(args: argparse.Namespace) -> int:
                                limit_maps(make, _grid(args.ankle_torque_limits,
                                                       "--ankle-torque-limits")))
     result = make(ankle_torque_limit=limit)
-    if args.figure:
+    if args.plot:
         from ..viz.maps import strategy_map_figure
         from ..viz.plots import save_figure
 
-        save_figure(strategy_map_figure(result), args.figure)
+        save_figure(strategy_map_figure(result), args.plot)
     out = {**result.to_dict(), **_design(controller),
            "joint_feedback_scale": args.joint_feedback_scale}
     if args.json:
@@ -185,11 +184,11 @@ def _two_parameters(args: argparse.Namespace, controller, maps) -> int:
     """Print (and draw) a map over ankle torque limits."""
     from ..studies.strategy import maps_to_dict
 
-    if args.figure:
+    if args.plot:
         from ..viz.maps import strategy_limit_figure
         from ..viz.plots import save_figure
 
-        save_figure(strategy_limit_figure(maps), args.figure)
+        save_figure(strategy_limit_figure(maps), args.plot)
     out = {**maps_to_dict(maps), **_design(controller),
            "joint_feedback_scale": args.joint_feedback_scale}
     if args.json:

@@ -24,6 +24,7 @@ from ..studies.sweep import (
 )
 from . import UsageError
 from ._common import check_writable, naming_given_options
+from ._flags import add_flag, add_flags
 from .simulate import add_experiment_arguments, experiment_inputs, scenario_from_args
 
 DESCRIPTION = f"""\
@@ -120,23 +121,17 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     g.add_argument("--strategy", action="store_true",
                    help="also a hip_fraction column: each run's share of the hip (anti-phase) "
                         "mode, after Creath et al. 2005 (every run again alone).")
-    g.add_argument("--progress", action="store_true",
-                   help="draw a progress bar on standard error even when it is not a terminal.")
+    add_flags(g, "--progress")
     e = p.add_argument_group("PRTS experiments (--experiment prts)")
     e.add_argument("--experiment", choices=["simulation", "prts"], default="simulation",
                    help="what each run is: one simulation (default) or a PRTS "
                    "identification experiment.")
-    e.add_argument("--cycles", type=int, default=None, metavar="N",
-                   help="cycles analysed per experiment (default 5).")
-    e.add_argument("--discard-cycles", type=int, default=None, metavar="N",
-                   help="cycles run first and dropped (default 1).")
-    e.add_argument("--sensor-noise", type=float, default=None, metavar="RAD",
-                   help="standard deviation of the measurement noise on the recorded angle "
-                   "[rad] (default 0).")
+    add_flags(e, "--cycles")
+    add_flag(e, "--discard-cycles", "1", default=None)
+    add_flags(e, "--sensor-noise")
     e.add_argument("--record-rate", type=float, default=None, metavar="HZ",
                    help="samples per second of the recording [Hz] (default 100).")
-    e.add_argument("--output", default=None, metavar="ANGLE",
-                   help="the angle recorded: com_angle (default) or thetaI.")
+    add_flag(e, "--output", " or thetaN", default=None)
     e.add_argument("--fit", metavar="NAMES",
                    help="fit these parameters to each experiment's FRF (comma-separated, "
                    "as for posturelab fit-frf --free).")
