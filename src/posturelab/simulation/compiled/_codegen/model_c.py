@@ -20,6 +20,7 @@ from ....model import events as ev
 from ....model.gains import GAIN_ROWS
 from . import filters_c
 from .codes import DIST_TERM_FIELDS, TILT_TERM_FIELDS
+from .headers import batch_row
 from .spec import SYMPY, c, symbols
 from .switch_c import switch_effects
 
@@ -38,7 +39,6 @@ HEADER = """/* The switched model for any N links: GENERATED, do not edit.
  * input), from pl_inputs_at; with torque feedback the state is [Θ, Θ̇, Y] (filters_c.py). */
 #include <math.h>
 #include "pl.h"
-#include "pl_events.h"
 """
 
 
@@ -69,19 +69,6 @@ def _platform() -> str:
                                               xp=SYMPY)
     sine = platform.sine_formula(t, **_row("sine", DIST_TERM_FIELDS, 2), xp=SYMPY)
     return f"""
-/* the largest k in [lo, hi) with x[k] <= t, by bisection (x increasing; lo if none) */
-static int64_t interval_of(const double *x, int64_t lo, int64_t hi, double t)
-{{
-    while (hi - lo > 1) {{
-        const int64_t mid = (lo + hi) >> 1;
-        if (x[mid] <= t)
-            lo = mid;
-        else
-            hi = mid;
-    }}
-    return lo;
-}}
-
 /* numpy.interp(t, xp, fp, left=0, right=0), xp = dp[first .. first+count), fp its col-th
  * block of count values after it */
 static double interp0(double t, const double *dp, int64_t first, int64_t count, int64_t col)
@@ -92,7 +79,7 @@ static double interp0(double t, const double *dp, int64_t first, int64_t count, 
     const int64_t off = col * count;
     if (t == dp[hi])
         return dp[hi + off];
-    const int64_t lo = interval_of(dp, first, hi, t);
+    const int64_t lo = pl_interval_of(dp, first, hi, t);
     const double slope = (dp[lo + 1 + off] - dp[lo + off]) / (dp[lo + 1] - dp[lo]);
     return slope * (t - dp[lo]) + dp[lo + off];
 }}
@@ -153,7 +140,7 @@ static void ppoly(double t, const double *x, const double *c, int64_t K, double 
         t = x[0];
     if (t > x[K])
         t = x[K];
-    const int64_t lo = interval_of(x, 0, K, t);
+    const int64_t lo = pl_interval_of(x, 0, K, t);
     const double u = t - x[lo], *q = c + 4 * lo;
     *angle = {c(cubic[0])};
     *rate = inside ? {c(cubic[1])} : 0.0;
@@ -192,7 +179,7 @@ void pl_motor_noise_add(double t, const double *mp, int64_t n, double *tau)
 {{
     const int64_t K = (int64_t)mp[0];
     const double *x = mp + 1, *c = mp + 2 + K;
-    const int64_t lo = interval_of(x, 0, K, t);  /* in [0, K - 1] */
+    const int64_t lo = pl_interval_of(x, 0, K, t);  /* in [0, K - 1] */
     const double u = t - x[lo], *q = c + lo * 4 * n;
     for (int64_t j = 0; j < n; j++)
         tau[j] += {c(noise)};
@@ -339,29 +326,21 @@ void pl_rhs_general(const pl_model *md, const double *x, double *out, const doub
     }}
 }}
 {filters_c.rhs()}
-void pl_moment_gains(const double *E, const double *C, const double *kd, const double *ld,
-                     const double *active, int64_t p, int64_t n, double *tk, double *tl)
+/* A segment's moment gains tm (GAIN_ROWS, n, n): T_K, T_L and their delayed parts,
+ * T = Cᵀ diag(g·active) E for each row g of the pair gains (GAIN_ROWS, p), plus the
+ * joint-space controller's rows jg (model.joint_feedback; NULL: none). */
+void pl_moment_gains(const double *E, const double *C, const double *gains, const double *jg,
+                     const double *active, int64_t p, int64_t n, double *tm)
 {{
-    for (int64_t j = 0; j < n; j++)
-        for (int64_t k = 0; k < n; k++) {{
-            double sk = 0.0, sl = 0.0;
-            for (int64_t q = 0; q < p; q++) {{
-                const double wgt = C[q * n + j] * E[q * n + k] * active[q];
-                sk += wgt * kd[q];
-                sl += wgt * ld[q];
+    for (int64_t r = 0; r < {len(GAIN_ROWS)}; r++)
+        for (int64_t j = 0; j < n; j++)
+            for (int64_t k = 0; k < n; k++) {{
+                double sum = 0.0;
+                for (int64_t q = 0; q < p; q++)
+                    sum += C[q * n + j] * E[q * n + k] * active[q] * gains[r * p + q];
+                tm[(r * n + j) * n + k] = sum;
             }}
-            tk[j * n + k] = sk;
-            tl[j * n + k] = sl;
-        }}
-}}
-
-/* The joint-space controller's moment gains (4, n, n), rows GAIN_*, added to the pairs' T_K,
- * T_L and their delayed parts (model.joint_feedback); jg NULL: none. */
-void pl_add_joint_gains(const double *jg, int64_t n, double *tm)
-{{
-    if (!jg)
-        return;
-    for (int64_t k = 0; k < 4 * n * n; k++)
+    for (int64_t k = 0; jg && k < {len(GAIN_ROWS)} * n * n; k++)
         tm[k] = {c(joint)};
 }}
 
@@ -532,4 +511,4 @@ double pl_event_value(const pl_ctx *cx, int64_t kind, int64_t idx, double side, 
 def generate() -> str:
     """The text of ``csrc/pl_model.c``."""
     return (HEADER + _platform() + _tilt() + _inputs() + _rhs() + _events()
-            + switch_effects())
+            + switch_effects() + batch_row())
