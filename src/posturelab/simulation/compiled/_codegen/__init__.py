@@ -34,7 +34,8 @@ def outputs() -> dict[Path, object]:
     from . import codes, headers, model_c, radau_c, rhs_small
 
     return {CSRC / "pl_model.c": model_c.generate, TARGET: rhs_small.generate,
-            CSRC / "pl_model.h": headers.header, CSRC / "pl_codes.h": codes.header,
+            CSRC / "pl_model.h": lambda: headers.header(model_c.generate(), rhs_small.generate()),
+            CSRC / "pl_codes.h": codes.header,
             CSRC / "pl_radau.h": radau_c.header, PACKAGE / "_layout.py": codes.layout}
 
 

@@ -13,15 +13,13 @@ from __future__ import annotations
 
 import inspect
 
-import sympy as sp
-
 from ....model import dynamics, joint_feedback, kinematics, platform, switched, tilt
 from ....model import events as ev
 from ....model.gains import GAIN_ROWS
 from . import filters_c
 from .codes import DIST_TERM_FIELDS, TILT_TERM_FIELDS
 from .headers import batch_row
-from .spec import SYMPY, c, symbols
+from .spec import SYMPY, c, symbols, trig_symbols
 from .switch_c import switch_effects
 
 HEADER = """/* The switched model for any N links: GENERATED, do not edit.
@@ -40,17 +38,6 @@ HEADER = """/* The switched model for any N links: GENERATED, do not edit.
 #include <math.h>
 #include "pl.h"
 """
-
-
-def _trig_symbols(expr, angles: dict):
-    """``expr`` with sin and cos of differences expanded and sin θ, cos θ of each angle in
-    ``angles`` (symbol -> (sin name, cos name)) replaced by those names."""
-    expr = sp.expand_trig(expr)
-    subs = {}
-    for angle, (s, co) in angles.items():
-        subs[sp.sin(angle)] = symbols(s)
-        subs[sp.cos(angle)] = symbols(co)
-    return expr.xreplace(subs)
 
 
 # ---------------------------------------------------------------------------
@@ -258,9 +245,9 @@ def _rhs() -> str:
     thi, thj, wj = symbols("thi", "thj", "x[n + j]")
     trig = {thi: ("si", "ci"), thj: ("sj", "cj")}
     cij, a_i = symbols("cij", "bp[i]")
-    coupling = _trig_symbols(dynamics.coupling_formula(cij, thi, thj, SYMPY), trig)
-    centripetal = _trig_symbols(dynamics.centripetal_formula(cij, thi, thj, wj, SYMPY), trig)
-    load = _trig_symbols(dynamics.load_formula(a_i, thi, *symbols("ga", "ax"), SYMPY), trig)
+    coupling = trig_symbols(dynamics.coupling_formula(cij, thi, thj, SYMPY), trig)
+    centripetal = trig_symbols(dynamics.centripetal_formula(cij, thi, thj, wj, SYMPY), trig)
+    load = trig_symbols(dynamics.load_formula(a_i, thi, *symbols("ga", "ax"), SYMPY), trig)
     saturated = switched.saturated_moment_formula(
         *symbols("t", "md->sat[j]", "md->lim[j]", "md->lim[n + j]"), SYMPY)
     xi, xj = symbols("x[i]", "x[j]")

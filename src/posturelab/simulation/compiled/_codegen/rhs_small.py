@@ -70,10 +70,9 @@ def _adjugate_lines(n: int, printer) -> tuple[list[str], list[list[str]]]:
 
 def _entry(expr, *links: int) -> str:
     """An entry formula on θ_i symbols printed with s[i], c[i] for sin θ_i, cos θ_i."""
-    from .model_c import _trig_symbols
-    from .spec import c, symbols
+    from .spec import c, symbols, trig_symbols
 
-    return c(_trig_symbols(expr, {symbols(f"th[{i}]"): (f"s[{i}]", f"c[{i}]") for i in links}))
+    return c(trig_symbols(expr, {symbols(f"th[{i}]"): (f"s[{i}]", f"c[{i}]") for i in links}))
 
 
 def _coupling(n: int, i: int, j: int) -> str:

@@ -188,33 +188,29 @@ static inline void pl_small_store(const pl_model *md, double *out, int n, const 
         out[n + i] = a[i];
 }
 
-/* the right-hand side (pl_model.c, pl_rhs_small.c) */
-void pl_rhs(const pl_model *md, const double *x, double *out, const double *inp, int locked);
-void pl_rhs_general(const pl_model *md, const double *x, double *out, const double *inp,
-                    int locked);
-void pl_rhs1(const pl_model *md, const double *x, double *out, const double *inp, int locked);
-void pl_rhs2(const pl_model *md, const double *x, double *out, const double *inp, int locked);
-void pl_rhs3(const pl_model *md, const double *x, double *out, const double *inp, int locked);
-void pl_set_base(const double *x, double *base, int64_t n);
-void pl_moment_gains(const double *E, const double *C, const double *gains, const double *jg,
-                     const double *active, int64_t p, int64_t n, double *tm);
-void pl_project_velocity(double *x, const double *bp, double *work, int64_t n);
-
-/* the inputs and the event values (pl_model.c) */
+/* the functions of pl_model.c and pl_rhs_small.c (what each does: there) */
 void pl_platform_acceleration(double t, const double *dp, double *ax, double *ay);
 void pl_tilt(double t, const double *tp, double *angle, double *rate, double *accel);
 void pl_motor_noise_add(double t, const double *mp, int64_t n, double *tau);
 void pl_inputs_at(const pl_ctx *cx, double t, double *out);
+void pl_set_base(const double *x, double *base, int64_t n);
+void pl_rhs_general(const pl_model *md, const double *x, double *out, const double *inp,
+                    int locked);
+void pl_rhs(const pl_model *md, const double *x, double *out, const double *inp, int locked);
+void pl_moment_gains(const double *E, const double *C, const double *gains, const double *jg,
+                     const double *active, int64_t p, int64_t n, double *tm);
+void pl_project_velocity(double *x, const double *bp, double *work, int64_t n);
 double pl_event_value(const pl_ctx *cx, int64_t kind, int64_t idx, double side, double t,
                       const double *y, int locked);
-
-/* what a switch does, which slots a segment lists (pl_model.c) */
+double pl_slot_side(int64_t kind, int64_t i, double side, const double *sat);
 int pl_switch_needs_feedback(int64_t kind);
 void pl_apply_switch(const pl_run *run, int64_t kind, int64_t j, double side,
                      const double *feedback, double *x, double *active, double *sat,
                      int *locked, double *work);
 int pl_slot_on(int64_t cond, int64_t i, const double *sat, const double *active, int locked);
-double pl_slot_side(int64_t kind, int64_t i, double side, const double *sat);
 void pl_batch_row(const pl_batch *b, int64_t r, pl_run *run, pl_out *out);
+void pl_rhs1(const pl_model *md, const double *x, double *out, const double *inp, int locked);
+void pl_rhs2(const pl_model *md, const double *x, double *out, const double *inp, int locked);
+void pl_rhs3(const pl_model *md, const double *x, double *out, const double *inp, int locked);
 
 #endif
