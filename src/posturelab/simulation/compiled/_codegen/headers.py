@@ -1,9 +1,10 @@
-"""Writes ``csrc/pl_model.h``: the interface of the generated model — the structs a run and its
-outputs are packed into (their fields stated once in :data:`RUN_FIELDS` and
-:data:`OUT_FIELDS`, which ``_layout.py`` also carries for the ctypes mirror in
-``_binding.py``), what the right-hand side and the event values need (``pl_model``,
-``pl_ctx``), the angle-sum rotation whose series sympy derives, and the generated functions'
-prototypes.
+"""Writes ``csrc/pl_model.h``: the interface of the generated model — the structs a run, its
+outputs and a batch are packed into (their fields stated once in :data:`RUN_FIELDS`,
+:data:`OUT_FIELDS` and :data:`BATCH_FIELDS`, which ``_layout.py`` also carries for the
+ctypes mirror in ``_binding.py``), what the right-hand side and the event values need
+(``pl_model``, ``pl_ctx``: :data:`MODEL_FIELDS`, :data:`CTX_FIELDS`), the angle-sum rotation
+whose series sympy derives, and the generated functions' prototypes, taken from their
+definitions.
 """
 
 from __future__ import annotations
@@ -186,8 +187,9 @@ def header(*sources: str) -> str:
     out = ["/* The interface of the generated model: GENERATED, do not edit.",
            " *",
            " * python -m posturelab.simulation.compiled._codegen writes this file from",
-           " * _codegen/headers.py (the structs' fields, which _layout.py carries for _binding.py,",
-           " * and the small-N helpers) and sympy (the rotation's series); pl.h includes it. */",
+           " * _codegen/headers.py (the structs' fields, which _layout.py carries for",
+           " * _binding.py), sympy (the rotation's series) and the definitions in pl_model.c",
+           " * and pl_rhs_small.c (the prototypes); pl.h includes it. */",
            "#ifndef PL_MODEL_H", "#define PL_MODEL_H", "",
            "/* One run: everything the integration needs (read only). */"]
     out += _struct("pl_run", RUN_FIELDS)
@@ -201,40 +203,10 @@ def header(*sources: str) -> str:
             "(t, y). */"]
     out += _struct("pl_ctx", CTX_FIELDS)
     out.append(_rotation())
-    out.append(SMALL_N_HELPERS)
     out += _prototypes(*sources) + [""]
     out.append("#endif")
     return "\n".join(out) + "\n"
 
-
-SMALL_N_HELPERS = """/* what the small-N right-hand sides (pl_rhs_small.c) read: θ_i, θ̇_i,
- * sin θ_i and cos θ_i of each link (about the base, pl_rotate), ẍ_d and g + ÿ_d */
-static inline void pl_small_unpack(const pl_model *md, const double *x, const double *inp, int n,
-                                   double *th, double *w, double *s, double *c, double *ax,
-                                   double *ga)
-{
-    for (int i = 0; i < n; i++) {
-        th[i] = x[i];
-        w[i] = x[n + i];
-        pl_rotate(th[i], md->base[i], md->base[n + i], md->base[2 * n + i], &s[i], &c[i]);
-    }
-    *ax = inp[0];
-    *ga = md->bp[2 * n + n * n] + inp[1];
-}
-
-/* the small-N right-hand sides' stores (pl_rhs_small.c), all last: out and tau may not be
- * read again, whatever they alias */
-static inline void pl_small_store(const pl_model *md, double *out, int n, const double *t,
-                                  const double *w, const double *a)
-{
-    for (int j = 0; j < n; j++)
-        md->tau[j] = t[j];
-    for (int i = 0; i < n; i++)
-        out[i] = w[i];
-    for (int i = 0; i < n; i++)
-        out[n + i] = a[i];
-}
-"""
 
 def _prototypes(*sources: str) -> list[str]:
     """The declaration of each function that the C ``sources`` define for the rest of the

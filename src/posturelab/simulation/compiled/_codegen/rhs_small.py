@@ -115,7 +115,12 @@ def _rhs_function(n: int, printer) -> str:
          f"    double th[{n}], w[{n}], s[{n}], c[{n}], t[{n}], a[{n}], ax, ga;"]
     if n == 1:
         L.append("    (void)locked;")
-    L.append(f"    pl_small_unpack(md, x, inp, {n}, th, w, s, c, &ax, &ga);")
+    for i in range(n):  # θ_i, θ̇_i, sin θ_i and cos θ_i (about the step's start: pl_rotate)
+        L.append(f"    th[{i}] = x[{i}];")
+        L.append(f"    w[{i}] = x[{n + i}];")
+        L.append(f"    pl_rotate(th[{i}], md->base[{i}], md->base[{n + i}], md->base[{2 * n + i}], "
+                 f"&s[{i}], &c[{i}]);")
+    L += ["    ax = inp[0];", f"    ga = bp[{2 * n + n * n}] + inp[1];"]
     for j in range(n):
         k_terms = " + ".join(f"tk[{j * n + k}] * th[{k}]" for k in range(n))
         l_terms = " + ".join(f"tl[{j * n + k}] * w[{k}]" for k in range(n))
@@ -148,7 +153,10 @@ def _rhs_function(n: int, printer) -> str:
         for i in range(n):
             L.append(f"        a[{i}] -= y{i} * lam;")
         L.append("    }")
-    L.append(f"    pl_small_store(md, out, {n}, t, w, a);")
+    # the stores, all last: out and tau may not be read again, whatever they alias
+    L += [f"    md->tau[{j}] = t[{j}];" for j in range(n)]
+    L += [f"    out[{i}] = w[{i}];" for i in range(n)]
+    L += [f"    out[{n + i}] = a[{i}];" for i in range(n)]
     L.append("}")
     return "\n".join(L) + "\n"
 

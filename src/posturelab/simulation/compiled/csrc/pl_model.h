@@ -1,8 +1,9 @@
 /* The interface of the generated model: GENERATED, do not edit.
  *
  * python -m posturelab.simulation.compiled._codegen writes this file from
- * _codegen/headers.py (the structs' fields, which _layout.py carries for _binding.py,
- * and the small-N helpers) and sympy (the rotation's series); pl.h includes it. */
+ * _codegen/headers.py (the structs' fields, which _layout.py carries for
+ * _binding.py), sympy (the rotation's series) and the definitions in pl_model.c
+ * and pl_rhs_small.c (the prototypes); pl.h includes it. */
 #ifndef PL_MODEL_H
 #define PL_MODEL_H
 
@@ -158,34 +159,6 @@ static inline void pl_rotate(double theta, double theta_b, double s_b, double c_
     const double cdm1 = z*(z*(z*((1.0/40320.0)*z - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
     *s = s_b + (s_b * cdm1 + c_b * sd);
     *c = c_b + (c_b * cdm1 - s_b * sd);
-}
-
-/* what the small-N right-hand sides (pl_rhs_small.c) read: θ_i, θ̇_i,
- * sin θ_i and cos θ_i of each link (about the base, pl_rotate), ẍ_d and g + ÿ_d */
-static inline void pl_small_unpack(const pl_model *md, const double *x, const double *inp, int n,
-                                   double *th, double *w, double *s, double *c, double *ax,
-                                   double *ga)
-{
-    for (int i = 0; i < n; i++) {
-        th[i] = x[i];
-        w[i] = x[n + i];
-        pl_rotate(th[i], md->base[i], md->base[n + i], md->base[2 * n + i], &s[i], &c[i]);
-    }
-    *ax = inp[0];
-    *ga = md->bp[2 * n + n * n] + inp[1];
-}
-
-/* the small-N right-hand sides' stores (pl_rhs_small.c), all last: out and tau may not be
- * read again, whatever they alias */
-static inline void pl_small_store(const pl_model *md, double *out, int n, const double *t,
-                                  const double *w, const double *a)
-{
-    for (int j = 0; j < n; j++)
-        md->tau[j] = t[j];
-    for (int i = 0; i < n; i++)
-        out[i] = w[i];
-    for (int i = 0; i < n; i++)
-        out[n + i] = a[i];
 }
 
 /* the functions of pl_model.c and pl_rhs_small.c (what each does: there) */
