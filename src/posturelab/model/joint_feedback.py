@@ -14,7 +14,7 @@ ankle F_θ[0, 0] < 0. The matrices come from a design on the linear system
 
 The moment is linear in the state, so the engines carry it as joint-space gain matrices in the
 rows of :mod:`.gains` (:func:`joint_gain_rows`), added to the pairs' T_K = Cᵀ diag(k) E
-(:func:`joint_moment_gain_formula`, which the compiled engine's ``pl_add_joint_gains`` is
+(:func:`joint_moment_gain_formula`, which the compiled engine's ``pl_moment_gains`` is
 generated from).
 """
 

@@ -15,7 +15,7 @@ import importlib.util
 import threading
 
 from ...errors import PostureLabError
-from ._layout import OUT_FIELDS, RUN_FIELDS
+from ._layout import BATCH_FIELDS, OUT_FIELDS, RUN_FIELDS
 from ._sources import stale_digest
 
 _P = ctypes.POINTER
@@ -27,9 +27,11 @@ _TYPES = {"i64": ctypes.c_int64, "f64": ctypes.c_double, "*f64": _d, "*i64": _i,
           "*u8": _P(ctypes.c_uint8)}
 
 
-def _fields(spec: tuple[str, ...]) -> list:
-    """ctypes fields from the ``name:type`` list of a struct in ``_layout.py``."""
-    return [(name, _TYPES[kind]) for name, kind in (item.split(":") for item in spec)]
+def _fields(spec: tuple[str, ...], **structs) -> list:
+    """ctypes fields from the ``name:type`` list of a struct in ``_layout.py``; ``structs``
+    names the struct types it embeds (``run=Run``)."""
+    types = {**_TYPES, **structs}
+    return [(name, types[kind]) for name, kind in (item.split(":") for item in spec)]
 
 
 class Run(ctypes.Structure):
@@ -47,12 +49,7 @@ class Out(ctypes.Structure):
 class Batch(ctypes.Structure):
     """``pl_batch``: a batch's shared inputs, per-level and per-run arrays, outputs."""
 
-    _fields_ = [("base", Run), ("which", _i), ("x0_all", _d), ("before_all", _d),
-                ("dp_all", _d), ("dp_stride", ctypes.c_int64), ("ipar_all", _i),
-                ("active0_all", _d), ("gains_all", _d), ("lim_all", _d), ("delay_all", _d),
-                ("sat0_all", _d), ("method_all", _i), ("results", _d), ("peaks", _d),
-                ("finals", _d), ("tilt_gain_all", _d), ("tilt_pair_gain_all", _d),
-                ("visual_gain_all", _d), ("visual_pair_gain_all", _d)]
+    _fields_ = _fields(BATCH_FIELDS, run=Run)
 
 
 def pointer(arr, kind=_d):

@@ -141,6 +141,12 @@ RUN_FIELDS = ("n:i64", "p:i64", "n_grid:i64", "n_bps:i64", "n_slots:i64", "n_sta
 #: The fields of ``pl_out`` (csrc/pl_model.h) and their types: i64, f64, *… arrays.
 OUT_FIELDS = ("samples:*f64", "fb:*f64", "locked:*u8", "switches:*f64", "switch_cap:i64",
               "peak:*f64", "final:*f64", "res:*f64")
+#: The fields of ``pl_batch`` (csrc/pl_model.h) and their types: i64, f64, *… arrays, run: a pl_run.
+BATCH_FIELDS = ("base:run", "which:*i64", "dp_stride:i64", "x0_all:*f64", "before_all:*f64",
+                "dp_all:*f64", "ipar_all:*i64", "active0_all:*f64", "gains_all:*f64",
+                "lim_all:*f64", "delay_all:*f64", "sat0_all:*f64", "method_all:*i64",
+                "tilt_gain_all:*f64", "tilt_pair_gain_all:*f64", "visual_gain_all:*f64",
+                "visual_pair_gain_all:*f64", "peaks:*f64", "finals:*f64", "results:*f64")
 
 
 def body_size(n: int) -> int:

@@ -10,9 +10,10 @@ sympy. Each says so in its first lines.
 ``csrc/pl_model.c``       inputs, right-hand side for any N, knee impact, event values
                           (:mod:`.model_c`), torque feedback filters (:mod:`.filters_c`)
 ``csrc/pl_rhs_small.c``   straight-line right-hand sides for N = 1, 2, 3 (:mod:`.rhs_small`)
-``csrc/pl_model.h``       the structs of a run and of the model, the rotation series,
+``csrc/pl_model.h``       the structs of a run, a batch and the model, the rotation series,
                           the prototypes (:mod:`.headers`)
 ``csrc/pl_codes.h``       the C enums (:mod:`.codes`)
+``csrc/pl_radau.h``       scipy's constants of Radau IIA (:mod:`.radau_c`)
 ``_layout.py``            the same codes for Python (:mod:`.codes`)
 ========================  =====================================================================
 """
@@ -30,11 +31,12 @@ TARGET = CSRC / "pl_rhs_small.c"
 
 def outputs() -> dict[Path, object]:
     """Each generated file and the function that returns its text."""
-    from . import codes, headers, model_c, rhs_small
+    from . import codes, headers, model_c, radau_c, rhs_small
 
     return {CSRC / "pl_model.c": model_c.generate, TARGET: rhs_small.generate,
-            CSRC / "pl_model.h": headers.header, CSRC / "pl_codes.h": codes.header,
-            PACKAGE / "_layout.py": codes.layout}
+            CSRC / "pl_model.h": lambda: headers.header(model_c.generate(), rhs_small.generate()),
+            CSRC / "pl_codes.h": codes.header,
+            CSRC / "pl_radau.h": radau_c.header, PACKAGE / "_layout.py": codes.layout}
 
 
 def generate() -> str:

@@ -169,7 +169,7 @@ def layout() -> str:
     out.append("#: The outcome of each code in the words of "
                "posturelab.simulation.setup.outcome_message.")
     out += _tuple("STATUS_OUTCOMES", [o for _, _, o in STATUS_TEXT])
-    from .headers import OUT_FIELDS, RUN_FIELDS
+    from .headers import BATCH_FIELDS, OUT_FIELDS, RUN_FIELDS
 
     for name, table, where in (("DIST_TERM_FIELDS", DIST_TERM_FIELDS, "after (kind, axis)"),
                                ("TILT_TERM_FIELDS", TILT_TERM_FIELDS, "after its kind")):
@@ -179,9 +179,10 @@ def layout() -> str:
         out.append("}")
 
     for name, fields, struct in (("RUN_FIELDS", RUN_FIELDS, "pl_run"),
-                                 ("OUT_FIELDS", OUT_FIELDS, "pl_out")):
+                                 ("OUT_FIELDS", OUT_FIELDS, "pl_out"),
+                                 ("BATCH_FIELDS", BATCH_FIELDS, "pl_batch")):
         out.append(f"#: The fields of ``{struct}`` (csrc/pl_model.h) and their types: i64, f64, "
-                   "*… arrays.")
+                   "*… arrays" + (", run: a pl_run." if struct == "pl_batch" else "."))
         out += _tuple(name, [f"{field}:{kind.lstrip('w')}" for field, kind, _ in fields])
     out += ["", "",
             "def body_size(n: int) -> int:",

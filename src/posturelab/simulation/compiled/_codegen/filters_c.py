@@ -21,6 +21,7 @@ from __future__ import annotations
 
 from ....model import switched
 from ....model.gains import DELAYED_STIFFNESS, DELAYED_VISCOSITY, GAIN_ROWS
+from .rhs_small import SIZES
 from .spec import c, symbols
 
 _DK, _DV = (f"GAIN_{GAIN_ROWS[k].upper()}" for k in (DELAYED_STIFFNESS, DELAYED_VISCOSITY))
@@ -65,6 +66,8 @@ def rhs() -> str:
     y, inp, act, gain, lag = symbols("x[2 * n + q]", "inp[2 + n + q]", "md->active[q]",
                                      "md->tf_gain", "md->tf_time")
     rate = switched.torque_feedback_rate_formula(y, inp + act * y, gain, lag)
+    small = "\n".join(f"    case {n}: pl_rhs{n}(md, x, out, inp, locked); break;"
+                      for n in reversed(SIZES))  # the straight-line code of rhs_small
     return f"""
 /* [Θ̇, Θ̈, Ẏ] at x = [Θ, Θ̇, Y]: the N-link right-hand side, with the torque feedback filters'
  * moments added to the inputs' and their rates after it (model.switched.raw_moments,
@@ -84,9 +87,7 @@ void pl_rhs(const pl_model *md, const double *x, double *out, const double *inp,
         inp = fs;
     }}
     switch (n) {{
-    case 3: pl_rhs3(md, x, out, inp, locked); break;
-    case 2: pl_rhs2(md, x, out, inp, locked); break;
-    case 1: pl_rhs1(md, x, out, inp, locked); break;
+{small}
     default: pl_rhs_general(md, x, out, inp, locked);
     }}
     for (int64_t q = 0; q < nf; q++)

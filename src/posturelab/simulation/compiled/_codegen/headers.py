@@ -1,16 +1,18 @@
-"""Writes ``csrc/pl_model.h``: the interface of the generated model — the structs a run and its
-outputs are packed into (their fields stated once in :data:`RUN_FIELDS` and
-:data:`OUT_FIELDS`, which ``_layout.py`` also carries for the ctypes mirror in
-``_binding.py``), what the right-hand side and the event values need (``pl_model``,
-``pl_ctx``), the angle-sum rotation whose series sympy derives, and the generated functions'
-prototypes.
+"""Writes ``csrc/pl_model.h``: the interface of the generated model — the structs a run, its
+outputs and a batch are packed into (their fields stated once in :data:`RUN_FIELDS`,
+:data:`OUT_FIELDS` and :data:`BATCH_FIELDS`, which ``_layout.py`` also carries for the
+ctypes mirror in ``_binding.py``), what the right-hand side and the event values need
+(``pl_model``, ``pl_ctx``: :data:`MODEL_FIELDS`, :data:`CTX_FIELDS`), the angle-sum rotation
+whose series sympy derives, and the generated functions' prototypes, taken from their
+definitions.
 """
 
 from __future__ import annotations
 
 #: C type of each field code: i64/f64 scalars, *… read-only arrays, w… arrays written to.
 C_TYPES = {"i64": "int64_t ", "f64": "double ", "*f64": "const double *",
-           "*i64": "const int64_t *", "w*f64": "double *", "w*u8": "uint8_t *"}
+           "*i64": "const int64_t *", "w*f64": "double *", "w*u8": "uint8_t *",
+           "run": "pl_run ", "*model": "const pl_model *", "*hist": "const struct pl_history *"}
 
 #: ``pl_run``: one run, everything the integration needs (read only): (field, type, comment).
 RUN_FIELDS = [
@@ -37,7 +39,9 @@ RUN_FIELDS = [
     ("tp", "*f64", "packed tilt (tp[0] = 0: none)"),
     ("tilt_gain", "*f64", "(4, n) joint moments per α(t), α̇(t), α(t−τ), α̇(t−τ)"),
     ("tilt_depth", "f64", "tilt axis below the ankle [m] (0: the ankle's)"),
-    ("mp", "*f64", "packed motor noise (mp[0] = 0: none)"),
+    ("mp", "*f64", "packed motor noise (model.noise.TorqueSeries): mp[0] = K intervals "
+            "(0: none), K + 1 knots, K·4·n coefficients (interval-major, ascending powers of "
+            "t − knot, joint fastest)"),
     ("n_filters", "i64", "torque feedback filter states after [Θ, Θ̇]: p, or 0"),
     ("filter_gain", "f64", "K_t of the torque feedback [-]"),
     ("filter_time", "f64", "τ_t of its filter [s]"),
@@ -55,6 +59,75 @@ OUT_FIELDS = [
     ("switches", "w*f64", "(switch_cap) or NULL"), ("switch_cap", "i64", ""),
     ("peak", "w*f64", "(n)"), ("final", "w*f64", "(2n)"), ("res", "w*f64", "(N_RESULT)"),
 ]
+#: ``pl_batch``: the fields of ``pl_run`` that differ between a batch's runs, (field, "level"
+#: or "run", numbers per row): an array of rows, one per level (a run's is ``which[r]``) or per
+#: run, called ``{field}_all``; the rest of a run is ``base``.
+BATCH_ROWS = [
+    ("x0", "level", "2 * n"), ("before", "level", "2 * n"), ("dp", "level", "b->dp_stride"),
+    ("ipar", "level", "N_IPAR"), ("active0", "level", "p"), ("gains", "run", "4 * p"),
+    ("lim", "run", "2 * n"), ("delay", "run", "1"), ("sat0", "run", "n"), ("method", "run", "1"),
+    ("tilt_gain", "run", "4 * n"), ("tilt_pair_gain", "run", "4 * p"),
+    ("visual_gain", "run", "4 * n"), ("visual_pair_gain", "run", "4 * p"),
+]
+#: The outputs a batch keeps, per run: (field of ``pl_out``, array of ``pl_batch``, per row).
+BATCH_OUTS = [("peak", "peaks", "n"), ("final", "finals", "2 * n"), ("res", "results", "N_RESULT")]
+
+
+def _batch_fields() -> list[tuple[str, str, str]]:
+    kinds = {field: kind for field, kind, _ in RUN_FIELDS}
+    rows = [(f"{field}_all", "*" + kinds[field].lstrip("*"),
+             f"({per}s)" if size == "1" else f"({per}s, {size.removeprefix('b->')})")
+            for field, per, size in BATCH_ROWS]
+    return ([("base", "run", "what the runs share"),
+             ("which", "*i64", "(runs) the level of each run"),
+             ("dp_stride", "i64", "numbers per level of dp_all")] + rows
+            + [(name, "w*f64", f"(runs, {size})") for _, name, size in BATCH_OUTS])
+
+
+#: ``pl_batch``: a batch's shared run, its per-level and per-run rows, its outputs.
+BATCH_FIELDS = _batch_fields()
+#: ``pl_model``: what the right-hand side needs besides the state.
+MODEL_FIELDS = [
+    ("n", "i64", ""), ("bp", "*f64", ""),
+    ("tm", "w*f64", "(4, n, n): T_K, T_L, delayed T_K, delayed T_L"),
+    ("lim", "*f64", "(2n): negative, positive limits"), ("sat", "w*f64", "(n) saturation signs"),
+    ("base", "w*f64", "(3n) θ, sin θ, cos θ at the step's start"),
+    ("work", "w*f64", "(n, n + 4)"), ("tau", "w*f64", "(n) receives the joint moments"),
+    ("nf", "i64", "torque feedback filter states after [Θ, Θ̇] (0: none)"),
+    ("tf_gain", "f64", "K_t [-]"), ("tf_time", "f64", "τ_t [s]"),
+    ("C", "*f64", "(p, n) joint-crossing rows"), ("active", "*f64", "(p) which pairs act"),
+    ("fscr", "w*f64", "(2 + n + nf) the inputs with the filters' moments, their rates"),
+]
+#: ``pl_ctx``: what the inputs and an event function need besides (t, y).
+CTX_FIELDS = [
+    ("md", "*model", ""), ("E", "*f64", ""), ("dp", "*f64", ""), ("fpar", "*f64", ""),
+    ("before", "*f64", ""), ("ev_offset", "*f64", ""), ("hist", "*hist", ""),
+    ("delay", "f64", ""), ("tp", "*f64", "packed tilt"),
+    ("tilt_gain", "*f64", "(4, n) joint gains on the tilt"),
+    ("tilt_depth", "f64", "tilt axis below the ankle [m]"),
+    ("mp", "*f64", "packed motor noise"), ("gains", "*f64", "(4, p) the run's pair gains"),
+    ("p", "i64", ""), ("sc_out", "w*f64", "scratch (m)"), ("sc_inp", "w*f64", "(2 + n + nf)"),
+    ("sc_x", "w*f64", "(m)"), ("ys", "w*f64", "(m)"),
+    ("tilt_pair_gain", "*f64", "(4, p) pair gains on the tilt"),
+    ("vp", "*f64", "packed visual-scene tilt"),
+    ("visual_gain", "*f64", "(4, n) joint gains on it"),
+    ("visual_pair_gain", "*f64", "(4, p) pair gains on it"),
+]
+
+
+def batch_row() -> str:
+    """``pl_batch_row``: run r of a batch, from :data:`BATCH_ROWS` and :data:`BATCH_OUTS`."""
+    lines = ["", "/* Run r of a batch and where its outputs go (headers.BATCH_ROWS, BATCH_OUTS) */",
+             "void pl_batch_row(const pl_batch *b, int64_t r, pl_run *run, pl_out *out)", "{",
+             "    const int64_t n = b->base.n, p = b->base.p, level = b->which[r];",
+             "    *run = b->base;"]
+    for field, per, size in BATCH_ROWS:
+        row = "level" if per == "level" else "r"
+        lines.append(f"    run->{field} = b->{field}_all[{row}];" if size == "1" else
+                     f"    run->{field} = b->{field}_all + {row} * ({size});")
+    outs = [f".{field} = b->{name} + r * ({size})" for field, name, size in BATCH_OUTS]
+    return "\n".join(lines + ["    *out = (pl_out){" + ",\n                     ".join(outs)
+                               + "};", "}", ""])
 
 
 def _struct(name: str, fields) -> list[str]:
@@ -108,119 +181,47 @@ static inline void pl_rotate(double theta, double theta_b, double s_b, double c_
 """
 
 
-def header() -> str:
-    """The text of ``csrc/pl_model.h``."""
+def header(*sources: str) -> str:
+    """The text of ``csrc/pl_model.h``, declaring the functions the generated C ``sources``
+    (the texts of pl_model.c and pl_rhs_small.c) define."""
     out = ["/* The interface of the generated model: GENERATED, do not edit.",
            " *",
            " * python -m posturelab.simulation.compiled._codegen writes this file from",
-           " * _codegen/headers.py (the structs' fields, which _layout.py carries for _binding.py,",
-           " * and the small-N helpers) and sympy (the rotation's series); pl.h includes it. */",
+           " * _codegen/headers.py (the structs' fields, which _layout.py carries for",
+           " * _binding.py), sympy (the rotation's series) and the definitions in pl_model.c",
+           " * and pl_rhs_small.c (the prototypes); pl.h includes it. */",
            "#ifndef PL_MODEL_H", "#define PL_MODEL_H", "",
            "/* One run: everything the integration needs (read only). */"]
     out += _struct("pl_run", RUN_FIELDS)
     out.append("/* Outputs of one run (any pointer may be NULL where noted). */")
     out += _struct("pl_out", OUT_FIELDS)
-    out.append(MODEL_STRUCTS)
+    out.append("/* A batch: its runs share base but for the rows below (pl_batch_row). */")
+    out += _struct("pl_batch", BATCH_FIELDS)
+    out.append("/* What the right-hand side needs besides the state. */")
+    out += _struct("pl_model", MODEL_FIELDS)
+    out += ["struct pl_history;", "", "/* What the inputs and an event function need besides "
+            "(t, y). */"]
+    out += _struct("pl_ctx", CTX_FIELDS)
     out.append(_rotation())
-    out.append(SMALL_N_HELPERS)
-    out.append(PROTOTYPES)
+    out += _prototypes(*sources) + [""]
     out.append("#endif")
     return "\n".join(out) + "\n"
 
 
-MODEL_STRUCTS = """/* What the right-hand side needs besides the state. */
-typedef struct {
-    int64_t n;
-    const double *bp;
-    double *tm;          /* (4, n, n): T_K, T_L, delayed T_K, delayed T_L */
-    const double *lim;   /* (2n): negative, positive limits */
-    double *sat;         /* (n) saturation signs */
-    double *base;        /* (3n) θ, sin θ, cos θ at the step's start */
-    double *work;        /* (n, n + 4) */
-    double *tau;         /* (n) receives the joint moments */
-    int64_t nf;          /* torque feedback filter states after [Θ, Θ̇] (0: none) */
-    double tf_gain;      /* K_t [-] */
-    double tf_time;      /* τ_t [s] */
-    const double *C;     /* (p, n) joint-crossing rows */
-    const double *active;  /* (p) which pairs act */
-    double *fscr;        /* (2 + n + nf) the inputs with the filters' moments, their rates */
-} pl_model;
+def _prototypes(*sources: str) -> list[str]:
+    """The declaration of each function that the C ``sources`` define for the rest of the
+    engine: the signature of its definition there (from the column-0 line that starts it to
+    the line before its ``{``)."""
+    out = ["/* the functions of pl_model.c and pl_rhs_small.c (what each does: there) */"]
+    for text in sources:
+        signature: list[str] = []
+        for line in text.splitlines():
+            if line == "{" and signature:
+                out += signature[:-1] + [signature[-1] + ";"]
+                signature = []
+            elif line[:1].isalpha() and "(" in line and not line.startswith("static"):
+                signature = [line]
+            elif signature:
+                signature.append(line)
+    return out
 
-struct pl_history;
-
-/* What the inputs and an event function need besides (t, y). */
-typedef struct {
-    const pl_model *md;
-    const double *E, *dp, *fpar, *before, *ev_offset;
-    const struct pl_history *hist;
-    double delay;
-    const double *tp, *tilt_gain;          /* packed tilt, (4, n) joint gains on it */
-    double tilt_depth;                     /* tilt axis below the ankle [m] */
-    const double *mp;                      /* packed motor noise */
-    const double *gains;                   /* (4, p) the run's pair gains */
-    int64_t p;
-    double *sc_out, *sc_inp, *sc_x, *ys;   /* scratch (m), (2 + n + nf), (m), (m) */
-    const double *tilt_pair_gain;          /* (4, p) pair gains on the tilt */
-    const double *vp, *visual_gain;        /* packed visual-scene tilt, (4, n) gains on it */
-    const double *visual_pair_gain;        /* (4, p) pair gains on the visual-scene tilt */
-} pl_ctx;
-"""
-
-SMALL_N_HELPERS = """/* what the small-N right-hand sides (pl_rhs_small.c) read: θ_i, θ̇_i,
- * sin θ_i and cos θ_i of each link (about the base, pl_rotate), ẍ_d and g + ÿ_d */
-static inline void pl_small_unpack(const pl_model *md, const double *x, const double *inp, int n,
-                                   double *th, double *w, double *s, double *c, double *ax,
-                                   double *ga)
-{
-    for (int i = 0; i < n; i++) {
-        th[i] = x[i];
-        w[i] = x[n + i];
-        pl_rotate(th[i], md->base[i], md->base[n + i], md->base[2 * n + i], &s[i], &c[i]);
-    }
-    *ax = inp[0];
-    *ga = md->bp[2 * n + n * n] + inp[1];
-}
-
-/* the small-N right-hand sides' stores (pl_rhs_small.c), all last: out and tau may not be
- * read again, whatever they alias */
-static inline void pl_small_store(const pl_model *md, double *out, int n, const double *t,
-                                  const double *w, const double *a)
-{
-    for (int j = 0; j < n; j++)
-        md->tau[j] = t[j];
-    for (int i = 0; i < n; i++)
-        out[i] = w[i];
-    for (int i = 0; i < n; i++)
-        out[n + i] = a[i];
-}
-"""
-
-PROTOTYPES = """/* the right-hand side (pl_model.c, pl_rhs_small.c) */
-void pl_rhs(const pl_model *md, const double *x, double *out, const double *inp, int locked);
-void pl_rhs_general(const pl_model *md, const double *x, double *out, const double *inp,
-                    int locked);
-void pl_rhs1(const pl_model *md, const double *x, double *out, const double *inp, int locked);
-void pl_rhs2(const pl_model *md, const double *x, double *out, const double *inp, int locked);
-void pl_rhs3(const pl_model *md, const double *x, double *out, const double *inp, int locked);
-void pl_set_base(const double *x, double *base, int64_t n);
-void pl_moment_gains(const double *E, const double *C, const double *kd, const double *ld,
-                     const double *active, int64_t p, int64_t n, double *tk, double *tl);
-void pl_add_joint_gains(const double *jg, int64_t n, double *tm);
-void pl_project_velocity(double *x, const double *bp, double *work, int64_t n);
-
-/* the inputs and the event values (pl_model.c) */
-void pl_platform_acceleration(double t, const double *dp, double *ax, double *ay);
-void pl_tilt(double t, const double *tp, double *angle, double *rate, double *accel);
-void pl_motor_noise_add(double t, const double *mp, int64_t n, double *tau);
-void pl_inputs_at(const pl_ctx *cx, double t, double *out);
-double pl_event_value(const pl_ctx *cx, int64_t kind, int64_t idx, double side, double t,
-                      const double *y, int locked);
-
-/* what a switch does, which slots a segment lists (pl_model.c) */
-int pl_switch_needs_feedback(int64_t kind);
-void pl_apply_switch(const pl_run *run, int64_t kind, int64_t j, double side,
-                     const double *feedback, double *x, double *active, double *sat,
-                     int *locked, double *work);
-int pl_slot_on(int64_t cond, int64_t i, const double *sat, const double *active, int locked);
-double pl_slot_side(int64_t kind, int64_t i, double side, const double *sat);
-"""

@@ -13,14 +13,13 @@ from __future__ import annotations
 
 import inspect
 
-import sympy as sp
-
 from ....model import dynamics, joint_feedback, kinematics, platform, switched, tilt
 from ....model import events as ev
 from ....model.gains import GAIN_ROWS
 from . import filters_c
 from .codes import DIST_TERM_FIELDS, TILT_TERM_FIELDS
-from .spec import SYMPY, c, symbols
+from .headers import batch_row
+from .spec import SYMPY, c, symbols, trig_symbols
 from .switch_c import switch_effects
 
 HEADER = """/* The switched model for any N links: GENERATED, do not edit.
@@ -38,19 +37,7 @@ HEADER = """/* The switched model for any N links: GENERATED, do not edit.
  * input), from pl_inputs_at; with torque feedback the state is [Θ, Θ̇, Y] (filters_c.py). */
 #include <math.h>
 #include "pl.h"
-#include "pl_events.h"
 """
-
-
-def _trig_symbols(expr, angles: dict):
-    """``expr`` with sin and cos of differences expanded and sin θ, cos θ of each angle in
-    ``angles`` (symbol -> (sin name, cos name)) replaced by those names."""
-    expr = sp.expand_trig(expr)
-    subs = {}
-    for angle, (s, co) in angles.items():
-        subs[sp.sin(angle)] = symbols(s)
-        subs[sp.cos(angle)] = symbols(co)
-    return expr.xreplace(subs)
 
 
 # ---------------------------------------------------------------------------
@@ -69,19 +56,6 @@ def _platform() -> str:
                                               xp=SYMPY)
     sine = platform.sine_formula(t, **_row("sine", DIST_TERM_FIELDS, 2), xp=SYMPY)
     return f"""
-/* the largest k in [lo, hi) with x[k] <= t, by bisection (x increasing; lo if none) */
-static int64_t interval_of(const double *x, int64_t lo, int64_t hi, double t)
-{{
-    while (hi - lo > 1) {{
-        const int64_t mid = (lo + hi) >> 1;
-        if (x[mid] <= t)
-            lo = mid;
-        else
-            hi = mid;
-    }}
-    return lo;
-}}
-
 /* numpy.interp(t, xp, fp, left=0, right=0), xp = dp[first .. first+count), fp its col-th
  * block of count values after it */
 static double interp0(double t, const double *dp, int64_t first, int64_t count, int64_t col)
@@ -92,7 +66,7 @@ static double interp0(double t, const double *dp, int64_t first, int64_t count, 
     const int64_t off = col * count;
     if (t == dp[hi])
         return dp[hi + off];
-    const int64_t lo = interval_of(dp, first, hi, t);
+    const int64_t lo = pl_interval_of(dp, first, hi, t);
     const double slope = (dp[lo + 1 + off] - dp[lo + off]) / (dp[lo + 1] - dp[lo]);
     return slope * (t - dp[lo]) + dp[lo + off];
 }}
@@ -153,7 +127,7 @@ static void ppoly(double t, const double *x, const double *c, int64_t K, double 
         t = x[0];
     if (t > x[K])
         t = x[K];
-    const int64_t lo = interval_of(x, 0, K, t);
+    const int64_t lo = pl_interval_of(x, 0, K, t);
     const double u = t - x[lo], *q = c + 4 * lo;
     *angle = {c(cubic[0])};
     *rate = inside ? {c(cubic[1])} : 0.0;
@@ -192,7 +166,7 @@ void pl_motor_noise_add(double t, const double *mp, int64_t n, double *tau)
 {{
     const int64_t K = (int64_t)mp[0];
     const double *x = mp + 1, *c = mp + 2 + K;
-    const int64_t lo = interval_of(x, 0, K, t);  /* in [0, K - 1] */
+    const int64_t lo = pl_interval_of(x, 0, K, t);  /* in [0, K - 1] */
     const double u = t - x[lo], *q = c + lo * 4 * n;
     for (int64_t j = 0; j < n; j++)
         tau[j] += {c(noise)};
@@ -271,9 +245,9 @@ def _rhs() -> str:
     thi, thj, wj = symbols("thi", "thj", "x[n + j]")
     trig = {thi: ("si", "ci"), thj: ("sj", "cj")}
     cij, a_i = symbols("cij", "bp[i]")
-    coupling = _trig_symbols(dynamics.coupling_formula(cij, thi, thj, SYMPY), trig)
-    centripetal = _trig_symbols(dynamics.centripetal_formula(cij, thi, thj, wj, SYMPY), trig)
-    load = _trig_symbols(dynamics.load_formula(a_i, thi, *symbols("ga", "ax"), SYMPY), trig)
+    coupling = trig_symbols(dynamics.coupling_formula(cij, thi, thj, SYMPY), trig)
+    centripetal = trig_symbols(dynamics.centripetal_formula(cij, thi, thj, wj, SYMPY), trig)
+    load = trig_symbols(dynamics.load_formula(a_i, thi, *symbols("ga", "ax"), SYMPY), trig)
     saturated = switched.saturated_moment_formula(
         *symbols("t", "md->sat[j]", "md->lim[j]", "md->lim[n + j]"), SYMPY)
     xi, xj = symbols("x[i]", "x[j]")
@@ -339,29 +313,21 @@ void pl_rhs_general(const pl_model *md, const double *x, double *out, const doub
     }}
 }}
 {filters_c.rhs()}
-void pl_moment_gains(const double *E, const double *C, const double *kd, const double *ld,
-                     const double *active, int64_t p, int64_t n, double *tk, double *tl)
+/* A segment's moment gains tm (GAIN_ROWS, n, n): T_K, T_L and their delayed parts,
+ * T = Cᵀ diag(g·active) E for each row g of the pair gains (GAIN_ROWS, p), plus the
+ * joint-space controller's rows jg (model.joint_feedback; NULL: none). */
+void pl_moment_gains(const double *E, const double *C, const double *gains, const double *jg,
+                     const double *active, int64_t p, int64_t n, double *tm)
 {{
-    for (int64_t j = 0; j < n; j++)
-        for (int64_t k = 0; k < n; k++) {{
-            double sk = 0.0, sl = 0.0;
-            for (int64_t q = 0; q < p; q++) {{
-                const double wgt = C[q * n + j] * E[q * n + k] * active[q];
-                sk += wgt * kd[q];
-                sl += wgt * ld[q];
+    for (int64_t r = 0; r < {len(GAIN_ROWS)}; r++)
+        for (int64_t j = 0; j < n; j++)
+            for (int64_t k = 0; k < n; k++) {{
+                double sum = 0.0;
+                for (int64_t q = 0; q < p; q++)
+                    sum += C[q * n + j] * E[q * n + k] * active[q] * gains[r * p + q];
+                tm[(r * n + j) * n + k] = sum;
             }}
-            tk[j * n + k] = sk;
-            tl[j * n + k] = sl;
-        }}
-}}
-
-/* The joint-space controller's moment gains (4, n, n), rows GAIN_*, added to the pairs' T_K,
- * T_L and their delayed parts (model.joint_feedback); jg NULL: none. */
-void pl_add_joint_gains(const double *jg, int64_t n, double *tm)
-{{
-    if (!jg)
-        return;
-    for (int64_t k = 0; k < 4 * n * n; k++)
+    for (int64_t k = 0; jg && k < {len(GAIN_ROWS)} * n * n; k++)
         tm[k] = {c(joint)};
 }}
 
@@ -532,4 +498,4 @@ double pl_event_value(const pl_ctx *cx, int64_t kind, int64_t idx, double side, 
 def generate() -> str:
     """The text of ``csrc/pl_model.c``."""
     return (HEADER + _platform() + _tilt() + _inputs() + _rhs() + _events()
-            + switch_effects())
+            + switch_effects() + batch_row())

@@ -70,10 +70,9 @@ def _adjugate_lines(n: int, printer) -> tuple[list[str], list[list[str]]]:
 
 def _entry(expr, *links: int) -> str:
     """An entry formula on θ_i symbols printed with s[i], c[i] for sin θ_i, cos θ_i."""
-    from .model_c import _trig_symbols
-    from .spec import c, symbols
+    from .spec import c, symbols, trig_symbols
 
-    return c(_trig_symbols(expr, {symbols(f"th[{i}]"): (f"s[{i}]", f"c[{i}]") for i in links}))
+    return c(trig_symbols(expr, {symbols(f"th[{i}]"): (f"s[{i}]", f"c[{i}]") for i in links}))
 
 
 def _coupling(n: int, i: int, j: int) -> str:
@@ -116,7 +115,12 @@ def _rhs_function(n: int, printer) -> str:
          f"    double th[{n}], w[{n}], s[{n}], c[{n}], t[{n}], a[{n}], ax, ga;"]
     if n == 1:
         L.append("    (void)locked;")
-    L.append(f"    pl_small_unpack(md, x, inp, {n}, th, w, s, c, &ax, &ga);")
+    for i in range(n):  # θ_i, θ̇_i, sin θ_i and cos θ_i (about the step's start: pl_rotate)
+        L.append(f"    th[{i}] = x[{i}];")
+        L.append(f"    w[{i}] = x[{n + i}];")
+        L.append(f"    pl_rotate(th[{i}], md->base[{i}], md->base[{n + i}], md->base[{2 * n + i}], "
+                 f"&s[{i}], &c[{i}]);")
+    L += ["    ax = inp[0];", f"    ga = bp[{2 * n + n * n}] + inp[1];"]
     for j in range(n):
         k_terms = " + ".join(f"tk[{j * n + k}] * th[{k}]" for k in range(n))
         l_terms = " + ".join(f"tl[{j * n + k}] * w[{k}]" for k in range(n))
@@ -149,7 +153,10 @@ def _rhs_function(n: int, printer) -> str:
         for i in range(n):
             L.append(f"        a[{i}] -= y{i} * lam;")
         L.append("    }")
-    L.append(f"    pl_small_store(md, out, {n}, t, w, a);")
+    # the stores, all last: out and tau may not be read again, whatever they alias
+    L += [f"    md->tau[{j}] = t[{j}];" for j in range(n)]
+    L += [f"    out[{i}] = w[{i}];" for i in range(n)]
+    L += [f"    out[{n + i}] = a[{i}];" for i in range(n)]
     L.append("}")
     return "\n".join(L) + "\n"
 

@@ -78,6 +78,17 @@ def c(expr) -> str:
     return _PRINTER.doprint(sp.sympify(expr))
 
 
+def trig_symbols(expr, angles: dict):
+    """``expr`` with sin and cos of differences expanded and sin θ, cos θ of each angle in
+    ``angles`` (symbol -> (sin name, cos name)) replaced by those names."""
+    expr = sp.expand_trig(expr)
+    subs = {}
+    for angle, (s, co) in angles.items():
+        subs[sp.sin(angle)] = symbols(s)
+        subs[sp.cos(angle)] = symbols(co)
+    return expr.xreplace(subs)
+
+
 def equation_of_motion(n: int):
     """J(Θ), BΘ̇, G, H of an N-link chain, assembled from the entry formulas of
     :mod:`posturelab.model.dynamics` on symbols θ_i, θ̇_i, c_ij, J_ii and a_i.

@@ -17,7 +17,6 @@
 #include <string.h>
 #include <time.h>
 #include "pl.h"
-#include "pl_events.h"
 
 #define EPS 2.220446049250313e-16
 #define SAMPLE_BLOCK 64  /* samples evaluated together */
@@ -42,55 +41,33 @@ static double wall_seconds(void)
     return (double)time(NULL);
 }
 
+/* the run's work arrays: the doubles in one block (pl_alloc_block, owned by tm) */
 typedef struct {
     double *tm, *sat, *base, *work, *tau, *active, *x, *y, *Q, *inp, *g_old, *g_new, *sc_out,
         *sc_inp, *sc_x, *ys, *ev_side, *block, *Qg, *yp, *fscr;
     int64_t *ev_kind, *ev_index;
 } buffers;
 
-static void free_buffers(buffers *b)
-{
-    double *d[] = {b->tm, b->sat, b->base, b->work, b->tau, b->active, b->x, b->y, b->Q,
-                   b->inp, b->g_old, b->g_new, b->sc_out, b->sc_inp, b->sc_x, b->ys,
-                   b->ev_side, b->block, b->Qg, b->yp, b->fscr};
-    for (size_t k = 0; k < sizeof(d) / sizeof(d[0]); k++)
-        free(d[k]);
-    free(b->ev_kind);
-    free(b->ev_index);
-}
-
 static int alloc_buffers(buffers *b, int64_t n, int64_t nf, int64_t p, int64_t n_nodes,
                          int64_t n_slots)
 {
     const int64_t m = 2 * n + nf, cap = n_slots > 0 ? n_slots : 1, width = 2 + n + nf;
-    memset(b, 0, sizeof(*b));
-    b->tm = calloc(4 * n * n, sizeof(double));
-    b->sat = calloc(n, sizeof(double));
-    b->base = calloc(3 * n, sizeof(double));
-    b->work = calloc(n * (n + 4), sizeof(double));
-    b->tau = calloc(n, sizeof(double));
-    b->active = calloc(p > 0 ? p : 1, sizeof(double));
-    b->x = calloc(m, sizeof(double));
-    b->y = calloc(m, sizeof(double));
-    b->Q = calloc(4 * m, sizeof(double));
-    b->inp = calloc(n_nodes * width, sizeof(double));
-    b->g_old = calloc(cap, sizeof(double));
-    b->g_new = calloc(cap, sizeof(double));
-    b->ev_side = calloc(cap, sizeof(double));
-    b->ev_kind = calloc(cap, sizeof(int64_t));
-    b->ev_index = calloc(cap, sizeof(int64_t));
-    b->sc_out = calloc(m, sizeof(double));
-    b->sc_inp = calloc(width, sizeof(double));
-    b->sc_x = calloc(m, sizeof(double));
-    b->ys = calloc(m, sizeof(double));
-    b->block = calloc(m * SAMPLE_BLOCK, sizeof(double));
-    b->Qg = calloc(4 * m, sizeof(double));
-    b->yp = calloc(m, sizeof(double));
-    b->fscr = calloc(width, sizeof(double));
-    return b->tm && b->sat && b->base && b->work && b->tau && b->active && b->x && b->y
-           && b->Q && b->inp && b->g_old && b->g_new && b->ev_side && b->ev_kind
-           && b->ev_index && b->sc_out && b->sc_inp && b->sc_x && b->ys && b->block && b->Qg
-           && b->yp && b->fscr;
+    double **slots[] = {&b->tm, &b->sat, &b->base, &b->work, &b->tau, &b->active, &b->x, &b->y,
+                        &b->Q, &b->inp, &b->g_old, &b->g_new, &b->ev_side, &b->sc_out,
+                        &b->sc_inp, &b->sc_x, &b->ys, &b->block, &b->Qg, &b->yp, &b->fscr};
+    const int64_t sizes[] = {4 * n * n, n, 3 * n, n * (n + 4), n, p > 0 ? p : 1, m, m, 4 * m,
+                             n_nodes * width, cap, cap, cap, m, width, m, m,
+                             m * SAMPLE_BLOCK, 4 * m, m, width};
+    const int ok = pl_alloc_block(slots, sizes, sizeof(sizes) / sizeof(sizes[0]));
+    b->ev_kind = calloc(2 * cap, sizeof(int64_t));
+    b->ev_index = b->ev_kind ? b->ev_kind + cap : NULL;
+    return ok && b->ev_kind;
+}
+
+static void free_buffers(buffers *b)
+{
+    free(b->tm);
+    free(b->ev_kind);
 }
 
 /* The events of a smooth segment: the slots (posturelab.model.events.event_slots) whose
@@ -139,8 +116,13 @@ static int jump_add(jump_list *j, double t)
     return 1;
 }
 
-static void jump_pass(jump_list *j, double t)
+/* past the stops at or before t: breakpoints (bi), multiples of the delay (di), jumps */
+static void pass_stops(const pl_run *run, double t, int64_t *bi, int64_t *di, jump_list *j)
 {
+    while (*bi < run->n_bps && run->bps[*bi] <= t + 1e-12)
+        ++*bi;
+    while (run->delay > 0.0 && *di <= run->delay_multiples && *di * run->delay <= t + 1e-12)
+        ++*di;
     while (j->next < j->n && j->t[j->next] <= t + 1e-12)
         j->next++;
 }
@@ -161,15 +143,64 @@ static double next_stop(const pl_run *run, int64_t bi, int64_t di, const jump_li
 static int is_echo(const pl_run *run, int64_t i)
 {
     const double want = run->bps[i] - run->delay, tol = 1e-12 * fmax(1.0, run->bps[i]);
-    int64_t lo = 0, hi = i;  /* the first of bps[0 .. i) at or after want − tol */
-    while (lo < hi) {
-        const int64_t mid = (lo + hi) >> 1;
-        if (run->bps[mid] < want - tol)
-            lo = mid + 1;
-        else
-            hi = mid;
+    const int64_t k = pl_interval_of(run->bps, 0, i, want + tol);  /* the last at or before */
+    return i > 0 && run->bps[k] >= want - tol && run->bps[k] <= want + tol;
+}
+
+/* The first step of a segment from y0 (f0 = f(t0, y0)): scipy's select_initial_step, for an
+ * error estimate of this order; y1 and f1 are scratch. [s] */
+static double initial_step(const pl_model *md, double t0, const double *y0, const double *f0,
+                           double t_bound, double max_step, double rtol, double atol, int locked,
+                           const double *inp, double *y1, double *f1, int64_t m, int64_t order)
+{
+    const double interval = t_bound - t0;
+    if (interval <= 0.0)
+        return 0.0;
+    double d0 = 0.0, d1 = 0.0;
+    for (int64_t i = 0; i < m; i++) {
+        const double sc = atol + fabs(y0[i]) * rtol;
+        d0 += (y0[i] / sc) * (y0[i] / sc);
+        d1 += (f0[i] / sc) * (f0[i] / sc);
     }
-    return lo < i && run->bps[lo] <= want + tol;
+    d0 = sqrt(d0 / m);
+    d1 = sqrt(d1 / m);
+    double h0 = (d0 < 1e-5 || d1 < 1e-5) ? 1e-6 : 0.01 * d0 / d1;
+    h0 = fmin(h0, interval);
+    for (int64_t i = 0; i < m; i++)
+        y1[i] = y0[i] + h0 * f0[i];
+    pl_rhs(md, y1, f1, inp, locked);
+    double d2 = 0.0;
+    for (int64_t i = 0; i < m; i++) {
+        const double sc = atol + fabs(y0[i]) * rtol, v = (f1[i] - f0[i]) / sc;
+        d2 += v * v;
+    }
+    d2 = sqrt(d2 / m) / h0;
+    double h1 = (d1 <= 1e-15 && d2 <= 1e-15) ? fmax(1e-6, h0 * 1e-3)
+                                             : pow(0.01 / fmax(d1, d2), 1.0 / (order + 1.0));
+    return fmin(fmin(100.0 * h0, h1), fmin(interval, max_step));
+}
+
+/* The peaks of len samples of the angles (angle i's at rows + i·stride) into out->peak; the
+ * last of the samples outside the settling band, −1 if none. */
+static int64_t scan(pl_out *out, const double *rows, int64_t stride, int64_t n, int64_t len,
+                    double settle_tol)
+{
+    int64_t last_out = -1;
+    for (int64_t i = 0; i < n; i++) {
+        const double *restrict row = rows + i * stride;
+        double pk = out->peak[i];
+        for (int64_t g = 0; g < len; g++) {
+            const double v = fabs(row[g]);
+            pk = v > pk ? v : pk;
+        }
+        out->peak[i] = pk;
+        for (int64_t g = len - 1; g > last_out; g--)
+            if (fabs(row[g]) > settle_tol) {
+                last_out = g;
+                break;
+            }
+    }
+    return last_out;
 }
 
 /* How far inside a step its inputs are taken at a breakpoint it starts or ends on: far
@@ -220,8 +251,8 @@ int64_t pl_integrate(const pl_run *run, pl_out *out)
             ok = jump_add(&jumps, echo);
         }
     if (!ok) {
-        if (me.release)
-            me.release(&me);
+        free(me.arrays);
+        free(me.ws);
         free_buffers(&b);
         pl_history_free(&hist);
         free(jumps.t);
@@ -250,16 +281,9 @@ int64_t pl_integrate(const pl_run *run, pl_out *out)
 
     while (t < duration) {
         if (restart) {  /* a smooth segment starts (t = 0, or after a switch) */
-            while (bi < run->n_bps && run->bps[bi] <= t + 1e-12)
-                bi++;
-            while (delay > 0.0 && di <= run->delay_multiples && di * delay <= t + 1e-12)
-                di++;
-            jump_pass(&jumps, t);
-            pl_moment_gains(run->E, run->C, run->gains, run->gains + run->p, b.active, run->p,
-                            n, b.tm, b.tm + n * n);
-            pl_moment_gains(run->E, run->C, run->gains + 2 * run->p, run->gains + 3 * run->p,
-                            b.active, run->p, n, b.tm + 2 * n * n, b.tm + 3 * n * n);
-            pl_add_joint_gains(run->joint_gain, n, b.tm);
+            pass_stops(run, t, &bi, &di, &jumps);
+            pl_moment_gains(run->E, run->C, run->gains, run->joint_gain, b.active, run->p, n,
+                            b.tm);
             pl_set_base(x, b.base, n);
             if (t == 0.0 && locked && run->ipar[I_KNEE_MODE] == KNEE_STOP
                 && pl_event_value(&cx, EV_KNEE_LEAVES_STOP, 1, 0.0, t, x, locked) < 0.0)
@@ -274,12 +298,19 @@ int64_t pl_integrate(const pl_run *run, pl_out *out)
                 b.g_old[e] = pl_event_value(&cx, b.ev_kind[e], b.ev_index[e], b.ev_side[e],
                                             t - side, x, locked);
             pl_inputs_at(&cx, t + side, inp);
-            h = me.start(&me, &md, t, x, next_stop(run, bi, di, &jumps, duration), max_step,
-                         rtol, atol, locked, inp, &n_evals);
+            pl_rhs(&md, x, me.f0, inp, locked);
+            h = initial_step(&md, t, x, me.f0, next_stop(run, bi, di, &jumps, duration),
+                             max_step, rtol, atol, locked, inp, b.yp, b.Qg, m, me.order);
+            n_evals += 2;
+            me.start(&me, &md, x, inp, locked, rtol, &n_evals);
             restart = 0;
         }
         const double t_stop = next_stop(run, bi, di, &jumps, duration);
-        h = me.limit(&me, h, max_step);
+        if (h > max_step) {
+            h = max_step;
+            if (me.capped)
+                me.capped(&me);
+        }
         int landing = 0;
         if (t + 1.01 * h >= t_stop) {
             h = t_stop - t;  /* land exactly on the breakpoint (or the end) */
@@ -301,7 +332,7 @@ int64_t pl_integrate(const pl_run *run, pl_out *out)
         const double t_new = landing ? t_stop : t + h;
         const int overlap = overlapping && h > delay;  /* its past reaches into itself */
         if (overlap) {
-            pl_history_extrapolate(&hist, t, h, x, b.Qg);
+            pl_history_extrapolate(&hist, t, h, b.Qg);
             if (!pl_history_add(&hist, t, h, x, b.Qg)) {
                 status = PL_NO_MEMORY;
                 break;
@@ -415,37 +446,22 @@ int64_t pl_integrate(const pl_run *run, pl_out *out)
             final_outside = 0;
         for (int64_t g0 = gi; !quiet && g0 < g_end; g0 += SAMPLE_BLOCK) {
             const int64_t g1 = g0 + SAMPLE_BLOCK < g_end ? g0 + SAMPLE_BLOCK : g_end;
-            const int64_t len = g1 - g0;
+            const int64_t len = g1 - g0, stride = out->samples ? T + 1 : SAMPLE_BLOCK;
             const double inv_h = 1.0 / h;
             /* component i of samples g0 … g1 − 1: straight into the stored rows, or into the
              * block (a batch row keeps the angles only) */
+            double *rows = out->samples ? out->samples + g0 : b.block;
             for (int64_t i = 0; i < comps; i++) {
                 const double xi = x[i], q0 = Q[4 * i], q1 = Q[4 * i + 1], q2 = Q[4 * i + 2],
                              q3 = Q[4 * i + 3];
-                double *restrict row = out->samples ? out->samples + i * (T + 1) + g0
-                                                    : b.block + i * SAMPLE_BLOCK;
+                double *restrict row = rows + i * stride;
                 for (int64_t g = 0; g < len; g++) {
                     const double sg = (grid[g0 + g] - t) * inv_h;
                     row[g] = xi + sg * (q0 + sg * (q1 + sg * (q2 + sg * q3)));
                 }
             }
             /* peaks, and the last sample outside the settling band */
-            int64_t last_out = -1;
-            for (int64_t i = 0; i < n; i++) {
-                const double *restrict row = out->samples ? out->samples + i * (T + 1) + g0
-                                                          : b.block + i * SAMPLE_BLOCK;
-                double pk = out->peak[i];
-                for (int64_t g = 0; g < len; g++) {
-                    const double v = fabs(row[g]);
-                    pk = v > pk ? v : pk;
-                }
-                out->peak[i] = pk;
-                for (int64_t g = len - 1; g > last_out; g--)
-                    if (fabs(row[g]) > settle_tol) {
-                        last_out = g;
-                        break;
-                    }
-            }
+            const int64_t last_out = scan(out, rows, stride, n, len, settle_tol);
             if (last_out >= 0) {
                 last_outside = grid[g0 + last_out];
                 any_outside = 1;
@@ -463,15 +479,11 @@ int64_t pl_integrate(const pl_run *run, pl_out *out)
         gi = g_end;
         if (gi > first_gi) {
             /* the expression of the samples above (a batch row keeps no samples) */
-            const double s = (grid[gi - 1] - t) * (1.0 / h);
-            for (int64_t i = 0; i < 2 * n; i++) {
-                const double *q = Q + 4 * i;
-                out->final[i] = x[i] + s * (q[0] + s * (q[1] + s * (q[2] + s * q[3])));
-            }
+            pl_dense_at(x, Q, 2 * n, (grid[gi - 1] - t) * (1.0 / h), out->final);
         }
 
         if (ev_hit >= 0) {
-            pl_dense_at(x, Q, m, t, h, t_ev, b.ys);
+            pl_dense_at(x, Q, m, (t_ev - t) / h, b.ys);
             memcpy(x, b.ys, sizeof(double) * m);
             const int64_t kind = b.ev_kind[ev_hit], j = b.ev_index[ev_hit];
             t = t_ev;
@@ -483,14 +495,7 @@ int64_t pl_integrate(const pl_run *run, pl_out *out)
                 if (gi == 0 || grid[gi - 1] < t_ev - 1e-12) {
                     /* the state at the fall closes the series (off the sample grid) */
                     fall_sample = 1;
-                    int outside = 0;
-                    for (int64_t i = 0; i < n; i++) {
-                        const double v = fabs(x[i]);
-                        if (v > out->peak[i])
-                            out->peak[i] = v;
-                        if (v > settle_tol)
-                            outside = 1;
-                    }
+                    const int outside = scan(out, x, 1, n, 1, settle_tol) >= 0;
                     if (outside) {
                         last_outside = t_ev;
                         any_outside = 1;
@@ -534,40 +539,31 @@ int64_t pl_integrate(const pl_run *run, pl_out *out)
                 status = PL_NO_MEMORY;
                 break;
             }
-            int finite = 1;
-            for (int64_t i = 0; i < m; i++)
-                finite = finite && isfinite(x[i]);
-            if (!finite) {
-                status = PL_NONFINITE;
-                break;
-            }
             restart = 1;
             at_stop = ev_at_stop;
-            continue;
         }
-
+        const double *next = restart ? x : y;  /* the state the run goes on from */
         int finite = 1;
         for (int64_t i = 0; i < m; i++)
-            finite = finite && isfinite(y[i]);
+            finite = finite && isfinite(next[i]);
         if (!finite) {
             status = PL_NONFINITE;
             break;
         }
+        if (restart)
+            continue;
         t = t_new;
         memcpy(x, y, sizeof(double) * m);
-        me.commit(&me);
+        memcpy(me.f0, me.f_end, sizeof(double) * m);  /* the next step's first stage */
         memcpy(b.g_old, b.g_new, sizeof(double) * n_ev);
         pl_set_base(x, b.base, n);
         at_stop = landing;
         if (landing) {
-            while (bi < run->n_bps && run->bps[bi] <= t + 1e-12)
-                bi++;
-            while (delay > 0.0 && di <= run->delay_multiples && di * delay <= t + 1e-12)
-                di++;
-            jump_pass(&jumps, t);
+            pass_stops(run, t, &bi, &di, &jumps);
             if (has_inputs && t < duration) {  /* the first stage from just after it */
                 pl_inputs_at(&cx, t + side_of(t, h_next), inp);
-                me.refresh(&me, &md, x, inp, locked, &n_evals);
+                pl_rhs(&md, x, me.f0, inp, locked);
+                n_evals++;
             }
         }
         h = h_next;
@@ -587,7 +583,8 @@ int64_t pl_integrate(const pl_run *run, pl_out *out)
     res[R_ANY_OUTSIDE] = any_outside;
     res[R_FINAL_OUTSIDE] = final_outside;
     res[R_FALL_SAMPLE] = fall_sample;
-    me.release(&me);
+    free(me.arrays);
+    free(me.ws);
     free_buffers(&b);
     pl_history_free(&hist);
     free(jumps.t);

@@ -7,7 +7,6 @@
  * solve_ivp, 4 ε (1 + |t|). */
 #include <math.h>
 #include "pl.h"
-#include "pl_events.h"
 
 #define EPS 2.220446049250313e-16
 
@@ -27,7 +26,7 @@ double pl_event_root(const pl_ctx *cx, int64_t kind, int64_t idx, double side, d
         double tc = (ta * gb - tb * ga) / (gb - ga);
         if (!(tc > fmin(ta, tb) && tc < fmax(ta, tb)))
             tc = 0.5 * (ta + tb);
-        pl_dense_at(x, Q, 2 * cx->md->n + cx->md->nf, t0, h, tc, cx->ys);
+        pl_dense_at(x, Q, 2 * cx->md->n + cx->md->nf, (tc - t0) / h, cx->ys);
         const double gc = pl_event_value(cx, kind, idx, side, tc, cx->ys, locked);
         if (gc == 0.0)
             return tc;

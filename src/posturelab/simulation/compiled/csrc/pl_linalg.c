@@ -1,7 +1,36 @@
 /* Small dense linear algebra: Gaussian elimination and LU with partial pivoting, in place,
- * row-major, for any N. */
+ * row-major, for any N; the search of a sorted array; the work arrays of a run in one block. */
 #include <math.h>
+#include <stdlib.h>
 #include "pl.h"
+
+/* One zeroed block for a set of work arrays: *slots[k] gets sizes[k] doubles of it. The first
+ * owns the block (free it to free them all); all are NULL when there is no memory (returns 0). */
+int pl_alloc_block(double **const *slots, const int64_t *sizes, int64_t count)
+{
+    int64_t total = 0;
+    for (int64_t k = 0; k < count; k++)
+        total += sizes[k];
+    double *next = calloc(total > 0 ? total : 1, sizeof(double));
+    for (int64_t k = 0; k < count; k++) {
+        *slots[k] = next;
+        next = next ? next + sizes[k] : NULL;
+    }
+    return *slots[0] != NULL;
+}
+
+/* the largest k in [lo, hi) with x[k] <= t, by bisection (x increasing; lo if none) */
+int64_t pl_interval_of(const double *x, int64_t lo, int64_t hi, double t)
+{
+    while (hi - lo > 1) {
+        const int64_t mid = (lo + hi) >> 1;
+        if (x[mid] <= t)
+            lo = mid;
+        else
+            hi = mid;
+    }
+    return lo;
+}
 
 /* Gaussian elimination on the augmented (n, n + ncol) matrix M (rows ``stride`` apart); the
  * solutions replace the last ncol columns. */

@@ -13,20 +13,6 @@
  * input), from pl_inputs_at; with torque feedback the state is [Θ, Θ̇, Y] (filters_c.py). */
 #include <math.h>
 #include "pl.h"
-#include "pl_events.h"
-
-/* the largest k in [lo, hi) with x[k] <= t, by bisection (x increasing; lo if none) */
-static int64_t interval_of(const double *x, int64_t lo, int64_t hi, double t)
-{
-    while (hi - lo > 1) {
-        const int64_t mid = (lo + hi) >> 1;
-        if (x[mid] <= t)
-            lo = mid;
-        else
-            hi = mid;
-    }
-    return lo;
-}
 
 /* numpy.interp(t, xp, fp, left=0, right=0), xp = dp[first .. first+count), fp its col-th
  * block of count values after it */
@@ -38,7 +24,7 @@ static double interp0(double t, const double *dp, int64_t first, int64_t count, 
     const int64_t off = col * count;
     if (t == dp[hi])
         return dp[hi + off];
-    const int64_t lo = interval_of(dp, first, hi, t);
+    const int64_t lo = pl_interval_of(dp, first, hi, t);
     const double slope = (dp[lo + 1 + off] - dp[lo + off]) / (dp[lo + 1] - dp[lo]);
     return slope * (t - dp[lo]) + dp[lo + off];
 }
@@ -82,7 +68,7 @@ static void ppoly(double t, const double *x, const double *c, int64_t K, double 
         t = x[0];
     if (t > x[K])
         t = x[K];
-    const int64_t lo = interval_of(x, 0, K, t);
+    const int64_t lo = pl_interval_of(x, 0, K, t);
     const double u = t - x[lo], *q = c + 4 * lo;
     *angle = q[0] + u*(q[1] + u*(q[2] + q[3]*u));
     *rate = inside ? q[1] + u*(2.0*q[2] + 3.0*q[3]*u) : 0.0;
@@ -125,7 +111,7 @@ void pl_motor_noise_add(double t, const double *mp, int64_t n, double *tau)
 {
     const int64_t K = (int64_t)mp[0];
     const double *x = mp + 1, *c = mp + 2 + K;
-    const int64_t lo = interval_of(x, 0, K, t);  /* in [0, K - 1] */
+    const int64_t lo = pl_interval_of(x, 0, K, t);  /* in [0, K - 1] */
     const double u = t - x[lo], *q = c + lo * 4 * n;
     for (int64_t j = 0; j < n; j++)
         tau[j] += q[j] + u*(q[n + j] + u*(q[2 * n + j] + q[3 * n + j]*u));
@@ -282,29 +268,21 @@ void pl_rhs(const pl_model *md, const double *x, double *out, const double *inp,
         out[2 * n + q] = fs[2 + n + q];
 }
 
-void pl_moment_gains(const double *E, const double *C, const double *kd, const double *ld,
-                     const double *active, int64_t p, int64_t n, double *tk, double *tl)
+/* A segment's moment gains tm (GAIN_ROWS, n, n): T_K, T_L and their delayed parts,
+ * T = Cᵀ diag(g·active) E for each row g of the pair gains (GAIN_ROWS, p), plus the
+ * joint-space controller's rows jg (model.joint_feedback; NULL: none). */
+void pl_moment_gains(const double *E, const double *C, const double *gains, const double *jg,
+                     const double *active, int64_t p, int64_t n, double *tm)
 {
-    for (int64_t j = 0; j < n; j++)
-        for (int64_t k = 0; k < n; k++) {
-            double sk = 0.0, sl = 0.0;
-            for (int64_t q = 0; q < p; q++) {
-                const double wgt = C[q * n + j] * E[q * n + k] * active[q];
-                sk += wgt * kd[q];
-                sl += wgt * ld[q];
+    for (int64_t r = 0; r < 4; r++)
+        for (int64_t j = 0; j < n; j++)
+            for (int64_t k = 0; k < n; k++) {
+                double sum = 0.0;
+                for (int64_t q = 0; q < p; q++)
+                    sum += C[q * n + j] * E[q * n + k] * active[q] * gains[r * p + q];
+                tm[(r * n + j) * n + k] = sum;
             }
-            tk[j * n + k] = sk;
-            tl[j * n + k] = sl;
-        }
-}
-
-/* The joint-space controller's moment gains (4, n, n), rows GAIN_*, added to the pairs' T_K,
- * T_L and their delayed parts (model.joint_feedback); jg NULL: none. */
-void pl_add_joint_gains(const double *jg, int64_t n, double *tm)
-{
-    if (!jg)
-        return;
-    for (int64_t k = 0; k < 4 * n * n; k++)
+    for (int64_t k = 0; jg && k < 4 * n * n; k++)
         tm[k] = jg[k] + tm[k];
 }
 
@@ -557,4 +535,28 @@ int pl_slot_on(int64_t cond, int64_t i, const double *sat, const double *active,
     case COND_KNEE_LOCKED: return locked;
     default: return 1;
     }
+}
+
+/* Run r of a batch and where its outputs go (headers.BATCH_ROWS, BATCH_OUTS) */
+void pl_batch_row(const pl_batch *b, int64_t r, pl_run *run, pl_out *out)
+{
+    const int64_t n = b->base.n, p = b->base.p, level = b->which[r];
+    *run = b->base;
+    run->x0 = b->x0_all + level * (2 * n);
+    run->before = b->before_all + level * (2 * n);
+    run->dp = b->dp_all + level * (b->dp_stride);
+    run->ipar = b->ipar_all + level * (N_IPAR);
+    run->active0 = b->active0_all + level * (p);
+    run->gains = b->gains_all + r * (4 * p);
+    run->lim = b->lim_all + r * (2 * n);
+    run->delay = b->delay_all[r];
+    run->sat0 = b->sat0_all + r * (n);
+    run->method = b->method_all[r];
+    run->tilt_gain = b->tilt_gain_all + r * (4 * n);
+    run->tilt_pair_gain = b->tilt_pair_gain_all + r * (4 * p);
+    run->visual_gain = b->visual_gain_all + r * (4 * n);
+    run->visual_pair_gain = b->visual_pair_gain_all + r * (4 * p);
+    *out = (pl_out){.peak = b->peaks + r * (n),
+                     .final = b->finals + r * (2 * n),
+                     .res = b->results + r * (N_RESULT)};
 }

@@ -1,8 +1,9 @@
 /* The interface of the generated model: GENERATED, do not edit.
  *
  * python -m posturelab.simulation.compiled._codegen writes this file from
- * _codegen/headers.py (the structs' fields, which _layout.py carries for _binding.py,
- * and the small-N helpers) and sympy (the rotation's series); pl.h includes it. */
+ * _codegen/headers.py (the structs' fields, which _layout.py carries for
+ * _binding.py), sympy (the rotation's series) and the definitions in pl_model.c
+ * and pl_rhs_small.c (the prototypes); pl.h includes it. */
 #ifndef PL_MODEL_H
 #define PL_MODEL_H
 
@@ -47,7 +48,7 @@ typedef struct {
     const double *tp;                   /* packed tilt (tp[0] = 0: none) */
     const double *tilt_gain;            /* (4, n) joint moments per α(t), α̇(t), α(t−τ), α̇(t−τ) */
     double tilt_depth;                  /* tilt axis below the ankle [m] (0: the ankle's) */
-    const double *mp;                   /* packed motor noise (mp[0] = 0: none) */
+    const double *mp;                   /* packed motor noise (model.noise.TorqueSeries): mp[0] = K intervals (0: none), K + 1 knots, K·4·n coefficients (interval-major, ascending powers of t − knot, joint fastest) */
     int64_t n_filters;                  /* torque feedback filter states after [Θ, Θ̇]: p, or 0 */
     double filter_gain;                 /* K_t of the torque feedback [-] */
     double filter_time;                 /* τ_t of its filter [s] */
@@ -70,22 +71,46 @@ typedef struct {
     double *res;                        /* (N_RESULT) */
 } pl_out;
 
+/* A batch: its runs share base but for the rows below (pl_batch_row). */
+typedef struct {
+    pl_run base;                        /* what the runs share */
+    const int64_t *which;               /* (runs) the level of each run */
+    int64_t dp_stride;                  /* numbers per level of dp_all */
+    const double *x0_all;               /* (levels, 2 * n) */
+    const double *before_all;           /* (levels, 2 * n) */
+    const double *dp_all;               /* (levels, dp_stride) */
+    const int64_t *ipar_all;            /* (levels, N_IPAR) */
+    const double *active0_all;          /* (levels, p) */
+    const double *gains_all;            /* (runs, 4 * p) */
+    const double *lim_all;              /* (runs, 2 * n) */
+    const double *delay_all;            /* (runs) */
+    const double *sat0_all;             /* (runs, n) */
+    const int64_t *method_all;          /* (runs) */
+    const double *tilt_gain_all;        /* (runs, 4 * n) */
+    const double *tilt_pair_gain_all;   /* (runs, 4 * p) */
+    const double *visual_gain_all;      /* (runs, 4 * n) */
+    const double *visual_pair_gain_all; /* (runs, 4 * p) */
+    double *peaks;                      /* (runs, n) */
+    double *finals;                     /* (runs, 2 * n) */
+    double *results;                    /* (runs, N_RESULT) */
+} pl_batch;
+
 /* What the right-hand side needs besides the state. */
 typedef struct {
     int64_t n;
     const double *bp;
-    double *tm;          /* (4, n, n): T_K, T_L, delayed T_K, delayed T_L */
-    const double *lim;   /* (2n): negative, positive limits */
-    double *sat;         /* (n) saturation signs */
-    double *base;        /* (3n) θ, sin θ, cos θ at the step's start */
-    double *work;        /* (n, n + 4) */
-    double *tau;         /* (n) receives the joint moments */
-    int64_t nf;          /* torque feedback filter states after [Θ, Θ̇] (0: none) */
-    double tf_gain;      /* K_t [-] */
-    double tf_time;      /* τ_t [s] */
-    const double *C;     /* (p, n) joint-crossing rows */
-    const double *active;  /* (p) which pairs act */
-    double *fscr;        /* (2 + n + nf) the inputs with the filters' moments, their rates */
+    double *tm;                         /* (4, n, n): T_K, T_L, delayed T_K, delayed T_L */
+    const double *lim;                  /* (2n): negative, positive limits */
+    double *sat;                        /* (n) saturation signs */
+    double *base;                       /* (3n) θ, sin θ, cos θ at the step's start */
+    double *work;                       /* (n, n + 4) */
+    double *tau;                        /* (n) receives the joint moments */
+    int64_t nf;                         /* torque feedback filter states after [Θ, Θ̇] (0: none) */
+    double tf_gain;                     /* K_t [-] */
+    double tf_time;                     /* τ_t [s] */
+    const double *C;                    /* (p, n) joint-crossing rows */
+    const double *active;               /* (p) which pairs act */
+    double *fscr;                       /* (2 + n + nf) the inputs with the filters' moments, their rates */
 } pl_model;
 
 struct pl_history;
@@ -93,18 +118,27 @@ struct pl_history;
 /* What the inputs and an event function need besides (t, y). */
 typedef struct {
     const pl_model *md;
-    const double *E, *dp, *fpar, *before, *ev_offset;
+    const double *E;
+    const double *dp;
+    const double *fpar;
+    const double *before;
+    const double *ev_offset;
     const struct pl_history *hist;
     double delay;
-    const double *tp, *tilt_gain;          /* packed tilt, (4, n) joint gains on it */
-    double tilt_depth;                     /* tilt axis below the ankle [m] */
-    const double *mp;                      /* packed motor noise */
-    const double *gains;                   /* (4, p) the run's pair gains */
+    const double *tp;                   /* packed tilt */
+    const double *tilt_gain;            /* (4, n) joint gains on the tilt */
+    double tilt_depth;                  /* tilt axis below the ankle [m] */
+    const double *mp;                   /* packed motor noise */
+    const double *gains;                /* (4, p) the run's pair gains */
     int64_t p;
-    double *sc_out, *sc_inp, *sc_x, *ys;   /* scratch (m), (2 + n + nf), (m), (m) */
-    const double *tilt_pair_gain;          /* (4, p) pair gains on the tilt */
-    const double *vp, *visual_gain;        /* packed visual-scene tilt, (4, n) gains on it */
-    const double *visual_pair_gain;        /* (4, p) pair gains on the visual-scene tilt */
+    double *sc_out;                     /* scratch (m) */
+    double *sc_inp;                     /* (2 + n + nf) */
+    double *sc_x;                       /* (m) */
+    double *ys;                         /* (m) */
+    const double *tilt_pair_gain;       /* (4, p) pair gains on the tilt */
+    const double *vp;                   /* packed visual-scene tilt */
+    const double *visual_gain;          /* (4, n) joint gains on it */
+    const double *visual_pair_gain;     /* (4, p) pair gains on it */
 } pl_ctx;
 
 /* sin θ and cos θ from those of a nearby θ_b by the angle-sum formulas: within a step the
@@ -127,61 +161,29 @@ static inline void pl_rotate(double theta, double theta_b, double s_b, double c_
     *c = c_b + (c_b * cdm1 - s_b * sd);
 }
 
-/* what the small-N right-hand sides (pl_rhs_small.c) read: θ_i, θ̇_i,
- * sin θ_i and cos θ_i of each link (about the base, pl_rotate), ẍ_d and g + ÿ_d */
-static inline void pl_small_unpack(const pl_model *md, const double *x, const double *inp, int n,
-                                   double *th, double *w, double *s, double *c, double *ax,
-                                   double *ga)
-{
-    for (int i = 0; i < n; i++) {
-        th[i] = x[i];
-        w[i] = x[n + i];
-        pl_rotate(th[i], md->base[i], md->base[n + i], md->base[2 * n + i], &s[i], &c[i]);
-    }
-    *ax = inp[0];
-    *ga = md->bp[2 * n + n * n] + inp[1];
-}
-
-/* the small-N right-hand sides' stores (pl_rhs_small.c), all last: out and tau may not be
- * read again, whatever they alias */
-static inline void pl_small_store(const pl_model *md, double *out, int n, const double *t,
-                                  const double *w, const double *a)
-{
-    for (int j = 0; j < n; j++)
-        md->tau[j] = t[j];
-    for (int i = 0; i < n; i++)
-        out[i] = w[i];
-    for (int i = 0; i < n; i++)
-        out[n + i] = a[i];
-}
-
-/* the right-hand side (pl_model.c, pl_rhs_small.c) */
-void pl_rhs(const pl_model *md, const double *x, double *out, const double *inp, int locked);
-void pl_rhs_general(const pl_model *md, const double *x, double *out, const double *inp,
-                    int locked);
-void pl_rhs1(const pl_model *md, const double *x, double *out, const double *inp, int locked);
-void pl_rhs2(const pl_model *md, const double *x, double *out, const double *inp, int locked);
-void pl_rhs3(const pl_model *md, const double *x, double *out, const double *inp, int locked);
-void pl_set_base(const double *x, double *base, int64_t n);
-void pl_moment_gains(const double *E, const double *C, const double *kd, const double *ld,
-                     const double *active, int64_t p, int64_t n, double *tk, double *tl);
-void pl_add_joint_gains(const double *jg, int64_t n, double *tm);
-void pl_project_velocity(double *x, const double *bp, double *work, int64_t n);
-
-/* the inputs and the event values (pl_model.c) */
+/* the functions of pl_model.c and pl_rhs_small.c (what each does: there) */
 void pl_platform_acceleration(double t, const double *dp, double *ax, double *ay);
 void pl_tilt(double t, const double *tp, double *angle, double *rate, double *accel);
 void pl_motor_noise_add(double t, const double *mp, int64_t n, double *tau);
 void pl_inputs_at(const pl_ctx *cx, double t, double *out);
+void pl_set_base(const double *x, double *base, int64_t n);
+void pl_rhs_general(const pl_model *md, const double *x, double *out, const double *inp,
+                    int locked);
+void pl_rhs(const pl_model *md, const double *x, double *out, const double *inp, int locked);
+void pl_moment_gains(const double *E, const double *C, const double *gains, const double *jg,
+                     const double *active, int64_t p, int64_t n, double *tm);
+void pl_project_velocity(double *x, const double *bp, double *work, int64_t n);
 double pl_event_value(const pl_ctx *cx, int64_t kind, int64_t idx, double side, double t,
                       const double *y, int locked);
-
-/* what a switch does, which slots a segment lists (pl_model.c) */
+double pl_slot_side(int64_t kind, int64_t i, double side, const double *sat);
 int pl_switch_needs_feedback(int64_t kind);
 void pl_apply_switch(const pl_run *run, int64_t kind, int64_t j, double side,
                      const double *feedback, double *x, double *active, double *sat,
                      int *locked, double *work);
 int pl_slot_on(int64_t cond, int64_t i, const double *sat, const double *active, int locked);
-double pl_slot_side(int64_t kind, int64_t i, double side, const double *sat);
+void pl_batch_row(const pl_batch *b, int64_t r, pl_run *run, pl_out *out);
+void pl_rhs1(const pl_model *md, const double *x, double *out, const double *inp, int locked);
+void pl_rhs2(const pl_model *md, const double *x, double *out, const double *inp, int locked);
+void pl_rhs3(const pl_model *md, const double *x, double *out, const double *inp, int locked);
 
 #endif

@@ -29,43 +29,14 @@ PL_EXPORT const char *pl_source_files(void) { return PL_SOURCE_FILES; }
 
 PL_EXPORT int64_t pl_run_one(const pl_run *run, pl_out *out) { return pl_integrate(run, out); }
 
-/* A batch: run r uses level which[r] (its start state, the state before, its disturbance,
- * options and pairs acting at the start) and its own gains, limits, delay and saturation. */
-typedef struct {
-    pl_run base;
-    const int64_t *which;
-    const double *x0_all, *before_all, *dp_all;
-    int64_t dp_stride;
-    const int64_t *ipar_all;
-    const double *active0_all, *gains_all, *lim_all, *delay_all, *sat0_all;
-    const int64_t *method_all;   /* per run: METHOD_RADAU or METHOD_EXPLICIT (the tableau) */
-    double *results, *peaks, *finals;
-    const double *tilt_gain_all, *tilt_pair_gain_all; /* per run (4, n), (4, p) */
-    const double *visual_gain_all, *visual_pair_gain_all; /* the same on the visual scene */
-} pl_batch;
-
+/* Rows [begin, end) of a batch (pl_batch_row: run r uses level which[r] and its own row of
+ * each per-run array). */
 PL_EXPORT void pl_run_batch(const pl_batch *b, int64_t begin, int64_t end)
 {
-    const int64_t n = b->base.n, m = 2 * n, p = b->base.p;
     for (int64_t r = begin; r < end; r++) {
-        pl_run run = b->base;
-        const int64_t lv = b->which[r];
-        run.x0 = b->x0_all + lv * m;
-        run.before = b->before_all + lv * m;
-        run.dp = b->dp_all + lv * b->dp_stride;
-        run.ipar = b->ipar_all + lv * N_IPAR;
-        run.active0 = b->active0_all + lv * p;
-        run.gains = b->gains_all + r * 4 * p;
-        run.lim = b->lim_all + r * 2 * n;  /* (2n): negative limits, positive limits */
-        run.delay = b->delay_all[r];
-        run.sat0 = b->sat0_all + r * n;
-        run.method = b->method_all[r];
-        run.tilt_gain = b->tilt_gain_all + r * 4 * n;
-        run.tilt_pair_gain = b->tilt_pair_gain_all + r * 4 * p;
-        run.visual_gain = b->visual_gain_all + r * 4 * n;
-        run.visual_pair_gain = b->visual_pair_gain_all + r * 4 * p;
-        pl_out out = {NULL, NULL, NULL, NULL, 0, b->peaks + r * n, b->finals + r * m,
-                      b->results + r * N_RESULT};
+        pl_run run;
+        pl_out out;
+        pl_batch_row(b, r, &run, &out);
         pl_integrate(&run, &out);
     }
 }
@@ -76,19 +47,13 @@ PL_EXPORT void pl_state_derivative(int64_t n, int64_t p, const double *bp, const
                                    const double *inp, int64_t locked, int64_t general,
                                    double *out, double *tau)
 {
-    double *tm = malloc(sizeof(double) * 4 * n * n), *base = malloc(sizeof(double) * 3 * n);
-    double *work = malloc(sizeof(double) * n * (n + 4)), *s = malloc(sizeof(double) * n);
-    if (!tm || !base || !work || !s) {
-        free(tm);
-        free(base);
-        free(work);
-        free(s);
+    double *tm, *base, *work, *s;
+    double **slots[] = {&tm, &base, &work, &s};
+    const int64_t sizes[] = {4 * n * n, 3 * n, n * (n + 4), n};
+    if (!pl_alloc_block(slots, sizes, 4))
         return;
-    }
     memcpy(s, sat, sizeof(double) * n);
-    pl_moment_gains(E, C, gains, gains + p, active, p, n, tm, tm + n * n);
-    pl_moment_gains(E, C, gains + 2 * p, gains + 3 * p, active, p, n, tm + 2 * n * n,
-                    tm + 3 * n * n);
+    pl_moment_gains(E, C, gains, NULL, active, p, n, tm);
     pl_set_base(x, base, n);
     pl_model md = {n, bp, tm, lim, s, base, work, tau};
     if (general)
@@ -96,9 +61,6 @@ PL_EXPORT void pl_state_derivative(int64_t n, int64_t p, const double *bp, const
     else
         pl_rhs(&md, x, out, inp, (int)locked);
     free(tm);
-    free(base);
-    free(work);
-    free(s);
 }
 
 PL_EXPORT void pl_rotate_value(double theta, double theta_b, double s_b, double c_b, double *s,
@@ -114,6 +76,5 @@ static struct PyModuleDef engine_module = {
 
 PyMODINIT_FUNC PyInit__engine(void)
 {
-    pl_radau_constants();
     return PyModule_Create(&engine_module);
 }

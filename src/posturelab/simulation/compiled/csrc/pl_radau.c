@@ -17,63 +17,24 @@
 #include <stdlib.h>
 #include <string.h>
 #include "pl.h"
+#include "pl_radau.h"  /* scipy's constants (generated): NODES, MU_*, E1–E3, P, T, TI */
 
 #define NEWTON_MAXITER 6
 #define SQRT_EPS 1.4901161193847656e-08
 #define EPS 2.220446049250313e-16
 
-static const double S6 = 2.449489742783178;  /* √6 */
-static double NODES[4];
-static double MU_REAL, MU_CRE, MU_CIM, E1, E2, E3;
-static double P[3][3];
-static int constants_ready = 0;
-/* the transformation that diagonalises the inverse Radau matrix, to the digits scipy prints */
-static const double T[3][3] = {{0.09443876248897524, -0.14125529502095421, 0.03002919410514742},
-                               {0.25021312296533332, 0.20412935229379994, -0.38294211275726192},
-                               {1.0, 1.0, 0.0}};
-static const double TI[3][3] = {{4.17871859155190428, 0.32768282076106237, 0.52337644549944951},
-                                {-4.17871859155190428, -0.32768282076106237,
-                                 0.47662355450055044},
-                                {0.50287263494578682, -2.57192694985560522,
-                                 0.59603920482822492}};
-
-void pl_radau_constants(void)
-{
-    if (constants_ready)
-        return;
-    NODES[0] = 0.0;
-    NODES[1] = (4.0 - S6) / 10.0;
-    NODES[2] = (4.0 + S6) / 10.0;
-    NODES[3] = 1.0;
-    E1 = (-13.0 - 7.0 * S6) / 3.0;
-    E2 = (-13.0 + 7.0 * S6) / 3.0;
-    E3 = -1.0 / 3.0;
-    MU_REAL = 3.0 + pow(3.0, 2.0 / 3.0) - pow(3.0, 1.0 / 3.0);
-    MU_CRE = 3.0 + 0.5 * (pow(3.0, 1.0 / 3.0) - pow(3.0, 2.0 / 3.0));
-    MU_CIM = -0.5 * (pow(3.0, 5.0 / 6.0) + pow(3.0, 7.0 / 6.0));
-    const double p[3][3] = {
-        {13.0 / 3.0 + 7.0 * S6 / 3.0, -23.0 / 3.0 - 22.0 * S6 / 3.0, 10.0 / 3.0 + 5.0 * S6},
-        {13.0 / 3.0 - 7.0 * S6 / 3.0, -23.0 / 3.0 + 22.0 * S6 / 3.0, 10.0 / 3.0 - 5.0 * S6},
-        {1.0 / 3.0, -8.0 / 3.0, 10.0 / 3.0}};
-    memcpy(P, p, sizeof(P));
-    constants_ready = 1;
-}
-
-typedef struct radau_ws radau_ws;
-static void prepared_solve(const radau_ws *w, const double *A, const int64_t *piv, double *b,
-                           int64_t k);
-
-struct radau_ws {
+typedef struct {
     int64_t n, m;
     double *Z, *Z0, *W, *F;       /* (3, m) */
     double *jac;                  /* (n + 1, m) acceleration rows, row n: D */
     double *lur; int64_t *pivr;   /* (n, n) real system: its factors, or inverse */
     double *luc; int64_t *pivc;   /* (2n, 2n) complex system, embedded: likewise */
     int closed;                   /* N = 3: closed-form inverses (matrix–vector solves) */
-    double *scale, *fr, *fcr, *fci, *tmp, *err, *xt, *s1, *s2, *xold, *f0, *fnew;
+    double *scale, *fr, *fcr, *fci, *tmp, *err, *xt, *s1, *xold, *f0, *fnew;
     double h_lu, h_old, err_old, h_start, t_prev, h_prev, newton_tol;
     int have_sol, current_jac, err_rejected, last_rejected;
-};
+    int64_t piv[];                /* (3n): pivr, pivc */
+} radau_ws;
 
 static int64_t jacobian(radau_ws *w, const pl_model *md, const double *x, const double *f0,
                         const double *inp, int locked)
@@ -306,32 +267,23 @@ static double predict(double h, double h_old, double err, double err_old)
     return fmin(1.0, mult) / sqrt(sqrt(err));
 }
 
-static double radau_start(pl_method *me, const pl_model *md, double t, const double *x,
-                          double t_stop, double max_step, double rtol, double atol,
-                          int locked, const double *inp, int64_t *evals)
+static void radau_start(pl_method *me, const pl_model *md, const double *x, const double *inp,
+                        int locked, double rtol, int64_t *evals)
 {
     radau_ws *w = me->ws;
-    pl_rhs(md, x, w->f0, inp, locked);
-    const double h = pl_initial_step(md, t, x, w->f0, t_stop, max_step, rtol, atol, locked, inp,
-                                     w->s1, w->s2, w->m, 3);
-    *evals += 2 + jacobian(w, md, x, w->f0, inp, locked);
+    *evals += jacobian(w, md, x, w->f0, inp, locked);
     w->current_jac = 1;
     w->have_sol = 0;
     w->err_rejected = 0;
     w->last_rejected = 0;
     w->h_lu = w->h_old = w->err_old = -1.0;
     w->newton_tol = fmax(10.0 * EPS / rtol, fmin(0.03, sqrt(rtol)));
-    return h;
 }
 
-static double radau_limit(pl_method *me, double h, double max_step)
+static void radau_capped(pl_method *me)
 {
     radau_ws *w = me->ws;
-    if (h > max_step) {  /* a capped step forgets the step-size history (scipy) */
-        w->h_old = w->err_old = -1.0;
-        return max_step;
-    }
-    return h;
+    w->h_old = w->err_old = -1.0;  /* a capped step forgets the step-size history (scipy) */
 }
 
 static int radau_attempt(pl_method *me, const pl_model *md, double t, double h,
@@ -344,16 +296,12 @@ static int radau_attempt(pl_method *me, const pl_model *md, double t, double h,
         w->h_start = h;
     if (h != w->h_lu)
         factor(w, h);
-    for (int64_t s = 0; s < 3; s++) {  /* first guess: the last collocation polynomial */
-        if (w->have_sol) {
-            const double sg = (t + NODES[s + 1] * h - w->t_prev) / w->h_prev;
-            for (int64_t i = 0; i < m; i++) {
-                const double *q = Q + 4 * i;
-                w->Z0[s * m + i] = w->xold[i] + sg * (q[0] + sg * (q[1] + sg * q[2])) - x[i];
-            }
-        } else {
-            for (int64_t i = 0; i < m; i++)
-                w->Z0[s * m + i] = 0.0;
+    memset(w->Z0, 0, sizeof(double) * 3 * m);  /* first guess: zero, or after a kept step */
+    for (int64_t s = 0; w->have_sol && s < 3; s++) {  /* the last collocation polynomial */
+        const double sg = (t + NODES[s + 1] * h - w->t_prev) / w->h_prev;
+        for (int64_t i = 0; i < m; i++) {
+            const double *q = Q + 4 * i;
+            w->Z0[s * m + i] = w->xold[i] + sg * (q[0] + sg * (q[1] + sg * q[2])) - x[i];
         }
     }
     for (int64_t i = 0; i < m; i++)
@@ -425,65 +373,26 @@ static int radau_attempt(pl_method *me, const pl_model *md, double t, double h,
     return 1;
 }
 
-static void radau_commit(pl_method *me)
-{
-    radau_ws *w = me->ws;
-    memcpy(w->f0, w->fnew, sizeof(double) * w->m);
-}
-
-/* after a step onto a breakpoint: f at the step's start from the inputs just after it */
-static void radau_refresh(pl_method *me, const pl_model *md, const double *x,
-                          const double *inp, int locked, int64_t *evals)
-{
-    radau_ws *w = me->ws;
-    pl_rhs(md, x, w->f0, inp, locked);
-    *evals += 1;
-}
-
-static void radau_release(pl_method *me)
-{
-    radau_ws *w = me->ws;
-    if (w) {
-        double *arrays[] = {w->Z, w->Z0, w->W, w->F, w->jac, w->lur, w->luc, w->scale, w->fr,
-                            w->fcr, w->fci, w->tmp, w->err, w->xt, w->s1, w->s2, w->xold,
-                            w->f0, w->fnew};
-        for (size_t k = 0; k < sizeof(arrays) / sizeof(arrays[0]); k++)
-            free(arrays[k]);
-        free(w->pivr);
-        free(w->pivc);
-        free(w);
-    }
-    me->ws = NULL;
-}
-
 int pl_radau_init(pl_method *me, int64_t n, int64_t m)
 {
-    pl_radau_constants();
-    radau_ws *w = calloc(1, sizeof(radau_ws));
-    *me = (pl_method){.n_nodes = 4, .nodes = NODES, .ws = w,
-                      .start = radau_start, .limit = radau_limit, .attempt = radau_attempt,
-                      .commit = radau_commit, .release = radau_release,
-                      .refresh = radau_refresh};
+    radau_ws *w = calloc(1, sizeof(radau_ws) + sizeof(int64_t) * 3 * n);
+    *me = (pl_method){.n_nodes = 4, .order = 3, .nodes = NODES, .ws = w, .start = radau_start,
+                      .capped = radau_capped, .attempt = radau_attempt};
     if (!w)
         return 0;
     w->n = n;
     w->m = m;
-    w->Z = calloc(3 * m, sizeof(double));
-    w->Z0 = calloc(3 * m, sizeof(double));
-    w->W = calloc(3 * m, sizeof(double));
-    w->F = calloc(3 * m, sizeof(double));
-    w->jac = calloc((n + 1) * m, sizeof(double));
-    w->lur = calloc(n * n, sizeof(double));
-    w->luc = calloc(4 * n * n, sizeof(double));
-    w->pivr = calloc(n, sizeof(int64_t));
-    w->pivc = calloc(2 * n, sizeof(int64_t));
     w->closed = n == 3;
-    double **vectors[] = {&w->scale, &w->fr, &w->fcr, &w->fci, &w->tmp, &w->err, &w->xt,
-                          &w->s1, &w->s2, &w->xold, &w->f0, &w->fnew};
-    int ok = w->Z && w->Z0 && w->W && w->F && w->jac && w->lur && w->luc && w->pivr && w->pivc;
-    for (size_t k = 0; k < sizeof(vectors) / sizeof(vectors[0]); k++) {
-        *vectors[k] = calloc(m, sizeof(double));
-        ok = ok && *vectors[k];
-    }
+    double **slots[] = {&w->Z, &w->Z0, &w->W, &w->F, &w->jac, &w->lur, &w->luc, &w->scale,
+                        &w->fr, &w->fcr, &w->fci, &w->tmp, &w->err, &w->xt, &w->s1, &w->xold,
+                        &w->f0, &w->fnew};
+    const int64_t sizes[] = {3 * m, 3 * m, 3 * m, 3 * m, (n + 1) * m, n * n, 4 * n * n, m, m, m,
+                             m, m, m, m, m, m, m, m};
+    const int ok = pl_alloc_block(slots, sizes, sizeof(sizes) / sizeof(sizes[0]));
+    w->pivr = w->piv;
+    w->pivc = w->piv + n;
+    me->arrays = w->Z;
+    me->f0 = w->f0;
+    me->f_end = w->fnew;
     return ok;
 }

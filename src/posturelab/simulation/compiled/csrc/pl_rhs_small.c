@@ -10,7 +10,11 @@ void pl_rhs1(const pl_model *md, const double *x, double *out, const double *inp
     const double *bp = md->bp, *tk = md->tm, *tl = md->tm + 1;
     double th[1], w[1], s[1], c[1], t[1], a[1], ax, ga;
     (void)locked;
-    pl_small_unpack(md, x, inp, 1, th, w, s, c, &ax, &ga);
+    th[0] = x[0];
+    w[0] = x[1];
+    pl_rotate(th[0], md->base[0], md->base[1], md->base[2], &s[0], &c[0]);
+    ax = inp[0];
+    ga = bp[3] + inp[1];
     t[0] = inp[2] + (tk[0] * th[0]) + (tl[0] * w[0]);
     t[0] = ((md->sat[0] != 0.0) ? (md->sat[0]*((md->sat[0] > 0.0) ? (md->lim[1]) : (md->lim[0]))) : (t[0]));
     const double u0 = -t[0];
@@ -19,14 +23,23 @@ void pl_rhs1(const pl_model *md, const double *x, double *out, const double *inp
     const double m00 = 1.0;
     const double inv_det = 1.0 / (j00 * m00);
     a[0] = (m00 * r0) * inv_det;
-    pl_small_store(md, out, 1, t, w, a);
+    md->tau[0] = t[0];
+    out[0] = w[0];
+    out[1] = a[0];
 }
 
 void pl_rhs2(const pl_model *md, const double *x, double *out, const double *inp, int locked)
 {
     const double *bp = md->bp, *tk = md->tm, *tl = md->tm + 4;
     double th[2], w[2], s[2], c[2], t[2], a[2], ax, ga;
-    pl_small_unpack(md, x, inp, 2, th, w, s, c, &ax, &ga);
+    th[0] = x[0];
+    w[0] = x[2];
+    pl_rotate(th[0], md->base[0], md->base[2], md->base[4], &s[0], &c[0]);
+    th[1] = x[1];
+    w[1] = x[3];
+    pl_rotate(th[1], md->base[1], md->base[3], md->base[5], &s[1], &c[1]);
+    ax = inp[0];
+    ga = bp[8] + inp[1];
     t[0] = inp[2] + (tk[0] * th[0] + tk[1] * th[1]) + (tl[0] * w[0] + tl[1] * w[1]);
     t[0] = ((md->sat[0] != 0.0) ? (md->sat[0]*((md->sat[0] > 0.0) ? (md->lim[2]) : (md->lim[0]))) : (t[0]));
     t[1] = inp[3] + (tk[2] * th[0] + tk[3] * th[1]) + (tl[2] * w[0] + tl[3] * w[1]);
@@ -53,14 +66,29 @@ void pl_rhs2(const pl_model *md, const double *x, double *out, const double *inp
         a[0] -= y0 * lam;
         a[1] -= y1 * lam;
     }
-    pl_small_store(md, out, 2, t, w, a);
+    md->tau[0] = t[0];
+    md->tau[1] = t[1];
+    out[0] = w[0];
+    out[1] = w[1];
+    out[2] = a[0];
+    out[3] = a[1];
 }
 
 void pl_rhs3(const pl_model *md, const double *x, double *out, const double *inp, int locked)
 {
     const double *bp = md->bp, *tk = md->tm, *tl = md->tm + 9;
     double th[3], w[3], s[3], c[3], t[3], a[3], ax, ga;
-    pl_small_unpack(md, x, inp, 3, th, w, s, c, &ax, &ga);
+    th[0] = x[0];
+    w[0] = x[3];
+    pl_rotate(th[0], md->base[0], md->base[3], md->base[6], &s[0], &c[0]);
+    th[1] = x[1];
+    w[1] = x[4];
+    pl_rotate(th[1], md->base[1], md->base[4], md->base[7], &s[1], &c[1]);
+    th[2] = x[2];
+    w[2] = x[5];
+    pl_rotate(th[2], md->base[2], md->base[5], md->base[8], &s[2], &c[2]);
+    ax = inp[0];
+    ga = bp[15] + inp[1];
     t[0] = inp[2] + (tk[0] * th[0] + tk[1] * th[1] + tk[2] * th[2]) + (tl[0] * w[0] + tl[1] * w[1] + tl[2] * w[2]);
     t[0] = ((md->sat[0] != 0.0) ? (md->sat[0]*((md->sat[0] > 0.0) ? (md->lim[3]) : (md->lim[0]))) : (t[0]));
     t[1] = inp[3] + (tk[3] * th[0] + tk[4] * th[1] + tk[5] * th[2]) + (tl[3] * w[0] + tl[4] * w[1] + tl[5] * w[2]);
@@ -104,5 +132,13 @@ void pl_rhs3(const pl_model *md, const double *x, double *out, const double *inp
         a[1] -= y1 * lam;
         a[2] -= y2 * lam;
     }
-    pl_small_store(md, out, 3, t, w, a);
+    md->tau[0] = t[0];
+    md->tau[1] = t[1];
+    md->tau[2] = t[2];
+    out[0] = w[0];
+    out[1] = w[1];
+    out[2] = w[2];
+    out[3] = a[0];
+    out[4] = a[1];
+    out[5] = a[2];
 }
