@@ -348,8 +348,9 @@ def run(args: argparse.Namespace) -> int:
               f"{hi:.4g}){note}")
     for w in fit.warnings:
         print(f"warning: {w}")
+    print(f"variance accounted for: {100 * fit.variance_accounted_for:.4g} % (VAF)")
     if not fit.success:
-        print(f"warning: the optimiser did not converge: {fit.message}")
+        print(f"warning: the fit is not a success: {fit.reason}")
     if comparison is not None:
         _print_comparison(comparison)
     for path in (args.plot, args.compare_out, args.compare_plot):
