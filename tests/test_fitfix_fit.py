@@ -124,3 +124,34 @@ def test_frf_fit_api_refuses_zero_dof():
     with pytest.raises(ParameterError, match="no degrees of freedom"):
         fit_frf(body, muscles, table, ["active_stiffness:ankle", "feedback_delay",
                                        "proprioceptive_weight"])
+
+
+def test_cohort_leaves_flagged_subjects_out_of_the_summary(capsys, tmp_path, tilt_trial):
+    """Trial issue 5: a noise subject and a degrees-as-radians subject no longer pull the
+    median; the table says why (stable, describes_data columns)."""
+    good = tmp_path / "good.csv"
+    tilt_trial.to_csv(good, index=False)
+    deg = tilt_trial.copy()
+    deg["tilt"] = np.degrees(deg["tilt"])
+    deg.to_csv(tmp_path / "deg.csv", index=False)
+    noise = tilt_trial.copy()
+    noise["com_angle"] = np.random.default_rng(5).normal(
+        0.0, float(tilt_trial["com_angle"].std()), len(noise))
+    noise.to_csv(tmp_path / "noise.csv", index=False)
+    out = tmp_path / "c.csv"
+    code, text, err = run_main(capsys, "cohort", "--data", str(good), str(tmp_path / "deg.csv"),
+                               str(tmp_path / "noise.csv"), *FRF_FIT[:-1], "--workers", "1",
+                               "--out", str(out), "--json")
+    assert code == 0, err
+    summary = json.loads(text)["summary"]
+    assert summary["left_out"]["count"] == 2
+    assert summary["left_out"]["by_reason"]["model does not describe the data"] == 2
+    delay = summary["parameters"]["feedback_delay"]
+    assert delay["subjects"] == 1 and abs(delay["median"] - 0.15) < 0.005
+    table = pd.read_csv(out, keep_default_na=False)
+    for column in ("stable", "describes_data", "converged", "variance_accounted_for"):
+        assert column in table.columns
+    by = table.drop_duplicates("subject").set_index("subject")
+    assert by.loc["good", "describes_data"] in (True, "true")
+    assert by.loc["noise", "describes_data"] in (False, "false")
+    assert by.loc["noise", "failed"] in (True, "true")
