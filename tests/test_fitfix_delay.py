@@ -58,3 +58,32 @@ def test_api_and_batch_roots_at_tiny_delay():
     b_tiny = batch_rightmost_root(body, muscles, k, v, delay=1e-15)
     np.testing.assert_allclose(b_tiny, b0, rtol=1e-9)
     assert abs(b0[0] - r0[0]) <= 1e-9 * abs(r0[0])
+
+
+def test_batch_with_mixed_sets_uses_the_poles_where_the_delay_is_negligible():
+    """At τ = 1e-9 s a set with gains of 1e5 N·m/rad (rate scale above 1e3/s: τρ > 1e-6)
+    takes the Chebyshev route while a soft set takes its τ = 0 poles; both agree with
+    rightmost_roots one set at a time."""
+    import posturelab as pl
+    from posturelab.linear.delay import delayed_system, system_rightmost_roots
+    from posturelab.linear.delay_batch import batch_rightmost_root
+
+    from posturelab.model.controllers import get_controller
+
+    body = pl.get_body("paper-1link")
+    muscles = get_controller("peterka-2002").muscles(body)
+    P = len(muscles.pairs)
+    k = np.array([[900.0] * P, [1e5] * P])
+    v = 0.25 * k
+    batch = batch_rightmost_root(body, muscles, k, v, delay=1e-9)
+    from dataclasses import replace
+
+    from posturelab.model.muscles import MuscleSet
+
+    for i in range(2):
+        pairs = tuple(replace(p, stiffness=float(k[i, j]), viscosity=float(v[i, j]),
+                              active_stiffness=None, active_viscosity=None)
+                      for j, p in enumerate(muscles.pairs))
+        one = MuscleSet(pairs, muscles.n_links)
+        top = system_rightmost_roots(delayed_system(body, one), 1e-9, 1)[0]
+        assert abs(batch[i] - top) <= 1e-6 * max(1.0, abs(top)), (i, batch[i], top)

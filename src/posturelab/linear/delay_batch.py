@@ -85,7 +85,8 @@ def batch_rightmost_root(body: Body, muscles: MuscleSet, stiffness, viscosity,
     A0, A1 = system.first_order()
     M, m = A0.shape[0], A0.shape[1]
     roots = np.empty(M, dtype=complex)
-    if delay == 0.0 or bool(np.all(negligible_delay(A0, A1, delay))):
+    negligible = negligible_delay(A0, A1, delay)
+    if delay == 0.0 or bool(np.all(negligible)):
         # no delay, or one negligible for every set (posturelab.linear.delay's notes): the
         # τ = 0 poles, refined at τ
         for lo in range(0, M, _CHUNK):
@@ -127,6 +128,9 @@ def batch_rightmost_root(body: Body, muscles: MuscleSet, stiffness, viscosity,
         chunk(0)
         if progress is not None:
             progress(M, M)
+    if negligible.any():  # sets whose delay is negligible: their τ = 0 poles, refined at τ
+        lam = np.linalg.eigvals(A0[negligible] + A1[negligible])
+        roots[negligible] = lam[np.arange(lam.shape[0]), np.argmax(lam.real, axis=1)]
     return _newton(system, roots)
 
 
