@@ -67,7 +67,6 @@ def test_batch_with_mixed_sets_uses_the_poles_where_the_delay_is_negligible():
     import posturelab as pl
     from posturelab.linear.delay import delayed_system, system_rightmost_roots
     from posturelab.linear.delay_batch import batch_rightmost_root
-
     from posturelab.model.controllers import get_controller
 
     body = pl.get_body("paper-1link")
