@@ -190,8 +190,9 @@ def test_the_cohort_command_writes_the_table_summary_and_figure(cohort_files, tm
     with open(out, newline="") as fh:
         rows = list(csv.DictReader(fh))
     assert list(rows[0]) == ["subject", "parameter", "unit", "value", "standard_error",
-                             "ci95_low", "ci95_high", "determined", "fit_error", "weighting",
-                             "failed", "reason"]
+                             "ci95_low", "ci95_high", "determined", "fit_error",
+                             "variance_accounted_for", "converged", "stable", "describes_data",
+                             "weighting", "failed", "reason"]
     assert len(rows) == 6 * len(FREE)
     s05 = {r["parameter"]: r for r in rows if r["subject"] == "s05"}
     w = s05["proprioceptive_weight"]
@@ -199,7 +200,8 @@ def test_the_cohort_command_writes_the_table_summary_and_figure(cohort_files, tm
     assert float(w["ci95_low"]) <= truths["s05"]["proprioceptive_weight"] <= float(
         w["ci95_high"])
     assert all(None not in r for r in rows)  # (a reason's commas stay in its cell)
-    assert all(r["failed"] == "true" and r["value"] == ""
+    assert w["stable"] == "true" and w["describes_data"] == "true"
+    assert all(r["failed"] == "true" and r["value"] == "" and r["stable"] == ""
                and r["reason"].endswith("needs frf, or gain and phase_deg")
                for r in rows if r["subject"] == "s06")
     assert (tmp_path / "c.png").read_bytes()[:4] == b"\x89PNG"
@@ -207,7 +209,7 @@ def test_the_cohort_command_writes_the_table_summary_and_figure(cohort_files, tm
     p = cli("cohort", "--data", *paths[:4], *CONTROLLER, "--free", ",".join(FREE), "--out",
             str(tmp_path / "plain.csv"), "--workers", "1")
     assert p.returncode == 0, p.stderr
-    assert "to 4 subject(s); 0 failed" in p.stdout and "quartiles" in p.stdout
+    assert "to 4 subject(s); 0 left out of the summary" in p.stdout and "quartiles" in p.stdout
     assert len((tmp_path / "plain.csv").read_text().splitlines()) == 1 + 4 * len(FREE)
 
 

@@ -118,7 +118,7 @@ def test_names_that_are_no_former_spelling():
     ("torque_limit:hip", 0.0, "torque_limit:hip [N·m] must be in (0, inf], got 0.0"),
     ("proprioceptive_weight", float("nan"), "must be in [0, 1], got nan"),
     ("viscosity_ratio", "abc", "viscosity_ratio [s] must be a number in [0, 10], got 'abc'"),
-    ("disturbance_scale", True, "must be in [0, 100], got True"),
+    ("disturbance_scale", True, "must be a number in [0, 100], got True (bool)"),
 ])
 def test_check_value_is_one_line_naming_field_value_and_range(name, value, words):
     with pytest.raises(ParameterError) as info:

@@ -349,12 +349,10 @@ def check_value(name: str, value, field: str | None = None) -> float:
     """
     q = quantity(name)
     label = f"{field or name} [{q.unit}]"
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise ParameterError(f"{label} must be a number in {q.interval()}, got "
-                             f"{value!r}") from None
-    if isinstance(value, bool) or math.isnan(v) or not (
+    from ._validation import as_number
+
+    v = as_number(label, value, f"a number in {q.interval()}")
+    if math.isnan(v) or not (
             (q.low < v if q.low_open else q.low <= v) and v <= q.high):
         raise ParameterError(f"{label} must be in {q.interval()}, got {value!r}")
     return v

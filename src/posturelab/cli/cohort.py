@@ -24,12 +24,15 @@ CPU, at most four per CPU; each subject is one task, so the results do not depen
 
 --out TABLE.csv|.parquet gets one row per subject and parameter: subject (the file's name
 without its suffix), parameter, unit, value, standard_error, ci95_low, ci95_high (95 %),
-determined, fit_error (√(χ²/dof), about 1 when the model explains the data), weighting,
-failed and reason. A subject whose file cannot be read or whose fit fails gets rows saying
-why and never stops the others (an optimiser that did not converge keeps its values, marked
-failed). Prints a summary per parameter: subjects fitted, median and quartiles (--json: one
-object, "summary" and the failed subjects, and "readings": what reading each resampled or
-cut trial did); --summary FILE.json writes it, --plot FIG.png
+determined, fit_error (√(χ²/dof), about 1 when the model explains the data),
+variance_accounted_for, converged, stable, describes_data (true/false, empty without a
+fit), weighting, failed and reason. A subject whose file cannot be read or whose fit fails
+gets rows saying why and never stops the others; a fit that is no success (not converged,
+an unstable fitted loop, or VAF below 50 %: the model does not describe the data) keeps its
+values, marked failed, and is left out of the summary, which says how many and why.
+Prints a summary per parameter: subjects fitted, median and quartiles (--json: one
+object, "summary" with the failed subjects and "left_out", and "readings": what reading
+each resampled or cut trial did); --summary FILE.json writes it, --plot FIG.png
 draws every subject's estimate with its interval over a box of the quartiles. Outputs are
 written only when every fit is done, each atomically (Ctrl-C leaves none half-written).
 Why a command and not fit-frf --each: fit-frf's --data are one subject's conditions; here
@@ -112,8 +115,11 @@ def run(args: argparse.Namespace) -> int:
         for line in item["reading"]:
             print(f"posturelab: note: {item['subject']}: {line}", file=sys.stderr)
     failed = summary["failed"]
+    left = summary["left_out"]
+    why = ", ".join(f"{n} {r}" for r, n in left["by_reason"].items())
     print(f"fitted {len(cohort.parameters)} parameter(s) to {len(cohort.subjects)} "
-          f"subject(s); {len(failed)} failed")
+          f"subject(s); {left['count']} left out of the summary" + (f" ({why})" if why
+                                                                    else ""))
     for name, row in summary["parameters"].items():
         def num(v):
             return "-" if v is None else f"{v:.4g}"
@@ -122,7 +128,7 @@ def run(args: argparse.Namespace) -> int:
               f"{num(row['q3'])}) {row['unit']}; {row['subjects']} fitted, "
               f"{row['determined']} determined")
     for item in failed:
-        print(f"failed: {item['subject']}: {item['reason']}")
+        print(f"left out: {item['subject']}: {item['reason']}")
     for path in (args.out, args.summary, args.plot):
         if path:
             print(f"wrote {path}")

@@ -23,10 +23,15 @@ Hotelling T² of [Re H, Im H] with each band's pooled 2×2 covariance: each band
 its own scatter, real and imaginary parts jointly, valid from 2 subjects per group;
 p = (1 + #{T* >= T}) / (1 + permutations). posturelab.frequency.statistics states why
 this statistic and its sources (Lippi 2025, arXiv:2505.23778 and 2504.20588).
+Which bands differ: each band's own Hotelling T² tested by the same permutations (its
+p-value, valid at any group size); a band is marked * when p <= 1 − --level. The bootstrap
+intervals are descriptive only: with 2–3 subjects per group they are far too narrow. With
+few subjects no band can be marked (2 + 2: the smallest p is 1/3; "smallest_band_p").
 
 --json prints one object: {"p_value", "statistic", "statistic_name", "permutations",
 "exact", "n_a", "n_b", "level", "resamples", "seed", "bands": [{"frequency" [Hz],
-"mean_a", "mean_b", "difference" ({"re", "im"}), "re_ci", "im_ci", "excludes_zero"}],
+"mean_a", "mean_b", "difference" ({"re", "im"}), "re_ci", "im_ci", "excludes_zero",
+"p_value", "differs"}], "smallest_band_p",
 "a", "b" (the files), and "recordings" (per trial file: "resampling", "trimming") when a
 recording was resampled or cut}. The recording options (--resample, --angle-unit,
 --time-unit, --start, --drop-partial, --sway, ...) are those of posturelab frf.
@@ -120,9 +125,14 @@ def run(args: argparse.Namespace) -> int:
     for k in range(result.difference.size):
         d = result.difference[k]
         (rlo, rhi), (ilo, ihi) = result.re_ci[k], result.im_ci[k]
-        mark = "  *" if not (rlo <= 0 <= rhi and ilo <= 0 <= ihi) else ""
+        mark = f"  p = {result.band_p_values[k]:.3g}" + ("  *" if result.band_differs[k]
+                                                          else "")
         print(f"{result.frequency[k]:8.3f} {d.real:10.4g} {d.imag:10.4g}  "
               f"{rlo:.4g} … {rhi:.4g}".ljust(58) + f"{ilo:.4g} … {ihi:.4g}{mark}")
-    print("(* the band's interval excludes 0 in its real or imaginary part; uncorrected "
-          "for the number of bands: the global p is the test)")
+    print(f"(p: the band's own permutation test; * p <= {1 - result.level:.3g}, uncorrected "
+          "for the number of bands: the global p is the test; the intervals are descriptive, "
+          "too narrow for small groups)")
+    if result.smallest_band_p > 1 - result.level:
+        print(f"(with {result.n_a} + {result.n_b} subjects the smallest attainable band p is "
+              f"{result.smallest_band_p:.3g}: no band can be marked)")
     return 0

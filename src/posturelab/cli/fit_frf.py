@@ -61,7 +61,12 @@ parameter's accepted range and its search bounds (said when it was); when the fi
 is too large for chance (p < 0.001) it says the model does not describe the data and
 widens the intervals by a model error it states;
 warns when a band's coherence is below 0.5. Bounds must lie within each parameter's range;
-a name given twice or a bound for a parameter not fitted is refused.
+a name given twice or a bound for a parameter not fitted is refused, and so is a fit with no
+residual degrees of freedom (as many free parameters as numbers: 2 per band). It prints the
+variance accounted for, VAF = 1 − Σ|H − Ĥ|²/Σ|Ĥ|²; the fit is a success ("success" in
+--json) only when the optimiser converged, the fitted loop is stable and VAF >= 50 % (the
+model describes the data: "describes_data"); otherwise "reason" says why, the estimates
+kept and flagged.
 
 Reweighting (posturelab.frequency.reweighting): --compare NAME (e.g. proprioceptive_weight)
 fits NAME once per condition and once shared by all, the rest as asked, and tests whether it
@@ -348,8 +353,9 @@ def run(args: argparse.Namespace) -> int:
               f"{hi:.4g}){note}")
     for w in fit.warnings:
         print(f"warning: {w}")
+    print(f"variance accounted for: {100 * fit.variance_accounted_for:.4g} % (VAF)")
     if not fit.success:
-        print(f"warning: the optimiser did not converge: {fit.message}")
+        print(f"warning: the fit is not a success: {fit.reason}")
     if comparison is not None:
         _print_comparison(comparison)
     for path in (args.plot, args.compare_out, args.compare_plot):

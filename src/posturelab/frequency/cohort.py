@@ -9,15 +9,19 @@ same starting body, gains and options, in worker processes (by default one per C
 process may use, at most four per CPU; each subject is one task, so the table does not
 depend on how many ran at once). A subject whose file
 cannot be read or whose fit fails gets rows saying why (``failed``, ``reason``) and never
-stops the others; a fit whose optimiser did not converge keeps its values, marked failed
-with the optimiser's message.
+stops the others; a fit that is no success (:attr:`posturelab.frequency.fit.FRFFit.success`:
+its optimiser did not converge, its fitted loop is unstable, or its model does not describe
+the data) keeps its values, marked failed with the fit's reason.
 
 The table (:meth:`CohortFit.columns`) has one row per subject and parameter: ``subject``,
 ``parameter``, ``unit``, ``value``, ``standard_error``, ``ci95_low``, ``ci95_high`` (the
-parameter's unit), ``determined``, ``fit_error`` [-], ``weighting``, ``failed``, ``reason``.
-The summary (:meth:`CohortFit.summary`) gives per parameter the number of subjects fitted,
-the median and the quartiles of their estimates (failed fits left out; ``determined`` counts
-those the data determined).
+parameter's unit), ``determined``, ``fit_error`` [-], ``variance_accounted_for`` [-],
+``converged``, ``stable``, ``describes_data`` ("true", "false", or empty when there is no
+fit), ``weighting``, ``failed``, ``reason``. The summary (:meth:`CohortFit.summary`) gives
+per parameter the number of subjects fitted, the median and the quartiles of their
+estimates (``determined`` counts those the data determined); failed and flagged fits are
+left out of it, and ``left_out`` says how many and why (no fit, not converged, unstable
+loop, model not describing the data; one subject may have several).
 """
 
 from __future__ import annotations
@@ -131,6 +135,10 @@ class SubjectFit:
     reading : tuple of str
         What reading the subject's trial recording did (resampled, cut; one line each;
         empty for an FRF file or a recording read as it was).
+    converged, stable, describes_data : bool or None
+        As :class:`posturelab.frequency.fit.FRFFit`'s (None: no fit, or not checked).
+    variance_accounted_for : float
+        As :attr:`posturelab.frequency.fit.FRFFit.variance_accounted_for` (NaN: no fit). [-]
     """
 
     subject: str
@@ -143,6 +151,22 @@ class SubjectFit:
     failed: bool = False
     reason: str = ""
     reading: tuple[str, ...] = ()
+    converged: bool | None = None
+    stable: bool | None = None
+    describes_data: bool | None = None
+    variance_accounted_for: float = math.nan
+
+    def left_out_because(self) -> tuple[str, ...]:
+        """Why the summary leaves this subject out (empty: it does not)."""
+        if not self.failed:
+            return ()
+        if self.converged is None:
+            return ("no fit",)
+        why = tuple(w for bad, w in ((not self.converged, "not converged"),
+                                     (self.stable is False, "unstable loop"),
+                                     (self.describes_data is False,
+                                      "model does not describe the data")) if bad)
+        return why or ("failed",)
 
 
 @dataclass(frozen=True)
@@ -182,6 +206,9 @@ class CohortFit:
         def col(values, dtype=float):
             return np.array(list(values), dtype=dtype)
 
+        def flag(v):
+            return "" if v is None else ("true" if v else "false")
+
         return [
             ("subject", col((s.subject for s, _ in rows), str)),
             ("parameter", col((self.parameters[k] for _, k in rows), str)),
@@ -192,13 +219,17 @@ class CohortFit:
             ("ci95_high", col(s.confidence_intervals[k, 1] for s, k in rows)),
             ("determined", col((bool(s.determined[k]) for s, k in rows), bool)),
             ("fit_error", col(s.fit_error for s, _ in rows)),
+            ("variance_accounted_for", col(s.variance_accounted_for for s, _ in rows)),
+            ("converged", col((flag(s.converged) for s, _ in rows), str)),
+            ("stable", col((flag(s.stable) for s, _ in rows), str)),
+            ("describes_data", col((flag(s.describes_data) for s, _ in rows), str)),
             ("weighting", col((s.weighting for s, _ in rows), str)),
             ("failed", col((s.failed for s, _ in rows), bool)),
             ("reason", col((s.reason for s, _ in rows), str))]
 
     def column_units(self) -> dict[str, str]:
         """Units of the table's numeric columns (a parameter's are in its ``unit`` column)."""
-        return {"fit_error": "-"}
+        return {"fit_error": "-", "variance_accounted_for": "-"}
 
     def write(self, path) -> None:
         """Write the table to ``path`` (.csv or .parquet by its suffix), atomically: an
@@ -213,9 +244,11 @@ class CohortFit:
             write_table(path, self.columns(), self.column_units())
 
     def summary(self) -> dict:
-        """Per parameter: ``unit``, ``subjects`` (fitted, failed left out), ``determined``,
-        ``median``, ``q1``, ``q3`` (quartiles) and ``min``, ``max`` of the estimates; and the
-        cohort's ``subjects``, ``failed`` (with their reasons). JSON-safe."""
+        """Per parameter: ``unit``, ``subjects`` (fitted, failed and flagged fits left out),
+        ``determined``, ``median``, ``q1``, ``q3`` (quartiles) and ``min``, ``max`` of the
+        estimates; and the cohort's ``subjects``, ``failed`` (with their reasons) and
+        ``left_out``: ``count`` and ``by_reason`` (subjects per reason: "no fit", "not
+        converged", "unstable loop", "model does not describe the data"). JSON-safe."""
         def num(v):
             return float(v) if math.isfinite(v) else None
 
@@ -228,9 +261,15 @@ class CohortFit:
                          "determined": sum(bool(s.determined[k]) for s in ok),
                          "median": num(q[2]), "q1": num(q[1]), "q3": num(q[3]),
                          "min": num(q[0]), "max": num(q[4])}
+        by_reason: dict[str, int] = {}
+        for s in self.subjects:
+            for why in s.left_out_because():
+                by_reason[why] = by_reason.get(why, 0) + 1
         return {"subjects": len(self.subjects), "parameters": out,
                 "failed": [{"subject": s.subject, "reason": s.reason}
-                           for s in self.subjects if s.failed]}
+                           for s in self.subjects if s.failed],
+                "left_out": {"count": sum(s.failed for s in self.subjects),
+                             "by_reason": by_reason}}
 
 
 def csv_text(columns) -> str:
@@ -293,10 +332,10 @@ def _fit_one(task: _CohortTask, subject: str, data) -> SubjectFit:
         return _failed(task, subject, str(exc))
     except Exception as exc:  # (any other failure of one subject's fit: said, not raised)
         return _failed(task, subject, f"{type(exc).__name__}: {exc}"[:300])
-    reason = "" if fit.success else f"the optimiser did not converge: {fit.message}"
     return SubjectFit(subject, fit.estimates, fit.standard_errors, fit.confidence_intervals,
-                      fit.determined, fit.fit_error, fit.weighting, not fit.success, reason,
-                      reading)
+                      fit.determined, fit.fit_error, fit.weighting, not fit.success, fit.reason,
+                      reading, fit.converged, fit.stable, fit.describes_data,
+                      fit.variance_accounted_for)
 
 
 def _refuse_repeated_files(subjects) -> None:

@@ -65,6 +65,13 @@ estimate stopped on its search bound (within 1e-6 of the bounds' range: ``at_bou
 :mod:`posturelab._bounds`) is reported as not determined; every interval is clipped to the
 parameter's accepted range (the parameter table) and its search bounds (``clipped``).
 Bands with coherence below 0.5 raise a warning in ``warnings``.
+
+Success: a fit with no residual degrees of freedom (2B ≤ K) is refused. A fit is a
+success (``success``) only when the optimiser converged, the fitted loop is stable about
+upright, and the model describes the data: its variance accounted for, VAF = 1 −
+Σ|H − Ĥ|²/Σ|Ĥ|² over every band, is at least 0.5 (the fit error alone cannot tell: a
+noise-only response is fitted "within its noise" by almost any loop). Otherwise
+``reason`` says which failed and the estimates stay, flagged.
 """
 
 from __future__ import annotations
@@ -87,7 +94,14 @@ from ..parameters import (
     resolve,
 )
 from ..parameters import unit as parameter_unit
-from ._fit_checks import loop_verdict, systematic_bound
+from ._fit_checks import (
+    MIN_VARIANCE_ACCOUNTED,
+    check_bounds,
+    group_conditions,
+    loop_verdict,
+    systematic_bound,
+    variance_accounted_for,
+)
 from ._fit_targets import chi2 as _chi2
 from ._fit_targets import target as _target
 from .estimate import FRFEstimate
@@ -137,7 +151,10 @@ class FRFFit:
         √(χ²/dof) of the band residuals (module notes; ≈ 1 when the model explains the data
         within their noise), before any model error was allowed. [-]
     success : bool
+        The optimiser converged, the fitted loop is stable and the model describes the data
+        (``reason`` says which failed; the estimates stay visible, flagged).
     message : str
+        The optimiser's message.
     warnings : tuple of str
     curves : tuple of (numpy.ndarray, numpy.ndarray)
         Per condition, the fitted model's FRF (complex) on 200 log-spaced frequencies [Hz]
@@ -170,7 +187,16 @@ class FRFFit:
         Whether the fitted loop of every condition is stable about upright at its delay
         (:func:`posturelab.linear.verdict.upright_verdict`, the engaged side); False adds a
         warning: an unstable loop's FRF is not measurable, so the estimates describe no
-        experiment. None when not checked.
+        experiment, and the fit is not a success. None when not checked.
+    converged : bool
+        The optimiser met its own criterion.
+    variance_accounted_for : float
+        VAF = 1 − Σ|H − Ĥ|²/Σ|Ĥ|² over all bands (module notes). [-]
+    describes_data : bool
+        VAF ≥ :data:`MIN_VARIANCE_ACCOUNTED` (0.5): the model accounts for at least half of
+        the measured FRF's variation; otherwise not a success.
+    reason : str
+        Why the fit is not a success, "; "-joined ("" when it is).
     """
 
     names: tuple[str, ...]
@@ -194,6 +220,10 @@ class FRFFit:
     residual_dof: float = math.nan
     noise_dof: float = math.inf
     stable: bool | None = None
+    converged: bool = True
+    variance_accounted_for: float = math.nan
+    describes_data: bool = True
+    reason: str = ""
 
     def unit(self, name: str) -> str:
         """Unit of a fitted parameter."""
@@ -222,7 +252,9 @@ class FRFFit:
             "model_error": num(self.model_error),
             "systematic": [num(v) for v in self.systematic],
             "success": bool(self.success), "stable": self.stable,
-            "message": self.message, "warnings": list(self.warnings)}
+            "converged": bool(self.converged), "describes_data": bool(self.describes_data),
+            "variance_accounted_for": num(self.variance_accounted_for),
+            "reason": self.reason, "message": self.message, "warnings": list(self.warnings)}
 
 
 def _name(name: str, muscles: MuscleSet) -> str:
@@ -239,39 +271,6 @@ def _canonical(name: str, spec, muscles: MuscleSet) -> str:
     """The parameter table's one spelling of a parsed name."""
     base, j = spec
     return base if j is None else f"{base}:{muscles.names[j]}"
-
-
-def _check_bounds(bounds, muscles: MuscleSet, fitted: dict) -> dict:
-    """``bounds`` as {canonical name: (low, high)}, each for a fitted parameter (``fitted``:
-    canonical name -> base name) and within its range."""
-    if bounds is None:
-        return {}
-    if not isinstance(bounds, dict):
-        raise ParameterError(f"bounds must be a dict of name -> (low, high), got {bounds!r}")
-    out = {}
-    for given, value in bounds.items():
-        name = _canonical(given, _parse(given, muscles), muscles)
-        if name not in fitted:
-            raise ParameterError(f"bounds given for {given!r}, which is not fitted; fitted: "
-                                 f"{', '.join(fitted)}")
-        if name in out:
-            raise ParameterError(f"bounds given twice for {name!r}")
-        try:
-            lo, hi = (float(v) for v in value)
-        except (TypeError, ValueError):
-            raise ParameterError(f"bounds of {given} must be (low, high), got {value!r}"
-                                 ) from None
-        if any(isinstance(v, bool) for v in value):
-            raise ParameterError(f"bounds of {given} must be numbers, got {value!r}")
-        if not (math.isfinite(lo) and math.isfinite(hi)):
-            raise ParameterError(f"bounds of {given} must be finite, got {lo:g}:{hi:g}")
-        check_value(name, lo, f"bound {name} LO")  # the parameter table's bounds
-        check_value(name, hi, f"bound {name} HI")
-        if not lo < hi:
-            raise ParameterError(f"bounds of {given} must satisfy low < high "
-                                 f"[{parameter_unit(name)}], got {lo:g}:{hi:g}")
-        out[name] = (lo, hi)
-    return out
 
 
 def check_fit_request(muscles: MuscleSet, free, per_condition=(), bounds=None) -> tuple:
@@ -301,8 +300,8 @@ def check_fit_request(muscles: MuscleSet, free, per_condition=(), bounds=None) -
                                  if shared == (i < len(free))
                                  else f"{name!r} is both shared and per condition")
         seen[name] = (given, i < len(free))
-    bounds = _check_bounds(bounds, muscles, dict(zip(canon, (s[0] for s in specs),
-                                                     strict=True)))
+    bounds = check_bounds(bounds, lambda g: _canonical(g, _parse(g, muscles), muscles),
+                          dict(zip(canon, (s[0] for s in specs), strict=True)))
     return canon[:len(free)], canon[len(free):], specs, canon, bounds
 
 
@@ -392,7 +391,7 @@ def fit_frf(body: Body, muscles: MuscleSet, data, free, *, input: str | Sequence
     targets = [_target(c, k) for k, c in enumerate(conditions)]
     base = np.stack([muscles.stiffnesses, muscles.viscosities, muscles.active_stiffnesses,
                      muscles.active_viscosities])
-    group_of = _condition_groups(condition_groups, len(conditions))
+    group_of = group_conditions(condition_groups, len(conditions))
     C = max(group_of) + 1  # the values of each per-condition parameter
     slots = [(i, None) for i in range(len(free))] + [
         (len(free) + j, k) for j in range(len(per)) for k in range(C)]
@@ -484,7 +483,11 @@ def fit_frf(body: Body, muscles: MuscleSet, data, free, *, input: str | Sequence
 
     K = x0.size
     m = 2 * sum(t.frf.size for t in targets)
-    dof = max(m - K, 1)
+    if m - K <= 0:
+        raise ParameterError(f"{K} free parameter(s) cannot be fitted to {m} numbers ({m // 2} "
+                             "band(s), real and imaginary parts): no degrees of freedom left; "
+                             "free fewer parameters or give more bands")
+    dof = m - K
     weighting = "+".join(dict.fromkeys(t.kind for t in targets))
     relative = weighting == "relative"
     delta = 0.0 if model_error is None else float_in_range("model_error [-]", model_error,
@@ -558,24 +561,18 @@ def fit_frf(body: Body, muscles: MuscleSet, data, free, *, input: str | Sequence
     if end_verdict:
         warnings.insert(0, f"the fitted loop is unstable ({end_verdict}): its FRF is not "
                         "measurable, so these estimates describe no experiment")
-    return FRFFit(tuple(labels), p, se, ci, determined, float(fit_error), bool(sol.success),
+    vaf = variance_accounted_for(targets, model(p))
+    reasons = [why for bad, why in (
+        (not sol.success, f"the optimiser did not converge ({sol.message})"),
+        (bool(end_verdict), "the fitted loop is unstable"),
+        (vaf < MIN_VARIANCE_ACCOUNTED, f"the model does not describe the data: it accounts "
+         f"for {100 * vaf:.3g} % of the FRF's variation (VAF; at least "
+         f"{100 * MIN_VARIANCE_ACCOUNTED:g} % needed)")) if bad]
+    return FRFFit(tuple(labels), p, se, ci, determined, float(fit_error), not reasons,
                   str(sol.message), tuple(warnings), tuple(model(p, dense=True)), weighting,
                   bool(mismatch), float(delta), systematic, sides,
                   np.stack([lo, hi], axis=1), clipped, float(u_all @ u_all), float(dof),
-                  float(nu), None if end_verdict == "" else end_verdict is None)
-
-
-def _condition_groups(groups, count: int) -> list[int]:
-    """Each condition's group (default its own), checked: integers 0 … G − 1, each used."""
-    if groups is None:
-        return list(range(count))
-    if isinstance(groups, str) or len(groups) != count or not all(
-            isinstance(g, int | np.integer) and not isinstance(g, bool) for g in groups):
-        raise ParameterError(f"condition_groups must give an integer group per condition "
-                             f"({count}), got {groups!r}"[:200])
-    out = [int(g) for g in groups]
-    if sorted(set(out)) != list(range(max(out) + 1)):
-        raise ParameterError(f"condition_groups must number the groups 0 … G − 1, each "
-                             f"used, got {out}")
-    return out
+                  float(nu), None if end_verdict == "" else end_verdict is None,
+                  bool(sol.success), float(vaf), vaf >= MIN_VARIANCE_ACCOUNTED,
+                  "; ".join(reasons))
 

@@ -65,6 +65,18 @@ permutations are one matrix product (module code). The p-value counts the observ
 among the permutations, p = (1 + #{T* ≥ T}) / (1 + P) (Phipson and Smyth 2010, Stat Appl
 Genet Mol Biol 9:39: never 0); when the number of distinct splits C(n_a + n_b, n_a) is at
 most P, every split is enumerated and p is exact.
+
+**Which bands differ.** The bootstrap intervals above are far too narrow for a handful of
+subjects (with 2–3 per group, 2–5 of 11 bands of two groups from one population excluded
+0 at 95 %), so they do not say which bands differ. Each band's own term of T,
+T_k = n_a n_b/(n_a + n_b) Δ_kᵀ S_k⁻¹ Δ_k, is tested by the same permutations (the same
+splits, its own count): p_k = (1 + #{T*_k ≥ T_k}) / (1 + P), exact when every split is
+enumerated. Under the null hypothesis each p_k is valid at any n (the labels are
+exchangeable), so a band is marked when p_k ≤ 1 − ``level``, uncorrected for the number
+of bands (the global p is the test of all of them). With few subjects no band can be
+marked: the smallest attainable p_k is 1/C(n_a + n_b, n_a) (2/C with n_a = n_b, where the
+swapped split gives the same T_k): 1/3 for 2 + 2 subjects, 1/10 for 3 + 2, 1/10 for 3 + 3,
+0.029 for 4 + 4 (``smallest_band_p``).
 """
 
 from __future__ import annotations
@@ -78,7 +90,8 @@ from .._validation import finite_array
 from ..errors import ParameterError
 
 __all__ = ["BootstrapBands", "bootstrap_frf_bands", "GroupComparison", "compare_frf_groups",
-           "frf_matrix", "band_t2_statistic", "permutation_statistics", "MAX_PERMUTATIONS",
+           "frf_matrix", "band_t2_statistic", "permutation_statistics",
+           "permutation_band_statistics", "MAX_PERMUTATIONS",
            "MAX_RESAMPLES", "MAX_SUBJECTS"]
 
 #: Most permutations a comparison may ask for. [-]
@@ -297,7 +310,13 @@ def band_t2_statistic(a: np.ndarray, b: np.ndarray) -> float:
 
 
 def permutation_statistics(Z: np.ndarray, in_a: np.ndarray) -> np.ndarray:
-    """T for many splits at once (module notes).
+    """T for many splits at once (module notes): the sum over the bands of
+    :func:`permutation_band_statistics`. [-]"""
+    return permutation_band_statistics(Z, in_a).sum(axis=1)
+
+
+def permutation_band_statistics(Z: np.ndarray, in_a: np.ndarray) -> np.ndarray:
+    """Each band's term T_k of T for many splits at once (module notes).
 
     Parameters
     ----------
@@ -308,7 +327,8 @@ def permutation_statistics(Z: np.ndarray, in_a: np.ndarray) -> np.ndarray:
 
     Returns
     -------
-    numpy.ndarray, shape (P,)
+    numpy.ndarray, shape (P, B)
+        [-]
     """
     N, B = Z.shape
     na = int(in_a[0].sum())
@@ -330,17 +350,18 @@ def permutation_statistics(Z: np.ndarray, in_a: np.ndarray) -> np.ndarray:
     dx, dy = d.real, d.imag
     with np.errstate(invalid="ignore", divide="ignore"):
         q = (syy * dx * dx - 2 * sxy * dx * dy + sxx * dy * dy) / det
-    # T is a sum of quadratic forms in positive definite matrices: >= 0; rounding can leave
+    # each T_k is a quadratic form in a positive definite matrix: >= 0; rounding can leave
     # -1e-16 where the means agree (NaN, a singular split, stays NaN)
-    return np.maximum(na * nb / (na + nb) * q.sum(axis=1), 0.0)
+    return np.maximum(na * nb / (na + nb) * q, 0.0)
 
 
-def _at_least(statistics: np.ndarray, observed: float) -> int:
+def _at_least(statistics: np.ndarray, observed):
     """How many permuted statistics reach the observed one (to rounding: 1e-12 relative and
     1e-9 absolute, T being dimensionless and of order one for chance differences, so equal
     means tie however rounding leaves them); a split whose pooled covariance is singular
-    (NaN) counts as reaching it, which can only make p larger."""
-    return int(np.sum(~(statistics < observed * (1 - 1e-12) - 1e-9)))
+    (NaN) counts as reaching it, which can only make p larger. Over axis 0: per band for
+    (P, B) statistics and (B,) observed ones."""
+    return np.sum(~(statistics < observed * (1 - 1e-12) - 1e-9), axis=0)
 
 
 @dataclass(frozen=True)
@@ -354,7 +375,8 @@ class GroupComparison:
     difference : numpy.ndarray of complex, shape (B,)
         Δ = H̄_A − H̄_B. [FRF unit]
     re_ci, im_ci : numpy.ndarray, shape (B, 2)
-        Percentile intervals of Re Δ and Im Δ (unpaired bootstrap).
+        Percentile intervals of Re Δ and Im Δ (unpaired bootstrap; descriptive, too
+        narrow for small groups: :attr:`band_p_values` says which bands differ).
     mean_a, mean_b : numpy.ndarray of complex, shape (B,)
     statistic : float
         T of the observed split. [-]
@@ -366,6 +388,11 @@ class GroupComparison:
         Every distinct split enumerated.
     n_a, n_b, resamples, seed : int
     level : float
+    band_p_values : numpy.ndarray, shape (B,)
+        Each band's permutation p-value, from the same splits as ``p_value`` (module notes,
+        "Which bands differ"). [-]
+    smallest_band_p : float
+        The smallest p-value a band can have with these group sizes and splits. [-]
     """
 
     frequency: np.ndarray
@@ -385,6 +412,13 @@ class GroupComparison:
     level: float
     statistic_name: str = field(default="sum over bands of the two-sample Hotelling T² of "
                                         "[Re H, Im H] (pooled 2×2 covariance per band)")
+    band_p_values: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    smallest_band_p: float = math.nan
+
+    @property
+    def band_differs(self) -> np.ndarray:
+        """Per band, p_k ≤ 1 − ``level`` (uncorrected for the number of bands). [-]"""
+        return self.band_p_values <= 1.0 - self.level + 1e-12
 
     def to_dict(self) -> dict:
         """What ``posturelab compare-frf --json`` prints."""
@@ -400,11 +434,14 @@ class GroupComparison:
                           "im_ci": [float(v) for v in self.im_ci[k]],
                           "excludes_zero": bool(not (self.re_ci[k, 0] <= 0 <= self.re_ci[k, 1]
                                                      and self.im_ci[k, 0] <= 0
-                                                     <= self.im_ci[k, 1]))})
+                                                     <= self.im_ci[k, 1])),
+                          "p_value": float(self.band_p_values[k]),
+                          "differs": bool(self.band_differs[k])})
         return {"p_value": self.p_value, "statistic": self.statistic,
                 "statistic_name": self.statistic_name, "permutations": self.permutations,
                 "exact": self.exact, "n_a": self.n_a, "n_b": self.n_b, "level": self.level,
-                "resamples": self.resamples, "seed": self.seed, "bands": bands}
+                "resamples": self.resamples, "seed": self.seed,
+                "smallest_band_p": float(self.smallest_band_p), "bands": bands}
 
 
 def compare_frf_groups(a, b, *, permutations: int = 10_000, resamples: int = 2000,
@@ -450,7 +487,8 @@ def compare_frf_groups(a, b, *, permutations: int = 10_000, resamples: int = 200
     N = na + nb
     observed = np.zeros((1, N), dtype=bool)
     observed[0, :na] = True
-    T = float(permutation_statistics(Z, observed)[0])
+    T_k = permutation_band_statistics(Z, observed)[0]
+    T = float(T_k.sum())
     if not math.isfinite(T):
         raise ParameterError("a band's FRFs have no scatter (a singular pooled covariance): "
                              "identical FRFs cannot be compared")
@@ -458,6 +496,7 @@ def compare_frf_groups(a, b, *, permutations: int = 10_000, resamples: int = 200
     splits = math.comb(N, na)
     chunk = max(1, _CHUNK_NUMBERS // max(N, Z.shape[1] * 8))
     exceed = 0
+    exceed_k = np.zeros(Z.shape[1], dtype=np.int64)
     if splits <= P:  # every split, the observed one among them
         it = combinations(range(N), na)
         done = 0
@@ -466,17 +505,25 @@ def compare_frf_groups(a, b, *, permutations: int = 10_000, resamples: int = 200
             in_a = np.zeros((n, N), dtype=bool)
             for r in range(n):
                 in_a[r, list(next(it))] = True
-            exceed += _at_least(permutation_statistics(Z, in_a), T)
+            terms = permutation_band_statistics(Z, in_a)
+            exceed += int(_at_least(terms.sum(axis=1), T))
+            exceed_k += _at_least(terms, T_k)
             done += n
         p, drawn = exceed / splits, splits
+        band_p = exceed_k / splits
+        smallest = (2 if na == nb else 1) / splits
     else:
         for lo in range(0, P, chunk):
             n = min(chunk, P - lo)
             order = rng.permuted(np.tile(np.arange(N), (n, 1)), axis=1)[:, :na]
             in_a = np.zeros((n, N), dtype=bool)
             np.put_along_axis(in_a, order, True, axis=1)
-            exceed += _at_least(permutation_statistics(Z, in_a), T)
+            terms = permutation_band_statistics(Z, in_a)
+            exceed += int(_at_least(terms.sum(axis=1), T))
+            exceed_k += _at_least(terms, T_k)
         p, drawn = (1 + exceed) / (1 + P), P
+        band_p = (1 + exceed_k) / (1 + P)
+        smallest = max(1 / (1 + P), (2 if na == nb else 1) / splits)
     ma, mb = A.mean(axis=0), Bm.mean(axis=0)
     diff = ma - mb
     boot = np.empty((R, Z.shape[1]), dtype=complex)
@@ -494,4 +541,5 @@ def compare_frf_groups(a, b, *, permutations: int = 10_000, resamples: int = 200
 
     return GroupComparison(fa, diff, interval(boot.real), interval(boot.imag),
                            ma, mb, T, float(p), int(drawn),
-                           splits <= P, na, nb, R, s, q)
+                           splits <= P, na, nb, R, s, q,
+                           band_p_values=band_p.astype(float), smallest_band_p=float(smallest))

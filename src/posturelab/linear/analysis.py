@@ -250,6 +250,8 @@ def disturbance_sensitivity(body: Body, posture: np.ndarray | None = None) -> np
 
 
 def _check_match(body: Body, muscles: MuscleSet) -> None:
+    from .._validation import expect_type
     from ..model.checks import check_model
 
+    expect_type("muscles", muscles, MuscleSet)  # (check_model lets None through)
     check_model(body, muscles)

@@ -35,6 +35,15 @@ approximate the rightmost roots with spectral accuracy, and Newton's method on
 det Δ(s) = 0 (step 1/tr(Δ⁻¹Δ')) then refines each to rounding. The tests check both
 against an independent frequency sweep of |z(ω)| = 1 for the pencil Δ(iω) = M0(ω) + z M1(ω)
 and against the closed form of the delayed inverted pendulum.
+
+**A negligible delay.** When τ·ρ ≤ :data:`NEGLIGIBLE_DELAY_PHASE` (ρ = max(1 [1/s], ‖A0‖₂,
+‖A1‖₂), the rate scale of the first-order form), the delay shifts the roots near the τ = 0
+poles by a relative O(τρ) only, and the roots it adds lie to the left of Re s ≈
+−ln(1/(τρ))/τ, far left of them (the equation is of retarded type, so its rightmost
+roots are continuous at τ = 0). Such a delay is treated as no delay for the starting
+guesses: the τ = 0 poles, refined by Newton's method at the actual τ. The Chebyshev
+generator, whose entries grow as nodes²/τ, would lose every root to rounding there (it
+did below about 1e-13 s).
 """
 
 from __future__ import annotations
@@ -68,6 +77,29 @@ __all__ = [
 
 #: Largest delay :func:`rightmost_roots` accepts: the parameter table's feedback delay bound. [s]
 MAX_DELAY_FOR_ROOTS = MAX_FEEDBACK_DELAY
+#: τ·ρ at or below which a delay is negligible (module notes): the τ = 0 poles are the
+#: starting guesses. [-]
+NEGLIGIBLE_DELAY_PHASE = 1e-6
+
+
+def negligible_delay(A0: np.ndarray, A1: np.ndarray, delay: float) -> np.ndarray:
+    """Whether ``delay`` is negligible for each first-order form (module notes):
+    τ·max(1, ‖A0‖₂, ‖A1‖₂) ≤ :data:`NEGLIGIBLE_DELAY_PHASE` (True at τ = 0).
+
+    Parameters
+    ----------
+    A0, A1 : numpy.ndarray, shape (..., m, m)
+        The first-order form's matrices. [1/s]
+    delay : float
+        τ. [s]
+
+    Returns
+    -------
+    numpy.ndarray of bool, shape (...)
+    """
+    rate = np.maximum(1.0, np.maximum(np.linalg.norm(A0, ord=2, axis=(-2, -1)),
+                                      np.linalg.norm(A1, ord=2, axis=(-2, -1))))
+    return delay * rate <= NEGLIGIBLE_DELAY_PHASE
 
 
 #: The linearised delayed chain: one :class:`~posturelab.linear.system.LinearSystem`.
@@ -390,8 +422,8 @@ def system_rightmost_roots(system: LinearSystem, delay: float, count: int = 6, *
     if isinstance(count, bool) or not isinstance(count, int | np.integer) \
             or not 1 <= count <= m * nodes:
         raise ParameterError(f"count must be an integer in [1, {m * nodes}], got {count!r}")
-    if delay == 0.0:
-        guesses = np.linalg.eigvals(A0 + A1)
+    if bool(negligible_delay(A0, A1, delay)):
+        guesses = np.linalg.eigvals(A0 + A1)  # refined at the actual τ below
     else:
         _, D = _chebyshev(nodes)
         D = D * (2.0 / delay)  # θ = τ (x − 1)/2 on [−τ, 0]; x_0 = 1 is θ = 0
@@ -407,6 +439,9 @@ def system_rightmost_roots(system: LinearSystem, delay: float, count: int = 6, *
         if refined is not None and not any(abs(refined - r) <= 1e-8 * max(1.0, abs(r))
                                            for r in roots):
             roots.append(refined)
+    if not roots:
+        raise ParameterError(f"no characteristic root converged at delay {delay:g} s "
+                             f"(nodes {nodes}); try more nodes")
     roots = np.array(sorted(roots, key=lambda r: (-r.real, -r.imag)))
     return roots[:count]
 

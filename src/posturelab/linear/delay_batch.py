@@ -24,7 +24,7 @@ from .._validation import float_in_range
 from ..errors import ParameterError
 from ..model.body import Body
 from ..model.muscles import MuscleSet
-from .delay import MAX_DELAY_FOR_ROOTS, _chebyshev
+from .delay import MAX_DELAY_FOR_ROOTS, _chebyshev, negligible_delay
 from .system import LinearSystem, linear_system
 
 __all__ = ["batch_rightmost_root", "batch_delay_stable", "DelayStabilityMap",
@@ -85,11 +85,14 @@ def batch_rightmost_root(body: Body, muscles: MuscleSet, stiffness, viscosity,
     A0, A1 = system.first_order()
     M, m = A0.shape[0], A0.shape[1]
     roots = np.empty(M, dtype=complex)
-    if delay == 0.0:
+    negligible = negligible_delay(A0, A1, delay)
+    if delay == 0.0 or bool(np.all(negligible)):
+        # no delay, or one negligible for every set (posturelab.linear.delay's notes): the
+        # τ = 0 poles, refined at τ
         for lo in range(0, M, _CHUNK):
             lam = np.linalg.eigvals(A0[lo:lo + _CHUNK] + A1[lo:lo + _CHUNK])
             roots[lo:lo + _CHUNK] = lam[np.arange(lam.shape[0]), np.argmax(lam.real, axis=1)]
-        return roots
+        return roots if delay == 0.0 else _newton(system, roots)
     _, D = _chebyshev(nodes)
     template = np.kron(D * (2.0 / delay), np.eye(m))
     template[:m, :] = 0.0
@@ -125,6 +128,9 @@ def batch_rightmost_root(body: Body, muscles: MuscleSet, stiffness, viscosity,
         chunk(0)
         if progress is not None:
             progress(M, M)
+    if negligible.any():  # sets whose delay is negligible: their τ = 0 poles, refined at τ
+        lam = np.linalg.eigvals(A0[negligible] + A1[negligible])
+        roots[negligible] = lam[np.arange(lam.shape[0]), np.argmax(lam.real, axis=1)]
     return _newton(system, roots)
 
 

@@ -12,7 +12,9 @@ its rightmost characteristic roots.
 of the delay equation (:func:`posturelab.linear.delay.rightmost_roots`): the pair gains
 are then the whole delayed feedback (no active gains) or the intrinsic part acting at once
 and the active gains delayed (:func:`posturelab.model.muscles.feedback_gains`). With
-τ = 0 the roots are the poles of :func:`posturelab.analyse`.
+τ = 0 the roots are the poles of :func:`posturelab.analyse`; a delay too small to matter
+(τ·ρ ≤ 1e-6, ρ the first-order form's rate scale: :mod:`posturelab.linear.delay`'s notes)
+starts from those poles, so the verdict as τ → 0 is continuous with the one at τ = 0.
 
 **One-sided pairs.** Upright is exactly the switching point of a one-sided pair: its
 stretch is 0 there, so the model has no derivative at upright and no one linearisation.

@@ -24,7 +24,7 @@ from typing import Any, Literal
 
 import numpy as np
 
-from .._validation import finite_array
+from .._validation import as_number, initial_state_array
 from ..errors import ParameterError
 from ..model.joint_feedback import JointFeedback
 from ..model.noise import MotorNoise
@@ -227,7 +227,7 @@ class RunOptions:
         duration = _setting("duration", self.duration)
         put("duration", duration)
         if self.initial_state is not None:
-            state = finite_array("initial_state [rad, rad/s]", self.initial_state, (None,))
+            state = initial_state_array(self.initial_state)
             put("initial_state", tuple(state.tolist()))
         if self.rates_from not in ("upright", "posture"):
             raise ParameterError(f"rates_from must be 'upright' or 'posture', got "
@@ -361,10 +361,7 @@ def _setting(name: str, value: Any) -> float:
     unit = "" if q.unit in ("-", "rad, rad/s") else q.unit
     label = f"{name} [{unit}]" if unit else name
     within = f"{q.interval()}{' ' + unit if unit else ''}"
-    try:
-        number = float(value)
-    except (TypeError, ValueError):
-        raise ParameterError(f"{label} must be a number in {within}, got {value!r:.60}") from None
+    number = as_number(label, value, f"a number in {within}")
     low_ok = q.low < number if q.low_open else q.low <= number
     if isinstance(value, bool) or not (low_ok and number <= q.high and math.isfinite(number)):
         raise ParameterError(f"{label} must be in {within}, got {number!r}")

@@ -20,7 +20,7 @@ from typing import Literal
 
 import numpy as np
 
-from .._validation import finite_array
+from .._validation import initial_state_array
 from ..errors import ParameterError
 from ..model import switched
 from ..model.body import Body
@@ -296,7 +296,7 @@ def initial_state_for(
     """
     n = body.n_links
     x0 = (np.zeros(2 * n) if initial_state is None
-          else finite_array("initial_state [rad, rad/s]", initial_state, (2 * n,)).copy())
+          else initial_state_array(initial_state, 2 * n))
     dv = tuple(float(a + b) for a, b in zip(disturbance.velocity_change, extra_velocity,
                                              strict=True))
     if dv != (0.0, 0.0):
@@ -379,7 +379,7 @@ def _prepare(body: Body, muscles: MuscleSet, disturbance: Disturbance,
     limits = body_torque_limits(options.torque_limits, body, options.fall.base_of_support)
     initial_state = options.initial_state
     before = (np.zeros(2 * n) if initial_state is None
-              else finite_array("initial_state [rad, rad/s]", initial_state, (2 * n,)).copy())
+              else initial_state_array(initial_state, 2 * n))
     jump = (0.0, 0.0)
     if tilt is not None and depth > 0:  # the ankle starts moving with the surface's rate
         jump = tuple(float(v) for v in axis_translation(tilt, depth, 0.0)[1])

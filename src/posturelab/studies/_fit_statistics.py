@@ -19,8 +19,15 @@ _NO_MOTION = 1e-12
 _DESCRIBES_FRACTION = 0.5
 #: ... or when the residuals look like noise: their RMS at most this multiple of the noise
 #: level estimated from successive differences (√(mean(Δr²)/2), the RMS of independent
-#: noise; a systematic misfit is smooth and its differences small). [-]
+#: noise; a systematic misfit is smooth and its differences small) ... [-]
 _NOISE_MULTIPLE = 2.0
+#: ... and the model still accounts for at least this share of the sway's mean square
+#: (variance accounted for, VAF = 1 − residual²/sway², RMS about upright): residuals that
+#: look like noise only say the model is right when the data are more than noise; fitted
+#: to white noise, any model leaves residuals as large as the data (VAF ≈ 0) that look
+#: like noise too. At 0.25 the residual RMS is at most √0.75 ≈ 0.87 of the sway's (our
+#: threshold, not a published one). [-]
+_MIN_VAF_WITH_NOISE = 0.25
 #: Seeded restarts after a fit that does not describe the data, and their seed. [-]
 _RESTARTS = 8
 _RESTART_SEED = 20261202
@@ -34,11 +41,14 @@ _DEPENDENT = 1e-4
 
 def _describes(residual: np.ndarray, sway: float, n_links: int) -> bool:
     """Whether residuals (sample-major, ``n_links`` per sample) [rad] are small against the
-    sway's RMS [rad] or look like noise (the notes of the constants above)."""
+    sway's RMS [rad] (VAF ≥ 0.75), or look like noise while the model accounts for at least
+    a quarter of the sway's mean square (the notes of the constants above)."""
     r = residual.reshape(-1, n_links)
     rms = float(np.sqrt(np.mean(r**2)))
     if rms <= _DESCRIBES_FRACTION * sway:
         return True
+    if not rms**2 <= (1.0 - _MIN_VAF_WITH_NOISE) * sway**2:
+        return False
     noise = float(np.sqrt(np.mean(np.diff(r, axis=0) ** 2) / 2)) if r.shape[0] > 1 else 0.0
     return rms <= _NOISE_MULTIPLE * noise
 

@@ -20,6 +20,14 @@ freedom Σᵢ Sᵢ(1 − ρᵢ)/(1 + ρᵢ) − P. For independent residuals (ρ
 textbook covariance; ``residual_model="independent"`` forces that one.
 ``examples/fit_coverage.py`` measures the coverage of both (its table: docs/design.md).
 
+Does the fit describe the data. The fit's variance accounted for, VAF = 1 − r²/σ²
+(r the residual RMS, σ the measured angles' RMS about upright, ``sway_rms``), must be at
+least 0.75 (r ≤ σ/2), or the residuals must look like noise (r at most twice the noise
+level from successive differences) while VAF is still at least 0.25: fitted to white
+noise any model leaves residuals as large as the data (VAF ≈ 0), which look like noise
+too. Otherwise ``describes_data`` is False, ``success`` False and ``warning`` says so
+(after seeded restarts from other starting points).
+
 The model of viscosity: every pair's viscosity is ``viscosity_ratio`` times
 its stiffness (the paper's L_d = 0.25 K_d); the ratio is fixed or fitted.
 
