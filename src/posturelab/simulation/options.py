@@ -361,6 +361,9 @@ def _setting(name: str, value: Any) -> float:
     unit = "" if q.unit in ("-", "rad, rad/s") else q.unit
     label = f"{name} [{unit}]" if unit else name
     within = f"{q.interval()}{' ' + unit if unit else ''}"
+    if isinstance(value, bool | np.bool_):  # (True is not 1 s)
+        raise ParameterError(f"{label} must be a number in {within}, not a bool, got "
+                             f"{value!r}")
     try:
         number = float(value)
     except (TypeError, ValueError):

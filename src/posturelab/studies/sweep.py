@@ -325,7 +325,7 @@ def _run_chunk(task, grid: SweepGrid, lo: int, hi: int) -> BatchResult:
 
 class SweepInterrupted(KeyboardInterrupt):
     """Ctrl-C (or SIGTERM) stopped a sweep: the chunks not started were dropped, those
-    running finished. ``parts`` are the finished chunks' results, a prefix of the grid's
+    running abandoned. ``parts`` are the finished chunks' results, a prefix of the grid's
     rows (``rows`` of ``total``); ``terminated`` tells SIGTERM from Ctrl-C; the sweep
     function sets ``result`` to the table of the finished rows."""
 
@@ -403,8 +403,9 @@ def run_chunks(task, grid: SweepGrid, *, workers: int | None = None, scheduler: 
     chunk per single-threaded worker task); the parts in row order.
 
     ``progress(done, total)`` after each finished chunk. The same parts whichever way.
-    Ctrl-C or SIGTERM drops the chunks not started, waits for those running and raises
-    :class:`SweepInterrupted` with the finished ones.
+    Ctrl-C or SIGTERM drops the chunks not started and raises :class:`SweepInterrupted`
+    with the leading finished ones at once (here a running chunk is abandoned, on Dask
+    cancelled).
     """
     m = grid.n_runs
     distributed_run = client is not None or scheduler is not None or workers is not None
@@ -429,38 +430,62 @@ def run_chunks(task, grid: SweepGrid, *, workers: int | None = None, scheduler: 
             raise
         except KeyboardInterrupt as exc:
             raise _interrupted(exc, parts, bounds, m) from None
-    done = 0
-    if threads <= 1:
-        try:
-            for k, (lo, hi) in enumerate(bounds):
-                parts[k] = task.run(grid, lo, hi, parallel=True)
-                done += hi - lo
-                if progress is not None:
-                    progress(done, m)
-        except KeyboardInterrupt as exc:
-            raise _interrupted(exc, parts, bounds, m) from None
-        return parts
-    from concurrent.futures import ThreadPoolExecutor, as_completed
+    return _run_here(task, grid, bounds, parts, progress, max(1, int(threads)))
 
-    pool = ThreadPoolExecutor(threads)
-    futures: dict = {}
+
+def _run_here(task, grid, bounds: list, parts: list, progress, threads: int) -> list:
+    """The chunks on ``threads`` daemon threads of this process, this thread waiting.
+
+    Ctrl-C (or SIGTERM) takes effect at once: no chunk starts after it, and a chunk still
+    running is abandoned, not awaited (a daemon thread does not hold the interpreter's exit;
+    one PRTS chunk may run for tens of seconds). Only the leading finished chunks are kept.
+    """
+    import queue
+    import threading
+
+    m = grid.n_runs
+    todo: queue.SimpleQueue = queue.SimpleQueue()
+    for k, (lo, hi) in enumerate(bounds):
+        todo.put((k, lo, hi))
+    finished: queue.SimpleQueue = queue.SimpleQueue()
+    stop = threading.Event()
+
+    def work() -> None:
+        while not stop.is_set():
+            try:
+                k, lo, hi = todo.get_nowait()
+            except queue.Empty:
+                return
+            try:
+                finished.put((k, task.run(grid, lo, hi, True), None))
+            except BaseException as exc:  # (re-raised in the waiting thread)
+                finished.put((k, None, exc))
+                return
+
+    for _ in range(min(threads, len(bounds))):
+        threading.Thread(target=work, name="posturelab-sweep", daemon=True).start()
     kept = _RowsKept(parts, bounds)
     try:
-        futures = {pool.submit(task.run, grid, lo, hi, True): k
-                   for k, (lo, hi) in enumerate(bounds)}
-        for fut in as_completed(futures):
-            parts[futures[fut]] = fut.result()
+        for _ in bounds:
+            k, part, error = finished.get()  # (a lock wait: Ctrl-C interrupts it)
+            if error is not None:
+                raise error
+            parts[k] = part
             if progress is not None:
                 progress(kept(), m)
     except KeyboardInterrupt as exc:
-        pool.shutdown(wait=True, cancel_futures=True)  # the running chunks finish
-        for fut, k in futures.items():
-            if parts[k] is None and fut.done() and not fut.cancelled() \
-                    and fut.exception() is None:
-                parts[k] = fut.result()
+        stop.set()
+        while True:  # chunks that finished meanwhile are kept; running ones abandoned
+            try:
+                k, part, error = finished.get_nowait()
+            except queue.Empty:
+                break
+            if error is None:
+                parts[k] = part
         raise _interrupted(exc, parts, bounds, m) from None
-    finally:
-        pool.shutdown(wait=True, cancel_futures=True)
+    except BaseException:
+        stop.set()
+        raise
     return parts
 
 

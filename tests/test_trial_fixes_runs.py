@@ -1,0 +1,73 @@
+"""Defects an adversarial trial of the wheel found in the commands that run many
+simulations (stability-map, sweep, strategy, design): each test fails before its fix."""
+
+import threading
+from types import SimpleNamespace
+
+import pytest
+from _cli import refused_in_one_line, run_main
+
+from posturelab.studies.sweep import SweepInterrupted, run_chunks
+
+
+def test_an_interrupt_does_not_wait_for_a_running_chunk():
+    """Ctrl-C during a sweep: the chunk still running is abandoned, not awaited (a PRTS
+    chunk ran on for 23 s); the leading finished chunk is kept."""
+    release, finished = threading.Event(), []
+
+    class Task:
+        def run(self, grid, lo, hi, parallel):
+            if lo > 0:  # the second chunk runs until released
+                release.wait(60)
+                finished.append(lo)
+            return [lo]
+
+    def progress(done, total):
+        raise KeyboardInterrupt  # (Ctrl-C once the first chunk is in)
+
+    try:
+        with pytest.raises(SweepInterrupted) as caught:
+            run_chunks(Task(), SimpleNamespace(n_runs=2), chunk_size=1, progress=progress,
+                       threads=2)
+        assert finished == []  # returned while the second chunk was still running
+        assert caught.value.parts == [[0]] and caught.value.rows == 1
+    finally:
+        release.set()
+
+
+def test_chunks_in_order_and_errors_raised():
+    class Task:
+        def run(self, grid, lo, hi, parallel):
+            if lo == 3:
+                raise ValueError("boom")
+            return list(range(lo, hi))
+
+    parts = run_chunks(Task(), SimpleNamespace(n_runs=3), chunk_size=2, threads=2)
+    assert parts == [[0, 1], [2]]
+    with pytest.raises(ValueError, match="boom"):
+        run_chunks(Task(), SimpleNamespace(n_runs=5), chunk_size=1, threads=1)
+
+
+def test_design_optimise_refuses_the_values_it_would_override(capsys):
+    """design --optimise chose 10,000 cycles at 0.07 rad over --cycles 5 --tilt prts:0.035."""
+    base = ("design", "--controller", "peterka-2002", "--free", "feedback_delay",
+            "--sensor-noise", "0.001", "--optimise", "--budget", "100")
+    assert "--cycles" in refused_in_one_line(capsys, *base, "--cycles", "5")
+    line = refused_in_one_line(capsys, *base, "--tilt", "prts:0.035")
+    assert "--tilt" in line and "--amplitudes" in line
+
+
+def test_stability_map_never_overwrites_a_csv_beside_the_figure(tmp_path, capsys):
+    victim = tmp_path / "victim.csv"
+    victim.write_text("mine\n1,2\n", encoding="utf-8")
+    axes = ("stability-map", "--x", "stiffness:ankle:0:2000", "--y", "stiffness:knee:0:1000",
+            "--resolution", "4")
+    line = refused_in_one_line(capsys, *axes, "--out", str(tmp_path / "victim.png"))
+    assert "victim.csv" in line and "--csv" in line
+    assert victim.read_text(encoding="utf-8") == "mine\n1,2\n"
+    assert not (tmp_path / "victim.png").exists()
+    code, out, err = run_main(capsys, *axes, "--out", str(tmp_path / "victim.png"),
+                              "--csv", str(tmp_path / "map.csv"))
+    assert code == 0, err
+    assert victim.read_text(encoding="utf-8") == "mine\n1,2\n"
+    assert (tmp_path / "map.csv").read_text(encoding="utf-8").startswith("stiffness:ankle,")
