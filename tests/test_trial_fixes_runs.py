@@ -71,3 +71,11 @@ def test_stability_map_never_overwrites_a_csv_beside_the_figure(tmp_path, capsys
     assert code == 0, err
     assert victim.read_text(encoding="utf-8") == "mine\n1,2\n"
     assert (tmp_path / "map.csv").read_text(encoding="utf-8").startswith("stiffness:ankle,")
+
+
+def test_stability_map_replaces_its_own_earlier_csv(tmp_path, capsys):
+    axes = ("stability-map", "--x", "stiffness:ankle:0:2000", "--y", "stiffness:knee:0:1000",
+            "--out", str(tmp_path / "map.png"))
+    assert run_main(capsys, *axes, "--resolution", "3")[0] == 0
+    assert run_main(capsys, *axes, "--resolution", "4")[0] == 0  # a rerun
+    assert len((tmp_path / "map.csv").read_text(encoding="utf-8").splitlines()) == 1 + 16
