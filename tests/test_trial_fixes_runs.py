@@ -79,3 +79,55 @@ def test_stability_map_replaces_its_own_earlier_csv(tmp_path, capsys):
     assert run_main(capsys, *axes, "--resolution", "3")[0] == 0
     assert run_main(capsys, *axes, "--resolution", "4")[0] == 0  # a rerun
     assert len((tmp_path / "map.csv").read_text(encoding="utf-8").splitlines()) == 1 + 16
+
+
+@pytest.mark.parametrize("argv, words", [
+    (("--oscillation", "0.05", "--frequencies", "0.002:0.002:1"),
+     ("--frequencies", "0.0025 Hz", "got 0.002")),
+    (("--translation", "backward", "--speeds", "0.05:100:8"), ("--speeds", "10 m/s", "got 100")),
+    (("--oscillation", "0.05", "--frequencies", "0.1:100:6"),
+     ("--frequencies", "20 Hz", "got 100")),
+    (("--translation", "backward", "--speeds", "0.05:1:1000", "--ankle-torque-limits",
+      "40:120:1000"), ("1,000,000 runs", "10,000")),
+])
+def test_strategy_names_the_option_and_the_value_typed(capsys, argv, words):
+    """Before: "duration [s] 2500 at sample_rate …" (strategy has neither option), "got
+    14.33" (a grid value, not the 100 typed), or a million runs started."""
+    line = refused_in_one_line(capsys, "strategy", *argv)
+    for w in words:
+        assert w in line, line
+
+
+def test_strategy_counts_every_map_in_its_progress():
+    """The runs of a two-parameter map counted as one whole (the estimate's total)."""
+    from posturelab.cli.strategy import _Overall
+
+    seen = []
+    overall = _Overall(6, 3)
+    overall.notice = lambda done, total: seen.append((done, total))
+    for _ in range(2):
+        for i in range(3):
+            overall(i + 1, 3)
+    assert seen == [(k, 6) for k in range(1, 7)]
+
+
+def test_api_simulate_refuses_a_bool_duration():
+    import posturelab as pl
+    from posturelab.errors import ParameterError
+
+    with pytest.raises(ParameterError, match="not a bool, got True"):
+        pl.simulate(pl.paper_body(), pl.paper_muscles("1"), pl.VelocityStep.backward(1.0),
+                    duration=True)
+
+
+def test_messages_name_the_value_given(capsys, tmp_path):
+    line = refused_in_one_line(capsys, "sweep", "--case", "1", "--disturbance", "backward",
+                               "--duration", "1", "--vary", "disturbance_scale=0:100:3",
+                               "--out", str(tmp_path / "sw.csv"))
+    assert "disturbance_scale 100" in line, line  # (was: "velocity … got -50.0")
+    line = refused_in_one_line(capsys, "frf-model", "--case", "1", "--frequencies", "0,1")
+    assert "--frequencies" in line and "got 0" in line
+    run = tmp_path / "run.csv"
+    run.write_text("t,theta1\n0,0\n", encoding="utf-8")
+    line = refused_in_one_line(capsys, "compare", str(run), "--plot", str(run))
+    assert "RUN.csv" not in line and "input run" in line
