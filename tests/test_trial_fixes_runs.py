@@ -5,8 +5,8 @@ import threading
 from types import SimpleNamespace
 
 import pytest
-from _cli import refused_in_one_line, run_main
 
+from _cli import refused_in_one_line, run_main
 from posturelab.studies.sweep import SweepInterrupted, run_chunks
 
 
@@ -131,3 +131,81 @@ def test_messages_name_the_value_given(capsys, tmp_path):
     run.write_text("t,theta1\n0,0\n", encoding="utf-8")
     line = refused_in_one_line(capsys, "compare", str(run), "--plot", str(run))
     assert "RUN.csv" not in line and "input run" in line
+
+
+def _server(reply: bytes | None):
+    """A local TCP server answering every connection with ``reply`` (None: silence, like an
+    HTTP server waiting for a request); its port and a stop function."""
+    import socket
+
+    listener = socket.socket()
+    listener.bind(("127.0.0.1", 0))
+    listener.listen(4)
+    held, stop = [], threading.Event()
+
+    def serve():
+        listener.settimeout(0.1)
+        while not stop.is_set():
+            try:
+                conn, _ = listener.accept()
+            except OSError:
+                continue
+            held.append(conn)
+            if reply is not None:
+                conn.sendall(reply)
+
+    threading.Thread(target=serve, daemon=True).start()
+
+    def close():
+        stop.set()
+        for c in held:
+            c.close()
+        listener.close()
+
+    return listener.getsockname()[1], close
+
+
+@pytest.mark.parametrize("reply, words", [
+    (b"HTTP/1.0 426 Upgrade Required\r\nContent-Length: 0\r\n\r\n",
+     ("is not a Dask scheduler", "HTTP/1.0")),
+    (None, ("no Dask scheduler answered within",)),
+])
+def test_a_scheduler_that_is_not_dask_is_refused_in_one_line(reply, words):
+    """Before: a 3.01 EiB allocation error with a traceback, or a hang of minutes."""
+    from posturelab.errors import PostureLabError
+    from posturelab.studies._sweep_dask import probe_scheduler
+
+    port, close = _server(reply)
+    try:
+        with pytest.raises(PostureLabError) as caught:
+            probe_scheduler(f"tcp://127.0.0.1:{port}", timeout=0.5)
+        for w in words:
+            assert w in str(caught.value)
+        assert "\n" not in str(caught.value)
+    finally:
+        close()
+
+
+def test_a_dask_like_handshake_passes_the_probe():
+    import struct
+
+    from posturelab.studies._sweep_dask import probe_scheduler
+
+    port, close = _server(struct.pack("<Q", 120) + b"\0" * 120)
+    try:
+        probe_scheduler(f"127.0.0.1:{port}", timeout=5)
+    finally:
+        close()
+
+
+def test_sweep_against_an_http_server_is_refused(tmp_path, capsys):
+    port, close = _server(b"HTTP/1.0 426 Upgrade Required\r\n\r\n")
+    try:
+        line = refused_in_one_line(
+            capsys, "sweep", "--case", "1", "--disturbance", "backward", "--duration", "1",
+            "--vary", "stiffness:ankle=0:2000:4", "--out", str(tmp_path / "sw.csv"),
+            "--scheduler", f"tcp://127.0.0.1:{port}")
+    finally:
+        close()
+    assert "not a Dask scheduler" in line
+    assert not (tmp_path / "sw.csv").exists()

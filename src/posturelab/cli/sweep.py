@@ -193,7 +193,7 @@ def _refuse_unused(args: argparse.Namespace) -> None:
     prts = args.experiment == "prts"
     unused = [f for f in (SIMULATION_ONLY if prts else PRTS_ONLY)
               if getattr(args, f, None) is not None]
-    if prts and args.rates_from != "upright":
+    if prts and args.rates_from is not None:
         unused.append("rates_from")
     if unused:
         names = ", ".join(f"--{f.replace('_', '-')}" for f in unused)

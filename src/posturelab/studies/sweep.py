@@ -34,7 +34,6 @@ the single-process path (each run is the same deterministic computation).
 
 from __future__ import annotations
 
-import contextlib
 import os
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -42,10 +41,17 @@ from typing import IO, TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..errors import ParameterError, PostureLabError
+from ..errors import ParameterError
 from ..scenarios import Scenario
 from ..simulation.options import RunOptions
 from ..simulation.tolerances import DEFAULT_ATOL, DEFAULT_RTOL
+from ._sweep_dask import (
+    SCHEDULER_PROTOCOLS,
+    SCHEDULER_TIMEOUT,
+    _RowsKept,
+    _run_on_dask,
+    check_scheduler_address,
+)
 from ._sweep_grid import (
     MAX_RUNS,
     OUTCOME_COLUMNS,
@@ -318,11 +324,6 @@ def run_sweep(
     return SweepResult(grid, _concatenate(parts))
 
 
-def _run_chunk(task, grid: SweepGrid, lo: int, hi: int) -> BatchResult:
-    """A chunk on a Dask worker: one thread per task (the worker's threads run tasks)."""
-    return task.run(grid, lo, hi, parallel=False)
-
-
 class SweepInterrupted(KeyboardInterrupt):
     """Ctrl-C (or SIGTERM) stopped a sweep: the chunks not started were dropped, those
     running abandoned. ``parts`` are the finished chunks' results, a prefix of the grid's
@@ -333,20 +334,6 @@ class SweepInterrupted(KeyboardInterrupt):
         super().__init__(f"interrupted after {rows} of {total} runs")
         self.parts, self.rows, self.total, self.terminated = parts, rows, total, terminated
         self.result: Any = None
-
-
-class _RowsKept:
-    """Rows of the leading finished chunks: what an interrupt keeps, and so what progress
-    counts (chunks finish out of order; one finished after a running one is not kept)."""
-
-    def __init__(self, parts: list, bounds: list) -> None:
-        self.parts, self.bounds, self.leading = parts, bounds, 0
-
-    def __call__(self) -> int:
-        """The rows kept now. [-]"""
-        while self.leading < len(self.parts) and self.parts[self.leading] is not None:
-            self.leading += 1
-        return self.bounds[self.leading - 1][1] if self.leading else 0
 
 
 def _interrupted(exc: BaseException, parts: list, bounds: list, total: int
@@ -363,35 +350,9 @@ def _interrupted(exc: BaseException, parts: list, bounds: list, total: int
 
 #: Dask worker processes a local sweep may start, per CPU. [-]
 WORKERS_PER_CPU = 4
-#: Seconds to wait for a Dask scheduler to answer before giving up. [s]
-SCHEDULER_TIMEOUT = 10
-
-
 def max_workers() -> int:
     """The most Dask worker processes a local sweep starts: 4 per CPU. [-]"""
     return WORKERS_PER_CPU * (os.cpu_count() or 1)
-
-
-#: Protocols a Dask scheduler address may name.
-SCHEDULER_PROTOCOLS = ("tcp", "tls", "ucx", "ws", "wss", "inproc")
-
-
-def check_scheduler_address(address: str) -> None:
-    """Refuse a Dask scheduler address that is not ``[PROTOCOL://]HOST:PORT`` (one line
-    naming it), before any connection is tried."""
-    form = "[tcp://]HOST:PORT, e.g. tcp://127.0.0.1:8786"
-    protocol, sep, rest = address.partition("://")
-    if not sep:
-        protocol, rest = "tcp", address
-    host, colon, port = rest.rpartition(":")
-    if protocol not in SCHEDULER_PROTOCOLS:
-        raise ParameterError(f"--scheduler {address!r}: unknown protocol {protocol!r} (one of "
-                             f"{', '.join(SCHEDULER_PROTOCOLS)}); the form is {form}")
-    if protocol == "inproc":
-        return
-    if not colon or not host or not port.isdigit() or not 1 <= int(port) <= 65535:
-        raise ParameterError(f"--scheduler {address!r} is not an address of the form {form} "
-                             "(PORT 1 … 65535)")
 
 
 def run_chunks(task, grid: SweepGrid, *, workers: int | None = None, scheduler: str | None = None,
@@ -487,115 +448,3 @@ def _run_here(task, grid, bounds: list, parts: list, progress, threads: int) -> 
         stop.set()
         raise
     return parts
-
-
-@contextlib.contextmanager
-def _quiet_dask():
-    """Every logger silent for the block (distributed's, tornado's and asyncio's report the
-    connections a shutdown after Ctrl-C cuts, as errors with tracebacks)."""
-    import logging
-
-    previous = logging.root.manager.disable
-    logging.disable(logging.CRITICAL)
-    try:
-        yield
-    finally:
-        logging.disable(previous)
-
-
-@contextlib.contextmanager
-def _sigint_held():
-    """Ctrl-C held back for the block and delivered after it (at once if it came meanwhile),
-    so that a cluster is not left half-started; the worker processes started in the block
-    ignore SIGINT (a terminal's Ctrl-C, or ``timeout -s INT``, reaches the whole process
-    group: only this process is to handle it, and then close the cluster)."""
-    import signal
-    import threading
-
-    hold = hasattr(signal, "pthread_sigmask") and \
-        threading.current_thread() is threading.main_thread()
-    if not hold:
-        yield
-        return
-    signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
-    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)  # (inherited by the workers; on
-    try:  # Linux a blocked signal stays pending though ignored)
-        yield
-    finally:
-        signal.signal(signal.SIGINT, previous)
-        signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
-
-
-def _close_dask(client, cluster, quiet: bool) -> None:
-    """Close the client, then the cluster (each at most a few seconds); after Ctrl-C with
-    every logger silent."""
-    with _quiet_dask() if quiet else contextlib.nullcontext():
-        for closing in (client, cluster):
-            if closing is None:
-                continue
-            try:
-                closing.close(timeout=5) if closing is client else closing.close()
-            except Exception:  # (a shutdown after Ctrl-C: the connections may be gone)
-                if not quiet:
-                    raise
-
-
-def _run_on_dask(task, grid, bounds, workers, scheduler, client, progress,
-                 parts: list) -> list[BatchResult]:
-    try:
-        import distributed
-    except ImportError:
-        raise PostureLabError("--workers/--scheduler need Dask: pip install 'dask[distributed]' "
-                              "(or 'posturelab[dask]')") from None
-    own_client = own_cluster = None
-    interrupted = False
-    try:
-        if client is None:
-            if scheduler is not None:
-                try:
-                    with _quiet_dask():
-                        own_client = client = distributed.Client(
-                            scheduler, timeout=SCHEDULER_TIMEOUT)
-                except (OSError, TimeoutError, ValueError) as exc:
-                    reason = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-                    raise PostureLabError(
-                        f"cannot reach the Dask scheduler at {scheduler!r} within "
-                        f"{SCHEDULER_TIMEOUT} s: {reason}") from None
-            else:
-                import logging
-
-                with _sigint_held():
-                    own_cluster = distributed.LocalCluster(
-                        n_workers=workers, threads_per_worker=1, processes=True,
-                        dashboard_address=None, silence_logs=logging.CRITICAL)
-                    own_client = client = distributed.Client(own_cluster)
-        shared = client.scatter(task, broadcast=True)
-        shared_grid = client.scatter(grid, broadcast=True)
-        futures = [client.submit(_run_chunk, shared, shared_grid, lo, hi, pure=False)
-                   for lo, hi in bounds]
-        index = {f.key: k for k, f in enumerate(futures)}
-        kept = _RowsKept(parts, bounds)
-        try:
-            for fut in distributed.as_completed(futures):
-                parts[index[fut.key]] = fut.result()
-                if progress is not None:
-                    progress(kept(), grid.n_runs)
-        except KeyboardInterrupt:
-            interrupted = True
-            with _quiet_dask():  # keep the chunks that finished, drop the rest
-                for k, fut in enumerate(futures):
-                    try:
-                        if parts[k] is None and fut.status == "finished":
-                            parts[k] = fut.result(timeout=5)
-                    except Exception:
-                        pass
-                with contextlib.suppress(Exception):
-                    client.cancel(futures)
-            raise
-        return parts  # type: ignore[return-value]
-    except KeyboardInterrupt:
-        interrupted = True
-        raise
-    finally:
-        _close_dask(own_client, own_cluster, quiet=interrupted)
-
