@@ -209,3 +209,12 @@ def test_sweep_against_an_http_server_is_refused(tmp_path, capsys):
         close()
     assert "not a Dask scheduler" in line
     assert not (tmp_path / "sw.csv").exists()
+
+
+def test_a_prts_sweep_beyond_its_bound_is_refused_before_it_starts(tmp_path, capsys):
+    """Before: 90,000 experiments of 990 cycles (~100 h) started without a word."""
+    line = refused_in_one_line(
+        capsys, "sweep", "--case", "1", "--tilt", "prts:0.035", "--experiment", "prts",
+        "--cycles", "990", "--vary", "stiffness:ankle=800:1200:300",
+        "--vary", "stiffness:knee=500:700:300", "--out", str(tmp_path / "p.csv"))
+    assert "90,000 PRTS experiments" in line and "--cycles" in line and "1e+08 s" in line

@@ -27,6 +27,10 @@ from ._common import check_writable, naming_given_options
 from ._flags import add_flag, add_flags
 from .simulate import add_experiment_arguments, experiment_inputs, scenario_from_args
 
+#: Most simulated time of all the experiments of one --experiment prts sweep (experiments
+#: × cycles × the cycle): about 8 CPU-hours of the compiled engine, a bound on the work. [s]
+MAX_PRTS_SIMULATED = 1e8
+
 DESCRIPTION = f"""\
 Simulate the nonlinear model for every combination of the --vary values (the full grid,
 the first --vary varying slowest) with the compiled engine, and write one row per run.
@@ -87,6 +91,10 @@ run), the FRF of --output at the sequence's bands, and with --fit NAMES the FRF 
 parameters (posturelab fit-frf's names) started from the base experiment's values. Its
 columns: the varied parameters, fell, gain_B, phase_deg_B [deg], coherence_B per band, then
 fit_NAME and se_NAME per fitted parameter (fit_active_stiffness:ankle, ...) and fit_error.
+Before it starts, a PRTS sweep says on standard error how many experiments of how much
+simulated time it runs; it refuses more than {MAX_PRTS_SIMULATED:.0e} s simulated in all
+(fewer --vary values or --cycles). Any sweep that will take over 10 s says, after its first
+chunk, about how long it will take in all.
 
 Parallelism: the runs use every CPU
 available (one thread each). --workers N sends chunks of runs to a Dask LocalCluster of N
@@ -260,19 +268,22 @@ def _with_progress(args: argparse.Namespace, total: int, work):
     --progress); returns its result and the seconds it took."""
     from .._progress import Progress, shown
 
+    from ._common import ExpectedTime
+
     bar = Progress(total, label="sweep", unit="runs") if shown(args.progress) else None
     t0 = time.perf_counter()
     try:
-        result = work(bar)
+        result = work(bar or ExpectedTime("sweep", "runs"))
     finally:
         if bar is not None:
             bar.close()
     return result, time.perf_counter() - t0
 
 
-def _check_experiment_length(args: argparse.Namespace, protocol, scenario) -> None:
+def _check_experiment_length(args: argparse.Namespace, protocol, scenario, varies) -> None:
     """Refuse, naming --cycles and --discard-cycles, an experiment longer than the longest
-    run."""
+    run, or experiments longer than :data:`MAX_PRTS_SIMULATED` in all; else say how many
+    and how long (standard error)."""
     from ..simulation.setup import MAX_DURATION
 
     tilt = scenario.options.tilt
@@ -280,11 +291,20 @@ def _check_experiment_length(args: argparse.Namespace, protocol, scenario) -> No
         return  # (prts_sweep says the tilt must be a PRTS)
     cycles = protocol.cycles + protocol.discard
     total = tilt.cycle * cycles
+    given = f"--cycles {protocol.cycles}" if protocol.discard == 0 else (
+        f"(--cycles {protocol.cycles} + --discard-cycles {protocol.discard})")
     if total > MAX_DURATION:
-        given = f"--cycles {protocol.cycles}" if protocol.discard == 0 else (
-            f"(--cycles {protocol.cycles} + --discard-cycles {protocol.discard})")
         raise ParameterError(f"{given} × the {tilt.cycle:g} s cycle = {total:.3g} s exceeds "
                              f"the longest run, {MAX_DURATION:,.0f} s")
+    runs = _runs(varies)
+    if runs * total > MAX_PRTS_SIMULATED:
+        raise ParameterError(f"{runs:,} PRTS experiments × {total:.4g} s ({given} × the "
+                             f"{tilt.cycle:g} s cycle) = {runs * total:.3g} s simulated; a "
+                             f"sweep runs at most {MAX_PRTS_SIMULATED:.0e} s (fewer --vary "
+                             "values or --cycles)")
+    if runs * total > 1e5:  # (over about half a minute)
+        print(f"posturelab: sweep: {runs:,} PRTS experiments of {total:.4g} s simulated each "
+              f"({runs * total:.3g} s in all)", file=sys.stderr)
 
 
 def _run_experiments(args: argparse.Namespace, scenario, varies, ratio) -> int:
@@ -297,7 +317,7 @@ def _run_experiments(args: argparse.Namespace, scenario, varies, ratio) -> int:
         ("sample_rate", "record_rate"), ("output", "output")) if getattr(args, flag) is not None}
     with naming_given_options(args, PROTOCOL_FIELD_OPTIONS):
         protocol = PRTSProtocol(seed=args.seed or 0, fit=fit, **given)
-    _check_experiment_length(args, protocol, scenario)
+    _check_experiment_length(args, protocol, scenario, varies)
     with naming_given_options(args, PROTOCOL_FIELD_OPTIONS):
         result, elapsed = _with_progress(args, _runs(varies), lambda progress: prts_sweep(
             scenario, varies, protocol, viscosity_ratio=ratio, workers=args.workers,
