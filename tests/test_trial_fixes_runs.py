@@ -218,3 +218,22 @@ def test_a_prts_sweep_beyond_its_bound_is_refused_before_it_starts(tmp_path, cap
         "--cycles", "990", "--vary", "stiffness:ankle=800:1200:300",
         "--vary", "stiffness:knee=500:700:300", "--out", str(tmp_path / "p.csv"))
     assert "90,000 PRTS experiments" in line and "--cycles" in line and "1e+08 s" in line
+
+
+def test_a_measured_profile_ends_where_its_motion_ends():
+    """−2 m/s² for 0.2 s, then zeros to 0.999 s: the perturbation ends at 0.201 s (the
+    sample after the last non-zero one, where the interpolated acceleration is back at 0),
+    not at the last sample, 0.999 s; an all-zero profile has ended at its first sample."""
+    import numpy as np
+
+    from posturelab.model.platform import MeasuredProfile
+    from posturelab.simulation.outcome import stimulus_timing
+
+    t = np.round(np.arange(0, 1.0, 0.001), 6)
+    moving = MeasuredProfile(t, np.where(t <= 0.2, -2.0, 0.0))
+    assert stimulus_timing(moving).end == pytest.approx(0.201, abs=1e-12)
+    assert stimulus_timing(MeasuredProfile(t, np.zeros_like(t))).end == 0.0
+    y = MeasuredProfile(t, np.zeros_like(t), np.where(t <= 0.5, 1.0, 0.0))
+    assert stimulus_timing(y).end == pytest.approx(0.501, abs=1e-12)
+    to_the_end = MeasuredProfile(t, np.full_like(t, 0.5))
+    assert stimulus_timing(to_the_end).end == pytest.approx(0.999, abs=1e-12)
