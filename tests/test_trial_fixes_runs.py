@@ -237,3 +237,15 @@ def test_a_measured_profile_ends_where_its_motion_ends():
     assert stimulus_timing(y).end == pytest.approx(0.501, abs=1e-12)
     to_the_end = MeasuredProfile(t, np.full_like(t, 0.5))
     assert stimulus_timing(to_the_end).end == pytest.approx(0.999, abs=1e-12)
+
+
+def test_a_csv_too_large_is_refused_before_the_run(tmp_path, capsys, monkeypatch):
+    """Before: 1999.999 s to CSV ran 22 s and took 1.1 GB, then was refused at 512 MiB."""
+    from posturelab.scenarios import Scenario
+
+    ran = []
+    monkeypatch.setattr(Scenario, "run", lambda self, **kw: ran.append(1))
+    line = refused_in_one_line(capsys, "simulate", "--case", "1", "--disturbance", "backward",
+                               "--duration", "1999.999", "--out", str(tmp_path / "long.csv"))
+    assert ran == [] and "--duration 1999.999" in line and ".parquet" in line
+    assert not (tmp_path / "long.csv").exists()

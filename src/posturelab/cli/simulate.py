@@ -438,6 +438,37 @@ def _write_run(result, path: str) -> None:
                                                  result.column_units()))
 
 
+#: Bytes a value of a perturbed run's CSV takes on average ("%.10g" and a comma: most
+#: values are 11 to 17 characters, a few columns zeros; 12.6 measured for a velocity step,
+#: 11.4 for a sine tilt), for the estimate made before a run. An unperturbed run from
+#: upright is zeros (2 to 3 bytes a value): not estimated. [B]
+CSV_BYTES_PER_VALUE = 12
+
+
+def check_csv_size(sc: Scenario, out: str) -> None:
+    """Refuse, before the run, a CSV whose rows (floor(duration × sample rate) + 1) times
+    its columns (those every run has, at least) at :data:`CSV_BYTES_PER_VALUE` would pass
+    what posturelab reads back (the write refuses what gets past this estimate)."""
+    from .._files import MAX_INPUT_BYTES
+
+    from ..simulation.outcome import stimulus_timing
+
+    o, n = sc.options, sc.body.n_links
+    still = not stimulus_timing(sc.disturbance, o.tilt, o.motor_noise, o.visual_tilt).perturbed
+    if still and not any(o.initial_state or ()):
+        return  # (zeros: the write's own check suffices)
+    rows = math.floor(o.duration * o.sample_rate) + 1
+    columns = 1 + 2 * n + len(sc.muscles.names) + 2 * n + 10  # t, θ, ω, M, U, joint, cog…
+    columns += (o.tilt is not None) + (o.visual_tilt is not None)
+    estimate = rows * columns * CSV_BYTES_PER_VALUE
+    if estimate > MAX_INPUT_BYTES:
+        raise ParameterError(
+            f"--out {out!r} would be about {estimate / 2**20:,.0f} MiB ({rows:,} rows of "
+            f"--duration {o.duration:.10g} s at --sample-rate {o.sample_rate:.10g} Hz × {columns} "
+            f"columns); at most {MAX_INPUT_BYTES // 2**20} MiB, the most posturelab reads "
+            "back: write .parquet, or lower --sample-rate or --duration")
+
+
 def run(args: argparse.Namespace) -> int:
     from .._files import refuse_input_as_output
 
@@ -447,6 +478,8 @@ def run(args: argparse.Namespace) -> int:
     outputs = [p for p in (args.out, args.plot, args.animate) if p]
     check_writable(outputs, {args.out: (".csv", ".parquet"), args.plot: FIGURE_SUFFIXES,
                              args.animate: (".gif",)})
+    if args.out and args.out.lower().endswith(".csv"):
+        check_csv_size(sc, args.out)
     if sc.options.time_limit is None:
         sc = sc.replace(time_limit=DEFAULT_TIME_LIMIT)
     with naming_given_options(args):
