@@ -249,3 +249,43 @@ def test_a_csv_too_large_is_refused_before_the_run(tmp_path, capsys, monkeypatch
                                "--duration", "1999.999", "--out", str(tmp_path / "long.csv"))
     assert ran == [] and "--duration 1999.999" in line and ".parquet" in line
     assert not (tmp_path / "long.csv").exists()
+
+
+def test_data_files_take_several_after_one_flag_or_the_flag_repeated():
+    import argparse
+
+    from posturelab.cli._flags import add_data_files
+
+    p = argparse.ArgumentParser()
+    add_data_files(p, "the trials")
+    assert p.parse_args(["--data", "a", "b"]).data == ["a", "b"]
+    assert p.parse_args(["--data", "a", "--data", "b"]).data == ["a", "b"]
+    assert p.parse_args(["--data", "a", "b", "--data", "c"]).data == ["a", "b", "c"]
+
+
+def test_a_prts_sweep_takes_sample_rate_as_its_record_rate(tmp_path, capsys):
+    """--sample-rate means the recording's samples per second there, as --record-rate."""
+    import argparse
+
+    from posturelab.cli import sweep
+
+    base = ["--case", "1", "--tilt", "prts:0.035", "--experiment", "prts", "--cycles", "3",
+            "--vary", "stiffness:ankle=800:1200:2", "--out", str(tmp_path / "p.csv")]
+    seen = []
+
+    def keep(args, scenario, varies, ratio):
+        seen.append(args.record_rate)
+        return 0
+
+    p = argparse.ArgumentParser()
+    sweep.add_arguments(p)
+    original = sweep._run_experiments
+    sweep._run_experiments = keep
+    try:
+        assert sweep.run(p.parse_args([*base, "--sample-rate", "50"])) == 0
+    finally:
+        sweep._run_experiments = original
+    assert seen == [50.0]
+    line = refused_in_one_line(capsys, "sweep", *base, "--sample-rate", "50", "--record-rate",
+                               "100")
+    assert "--sample-rate" in line and "--record-rate" in line

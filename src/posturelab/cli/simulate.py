@@ -450,7 +450,6 @@ def check_csv_size(sc: Scenario, out: str) -> None:
     its columns (those every run has, at least) at :data:`CSV_BYTES_PER_VALUE` would pass
     what posturelab reads back (the write refuses what gets past this estimate)."""
     from .._files import MAX_INPUT_BYTES
-
     from ..simulation.outcome import stimulus_timing
 
     o, n = sc.options, sc.body.n_links

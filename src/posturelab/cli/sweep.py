@@ -16,7 +16,6 @@ from ..studies.sweep import (
     OUTCOME_COLUMNS,
     SWEEP_PARAMETERS,
     SweepInterrupted,
-    check_scheduler_address,
     max_workers,
     parse_vary,
     run_sweep,
@@ -138,7 +137,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     add_flag(e, "--discard-cycles", "1", default=None)
     add_flags(e, "--sensor-noise")
     e.add_argument("--record-rate", type=float, default=None, metavar="HZ",
-                   help="samples per second of the recording [Hz] (default 100).")
+                   help="samples per second of the recording [Hz] (default 100); "
+                   "--sample-rate says the same with --experiment prts.")
     add_flag(e, "--output", " or thetaN", default=None)
     e.add_argument("--fit", metavar="NAMES",
                    help="fit these parameters to each experiment's FRF (comma-separated, "
@@ -166,12 +166,21 @@ def run(args: argparse.Namespace) -> int:
         raise ParameterError(f"--workers must be in 1 … {max_workers()} (4 × the "
                              f"{os.cpu_count() or 1} CPUs), got {args.workers}")
     if args.scheduler is not None:
+        from ..studies._sweep_dask import check_scheduler_address
+
         check_scheduler_address(args.scheduler)
     if args.chunk_size is not None and args.chunk_size < 1:
         raise ParameterError(f"--chunk-size must be >= 1, got {args.chunk_size}")
     ratio = args.viscosity_ratio
     if ratio is None and not (args.scenario or args.builtin or args.controller):
         args.viscosity_ratio = DEFAULT_VISCOSITY_RATIO  # what --case / --stiffness build with
+    if args.experiment == "prts" and args.sample_rate is not None:
+        # (the recording's samples per second: --sample-rate, as everywhere, or --record-rate)
+        if args.record_rate is not None and args.record_rate != args.sample_rate:
+            raise UsageError(f"sweep: --sample-rate {args.sample_rate:g} and --record-rate "
+                             f"{args.record_rate:g} are the same setting with --experiment "
+                             "prts; give one")
+        args.record_rate, args.sample_rate = args.sample_rate, None
     _refuse_unused(args)
     scenario = scenario_from_args(args, "sweep")
     try:
@@ -191,7 +200,7 @@ PROTOCOL_FIELD_OPTIONS = {"cycles": "--cycles", "discard": "--discard-cycles",
 PRTS_ONLY = ("cycles", "discard_cycles", "sensor_noise", "record_rate", "output", "fit")
 #: The base experiment's options a PRTS experiment has no use for: its stimulus is the tilt,
 #: its length the cycles, its recording --record-rate, its integrator its own.
-SIMULATION_ONLY = ("disturbance", "speed", "platform_profile", "duration", "sample_rate",
+SIMULATION_ONLY = ("disturbance", "speed", "platform_profile", "duration",
                    "initial_posture", "initial_rates", "rtol", "atol", "max_steps",
                    "time_limit", "tilt_axis_depth")
 
@@ -267,7 +276,6 @@ def _with_progress(args: argparse.Namespace, total: int, work):
     """``work(progress)`` with a progress bar on standard error (a terminal, or
     --progress); returns its result and the seconds it took."""
     from .._progress import Progress, shown
-
     from ._common import ExpectedTime
 
     bar = Progress(total, label="sweep", unit="runs") if shown(args.progress) else None

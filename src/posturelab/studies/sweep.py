@@ -45,13 +45,6 @@ from ..errors import ParameterError
 from ..scenarios import Scenario
 from ..simulation.options import RunOptions
 from ..simulation.tolerances import DEFAULT_ATOL, DEFAULT_RTOL
-from ._sweep_dask import (
-    SCHEDULER_PROTOCOLS,
-    SCHEDULER_TIMEOUT,
-    _RowsKept,
-    _run_on_dask,
-    check_scheduler_address,
-)
 from ._sweep_grid import (
     MAX_RUNS,
     OUTCOME_COLUMNS,
@@ -78,6 +71,11 @@ from ._sweep_grid import (
 
 if TYPE_CHECKING:  # (the engine loads when a sweep runs: posturelab --help stays light)
     from ..simulation.compiled import BatchResult
+    from ._sweep_dask import (  # (given by __getattr__ below)
+        SCHEDULER_PROTOCOLS,
+        SCHEDULER_TIMEOUT,
+        check_scheduler_address,
+    )
 
 __all__ = [
     "SWEEP_PARAMETERS",
@@ -374,6 +372,8 @@ def run_chunks(task, grid: SweepGrid, *, workers: int | None = None, scheduler: 
                                 or not 1 <= workers <= max_workers()):
         raise ParameterError(f"--workers must be an integer in 1 … {max_workers()} (4 × the "
                              f"{os.cpu_count() or 1} CPUs), got {workers!r}")
+    from ._sweep_dask import _run_on_dask, check_scheduler_address
+
     if scheduler is not None:
         check_scheduler_address(scheduler)
     if chunk_size is None:
@@ -403,6 +403,8 @@ def _run_here(task, grid, bounds: list, parts: list, progress, threads: int) -> 
     """
     import queue
     import threading
+
+    from ._sweep_dask import _RowsKept
 
     m = grid.n_runs
     todo: queue.SimpleQueue = queue.SimpleQueue()
@@ -448,3 +450,16 @@ def _run_here(task, grid, bounds: list, parts: list, progress, threads: int) -> 
         stop.set()
         raise
     return parts
+
+
+#: What this module gives of :mod:`posturelab.studies._sweep_dask`, imported on first use
+#: (``posturelab sweep --help`` stays light).
+_FROM_DASK_PART = ("SCHEDULER_PROTOCOLS", "SCHEDULER_TIMEOUT", "check_scheduler_address")
+
+
+def __getattr__(name: str):
+    if name in _FROM_DASK_PART:
+        from . import _sweep_dask
+
+        return getattr(_sweep_dask, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
