@@ -215,7 +215,7 @@ def output_paths(out: str, csv: str | None = None) -> tuple[Path, Path, str]:
 
     if csv is None:
         table = figure.with_suffix(".csv")
-        if (table.exists() or table.is_symlink()) and not _is_a_map_csv(table):
+        if (table.is_file() or table.is_symlink()) and not _is_a_map_csv(table):
             raise ParameterError(
                 f"{str(table)!r} exists: the map's CSV is written beside --out and never "
                 f"overwrites a file; remove it, or choose the CSV with --csv PATH")
