@@ -289,3 +289,19 @@ def test_a_prts_sweep_takes_sample_rate_as_its_record_rate(tmp_path, capsys):
     line = refused_in_one_line(capsys, "sweep", *base, "--sample-rate", "50", "--record-rate",
                                "100")
     assert "--sample-rate" in line and "--record-rate" in line
+
+
+def test_a_real_dask_scheduler_passes_the_probe():
+    import asyncio
+
+    distributed = pytest.importorskip("distributed")
+    from posturelab.studies._sweep_dask import probe_scheduler
+
+    async def main():
+        async with distributed.Scheduler(host="127.0.0.1", port=0,
+                                         dashboard_address=None) as scheduler:
+            loop = asyncio.get_running_loop()
+            await loop.run_in_executor(None, probe_scheduler, scheduler.address)
+            return scheduler.address
+
+    assert asyncio.run(main()).startswith("tcp://127.0.0.1:")
