@@ -98,17 +98,23 @@ def test_strategy_names_the_option_and_the_value_typed(capsys, argv, words):
         assert w in line, line
 
 
-def test_strategy_counts_every_map_in_its_progress():
-    """The runs of a two-parameter map counted as one whole (the estimate's total)."""
+def test_strategy_counts_every_map_in_its_progress(monkeypatch):
+    """The runs of a two-parameter map counted as one whole: one notice after the second
+    run naming all of them, timed from the end of the first (which loads the engine)."""
+    import io
+    import time
+
     from posturelab.cli.strategy import _Overall
 
-    seen = []
-    overall = _Overall(6, 3)
-    overall.notice = lambda done, total: seen.append((done, total))
+    clock = iter([100.0, 120.0, 130.0, 140.0, 150.0, 160.0])  # (a fake clock: 20 s a run)
+    monkeypatch.setattr(time, "perf_counter", lambda: next(clock))
+    stream = io.StringIO()
+    overall = _Overall(6, 3, stream)
     for _ in range(2):
         for i in range(3):
             overall(i + 1, 3)
-    assert seen == [(k, 6) for k in range(1, 7)]
+    assert overall.maps_done == 2
+    assert stream.getvalue() == "posturelab: strategy: 6 runs, about 100 s in all\n"
 
 
 def test_api_simulate_refuses_a_bool_duration():

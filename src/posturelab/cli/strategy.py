@@ -198,20 +198,34 @@ def run(args: argparse.Namespace) -> int:
 
 
 class _Overall:
-    """The progress of every map's runs as one count: after the first run, one line on
-    standard error with the runs and about how long they take in all, if over 10 s
-    (:class:`~posturelab.cli._common.ExpectedTime`)."""
+    """The progress of every map's runs as one count: after the second run, one line on
+    standard error with the runs and about how long they take in all, if over 10 s (as
+    :class:`~posturelab.cli._common.ExpectedTime` says it; timed from the end of the first
+    run, which also loads the engine)."""
 
-    def __init__(self, total: int, per_map: int) -> None:
-        from ._common import ExpectedTime
-
-        self.notice = ExpectedTime("strategy", "runs")
+    def __init__(self, total: int, per_map: int, stream=None) -> None:
         self.total, self.per_map, self.maps_done = total, per_map, 0
+        self.stream, self.first, self.said = stream, None, False
 
     def __call__(self, done: int, total: int) -> None:
-        self.notice(self.maps_done * self.per_map + done, self.total)
+        import sys
+        import time
+
+        overall = self.maps_done * self.per_map + done
         if done >= total:
             self.maps_done += 1
+        now = time.perf_counter()
+        if self.first is None:
+            self.first = now
+            return
+        if self.said or overall >= self.total:
+            return
+        self.said = True
+        expected = (now - self.first) * (self.total - 1) / (overall - 1)
+        if expected > 10.0:
+            about = f"{expected / 60:.0f} min" if expected >= 120 else f"{expected:.0f} s"
+            print(f"posturelab: strategy: {self.total:,} runs, about {about} in all",
+                  file=self.stream or sys.stderr, flush=True)
 
 
 def _share(run, spec: str) -> str:
