@@ -75,8 +75,9 @@ written to a temporary file and renamed, so no half-written file is left behind.
 
 Ctrl-C (or SIGTERM) stops a sweep at once: the runs not started are dropped, the rows that
 finished are written and counted (exit 130, 143). Options this kind of sweep does not use
-(the PRTS options on a simulation sweep; the step, profile, duration, sampling, initial
-state and integrator options on --experiment prts) are refused.
+(the PRTS options on a simulation sweep; the step, profile, duration, initial state and
+integrator options on --experiment prts, where --sample-rate is the recording's, as
+--record-rate) are refused.
 
 Everything of the base experiment carries into every run: --torque-limits, --feedback-delay,
 active gains, --tilt and --proprioceptive-weight, --visual-tilt and --visual-weight, --foot
