@@ -89,6 +89,11 @@ def test_stability_map_replaces_its_own_earlier_csv(tmp_path, capsys):
      ("--frequencies", "20 Hz", "got 100")),
     (("--translation", "backward", "--speeds", "0.05:1:1000", "--ankle-torque-limits",
       "40:120:1000"), ("1,000,000 runs", "10,000")),
+    (("--translation", "backward", "--speeds", "0.05:1:3", "--displacement", "5"),
+     ("--displacement", "got 5")),
+    (("--oscillation", "2", "--frequencies", "0.5:1:2"), ("--oscillation", "got 2")),
+    (("--oscillation", "0.05", "--frequencies", "0.5:1:2", "--ankle-torque-limit", "-3"),
+     ("--ankle-torque-limit", "got -3")),
 ])
 def test_strategy_names_the_option_and_the_value_typed(capsys, argv, words):
     """Before: "duration [s] 2500 at sample_rate …" (strategy has neither option), "got

@@ -105,7 +105,20 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     add_flags(p, "--json")
 
 
+#: The message prefix of a check deeper in -> the option that gives the value.
+FIELD_OPTIONS = {"displacement [m]": "--displacement", "amplitude [m]": "--oscillation",
+                 "ankle_torque_limit [N·m]": "--ankle-torque-limit",
+                 "joint_feedback_scale": "--joint-feedback-scale"}
+
+
 def run(args: argparse.Namespace) -> int:
+    from ._common import naming_given_options
+
+    with naming_given_options(args, FIELD_OPTIONS):  # (a bad value names its option)
+        return _run(args)
+
+
+def _run(args: argparse.Namespace) -> int:
     from ..linear.lqr import multijoint_controller
     from ..model.body import get_body
     from ..simulation.options import MAX_OUTPUT_SAMPLES
