@@ -55,8 +55,7 @@ NOT_EXPERIMENT = {
                  "--engine"},
     "sweep": {"--scenario", "--builtin", "--vary", "--out", "--workers", "--scheduler",
               "--chunk-size", "--strategy", "--progress", "--experiment", "--cycles",
-              "--discard-cycles", "--sensor-noise", "--record-rate", "--output", "--fit",
-              "--yes"},
+              "--discard-cycles", "--sensor-noise", "--record-rate", "--output", "--fit"},
 }
 
 
