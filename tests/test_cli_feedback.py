@@ -31,7 +31,8 @@ def test_delay_margin_json_is_the_api_s_for_a_one_link_body(capsys):
                          "--viscosity", "100", "--json")
     assert code == 0 and err == ""
     obj = json.loads(out)
-    assert set(obj) == {"delay_margin", "crossing_frequency", "stable_without_delay", "units"}
+    assert set(obj) == {"delay_margin", "crossing_frequency", "stable_without_delay",
+                        "stable_at_every_delay", "units"}
     muscles = MuscleSet((MusclePair("ankle", 0, 1, 1000.0, 100.0),), 1)
     api = pl.delay_margin(pl.get_body("paper-1link"), muscles)
     assert obj["delay_margin"] == api.delay_margin
@@ -41,9 +42,11 @@ def test_delay_margin_json_is_the_api_s_for_a_one_link_body(capsys):
 
 @pytest.mark.parametrize("argv,expected", [
     (["--body", "paper-1link", "--stiffness", "300"],
-     {"delay_margin": None, "crossing_frequency": None, "stable_without_delay": False}),
-    (["--case", "1", "--active-stiffness", "0,0,0,0,0"],
-     {"delay_margin": "infinite", "crossing_frequency": None, "stable_without_delay": True}),
+     {"delay_margin": None, "crossing_frequency": None, "stable_without_delay": False,
+      "stable_at_every_delay": False}),
+    (["--case", "1", "--active-stiffness", "0,0,0,0,0"],  # (null, not "infinite")
+     {"delay_margin": None, "crossing_frequency": None, "stable_without_delay": True,
+      "stable_at_every_delay": True}),
 ])
 def test_delay_margin_verdicts(capsys, argv, expected):
     code, out, _ = run(capsys, "delay-margin", *argv, "--json")

@@ -143,7 +143,7 @@ def test_bad_out_one_line_exit_2(tmp_path, capsys, out, message):
 def test_write_failure_leaves_nothing_and_keeps_old_files(tmp_path, capsys, monkeypatch):
     """A failure while writing: one-line error, old outputs untouched, no temporaries."""
     (tmp_path / "map.png").write_bytes(b"old figure")
-    (tmp_path / "map.csv").write_text("old csv")
+    (tmp_path / "map.csv").write_text("stiffness:ankle,stiffness:hip,max_real_part,stable\n")
 
     def disk_full(*args, **kwargs):
         raise OSError(28, "No space left on device")
@@ -156,7 +156,8 @@ def test_write_failure_leaves_nothing_and_keeps_old_files(tmp_path, capsys, monk
     assert stderr.count("\n") == 1 and "No space left on device" in stderr
     assert sorted(p.name for p in tmp_path.iterdir()) == ["map.csv", "map.png"]
     assert (tmp_path / "map.png").read_bytes() == b"old figure"
-    assert (tmp_path / "map.csv").read_text() == "old csv"
+    assert (tmp_path / "map.csv").read_text() == ("stiffness:ankle,stiffness:hip,"
+                                                  "max_real_part,stable\n")
 
 
 def test_interrupt_leaves_nothing(tmp_path, capsys, monkeypatch):

@@ -6,6 +6,7 @@ and a published one-link controller on a body from height and mass on every comm
 from __future__ import annotations
 
 import json
+import math
 import subprocess
 import sys
 
@@ -214,7 +215,10 @@ def test_a_published_controller_on_a_body_from_height_and_mass_on_every_command(
     assert p.returncode == 0, p.stderr
     margin = json.loads(p.stdout)
     assert margin.pop("units") == {"delay_margin": "s", "crossing_frequency": "rad/s"}
-    assert margin == pl.delay_margin(body, muscles).to_dict()
+    api = pl.delay_margin(body, muscles)
+    assert margin.pop("stable_at_every_delay") == (api.stable_without_delay
+                                                   and math.isinf(api.delay_margin))
+    assert margin == api.to_dict()
 
     p = posturelab("frf-model", *c, "--bands", "peterka", "--json")
     assert p.returncode == 0, p.stderr

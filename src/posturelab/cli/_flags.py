@@ -66,6 +66,21 @@ SHARED: dict[str, dict] = {
                      "response is: com_angle (default){}."),
 }
 
+#: ``--data`` of the commands that read several files: ``--data A B`` and ``--data A
+#: --data B`` alike (argparse's extend). The declaration to add with
+#: :func:`add_data_files`; it joins :data:`SHARED` once every such command takes it.
+DATA_FILES = dict(action="extend", nargs="+", required=True, metavar="FILE",
+                  help="{} (several after one --data, or --data repeated).")
+
+
+def add_data_files(p: Parser, detail: str, **changes) -> argparse.Action:
+    """Add ``--data`` (:data:`DATA_FILES`) with the subcommand's words for its files
+    (``detail``); ``changes`` replace keywords other than the help."""
+    spec = {**DATA_FILES, **changes}
+    spec["help"] = DATA_FILES["help"].format(detail)
+    return p.add_argument("--data", **spec)
+
+
 #: The outputs of a model FRF (``--output``'s detail where the linear model is evaluated).
 MODEL_OUTPUTS = ", thetaN or a joint angle (ankle_angle, knee_angle, hip_angle)"
 

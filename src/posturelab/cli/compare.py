@@ -71,7 +71,7 @@ def run(args: argparse.Namespace) -> int:
     from ..errors import ParameterError
     from ..simulation.results import read_run_csv
 
-    refuse_input_as_output({"RUN.csv": args.runs}, {"--plot": args.plot})
+    refuse_input_as_output({"run": args.runs}, {"--plot": args.plot})  # ("the input run")
     if args.plot:
         check_writable([args.plot], {args.plot: FIGURE_SUFFIXES})
     labels = ([s.strip() for s in args.labels.split(",")] if args.labels

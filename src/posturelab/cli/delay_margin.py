@@ -32,8 +32,9 @@ feedback": {"gain", "time_constant"} in --json).
 
 Prints the margin in s and ms and the crossing frequency; with --feedback-delay also the
 rightmost roots at that delay. --json prints one object:
-  {"delay_margin": seconds, or null if unstable without delay, or "infinite" if no crossing,
-   "crossing_frequency": rad/s or null, "stable_without_delay": true/false,
+  {"delay_margin": seconds, or null when there is none (then "stable_at_every_delay"
+   says why: true, no crossing; false, unstable without delay), "crossing_frequency":
+   rad/s or null, "stable_without_delay": true/false, "stable_at_every_delay": true/false,
    "units": {"delay_margin": "s", "crossing_frequency": "rad/s"}}
 With one-sided pairs the margin is of the side where they are engaged, and
 "unstable_sides" lists each other side on which upright is unstable already without delay
@@ -84,7 +85,7 @@ def run(args: argparse.Namespace) -> int:
         sides = {"unstable_sides": unstable} if muscles.one_sided_mask.any() else {}
         units = {**JSON_UNITS, "torque_feedback": {"gain": "-", "time_constant": "s"}} \
             if filtered else JSON_UNITS
-        print_json({**result.to_dict(), **sides, **filtered, "units": units})
+        print_json({**_json_margin(result), **sides, **filtered, "units": units})
         return 0
     kind = ("intrinsic gains at once, active gains delayed" if muscles.has_active_feedback
             else "every pair's whole feedback delayed")
@@ -119,6 +120,16 @@ def run(args: argparse.Namespace) -> int:
         print(f"at τ = {delay or 0.0:g} s: {verdict.describe()}; rightmost roots [1/s]: "
               + ", ".join(f"{z.real:.4g}{z.imag:+.4g}j" for z in roots))
     return 0
+
+
+def _json_margin(result) -> dict:
+    """The margin's JSON fields: a number or null in every numeric field (no "infinite"),
+    and "stable_at_every_delay" telling a margin of no crossing from none at all."""
+    out = result.to_dict()
+    every = bool(result.stable_without_delay and math.isinf(result.delay_margin))
+    if every:
+        out["delay_margin"] = None
+    return {**out, "stable_at_every_delay": every}
 
 
 def _unstable_sides(body, muscles, torque_feedback: dict) -> list[dict]:

@@ -31,7 +31,9 @@ posturelab.frequency.design_search the search). The errors fall as
 amplitude (--amplitudes LO:HI rad peak to peak, default 0.005:0.07) and the cycles (as many
 as fit) on a --grid of values per range (default 9, at most 41) for the smallest Σ (se/|θ|)²
 over --targets (default: every --free parameter) within --budget SECONDS of recording,
-discarded cycles included. Under the linear model the largest amplitude always wins; a real
+discarded cycles included. --optimise chooses the cycles and the PRTS amplitude and state
+duration itself: it refuses --cycles and --tilt (bound the search with --amplitudes and
+--state-durations instead). Under the linear model the largest amplitude always wins; a real
 subject reweights with amplitude (Peterka 2002), which the prediction does not know.
 
 --json prints one object: {"parameters": {NAME: {"value", "standard_error",
@@ -50,7 +52,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
              "prts:0.035: posturelab-80, 0.25 s states, 20 s cycle).")
     add_flag(p, "--visual-tilt", "; the PRTS then moves the visual scene instead of the "
              "surface (--free may name visual_weight)")
-    add_flag(p, "--cycles", default=5)
+    add_flag(p, "--cycles")  # (None: 5; refused with --optimise, which chooses them)
     add_flag(p, "--discard-cycles", "1; run before the analysed ones, they count in the "
              "duration", former=("--discard",), dest="discard", default=1)
     p.add_argument("--free", required=True, metavar="NAMES",
@@ -104,7 +106,8 @@ def _check_numbers(args: argparse.Namespace) -> None:
 
     float_in_range("--sensor-noise [rad]", args.sensor_noise, 0.0, 1.0, unit="rad")
     float_in_range("--sample-rate [Hz]", args.sample_rate, 1.0, 1e5, unit="Hz")
-    for option, value, least, most in (("--cycles", args.cycles, 2, MAX_CYCLES),
+    for option, value, least, most in (("--cycles", 5 if args.cycles is None else args.cycles,
+                                        2, MAX_CYCLES),
                                        ("--discard-cycles", args.discard, 0, MAX_CYCLES),
                                        ("--grid", args.grid, 2, MAX_GRID)):
         if not least <= value <= most:
@@ -144,6 +147,15 @@ def run(args: argparse.Namespace) -> int:
     if args.optimise:
         if args.budget is None:
             raise ParameterError("--optimise needs --budget SECONDS")
+        if args.cycles is not None:
+            raise ParameterError("--cycles cannot be given with --optimise: the search chooses "
+                                 "the cycles (as many as --budget holds); drop --cycles, or "
+                                 "drop --optimise to predict that design")
+        if args.tilt is not None or args.visual_tilt is not None:
+            flag = "--tilt" if args.tilt is not None else "--visual-tilt"
+            raise ParameterError(f"{flag} cannot be given with --optimise: the search chooses "
+                                 "the amplitude and state duration; bound them with "
+                                 "--amplitudes LO:HI and --state-durations LO:HI instead")
         result = optimise_design(
             body, muscles, free, budget=args.budget,
             targets=None if args.targets is None else _names(args.targets), tilt=tilt,
@@ -155,7 +167,8 @@ def run(args: argparse.Namespace) -> int:
         for flag in ("budget", "targets", "amplitudes", "state_durations"):
             if getattr(args, flag) is not None:
                 raise ParameterError(f"--{flag.replace('_', '-')} needs --optimise")
-        prediction = predict_errors(body, muscles, free, tilt=tilt, cycles=args.cycles,
+        prediction = predict_errors(body, muscles, free, tilt=tilt,
+                                    cycles=5 if args.cycles is None else args.cycles,
                                     **common)
         out = prediction.to_dict()
     if args.json:

@@ -78,8 +78,13 @@ def run(args: argparse.Namespace) -> int:
                            torque_feedback_time_constant=options.torque_feedback_time_constant)
     if args.frequencies is not None:
         f = np.array(parse_float_list(args.frequencies, "--frequencies [Hz]"))
-        if np.any(f <= 0) or np.any(f > 1e4) or f.size > 100_000:
-            raise ParameterError("--frequencies [Hz] must be 1 … 100,000 values in (0, 1e4] Hz")
+        if f.size > 100_000:
+            raise ParameterError(f"--frequencies [Hz] must be 1 … 100,000 values, got "
+                                 f"{f.size:,}")
+        bad = f[(f <= 0) | (f > 1e4)]
+        if bad.size:
+            raise ParameterError(f"--frequencies [Hz] must be values in (0, 1e4] Hz, got "
+                                 f"{bad[0]:g}")
     else:
         bands = SEQUENCE_BANDS.get(args.bands, PETERKA_BAND_HARMONICS)
         cycle = args.cycle_length

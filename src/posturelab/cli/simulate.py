@@ -107,6 +107,9 @@ def add_experiment_arguments(p: argparse.ArgumentParser) -> None:
     src.add_argument("--builtin", metavar="NAME",
                      help="a built-in scenario: " + ", ".join(builtin_scenario_names()) + ".")
     add_muscle_arguments(p)
+    # None: not given (then the scenario's form, else two-sided), so that a given value
+    # overrides a scenario's
+    p.set_defaults(gastrocnemius=None)
     add_torque_feedback_arguments(p)
     src.add_argument("--disturbance", choices=["backward", "forward", "none"],
                      help="platform velocity step of --speed m/s at t = 0 (backward: the "
@@ -122,15 +125,17 @@ def add_experiment_arguments(p: argparse.ArgumentParser) -> None:
                      help="initial link angles [rad] (forward positive).")
     src.add_argument("--initial-rates", metavar="W1,W2,W3",
                      help="initial link rates before any velocity step [rad/s].")
-    src.add_argument("--rates-from", choices=["upright", "posture"], default="upright",
-                     help="evaluate J⁻¹H for the velocity step at upright (the paper) or at the "
-                     "initial posture (exact).")
+    src.add_argument("--rates-from", choices=["upright", "posture"], default=None,
+                     help="evaluate J⁻¹H for the velocity step at upright (the paper; the "
+                     "default unless a scenario says otherwise) or at the initial posture "
+                     "(exact).")
     src.add_argument("--knee", choices=["free", "locked", "stop"], default=None,
                      help="free (the paper's default), locked (θ2 − θ1 constant), or a "
                      "hyper-extension stop at θ2 − θ1 = 0; default: the scenario's, or the "
                      "multi-joint controller's design (locked), else free.")
-    src.add_argument("--foot", metavar="none|literature|HEEL,TOE", default="none",
-                     help="base of support for the fall test: none (the paper; the foot never "
+    src.add_argument("--foot", metavar="none|literature|HEEL,TOE", default=None,
+                     help="base of support for the fall test: none (the paper, and the "
+                     "default unless a scenario has a foot; the foot never "
                      "tips), literature (heel −0.063 m, toe 0.188 m: a 1.65 m person) or "
                      "HEEL,TOE [m] relative to the ankle.")
     src.add_argument("--centre-of-pressure", action="store_true",
@@ -201,10 +206,33 @@ def scenario_from_args(args: argparse.Namespace, command: str = "simulate") -> S
         if clash:
             raise UsageError(f"{command}: --{clash[0].replace('_', '-')} cannot be "
                              "combined with a scenario; edit the scenario instead")
+        if command == "simulate" and args.viscosity_ratio is not None:
+            raise UsageError(f"{command}: --viscosity-ratio cannot be combined with a scenario "
+                             "(its [muscles] viscosity_ratio or viscosity); edit the scenario "
+                             "instead")
         sc = load_scenario(args.scenario) if args.scenario else builtin_scenario(args.builtin)
+        if args.gastrocnemius is not None:
+            sc = sc.replace(muscles=with_gastrocnemius(sc.muscles, args.gastrocnemius))
     else:
         sc = _scenario_from_options(args, command)
     return sc.replace(options=run_options_from_args(args, sc, command))
+
+
+def with_gastrocnemius(muscles, form: str):
+    """``muscles`` with the gastrocnemius pair of ``form`` ("two-sided", "one-sided",
+    "pull-only"; :data:`posturelab.model.muscles.GASTROCNEMIUS_FORMS`): --gastrocnemius over
+    a scenario's own. Refused in one line when there is no such pair."""
+    from dataclasses import replace
+
+    from ..model.muscles import GASTROCNEMIUS_FORMS, MuscleSet
+
+    if "gastrocnemius" not in muscles.names:
+        raise UsageError(f"--gastrocnemius {form}: this experiment's body has no gastrocnemius "
+                         f"pair (pairs: {', '.join(muscles.names)})")
+    one_sided, pull_only, _ = GASTROCNEMIUS_FORMS[form]
+    pairs = tuple(replace(p, one_sided=one_sided, pull_only=pull_only)
+                  if p.name == "gastrocnemius" else p for p in muscles.pairs)
+    return MuscleSet(pairs, muscles.n_links)
 
 
 def run_options_from_args(args: argparse.Namespace, sc: Scenario,
@@ -218,7 +246,7 @@ def run_options_from_args(args: argparse.Namespace, sc: Scenario,
     n = sc.body.n_links
     fall = base.fall
     fall_table = {"max_link_angle": args.max_link_angle,
-                  "base_of_support": None if args.foot == "none" else args.foot,
+                  "base_of_support": args.foot,  # ("none" given: no foot, whatever the scenario)
                   "centre_of_pressure": args.centre_of_pressure or None}
     fall_table = {k: v for k, v in fall_table.items() if v is not None}
     if fall_table:
@@ -265,7 +293,7 @@ def run_options_from_args(args: argparse.Namespace, sc: Scenario,
             torque_limits=torque_limits,
             motor_noise=motor_noise, description=description,
             knee=KneeModel(args.knee) if args.knee is not None else base.knee,
-            rates_from=args.rates_from if args.rates_from != "upright" else base.rates_from)
+            rates_from=_given(args.rates_from, base.rates_from))
 
 
 #: What --tilt and --visual-tilt set: the ``args`` attribute (and scenario table) -> the
@@ -338,7 +366,7 @@ def _scenario_from_options(args: argparse.Namespace, command: str) -> Scenario:
         initial = tuple(BACKWARD_INITIAL_STATE[:n]) + tuple(rates)
     label = (f"case {args.case}" if args.case else f"controller {args.controller}"
              if args.controller else "custom stiffness")
-    if args.gastrocnemius != "two-sided":
+    if args.gastrocnemius not in (None, "two-sided"):
         label += f", {args.gastrocnemius} gastrocnemius"
     if args.body is not None or args.height is not None:
         label += f", body {sc.body.name}"
@@ -410,6 +438,36 @@ def _write_run(result, path: str) -> None:
                                                  result.column_units()))
 
 
+#: Bytes a value of a perturbed run's CSV takes on average ("%.10g" and a comma: most
+#: values are 11 to 17 characters, a few columns zeros; 12.6 measured for a velocity step,
+#: 11.4 for a sine tilt), for the estimate made before a run. An unperturbed run from
+#: upright is zeros (2 to 3 bytes a value): not estimated. [B]
+CSV_BYTES_PER_VALUE = 12
+
+
+def check_csv_size(sc: Scenario, out: str) -> None:
+    """Refuse, before the run, a CSV whose rows (floor(duration × sample rate) + 1) times
+    its columns (those every run has, at least) at :data:`CSV_BYTES_PER_VALUE` would pass
+    what posturelab reads back (the write refuses what gets past this estimate)."""
+    from .._files import MAX_INPUT_BYTES
+    from ..simulation.outcome import stimulus_timing
+
+    o, n = sc.options, sc.body.n_links
+    still = not stimulus_timing(sc.disturbance, o.tilt, o.motor_noise, o.visual_tilt).perturbed
+    if still and not any(o.initial_state or ()):
+        return  # (zeros: the write's own check suffices)
+    rows = math.floor(o.duration * o.sample_rate) + 1
+    columns = 1 + 2 * n + len(sc.muscles.names) + 2 * n + 10  # t, θ, ω, M, U, joint, cog…
+    columns += (o.tilt is not None) + (o.visual_tilt is not None)
+    estimate = rows * columns * CSV_BYTES_PER_VALUE
+    if estimate > MAX_INPUT_BYTES:
+        raise ParameterError(
+            f"--out {out!r} would be about {estimate / 2**20:,.0f} MiB ({rows:,} rows of "
+            f"--duration {o.duration:.10g} s at --sample-rate {o.sample_rate:.10g} Hz × {columns} "
+            f"columns); at most {MAX_INPUT_BYTES // 2**20} MiB, the most posturelab reads "
+            "back: write .parquet, or lower --sample-rate or --duration")
+
+
 def run(args: argparse.Namespace) -> int:
     from .._files import refuse_input_as_output
 
@@ -419,6 +477,8 @@ def run(args: argparse.Namespace) -> int:
     outputs = [p for p in (args.out, args.plot, args.animate) if p]
     check_writable(outputs, {args.out: (".csv", ".parquet"), args.plot: FIGURE_SUFFIXES,
                              args.animate: (".gif",)})
+    if args.out and args.out.lower().endswith(".csv"):
+        check_csv_size(sc, args.out)
     if sc.options.time_limit is None:
         sc = sc.replace(time_limit=DEFAULT_TIME_LIMIT)
     with naming_given_options(args):

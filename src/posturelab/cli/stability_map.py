@@ -35,7 +35,8 @@ from --stiffness (one value per pair, any body), with viscosity = 0.25 × stiffn
 
 Writes the figure --out (colour = largest real part of the poles [1/s], stable region
 outlined, Table I cases that lie in the plane marked) and a CSV beside it with the same
-stem (columns: x name, y name, max_real_part [1/s], stable [1 or 0]). Stable means every
+stem (columns: x name, y name, max_real_part [1/s], stable [1 or 0]; it replaces an earlier
+map's CSV only: another file there is refused, --csv PATH names the CSV). Stable means every
 pole has real part < -δ, δ = 1e-9 × the poles' magnitude scale [1/s] (a set with
 undamped poles on the imaginary axis is not stable; see posturelab.linear.batch).
 
@@ -76,7 +77,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help=f"grid points per axis, 2..{MAX_RESOLUTION} (default 200).")
     p.add_argument("--out", required=True, metavar="FILE",
                    help="figure file (.png, .pdf, .svg, ...); the CSV is written beside it "
-                   "as FILE with suffix .csv.")
+                   "as FILE with suffix .csv, replacing only an earlier map's CSV (any "
+                   "other file there is refused: choose the CSV with --csv).")
+    p.add_argument("--csv", default=None, metavar="PATH",
+                   help="the map's CSV (default: --out with suffix .csv, refused if it "
+                   "exists; a PATH given is written even if it exists).")
     p.add_argument("--case", default="1", metavar="CASE",
                    help="Table I case for the parameters not swept (default 1).")
     p.add_argument("--viscosity-ratio", default=None, metavar="R",
@@ -170,8 +175,26 @@ FIGURE_FORMATS = frozenset({"eps", "jpeg", "jpg", "pdf", "pgf", "png", "ps", "ra
                             "svg", "svgz", "tif", "tiff", "webp"})
 
 
-def output_paths(out: str) -> tuple[Path, Path, str]:
-    """Figure path, CSV path beside it, and the figure format; checks the directory."""
+#: The end of a map CSV's header (both kinds of map): a file beside --out with it is an
+#: earlier map, replaced on a rerun; any other file there is refused, never overwritten.
+MAP_CSV_HEADER_END = ",max_real_part,stable"
+
+
+def _is_a_map_csv(path: Path) -> bool:
+    """Whether ``path`` is a regular file whose first line is a stability map's header."""
+    try:
+        if not path.is_file() or path.is_symlink():
+            return False
+        with open(path, "rb") as stream:
+            head = stream.readline(4096)
+    except OSError:
+        return False
+    return head.rstrip(b"\r\n").endswith(MAP_CSV_HEADER_END.encode())
+
+
+def output_paths(out: str, csv: str | None = None) -> tuple[Path, Path, str]:
+    """Figure path, CSV path (``csv``, or beside the figure: refused if that exists, an
+    unrelated file is never overwritten) and the figure format; checks the directories."""
     figure = Path(out)
     fmt = figure.suffix.lower().lstrip(".")
     if fmt not in FIGURE_FORMATS:
@@ -190,8 +213,18 @@ def output_paths(out: str) -> tuple[Path, Path, str]:
         raise ParameterError(f"--out {out!r} is a directory")
     from ._common import check_writable
 
-    check_writable([str(figure), str(figure.with_suffix(".csv"))])  # both, before any work
-    return figure, figure.with_suffix(".csv"), fmt
+    if csv is None:
+        table = figure.with_suffix(".csv")
+        if (table.is_file() or table.is_symlink()) and not _is_a_map_csv(table):
+            raise ParameterError(
+                f"{str(table)!r} exists: the map's CSV is written beside --out and never "
+                f"overwrites a file; remove it, or choose the CSV with --csv PATH")
+    else:
+        table = Path(csv)
+        if table.suffix.lower() != ".csv":
+            raise ParameterError(f"--csv must end in .csv, got {csv!r}")
+    check_writable([str(figure), str(table)])  # both, before any work
+    return figure, table, fmt
 
 
 # ---- run ------------------------------------------------------------------------
@@ -284,7 +317,7 @@ def _run_pair_map(args: argparse.Namespace) -> int:
         raise ParameterError(
             "--viscosity-ratio cannot be given when viscosity_ratio is an axis"
         )
-    figure_path, csv_path, fmt = output_paths(args.out)
+    figure_path, csv_path, fmt = output_paths(args.out, args.csv)
 
     from ..linear.batch import parameter_grid, stability_map
 
@@ -400,7 +433,7 @@ def _run_delayed_map(args: argparse.Namespace) -> int:
                                   "with a feedback delay")
     if not feedback_given(args):
         raise ParameterError("a map over active gains needs --feedback-delay S [s]")
-    figure_path, csv_path, fmt = output_paths(args.out)
+    figure_path, csv_path, fmt = output_paths(args.out, args.csv)
     muscles, delay = muscles_and_delay_from_args(args, body)
     torque_feedback = torque_feedback_options_from_args(args)
     bar = Progress(resolution**2, label="stability-map", unit="sets") \

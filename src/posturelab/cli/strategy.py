@@ -41,7 +41,10 @@ Example: posturelab strategy --translation backward --speeds 0.05:0.6:8 --json
 """
 
 
-def _grid(text: str, flag: str):
+def _grid(text: str, flag: str, unit: str = "", low: float = 0.0, high: float | None = None,
+          why: str = ""):
+    """``LO:HI:N`` of ``flag`` as N values: 0 < ``low`` <= LO <= HI <= ``high`` [``unit``]
+    (``why``: what sets ``low``), the user's values named in a refusal."""
     parts = text.split(":")
     try:
         lo, hi, n = float(parts[0]), float(parts[1]), int(parts[2])
@@ -56,6 +59,12 @@ def _grid(text: str, flag: str):
                          f"got {text!r}")
     if n == 1 and lo != hi:
         raise UsageError(f"{flag} with N = 1 must have LO = HI (one value), got {text!r}")
+    if high is not None and hi > high:
+        raise UsageError(f"{flag} HI must be at most {high:g} {unit}, got {parts[1].strip()} "
+                         f"in {text!r}")
+    if lo < low:
+        raise UsageError(f"{flag} LO must be at least {low:.4g} {unit}{why}, got "
+                         f"{parts[0].strip()} in {text!r}")
     import numpy as np
 
     return np.linspace(lo, hi, n)
@@ -96,10 +105,34 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     add_flags(p, "--json")
 
 
+#: The message prefix of a check deeper in -> the option that gives the value.
+FIELD_OPTIONS = {"displacement [m]": "--displacement", "amplitude [m]": "--oscillation",
+                 "ankle_torque_limit [N·m]": "--ankle-torque-limit",
+                 "joint_feedback_scale": "--joint-feedback-scale"}
+
+
 def run(args: argparse.Namespace) -> int:
+    from ._common import naming_given_options
+
+    with naming_given_options(args, FIELD_OPTIONS):  # (a bad value names its option)
+        return _run(args)
+
+
+def _run(args: argparse.Namespace) -> int:
     from ..linear.lqr import multijoint_controller
     from ..model.body import get_body
-    from ..studies.strategy import limit_maps, oscillation_map, translation_map
+    from ..simulation.options import MAX_OUTPUT_SAMPLES
+    from ..studies.strategy import (
+        MAX_FREQUENCY,
+        MAX_SPEED,
+        MAX_STUDY_RUNS,
+        SETTLE_CYCLES,
+        STEADY_CYCLES,
+        limit_maps,
+        lowest_frequency,
+        oscillation_map,
+        translation_map,
+    )
 
     if args.translation is not None and args.speeds is None:
         raise UsageError("strategy: --translation needs --speeds LO:HI:N")
@@ -127,17 +160,31 @@ def run(args: argparse.Namespace) -> int:
         limit = foot_moment_limits(body.total_mass * body.gravity, FOOT.heel, FOOT.toe)
     common = dict(engine=args.engine, **controller.run_options())
     if args.translation is not None:
+        values = _grid(args.speeds, "--speeds", "m/s", high=MAX_SPEED)
         make = functools.partial(translation_map, body, controller.muscles,
-                                 _grid(args.speeds, "--speeds"), direction=args.translation,
+                                 values, direction=args.translation,
                                  displacement=(0.06 if args.displacement is None
                                                else args.displacement), **common)
     else:
+        rate = 1000.0  # [Hz] (simulate's default sample rate, the runs')
+        least = lowest_frequency(rate)
+        values = _grid(args.frequencies, "--frequencies", "Hz", least, MAX_FREQUENCY,
+                       f" (each run lasts {SETTLE_CYCLES + STEADY_CYCLES} cycles, "
+                       f"{SETTLE_CYCLES + STEADY_CYCLES}/LO s, at most {MAX_OUTPUT_SAMPLES:,} "
+                       f"samples at {rate:g} Hz)")
         make = functools.partial(oscillation_map, body, controller.muscles, args.oscillation,
-                                 _grid(args.frequencies, "--frequencies"), **common)
-    if args.ankle_torque_limits is not None:
-        return _two_parameters(args, controller,
-                               limit_maps(make, _grid(args.ankle_torque_limits,
-                                                      "--ankle-torque-limits")))
+                                 values, **common)
+    limits = (None if args.ankle_torque_limits is None else
+              _grid(args.ankle_torque_limits, "--ankle-torque-limits", "N·m"))
+    total = values.size * (1 if limits is None else limits.size)
+    if total > MAX_STUDY_RUNS:
+        given = f"{values.size:,}" + ("" if limits is None else f" × {limits.size:,} limits")
+        raise UsageError(f"strategy: {given} = {total:,} runs; at most {MAX_STUDY_RUNS:,} "
+                         "(fewer values in --speeds/--frequencies or --ankle-torque-limits; "
+                         "sweep --strategy runs larger maps, on Dask with --workers)")
+    make = functools.partial(make, progress=_Overall(total, values.size))
+    if limits is not None:
+        return _two_parameters(args, controller, limit_maps(make, limits))
     result = make(ankle_torque_limit=limit)
     if args.plot:
         from ..viz.maps import strategy_map_figure
@@ -161,6 +208,37 @@ def run(args: argparse.Namespace) -> int:
         print("transition frequency: " + ("none found (no recovered run with hip fraction "
                                           "> 0.5)" if found is None else f"{found:.4g} Hz"))
     return 0
+
+
+class _Overall:
+    """The progress of every map's runs as one count: after the second run, one line on
+    standard error with the runs and about how long they take in all, if over 10 s (as
+    :class:`~posturelab.cli._common.ExpectedTime` says it; timed from the end of the first
+    run, which also loads the engine)."""
+
+    def __init__(self, total: int, per_map: int, stream=None) -> None:
+        self.total, self.per_map, self.maps_done = total, per_map, 0
+        self.stream, self.first, self.said = stream, None, False
+
+    def __call__(self, done: int, total: int) -> None:
+        import sys
+        import time
+
+        overall = self.maps_done * self.per_map + done
+        if done >= total:
+            self.maps_done += 1
+        now = time.perf_counter()
+        if self.first is None:
+            self.first = now
+            return
+        if self.said or overall >= self.total:
+            return
+        self.said = True
+        expected = (now - self.first) * (self.total - 1) / (overall - 1)
+        if expected > 10.0:
+            about = f"{expected / 60:.0f} min" if expected >= 120 else f"{expected:.0f} s"
+            print(f"posturelab: strategy: {self.total:,} runs, about {about} in all",
+                  file=self.stream or sys.stderr, flush=True)
 
 
 def _share(run, spec: str) -> str:

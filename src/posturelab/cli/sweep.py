@@ -16,7 +16,6 @@ from ..studies.sweep import (
     OUTCOME_COLUMNS,
     SWEEP_PARAMETERS,
     SweepInterrupted,
-    check_scheduler_address,
     max_workers,
     parse_vary,
     run_sweep,
@@ -26,6 +25,10 @@ from . import UsageError
 from ._common import check_writable, naming_given_options
 from ._flags import add_flag, add_flags
 from .simulate import add_experiment_arguments, experiment_inputs, scenario_from_args
+
+#: Most simulated time of all the experiments of one --experiment prts sweep (experiments
+#: × cycles × the cycle): about 8 CPU-hours of the compiled engine, a bound on the work. [s]
+MAX_PRTS_SIMULATED = 1e8
 
 DESCRIPTION = f"""\
 Simulate the nonlinear model for every combination of the --vary values (the full grid,
@@ -72,8 +75,9 @@ written to a temporary file and renamed, so no half-written file is left behind.
 
 Ctrl-C (or SIGTERM) stops a sweep at once: the runs not started are dropped, the rows that
 finished are written and counted (exit 130, 143). Options this kind of sweep does not use
-(the PRTS options on a simulation sweep; the step, profile, duration, sampling, initial
-state and integrator options on --experiment prts) are refused.
+(the PRTS options on a simulation sweep; the step, profile, duration, initial state and
+integrator options on --experiment prts, where --sample-rate is the recording's, as
+--record-rate) are refused.
 
 Everything of the base experiment carries into every run: --torque-limits, --feedback-delay,
 active gains, --tilt and --proprioceptive-weight, --visual-tilt and --visual-weight, --foot
@@ -87,6 +91,10 @@ run), the FRF of --output at the sequence's bands, and with --fit NAMES the FRF 
 parameters (posturelab fit-frf's names) started from the base experiment's values. Its
 columns: the varied parameters, fell, gain_B, phase_deg_B [deg], coherence_B per band, then
 fit_NAME and se_NAME per fitted parameter (fit_active_stiffness:ankle, ...) and fit_error.
+Before it starts, a PRTS sweep says on standard error how many experiments of how much
+simulated time it runs; it refuses more than {MAX_PRTS_SIMULATED:.0e} s simulated in all
+(fewer --vary values or --cycles). Any sweep that will take over 10 s says, after its first
+chunk, about how long it will take in all.
 
 Parallelism: the runs use every CPU
 available (one thread each). --workers N sends chunks of runs to a Dask LocalCluster of N
@@ -130,7 +138,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     add_flag(e, "--discard-cycles", "1", default=None)
     add_flags(e, "--sensor-noise")
     e.add_argument("--record-rate", type=float, default=None, metavar="HZ",
-                   help="samples per second of the recording [Hz] (default 100).")
+                   help="samples per second of the recording [Hz] (default 100); "
+                   "--sample-rate says the same with --experiment prts.")
     add_flag(e, "--output", " or thetaN", default=None)
     e.add_argument("--fit", metavar="NAMES",
                    help="fit these parameters to each experiment's FRF (comma-separated, "
@@ -158,12 +167,21 @@ def run(args: argparse.Namespace) -> int:
         raise ParameterError(f"--workers must be in 1 … {max_workers()} (4 × the "
                              f"{os.cpu_count() or 1} CPUs), got {args.workers}")
     if args.scheduler is not None:
+        from ..studies._sweep_dask import check_scheduler_address
+
         check_scheduler_address(args.scheduler)
     if args.chunk_size is not None and args.chunk_size < 1:
         raise ParameterError(f"--chunk-size must be >= 1, got {args.chunk_size}")
     ratio = args.viscosity_ratio
     if ratio is None and not (args.scenario or args.builtin or args.controller):
         args.viscosity_ratio = DEFAULT_VISCOSITY_RATIO  # what --case / --stiffness build with
+    if args.experiment == "prts" and args.sample_rate is not None:
+        # (the recording's samples per second: --sample-rate, as everywhere, or --record-rate)
+        if args.record_rate is not None and args.record_rate != args.sample_rate:
+            raise UsageError(f"sweep: --sample-rate {args.sample_rate:g} and --record-rate "
+                             f"{args.record_rate:g} are the same setting with --experiment "
+                             "prts; give one")
+        args.record_rate, args.sample_rate = args.sample_rate, None
     _refuse_unused(args)
     scenario = scenario_from_args(args, "sweep")
     try:
@@ -183,7 +201,7 @@ PROTOCOL_FIELD_OPTIONS = {"cycles": "--cycles", "discard": "--discard-cycles",
 PRTS_ONLY = ("cycles", "discard_cycles", "sensor_noise", "record_rate", "output", "fit")
 #: The base experiment's options a PRTS experiment has no use for: its stimulus is the tilt,
 #: its length the cycles, its recording --record-rate, its integrator its own.
-SIMULATION_ONLY = ("disturbance", "speed", "platform_profile", "duration", "sample_rate",
+SIMULATION_ONLY = ("disturbance", "speed", "platform_profile", "duration",
                    "initial_posture", "initial_rates", "rtol", "atol", "max_steps",
                    "time_limit", "tilt_axis_depth")
 
@@ -193,7 +211,7 @@ def _refuse_unused(args: argparse.Namespace) -> None:
     prts = args.experiment == "prts"
     unused = [f for f in (SIMULATION_ONLY if prts else PRTS_ONLY)
               if getattr(args, f, None) is not None]
-    if prts and args.rates_from != "upright":
+    if prts and args.rates_from is not None:
         unused.append("rates_from")
     if unused:
         names = ", ".join(f"--{f.replace('_', '-')}" for f in unused)
@@ -259,20 +277,22 @@ def _with_progress(args: argparse.Namespace, total: int, work):
     """``work(progress)`` with a progress bar on standard error (a terminal, or
     --progress); returns its result and the seconds it took."""
     from .._progress import Progress, shown
+    from ._common import ExpectedTime
 
     bar = Progress(total, label="sweep", unit="runs") if shown(args.progress) else None
     t0 = time.perf_counter()
     try:
-        result = work(bar)
+        result = work(bar or ExpectedTime("sweep", "runs"))
     finally:
         if bar is not None:
             bar.close()
     return result, time.perf_counter() - t0
 
 
-def _check_experiment_length(args: argparse.Namespace, protocol, scenario) -> None:
+def _check_experiment_length(args: argparse.Namespace, protocol, scenario, varies) -> None:
     """Refuse, naming --cycles and --discard-cycles, an experiment longer than the longest
-    run."""
+    run, or experiments longer than :data:`MAX_PRTS_SIMULATED` in all; else say how many
+    and how long (standard error)."""
     from ..simulation.setup import MAX_DURATION
 
     tilt = scenario.options.tilt
@@ -280,11 +300,20 @@ def _check_experiment_length(args: argparse.Namespace, protocol, scenario) -> No
         return  # (prts_sweep says the tilt must be a PRTS)
     cycles = protocol.cycles + protocol.discard
     total = tilt.cycle * cycles
+    given = f"--cycles {protocol.cycles}" if protocol.discard == 0 else (
+        f"(--cycles {protocol.cycles} + --discard-cycles {protocol.discard})")
     if total > MAX_DURATION:
-        given = f"--cycles {protocol.cycles}" if protocol.discard == 0 else (
-            f"(--cycles {protocol.cycles} + --discard-cycles {protocol.discard})")
         raise ParameterError(f"{given} × the {tilt.cycle:g} s cycle = {total:.3g} s exceeds "
                              f"the longest run, {MAX_DURATION:,.0f} s")
+    runs = _runs(varies)
+    if runs * total > MAX_PRTS_SIMULATED:
+        raise ParameterError(f"{runs:,} PRTS experiments × {total:.4g} s ({given} × the "
+                             f"{tilt.cycle:g} s cycle) = {runs * total:.3g} s simulated; a "
+                             f"sweep runs at most {MAX_PRTS_SIMULATED:.0e} s (fewer --vary "
+                             "values or --cycles)")
+    if runs * total > 1e5:  # (over about half a minute)
+        print(f"posturelab: sweep: {runs:,} PRTS experiments of {total:.4g} s simulated each "
+              f"({runs * total:.3g} s in all)", file=sys.stderr)
 
 
 def _run_experiments(args: argparse.Namespace, scenario, varies, ratio) -> int:
@@ -297,7 +326,7 @@ def _run_experiments(args: argparse.Namespace, scenario, varies, ratio) -> int:
         ("sample_rate", "record_rate"), ("output", "output")) if getattr(args, flag) is not None}
     with naming_given_options(args, PROTOCOL_FIELD_OPTIONS):
         protocol = PRTSProtocol(seed=args.seed or 0, fit=fit, **given)
-    _check_experiment_length(args, protocol, scenario)
+    _check_experiment_length(args, protocol, scenario, varies)
     with naming_given_options(args, PROTOCOL_FIELD_OPTIONS):
         result, elapsed = _with_progress(args, _runs(varies), lambda progress: prts_sweep(
             scenario, varies, protocol, viscosity_ratio=ratio, workers=args.workers,

@@ -36,7 +36,7 @@ import numpy as np
 
 __all__ = ["UPRIGHT_BAND", "REST_RATE", "OUTCOMES", "Outcome", "SteadySway", "StimulusTiming",
            "stimulus_timing", "check_starts_within", "steady_sway", "classify",
-           "classify_rows"]
+           "classify_rows", "profile_motion_end"]
 
 #: Half-width of the band about upright a recovered run ends in (and of the settling time). [rad]
 UPRIGHT_BAND = 0.01
@@ -109,7 +109,7 @@ def stimulus_timing(disturbance=None, tilt=None, motor_noise=None,
             periods.append(1.0 / min(part.frequencies))
             what.append("sum of sines")
         elif isinstance(part, pf.MeasuredProfile):
-            ends.append(float(part.time[-1]))
+            ends.append(profile_motion_end(part))
         elif isinstance(part, tl.SineTilt):
             periods.append(1.0 / part.frequency)
             what.append("sine tilt")
@@ -134,6 +134,23 @@ def stimulus_timing(disturbance=None, tilt=None, motor_noise=None,
         return StimulusTiming(True, math.inf, max(periods) if periods else None,
                               ", ".join(what))
     return StimulusTiming(False, max(ends), perturbed=bool(parts) or motor_noise is not None)
+
+
+def profile_motion_end(profile) -> float:
+    """When a measured platform profile's motion ends: the sample after its last sample of
+    non-zero acceleration (x or y), where the linearly interpolated acceleration has come
+    back to zero for good; the last sample if that one is non-zero, the first if none is
+    (trailing zeros, a recording's quiet tail, are not part of the perturbation). [s]"""
+    import numpy as np
+
+    moving = np.asarray(profile.acceleration_x) != 0
+    if profile.acceleration_y is not None:
+        moving |= np.asarray(profile.acceleration_y) != 0
+    t = np.asarray(profile.time, dtype=float)
+    if not moving.any():
+        return float(t[0])
+    last = int(np.flatnonzero(moving)[-1])
+    return float(t[min(last + 1, t.size - 1)])
 
 
 def _start(part) -> tuple[str, float] | None:
@@ -261,7 +278,9 @@ class Outcome:
     message : str
         The outcome in words.
     perturbation_end : float
-        End of a transient perturbation; ``inf`` for a sustained one. [s]
+        End of a transient perturbation (a measured platform profile's: the sample after
+        its last non-zero acceleration, :func:`profile_motion_end`); ``inf`` for a
+        sustained one. [s]
     steady : SteadySway or None
         The steady sway of a sustained run that completed; None otherwise.
     """

@@ -367,6 +367,7 @@ def sweep_grid(scenario: Scenario, varies: Sequence[VaryRange],
             ratios[:] = column[:, None]
         elif quantity == "disturbance_scale":
             scale = np.ascontiguousarray(column)
+            _check_scales(scenario.disturbance, column)
         elif quantity == "feedback_delay":
             delay = np.ascontiguousarray(column)
         elif quantity == "proprioceptive_weight":
@@ -396,6 +397,18 @@ def sweep_grid(scenario: Scenario, varies: Sequence[VaryRange],
     return SweepGrid(tuple(names), values, stiffness, pair_viscosity, scale, delay,
                      None if np.all(np.isinf(limits)) else limits, ka, va, weight, control,
                      visual)
+
+
+def _check_scales(disturbance, scales: np.ndarray) -> None:
+    """Each disturbance_scale's motion within its bounds: refused in one line naming the
+    scale (the value given), the base motion and the bound it breaks."""
+    for factor in sorted({float(scales.min()), float(scales.max())}):
+        try:
+            disturbance.scaled(factor)
+        except ParameterError as exc:
+            raise ParameterError(f"disturbance_scale {factor:g} × the base experiment's "
+                                 f"{type(disturbance).__name__} is out of bounds: {exc} "
+                                 "(narrow --vary disturbance_scale)") from None
 
 
 def _check_weights(scenario: Scenario, weight: np.ndarray | None, visual: np.ndarray | None,

@@ -34,7 +34,8 @@ from ..model.limits import limit_entries
 
 __all__ = ["strategy_modes", "hip_fraction", "HipFractionStudy", "hip_fraction_study",
            "CREATH_2005_CITATION", "RUNGE_1999_CITATION", "MAX_STUDY_RUNS",
-           "HORAK_NASHNER_1986_CITATION", "StrategyRun", "StrategyMap", "translation_map",
+           "HORAK_NASHNER_1986_CITATION", "StrategyRun", "MAX_SPEED", "MAX_FREQUENCY",
+           "oscillation_duration", "lowest_frequency", "StrategyMap", "translation_map",
            "oscillation_map", "translation_profile", "oscillation_profile", "limit_maps",
            "maps_to_dict"]
 
@@ -152,6 +153,28 @@ STEADY_CYCLES = 3
 MIN_STEADY_TIME = 4.0
 #: Hip fraction above which the hip mode dominates (transition_frequency). [-]
 HIP_DOMINATES = 0.5
+#: Largest peak speed of a transient translation (:func:`translation_profile`). [m/s]
+MAX_SPEED = 10.0
+#: Highest frequency of a sinusoidal translation (:func:`oscillation_profile`). [Hz]
+MAX_FREQUENCY = 20.0
+
+
+def oscillation_duration(frequency: float) -> float:
+    """Simulated time of one run of :func:`oscillation_map` at ``frequency`` [Hz]:
+    :data:`SETTLE_CYCLES` cycles, then :data:`STEADY_CYCLES` and at least
+    :data:`MIN_STEADY_TIME`. [s]"""
+    return SETTLE_CYCLES / frequency + max(STEADY_CYCLES / frequency, MIN_STEADY_TIME)
+
+
+def lowest_frequency(sample_rate: float = 1000.0) -> float:
+    """The lowest frequency [Hz] whose :func:`oscillation_duration` a run can record at
+    ``sample_rate`` [Hz]: floor(duration × rate) + 1 <= the most output samples of a run
+    (:data:`posturelab.simulation.options.MAX_OUTPUT_SAMPLES`)."""
+    from ..simulation.options import MAX_OUTPUT_SAMPLES
+
+    longest = (MAX_OUTPUT_SAMPLES - 1) / sample_rate  # [s]
+    # the slow branch: (SETTLE + STEADY) / f <= longest (there 3/f >= MIN_STEADY_TIME)
+    return (SETTLE_CYCLES + STEADY_CYCLES) / longest
 
 
 def translation_profile(speed: float, direction: str, displacement: float = DEFAULT_TRANSLATION):
@@ -163,7 +186,7 @@ def translation_profile(speed: float, direction: str, displacement: float = DEFA
 
     if direction not in ("backward", "forward"):
         raise ParameterError(f"translation must be 'backward' or 'forward', got {direction!r}")
-    v = float_in_range("speed [m/s]", speed, 0.0, 10.0, include_low=False)
+    v = float_in_range("speed [m/s]", speed, 0.0, MAX_SPEED, include_low=False)
     d = float_in_range("displacement [m]", displacement, 0.0, 2.0, include_low=False)
     return RampAndHold(-d if direction == "backward" else d, 2.0 * d / v)
 
@@ -176,7 +199,7 @@ def oscillation_profile(amplitude: float, frequency: float):
     from ..model.platform import SumOfSines
 
     a = float_in_range("amplitude [m]", amplitude, 0.0, 1.0, include_low=False)
-    f = float_in_range("frequency [Hz]", frequency, 0.0, 20.0, include_low=False)
+    f = float_in_range("frequency [Hz]", frequency, 0.0, MAX_FREQUENCY, include_low=False)
     return SumOfSines((-a * (2 * np.pi * f) ** 2,), (f,))
 
 
@@ -371,7 +394,7 @@ def oscillation_map(body, muscles, amplitude: float, frequencies, *,
     runs = []
     for i, f in enumerate(values):
         settle = SETTLE_CYCLES / f
-        duration = settle + max(STEADY_CYCLES / f, MIN_STEADY_TIME)
+        duration = oscillation_duration(f)
         r = simulate(body, muscles, oscillation_profile(amplitude, f), duration,
                      torque_limits=limits, **run_options)
         start = int(np.searchsorted(r.time, settle))

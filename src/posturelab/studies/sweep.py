@@ -34,7 +34,6 @@ the single-process path (each run is the same deterministic computation).
 
 from __future__ import annotations
 
-import contextlib
 import os
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -42,7 +41,7 @@ from typing import IO, TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..errors import ParameterError, PostureLabError
+from ..errors import ParameterError
 from ..scenarios import Scenario
 from ..simulation.options import RunOptions
 from ..simulation.tolerances import DEFAULT_ATOL, DEFAULT_RTOL
@@ -72,6 +71,11 @@ from ._sweep_grid import (
 
 if TYPE_CHECKING:  # (the engine loads when a sweep runs: posturelab --help stays light)
     from ..simulation.compiled import BatchResult
+    from ._sweep_dask import (  # (given by __getattr__ below)
+        SCHEDULER_PROTOCOLS,
+        SCHEDULER_TIMEOUT,
+        check_scheduler_address,
+    )
 
 __all__ = [
     "SWEEP_PARAMETERS",
@@ -318,14 +322,9 @@ def run_sweep(
     return SweepResult(grid, _concatenate(parts))
 
 
-def _run_chunk(task, grid: SweepGrid, lo: int, hi: int) -> BatchResult:
-    """A chunk on a Dask worker: one thread per task (the worker's threads run tasks)."""
-    return task.run(grid, lo, hi, parallel=False)
-
-
 class SweepInterrupted(KeyboardInterrupt):
     """Ctrl-C (or SIGTERM) stopped a sweep: the chunks not started were dropped, those
-    running finished. ``parts`` are the finished chunks' results, a prefix of the grid's
+    running abandoned. ``parts`` are the finished chunks' results, a prefix of the grid's
     rows (``rows`` of ``total``); ``terminated`` tells SIGTERM from Ctrl-C; the sweep
     function sets ``result`` to the table of the finished rows."""
 
@@ -333,20 +332,6 @@ class SweepInterrupted(KeyboardInterrupt):
         super().__init__(f"interrupted after {rows} of {total} runs")
         self.parts, self.rows, self.total, self.terminated = parts, rows, total, terminated
         self.result: Any = None
-
-
-class _RowsKept:
-    """Rows of the leading finished chunks: what an interrupt keeps, and so what progress
-    counts (chunks finish out of order; one finished after a running one is not kept)."""
-
-    def __init__(self, parts: list, bounds: list) -> None:
-        self.parts, self.bounds, self.leading = parts, bounds, 0
-
-    def __call__(self) -> int:
-        """The rows kept now. [-]"""
-        while self.leading < len(self.parts) and self.parts[self.leading] is not None:
-            self.leading += 1
-        return self.bounds[self.leading - 1][1] if self.leading else 0
 
 
 def _interrupted(exc: BaseException, parts: list, bounds: list, total: int
@@ -363,35 +348,9 @@ def _interrupted(exc: BaseException, parts: list, bounds: list, total: int
 
 #: Dask worker processes a local sweep may start, per CPU. [-]
 WORKERS_PER_CPU = 4
-#: Seconds to wait for a Dask scheduler to answer before giving up. [s]
-SCHEDULER_TIMEOUT = 10
-
-
 def max_workers() -> int:
     """The most Dask worker processes a local sweep starts: 4 per CPU. [-]"""
     return WORKERS_PER_CPU * (os.cpu_count() or 1)
-
-
-#: Protocols a Dask scheduler address may name.
-SCHEDULER_PROTOCOLS = ("tcp", "tls", "ucx", "ws", "wss", "inproc")
-
-
-def check_scheduler_address(address: str) -> None:
-    """Refuse a Dask scheduler address that is not ``[PROTOCOL://]HOST:PORT`` (one line
-    naming it), before any connection is tried."""
-    form = "[tcp://]HOST:PORT, e.g. tcp://127.0.0.1:8786"
-    protocol, sep, rest = address.partition("://")
-    if not sep:
-        protocol, rest = "tcp", address
-    host, colon, port = rest.rpartition(":")
-    if protocol not in SCHEDULER_PROTOCOLS:
-        raise ParameterError(f"--scheduler {address!r}: unknown protocol {protocol!r} (one of "
-                             f"{', '.join(SCHEDULER_PROTOCOLS)}); the form is {form}")
-    if protocol == "inproc":
-        return
-    if not colon or not host or not port.isdigit() or not 1 <= int(port) <= 65535:
-        raise ParameterError(f"--scheduler {address!r} is not an address of the form {form} "
-                             "(PORT 1 … 65535)")
 
 
 def run_chunks(task, grid: SweepGrid, *, workers: int | None = None, scheduler: str | None = None,
@@ -403,8 +362,9 @@ def run_chunks(task, grid: SweepGrid, *, workers: int | None = None, scheduler: 
     chunk per single-threaded worker task); the parts in row order.
 
     ``progress(done, total)`` after each finished chunk. The same parts whichever way.
-    Ctrl-C or SIGTERM drops the chunks not started, waits for those running and raises
-    :class:`SweepInterrupted` with the finished ones.
+    Ctrl-C or SIGTERM drops the chunks not started and raises :class:`SweepInterrupted`
+    with the leading finished ones at once (here a running chunk is abandoned, on Dask
+    cancelled).
     """
     m = grid.n_runs
     distributed_run = client is not None or scheduler is not None or workers is not None
@@ -412,6 +372,8 @@ def run_chunks(task, grid: SweepGrid, *, workers: int | None = None, scheduler: 
                                 or not 1 <= workers <= max_workers()):
         raise ParameterError(f"--workers must be an integer in 1 … {max_workers()} (4 × the "
                              f"{os.cpu_count() or 1} CPUs), got {workers!r}")
+    from ._sweep_dask import _run_on_dask, check_scheduler_address
+
     if scheduler is not None:
         check_scheduler_address(scheduler)
     if chunk_size is None:
@@ -429,148 +391,75 @@ def run_chunks(task, grid: SweepGrid, *, workers: int | None = None, scheduler: 
             raise
         except KeyboardInterrupt as exc:
             raise _interrupted(exc, parts, bounds, m) from None
-    done = 0
-    if threads <= 1:
-        try:
-            for k, (lo, hi) in enumerate(bounds):
-                parts[k] = task.run(grid, lo, hi, parallel=True)
-                done += hi - lo
-                if progress is not None:
-                    progress(done, m)
-        except KeyboardInterrupt as exc:
-            raise _interrupted(exc, parts, bounds, m) from None
-        return parts
-    from concurrent.futures import ThreadPoolExecutor, as_completed
+    return _run_here(task, grid, bounds, parts, progress, max(1, int(threads)))
 
-    pool = ThreadPoolExecutor(threads)
-    futures: dict = {}
+
+def _run_here(task, grid, bounds: list, parts: list, progress, threads: int) -> list:
+    """The chunks on ``threads`` daemon threads of this process, this thread waiting.
+
+    Ctrl-C (or SIGTERM) takes effect at once: no chunk starts after it, and a chunk still
+    running is abandoned, not awaited (a daemon thread does not hold the interpreter's exit;
+    one PRTS chunk may run for tens of seconds). Only the leading finished chunks are kept.
+    """
+    import queue
+    import threading
+
+    from ._sweep_dask import _RowsKept
+
+    m = grid.n_runs
+    todo: queue.SimpleQueue = queue.SimpleQueue()
+    for k, (lo, hi) in enumerate(bounds):
+        todo.put((k, lo, hi))
+    finished: queue.SimpleQueue = queue.SimpleQueue()
+    stop = threading.Event()
+
+    def work() -> None:
+        while not stop.is_set():
+            try:
+                k, lo, hi = todo.get_nowait()
+            except queue.Empty:
+                return
+            try:
+                finished.put((k, task.run(grid, lo, hi, True), None))
+            except BaseException as exc:  # (re-raised in the waiting thread)
+                finished.put((k, None, exc))
+                return
+
+    for _ in range(min(threads, len(bounds))):
+        threading.Thread(target=work, name="posturelab-sweep", daemon=True).start()
     kept = _RowsKept(parts, bounds)
     try:
-        futures = {pool.submit(task.run, grid, lo, hi, True): k
-                   for k, (lo, hi) in enumerate(bounds)}
-        for fut in as_completed(futures):
-            parts[futures[fut]] = fut.result()
+        for _ in bounds:
+            k, part, error = finished.get()  # (a lock wait: Ctrl-C interrupts it)
+            if error is not None:
+                raise error
+            parts[k] = part
             if progress is not None:
                 progress(kept(), m)
     except KeyboardInterrupt as exc:
-        pool.shutdown(wait=True, cancel_futures=True)  # the running chunks finish
-        for fut, k in futures.items():
-            if parts[k] is None and fut.done() and not fut.cancelled() \
-                    and fut.exception() is None:
-                parts[k] = fut.result()
+        stop.set()
+        while True:  # chunks that finished meanwhile are kept; running ones abandoned
+            try:
+                k, part, error = finished.get_nowait()
+            except queue.Empty:
+                break
+            if error is None:
+                parts[k] = part
         raise _interrupted(exc, parts, bounds, m) from None
-    finally:
-        pool.shutdown(wait=True, cancel_futures=True)
+    except BaseException:
+        stop.set()
+        raise
     return parts
 
 
-@contextlib.contextmanager
-def _quiet_dask():
-    """Every logger silent for the block (distributed's, tornado's and asyncio's report the
-    connections a shutdown after Ctrl-C cuts, as errors with tracebacks)."""
-    import logging
-
-    previous = logging.root.manager.disable
-    logging.disable(logging.CRITICAL)
-    try:
-        yield
-    finally:
-        logging.disable(previous)
+#: What this module gives of :mod:`posturelab.studies._sweep_dask`, imported on first use
+#: (``posturelab sweep --help`` stays light).
+_FROM_DASK_PART = ("SCHEDULER_PROTOCOLS", "SCHEDULER_TIMEOUT", "check_scheduler_address")
 
 
-@contextlib.contextmanager
-def _sigint_held():
-    """Ctrl-C held back for the block and delivered after it (at once if it came meanwhile),
-    so that a cluster is not left half-started; the worker processes started in the block
-    ignore SIGINT (a terminal's Ctrl-C, or ``timeout -s INT``, reaches the whole process
-    group: only this process is to handle it, and then close the cluster)."""
-    import signal
-    import threading
+def __getattr__(name: str):
+    if name in _FROM_DASK_PART:
+        from . import _sweep_dask
 
-    hold = hasattr(signal, "pthread_sigmask") and \
-        threading.current_thread() is threading.main_thread()
-    if not hold:
-        yield
-        return
-    signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
-    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)  # (inherited by the workers; on
-    try:  # Linux a blocked signal stays pending though ignored)
-        yield
-    finally:
-        signal.signal(signal.SIGINT, previous)
-        signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
-
-
-def _close_dask(client, cluster, quiet: bool) -> None:
-    """Close the client, then the cluster (each at most a few seconds); after Ctrl-C with
-    every logger silent."""
-    with _quiet_dask() if quiet else contextlib.nullcontext():
-        for closing in (client, cluster):
-            if closing is None:
-                continue
-            try:
-                closing.close(timeout=5) if closing is client else closing.close()
-            except Exception:  # (a shutdown after Ctrl-C: the connections may be gone)
-                if not quiet:
-                    raise
-
-
-def _run_on_dask(task, grid, bounds, workers, scheduler, client, progress,
-                 parts: list) -> list[BatchResult]:
-    try:
-        import distributed
-    except ImportError:
-        raise PostureLabError("--workers/--scheduler need Dask: pip install 'dask[distributed]' "
-                              "(or 'posturelab[dask]')") from None
-    own_client = own_cluster = None
-    interrupted = False
-    try:
-        if client is None:
-            if scheduler is not None:
-                try:
-                    with _quiet_dask():
-                        own_client = client = distributed.Client(
-                            scheduler, timeout=SCHEDULER_TIMEOUT)
-                except (OSError, TimeoutError, ValueError) as exc:
-                    reason = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-                    raise PostureLabError(
-                        f"cannot reach the Dask scheduler at {scheduler!r} within "
-                        f"{SCHEDULER_TIMEOUT} s: {reason}") from None
-            else:
-                import logging
-
-                with _sigint_held():
-                    own_cluster = distributed.LocalCluster(
-                        n_workers=workers, threads_per_worker=1, processes=True,
-                        dashboard_address=None, silence_logs=logging.CRITICAL)
-                    own_client = client = distributed.Client(own_cluster)
-        shared = client.scatter(task, broadcast=True)
-        shared_grid = client.scatter(grid, broadcast=True)
-        futures = [client.submit(_run_chunk, shared, shared_grid, lo, hi, pure=False)
-                   for lo, hi in bounds]
-        index = {f.key: k for k, f in enumerate(futures)}
-        kept = _RowsKept(parts, bounds)
-        try:
-            for fut in distributed.as_completed(futures):
-                parts[index[fut.key]] = fut.result()
-                if progress is not None:
-                    progress(kept(), grid.n_runs)
-        except KeyboardInterrupt:
-            interrupted = True
-            with _quiet_dask():  # keep the chunks that finished, drop the rest
-                for k, fut in enumerate(futures):
-                    try:
-                        if parts[k] is None and fut.status == "finished":
-                            parts[k] = fut.result(timeout=5)
-                    except Exception:
-                        pass
-                with contextlib.suppress(Exception):
-                    client.cancel(futures)
-            raise
-        return parts  # type: ignore[return-value]
-    except KeyboardInterrupt:
-        interrupted = True
-        raise
-    finally:
-        _close_dask(own_client, own_cluster, quiet=interrupted)
-
+        return getattr(_sweep_dask, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
