@@ -26,11 +26,13 @@ def add_recording_arguments(p: argparse.ArgumentParser, *, sway: bool = True,
                    help="with --resample: the longest gap accepted [s] (default 3 median "
                    "steps of the time column).")
     g.add_argument("--angle-unit", choices=["rad", "deg"], default="rad",
-                   help="the unit of angle columns without a unit in their header "
-                   "(default rad; deg is converted).")
+                   help="the unit of angle columns whose header declares no unit "
+                   "(default rad; deg is converted); a unit a header declares, e.g. "
+                   "tilt [deg], is always honoured and converted, whatever this says.")
     g.add_argument("--length-unit", choices=["m", "mm"], default="m",
-                   help="the unit of length columns (and a CSV's marker columns) without a "
-                   "unit in their header (default m; mm is converted).")
+                   help="the unit of length columns (and a CSV's marker columns) whose "
+                   "header declares no unit (default m; mm is converted); a unit a header "
+                   "declares, e.g. x [mm], is always honoured and converted.")
     g.add_argument("--time-unit", choices=["s", "ms"], default="s",
                    help="the unit of a CSV's time column (default s; ms is converted; a "
                    "header [ms] needs it).")

@@ -29,9 +29,11 @@ FRF is G_xy/G_xx, with the coherence and 95 % bounds on gain and phase.
 
 The file has a header row and a uniform time column, t or time [s] (the sample rate comes
 from it); --resample HZ puts an uneven one on a uniform grid (cubic spline; a gap over
---max-gap refused). A header may declare units, e.g. com [rad]; posturelab reads SI (time
-in s, angles in rad, translations in m) and refuses a column in another unit (deg, ms,
-mm, ...) unless declared with --angle-unit deg / --length-unit mm / --time-unit ms. A .c3d
+--max-gap refused). A header may declare units, e.g. tilt [deg]: a declared deg or mm is
+converted to rad or m, another unit refused (time [ms] needs --time-unit ms). Columns that
+declare no unit are read in SI (angles in rad, translations in m, time in s) unless
+--angle-unit deg / --length-unit mm / --time-unit ms says otherwise (these apply only to
+columns without a declared unit). A .c3d
 is read directly (columns as posturelab convert names them). --sway METHOD with its markers
 (--hip-marker LABEL --shoulder-marker LABEL, ...) computes com_angle from a C3D's or a lab
 CSV's markers as posturelab convert --sway does; then --response com_angle, --length-unit
