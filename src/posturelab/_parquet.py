@@ -27,9 +27,10 @@ def is_parquet(path: str | Path) -> bool:
 
 
 def read_parquet(path: str | Path, what: str
-                 ) -> tuple[list[str], list[np.ndarray | None], list[str]]:
-    """The header cells, the columns (float, nulls as NaN; None for a column that is not
-    numeric) and each column's type name, of a Parquet table (size and rows bounded as a
+                 ) -> tuple[list[str], list[np.ndarray], list[str]]:
+    """The header cells, the columns (float, nulls as NaN; a column that is not numeric as
+    an object array of its values as text) and each column's type name, of a Parquet
+    table (size and rows bounded as a
     CSV's).
 
     Raises
@@ -55,12 +56,12 @@ def read_parquet(path: str | Path, what: str
         if meta.num_rows > MAX_DATA_ROWS:
             raise DataFileError(f"{what} has {meta.num_rows:,} rows; at most "
                                 f"{MAX_DATA_ROWS:,}")
-        table = pq.read_table(path)
+        table = pq.ParquetFile(path).read()  # (read_table refuses a name given twice)
     except (OSError, pa.ArrowException) as exc:
         first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
         raise DataFileError(f"cannot read {what} as Parquet: {first}") from None
     header, columns, types = [], [], []
-    for f in table.schema:
+    for k, f in enumerate(table.schema):
         meta_unit = (f.metadata or {}).get(b"unit", b"").decode("utf-8", "replace").strip()
         named = column_unit(f.name)
         if meta_unit and named and meta_unit != named:
@@ -68,8 +69,10 @@ def read_parquet(path: str | Path, what: str
                                 f"{meta_unit} in its metadata; which one holds is not guessed")
         header.append(f"{f.name} [{meta_unit}]" if meta_unit and not named else f.name)
         numeric = pa.types.is_floating(f.type) or pa.types.is_integer(f.type)
-        columns.append(table.column(f.name).to_numpy(zero_copy_only=False).astype(float)
-                       if numeric else None)
+        col = table.column(k)
+        columns.append(col.to_numpy(zero_copy_only=False).astype(float) if numeric else
+                       np.array(["" if v is None else str(v) for v in col.to_pylist()],
+                                dtype=object))
         types.append(str(f.type))
     return header, columns, types
 
@@ -77,13 +80,17 @@ def read_parquet(path: str | Path, what: str
 def parquet_rows(path: str | Path, what: str) -> Iterator[tuple[int, list[str]]]:
     """(row number, cells) of a Parquet table as :func:`posturelab._files.csv_rows` gives a
     CSV's: the header first (units in brackets), then each row's numbers as text (exact:
-    ``repr``), a null as an empty cell; a column that is not numeric is refused."""
-    header, columns, types = read_parquet(path, what)
-    for name, col, typ in zip(header, columns, types, strict=True):
-        if col is None:
-            raise DataFileError(f"{what}: column {name!r} is {typ}, not a number")
+    ``repr``), a null as an empty cell, other values as their text (a reader refuses them
+    as it refuses such a CSV cell)."""
+    header, columns, _ = read_parquet(path, what)
     yield 1, header
     if not columns:
         return
+
+    def cell(c: np.ndarray, i: int) -> str:
+        if c.dtype == object:
+            return c[i]
+        return "" if np.isnan(c[i]) else repr(float(c[i]))
+
     for i in range(columns[0].size):
-        yield i + 2, ["" if np.isnan(c[i]) else repr(float(c[i])) for c in columns]
+        yield i + 2, [cell(c, i) for c in columns]

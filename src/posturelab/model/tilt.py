@@ -456,8 +456,9 @@ class MeasuredTilt(Tilt):
 
 
 def read_tilt_csv(path) -> MeasuredTilt:
-    """A measured tilt from a CSV file with a header row and the columns ``time`` [s] and
-    ``tilt`` [rad] (by name, a ``[unit]`` suffix must be that one; other columns are ignored, so a
+    """A measured tilt from a CSV (or Parquet) file with a header row and the columns
+    ``time`` [s] and ``tilt`` [rad] (by name, a ``[unit]`` suffix must be that one, a column
+    named twice is refused; other columns are ignored, so a
     measured platform profile may carry its tilt). The first time is >= 0 (a run starts at
     0; a negative time is refused, not dropped).
 
@@ -469,11 +470,14 @@ def read_tilt_csv(path) -> MeasuredTilt:
     from pathlib import Path
 
     from .._files import check_column_unit, csv_rows, read_text
+    from .._parquet import is_parquet, parquet_rows
     from ..errors import DataFileError
+    from .platform import refuse_time_in_ms
 
     path = Path(path)
-    numbered = list(csv_rows(read_text(path, "tilt profile"),
-                             f"tilt profile {str(path)!r}"))
+    what = f"tilt profile {str(path)!r}"
+    numbered = list(parquet_rows(path, what) if is_parquet(path)
+                    else csv_rows(read_text(path, "tilt profile"), what))
     rows = [r for _, r in numbered]
     if len(rows) < 5:
         raise DataFileError(f"tilt profile {str(path)!r} needs a header row and at least 4 "
@@ -484,6 +488,12 @@ def read_tilt_csv(path) -> MeasuredTilt:
         if name not in header:
             raise DataFileError(f"tilt profile {str(path)!r} lacks column {name!r}; needs "
                                 "time [s] and tilt [rad]")
+    for name in ("time", "tilt"):
+        if header.count(name) > 1:
+            where = [str(j + 1) for j, h in enumerate(header) if h == name]
+            raise DataFileError(f"{what}: the header names {name!r} {len(where)} times "
+                                f"(columns {', '.join(where)}); which one is meant is not "
+                                "guessed")
     it, ia = header.index("time"), header.index("tilt")
     for j, unit in ((it, "s"), (ia, "rad")):
         check_column_unit(f"tilt profile {str(path)!r}", rows[0][j], (unit,),
@@ -500,6 +510,7 @@ def read_tilt_csv(path) -> MeasuredTilt:
                 raise DataFileError(f"tilt profile {str(path)!r} line {lineno}: column "
                                     f"{name!r} is not finite")
             values[row_index, col] = v
+    refuse_time_in_ms(what, values[:, 0], rows[0][it])
     if values[0, 0] < 0:
         raise DataFileError(f"tilt profile {str(path)!r} line {numbered[1][0]}: time "
                             f"{values[0, 0]:g} s is before 0; a profile starts at t >= 0 "

@@ -25,7 +25,8 @@ import numpy as np
 from .._files import check_column_unit, column_unit
 from ..errors import DataFileError, ParameterError
 
-__all__ = ["read_table", "check_time", "check_start", "check_time_steps", "SI_UNITS", "ANGLE_UNITS", "LENGTH_UNITS",
+__all__ = ["read_table", "check_time", "check_start", "check_time_steps", "SI_UNITS",
+           "ANGLE_UNITS", "LENGTH_UNITS",
            "TIME_UNITS", "MAX_ROWS", "SCALE"]
 
 #: Most data rows a series file may have. [-]
@@ -267,7 +268,7 @@ def _read_parquet(path: Path, columns: list[str] | None, skipped: list[str] | No
         for n, d in zip(names, data, strict=True):
             if n == "time" or n in wanted_cols:
                 continue
-            if d is not None:
+            if d.dtype != object:
                 wanted_cols.append(n)
             elif skipped is not None:
                 skipped.append(n)
@@ -279,7 +280,7 @@ def _read_parquet(path: Path, columns: list[str] | None, skipped: list[str] | No
     units, out = {}, {}
     for c, j in zip(wanted, index, strict=True):
         values = data[j]
-        if values is None:
+        if values.dtype == object:
             raise DataFileError(f"{what}: column {c!r} is {types[j]}, not a number")
         bad = np.flatnonzero(np.isinf(values) | (np.isnan(values) & (c == "time")))
         if bad.size:

@@ -500,9 +500,11 @@ def read_trajectory_csv(path: str | Path, n_links: int) -> tuple[np.ndarray, np.
         [rad]
     """
     from .._files import check_column_unit, csv_rows, read_text
+    from .._parquet import is_parquet, parquet_rows
 
     path = Path(path)
-    rows = [r for _, r in csv_rows(read_text(path, "trajectory"), repr(str(path)))]
+    rows = [r for _, r in (parquet_rows(path, repr(str(path))) if is_parquet(path) else
+                           csv_rows(read_text(path, "trajectory"), repr(str(path))))]
     if len(rows) < 3:
         raise DataFileError(f"{str(path)!r} needs a header row and at least 2 samples")
     header = [h.split("[")[0].strip().lower() for h in rows[0]]
