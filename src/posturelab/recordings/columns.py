@@ -27,7 +27,7 @@ from ..errors import DataFileError, ParameterError
 
 __all__ = ["read_table", "check_time", "check_start", "check_time_steps", "SI_UNITS",
            "ANGLE_UNITS", "LENGTH_UNITS",
-           "TIME_UNITS", "MAX_ROWS", "SCALE"]
+           "TIME_UNITS", "MAX_ROWS", "SCALE", "TO_SI", "KNOWN_SI"]
 
 #: Most data rows a series file may have. [-]
 MAX_ROWS = 2_000_000  # posturelab._files.MAX_DATA_ROWS
@@ -41,6 +41,12 @@ LENGTH_UNITS = ("m", "mm")
 TIME_UNITS = ("s", "ms")
 #: Factor to SI of each declarable unit. [SI unit per unit]
 SCALE = {"rad": 1.0, "deg": math.pi / 180.0, "m": 1.0, "mm": 1e-3, "s": 1.0, "ms": 1e-3}
+#: Units a column may declare that ``convert`` turns into SI: unit -> (SI unit, factor). [-]
+TO_SI = {"deg": ("rad", SCALE["deg"]), "mm": ("m", SCALE["mm"]),
+         "deg/s": ("rad/s", SCALE["deg"]), "mm/s": ("m/s", SCALE["mm"])}
+#: SI (and dimensionless) units a column may declare as they stand. [-]
+KNOWN_SI = SI_UNITS + ("s", "m/s²", "m/s^2", "m/s2", "rad/s²", "rad/s^2", "kg", "V", "-",
+                       "1", "%")
 
 
 def _name(header: str) -> str:

@@ -218,7 +218,8 @@ def read_recording(path: str | Path, columns: list[str],
         from .convert import convert_recording
 
         conv = convert_recording(path, resample=resample, max_gap=max_gap,
-                                 length_unit=length_unit, time_unit=time_unit,
+                                 length_unit=None if length_unit == "m" else length_unit,
+                                 time_unit=time_unit, refuse_unknown_units=False,
                                  start=start, **sway.options())
         missing = [c for c in columns if c not in conv.columns]
         if missing:
