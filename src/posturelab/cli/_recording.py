@@ -173,3 +173,20 @@ def print_resampling(report) -> None:
         import sys
 
         print(f"posturelab: note: {report.text()}", file=sys.stderr)
+
+
+def refuse_repeated_files(paths: list[str], option: str = "--data") -> None:
+    """Refuse one file given twice among the FRFs (it would count as two independent
+    measurements and narrow every interval by about √2), as ``cohort`` refuses it
+    (:func:`posturelab.frequency.cohort._refuse_repeated_files`, here naming ``option``)."""
+    from pathlib import Path
+
+    from ..errors import ParameterError
+
+    seen: dict[Path, str] = {}
+    for p in paths:
+        key = Path(p).resolve()
+        if key in seen:
+            raise ParameterError(f"{option} names the same file twice ({seen[key]!r} and "
+                                 f"{str(p)!r}); each FRF is one measurement, given once")
+        seen[key] = str(p)

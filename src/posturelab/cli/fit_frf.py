@@ -259,6 +259,9 @@ def run(args: argparse.Namespace) -> int:
     else:
         check_fit_request(muscles, free, per, _bounds(args.bounds))
     readings: dict = {}
+    from ._recording import refuse_repeated_files
+
+    refuse_repeated_files(args.data)
     found = [c for path in args.data for c in _conditions(path, args, readings)]
     conditions = [c for c, _, _ in found]
     names = [label for _, _, label in found]
@@ -304,7 +307,7 @@ def run(args: argparse.Namespace) -> int:
 
         for w in sign_warnings:
             print(f"warning: {w}", file=sys.stderr)
-    kinds = [{"data": p, "kind": "trial" if isinstance(c, FRFEstimate) else "table",
+    kinds = [{"data": p, "kind": "trial" if isinstance(c, FRFEstimate) else c.kind,
               **(readings[p].report_dict() if p in readings else {})}
              for p, c in zip(names, conditions, strict=True)]
     if any(source != args.input for _, source, _ in found):  # (a visual tilt among them)

@@ -173,6 +173,10 @@ def run(args: argparse.Namespace) -> int:
     if not stimuli:
         raise ParameterError(f"--data {args.data!r} has no tilt or visual_tilt column: give "
                              "--stimulus COLUMN")
+    if resp in stimuli or len(set(stimuli)) < len(stimuli):
+        raise ParameterError(f"--stimulus {args.stimulus or ','.join(stimuli)!r} and --response "
+                             f"{resp!r} name the same column twice; an FRF relates two "
+                             "different columns")
     kinds = {k: v for s in stimuli
              for k, v in trial_kinds(s, resp, args.length_unit,
                                      "tilt" if args.sway else None).items()}

@@ -332,12 +332,6 @@ def estimate_frf(stimulus, response, sample_rate: float, cycle_length: float, *,
     if n_cycles < 2:
         raise ParameterError(f"an FRF needs at least 2 cycles; the record has {n_cycles} "
                              "after discarding")
-    check_repeats(cx, xs, fs, T)
-    yall = np.concatenate(cy)
-    if np.ptp(yall) == 0 or np.ptp(yall) <= 1e-12 * np.max(np.abs(yall)):
-        raise ParameterError(f"the response is constant ({float(yall[0]):g} throughout): it "
-                             "has no variation to relate to the stimulus (a dead channel, "
-                             "or the wrong column?)")
     if isinstance(harmonic_step, bool) or not isinstance(harmonic_step, int | np.integer) \
             or not 1 <= harmonic_step <= L // 4:
         raise ParameterError(f"harmonic_step must be an integer in [1, {L // 4}], got "
@@ -345,6 +339,12 @@ def estimate_frf(stimulus, response, sample_rate: float, cycle_length: float, *,
     step = int(harmonic_step)
     n_odd = L // (4 * step)  # odd bins step·(1, 3, …) below the Nyquist bin L/2
     chosen = resolve_bands(bands, n_odd)
+    check_repeats(cx, xs, fs, T)
+    yall = np.concatenate(cy)
+    if np.ptp(yall) <= 1e-12 * np.max(np.abs(yall)):
+        raise ParameterError(f"the response is constant ({float(yall.flat[0]) + 0.0:g} "
+                             "throughout): it has no variation to relate to the stimulus "
+                             "(a dead channel, or the wrong column?)")
     bins = [np.array([step * (2 * k - 1) for k in band]) for band in chosen]
     Gxx_h = np.mean(np.abs(X) ** 2, axis=0)
     Gyy_h = np.mean(np.abs(Y) ** 2, axis=0)

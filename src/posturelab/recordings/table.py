@@ -212,6 +212,10 @@ def read_recording(path: str | Path, columns: list[str],
                              f"{length_unit!r}")
     path = Path(path)
     what = repr(str(path))
+    twice = next((c for k, c in enumerate(columns) if c in columns[:k]), None)
+    if twice is not None:
+        raise ParameterError(f"the column {twice!r} is asked for twice (a stimulus and a "
+                             "response must be different columns)")
     notes: list[str] = []
     resampling = None
     if sway is not None:
