@@ -30,8 +30,7 @@ def read_parquet(path: str | Path, what: str
                  ) -> tuple[list[str], list[np.ndarray], list[str]]:
     """The header cells, the columns (float, nulls as NaN; a column that is not numeric as
     an object array of its values as text) and each column's type name, of a Parquet
-    table (size and rows bounded as a
-    CSV's).
+    table (its size and rows bounded as a CSV's).
 
     Raises
     ------

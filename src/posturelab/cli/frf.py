@@ -25,7 +25,11 @@ Estimate the frequency response function (FRF) of one column to another in a CSV
 periodic stimulus (a PRTS), by Peterka's (2002) method: the record is cut into cycles of
 --cycle-length s (--discard-cycles leading ones dropped), the DFT cross- and auto-spectra are
 averaged over cycles at the stimulus's odd harmonics and then over frequency bands, and the
-FRF is G_xy/G_xx, with the coherence and 95 % bounds on gain and phase.
+FRF is G_xy/G_xx, with the coherence and 95 % bounds on gain and phase. A stimulus that does
+not repeat every --cycle-length (its cycles differing by more than 25 % of its RMS; a
+measured tilt with sensor noise differs by a few %) is refused, naming the period its
+autocorrelation shows; so are a response with no variation and a response that is the
+stimulus's column.
 
 The file has a header row and a uniform time column, t or time [s] (the sample rate comes
 from it); --resample HZ puts an uneven one on a uniform grid (cubic spline; a gap over

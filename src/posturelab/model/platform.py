@@ -426,6 +426,17 @@ def combine(*parts: Disturbance) -> Disturbance:
 REQUIRED_COLUMNS = ("time", "x_acceleration")
 
 
+def refuse_named_twice(what: str, header: list[str], names: list[str]) -> None:
+    """Refuse a header naming one of ``names`` more than once (which is meant is not
+    guessed)."""
+    for name in names:
+        if header.count(name) > 1:
+            where = [str(j + 1) for j, h in enumerate(header) if h == name]
+            raise DataFileError(f"{what}: the header names {name!r} {len(where)} times "
+                                f"(columns {', '.join(where)}); which one is meant is not "
+                                "guessed")
+
+
 def refuse_time_in_ms(what: str, t: np.ndarray, header: str) -> None:
     """Refuse a time column that declares no unit and steps by whole numbers of at least
     1 s over 20 or more samples: milliseconds read as seconds (``time [s]`` in the header
@@ -489,12 +500,7 @@ def read_profile_csv(path: str | Path) -> MeasuredProfile:
         )
     idx = {name: header.index(name) for name in ("time", "x_acceleration", "y_acceleration")
            if name in header}
-    for name in idx:
-        if header.count(name) > 1:
-            where = [str(j + 1) for j, h in enumerate(header) if h == name]
-            raise DataFileError(f"{what}: the header names {name!r} {len(where)} times "
-                                f"(columns {', '.join(where)}); which one is meant is not "
-                                "guessed")
+    refuse_named_twice(what, header, list(idx))
     for name, j in idx.items():
         accepted = ("s",) if name == "time" else ("m/s²", "m/s^2", "m/s2")
         check_column_unit(what, rows[0][j], accepted, "accelerations in m/s² and time in s")
