@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -193,7 +194,9 @@ def test_the_figures_of_frf_and_fit_frf_are_written(capsys, trial, tmp_path):
     assert code == 0, err
     assert bode.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and b"<svg" in cycles.read_bytes()[:500]
     assert f"wrote {cycles}" in out
-    code, out, err = run(capsys, "fit-frf", "--data", str(trial), "--data", str(trial),
+    second = tmp_path / "trial2.csv"  # (one file given twice is refused)
+    second.write_bytes(Path(trial).read_bytes())
+    code, out, err = run(capsys, "fit-frf", "--data", str(trial), "--data", str(second),
                          "--stimulus", "tilt", "--response", "com_angle", "--cycle-length",
                          "20", "--discard-cycles", "1", "--controller", "peterka-2002",
                          "--free", "active_stiffness", "--plot", str(fitted))

@@ -42,7 +42,7 @@ def test_si_units_in_the_header_are_read(tmp_path):
 
 
 @pytest.mark.parametrize("header, words", [
-    ("time [s],stim [deg],com [rad]", ("'stim [deg]'", "is in deg", "rad")),
+    ("time [s],stim [furlong],com [rad]", ("'stim [furlong]'", "is in furlong", "rad")),
     ("time [ms],stim [rad],com [rad]", ("'time [ms]'", "is in ms", "time in s")),
     ("t [s],stim [rad],com [mm]", ("'com [mm]'", "is in mm")),
 ])
@@ -50,11 +50,11 @@ def test_frf_refuses_a_column_in_another_unit(tmp_path, header, words):
     one_line_exit_2(frf(write_trial(tmp_path / "mixed.csv", header)), *words)
 
 
-def test_fit_frf_refuses_a_tilt_in_degrees(tmp_path):
-    path = write_trial(tmp_path / "mixed.csv", "time [s],stim [deg],com [rad]")
+def test_fit_frf_refuses_a_tilt_in_an_unknown_unit(tmp_path):
+    path = write_trial(tmp_path / "mixed.csv", "time [s],stim [furlong],com [rad]")
     one_line_exit_2(cli("fit-frf", "--data", path, "--stimulus", "stim", "--response", "com",
                         "--cycle-length", str(CYCLE), "--controller", "peterka-2002",
-                        "--free", "feedback_delay"), "'stim [deg]'", "is in deg")
+                        "--free", "feedback_delay"), "'stim [furlong]'", "is in furlong")
 
 
 def test_fit_frf_refuses_a_tilt_in_metres(tmp_path):

@@ -38,7 +38,7 @@ SOURCE = Path(__file__).resolve().parents[1] / "src" / "posturelab"
 #: cycles); between layers only downward.
 LAYERS: tuple[tuple[str, ...], ...] = (
     ("errors", "conventions", "_lazy", "_jit", "_progress", "_compat"),  # no posturelab imports
-    ("parameters", "_validation", "_files", "_bounds", "__init__"),      # the foundation
+    ("parameters", "_validation", "_files", "_parquet", "_bounds", "__init__"),  # foundation
     ("model",),          # validated parameters and the physics as functions over arrays
     ("linear",),         # the linearisation: poles, delays, batched maps
     ("simulation",),     # both engines, the run set-up, results

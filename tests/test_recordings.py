@@ -316,9 +316,9 @@ def test_bad_files_get_one_line_and_exit_2(tmp_path, capsys, rng):
                            "com_angle", "--cycle-length", "1")
     assert "--resample" in line
     deg = tmp_path / "deg.csv"
-    deg.write_text("time,tilt [deg],com_angle\n" + "".join(
+    deg.write_text("time,tilt [furlong],com_angle\n" + "".join(
         f"{k * 0.01},{k},{k}\n" for k in range(50)))
-    assert "--angle-unit deg" in one_line_exit_2(
+    assert "is in furlong" in one_line_exit_2(
         capsys, "frf", "--data", deg, "--stimulus", "tilt", "--response", "com_angle",
         "--cycle-length", "0.1")
     assert not (tmp_path / "o.csv").exists()

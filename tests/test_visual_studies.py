@@ -192,7 +192,7 @@ def test_fit_frf_reads_the_dual_json_of_frf_as_the_trial(tmp_path, capsys):
     assert main(["fit-frf", "--data", str(frfs), *GAINS, *free]) == 0
     by_json = json.loads(capsys.readouterr().out)
     assert [c["input"] for c in by_json["conditions"]] == ["tilt", "visual-tilt"]
-    assert [c["kind"] for c in by_json["conditions"]] == ["table", "table"]
+    assert [c["kind"] for c in by_json["conditions"]] == ["frf --json", "frf --json"]
     for a, b in zip(by_csv["parameters"], by_json["parameters"], strict=True):
         assert a["name"] == b["name"]
         assert b["estimate"] == pytest.approx(a["estimate"], rel=1e-9, abs=1e-12)

@@ -26,11 +26,13 @@ def add_recording_arguments(p: argparse.ArgumentParser, *, sway: bool = True,
                    help="with --resample: the longest gap accepted [s] (default 3 median "
                    "steps of the time column).")
     g.add_argument("--angle-unit", choices=["rad", "deg"], default="rad",
-                   help="the unit of angle columns without a unit in their header "
-                   "(default rad; deg is converted).")
+                   help="the unit of angle columns whose header declares no unit "
+                   "(default rad; deg is converted); a unit a header declares, e.g. "
+                   "tilt [deg], is always honoured and converted, whatever this says.")
     g.add_argument("--length-unit", choices=["m", "mm"], default="m",
-                   help="the unit of length columns (and a CSV's marker columns) without a "
-                   "unit in their header (default m; mm is converted).")
+                   help="the unit of length columns (and a CSV's marker columns) whose "
+                   "header declares no unit (default m; mm is converted); a unit a header "
+                   "declares, e.g. x [mm], is always honoured and converted.")
     g.add_argument("--time-unit", choices=["s", "ms"], default="s",
                    help="the unit of a CSV's time column (default s; ms is converted; a "
                    "header [ms] needs it).")
@@ -171,3 +173,20 @@ def print_resampling(report) -> None:
         import sys
 
         print(f"posturelab: note: {report.text()}", file=sys.stderr)
+
+
+def refuse_repeated_files(paths: list[str], option: str = "--data") -> None:
+    """Refuse one file given twice among the FRFs (it would count as two independent
+    measurements and narrow every interval by about √2), as ``cohort`` refuses it
+    (:func:`posturelab.frequency.cohort._refuse_repeated_files`, here naming ``option``)."""
+    from pathlib import Path
+
+    from ..errors import ParameterError
+
+    seen: dict[Path, str] = {}
+    for p in paths:
+        key = Path(p).resolve()
+        if key in seen:
+            raise ParameterError(f"{option} names the same file twice ({seen[key]!r} and "
+                                 f"{str(p)!r}); each FRF is one measurement, given once")
+        seen[key] = str(p)

@@ -101,7 +101,9 @@ def one_sign(paths: list[str], frfs: list) -> None:
 def run(args: argparse.Namespace) -> int:
     from ..frequency.statistics import compare_frf_groups
     from ._common import print_json
+    from ._recording import refuse_repeated_files
 
+    refuse_repeated_files(list(args.a) + list(args.b), "--a/--b")
     readings: dict | None = {} if args.json else None
     a, b = read_frfs(args.a, args, readings), read_frfs(args.b, args, readings)
     one_sign(args.a + args.b, a + b)

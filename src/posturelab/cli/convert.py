@@ -16,8 +16,12 @@ LABEL_y, LABEL_z in m (scaled from POINT:UNITS), every analog channel by its lab
 ANALOG:UNITS unit), each force plate k as fpk_fx, fpk_fy, fpk_fz [N] and its centre of
 pressure fpk_copx, fpk_copy, fpk_copz [m], at the marker rate or --rate HZ (analogs
 decimated by a zero-phase FIR low-pass). Labels are lower-cased. A CSV needs a time
-column. --angle-columns names the angle columns, converted to rad from the unit they
-declare (or --angle-unit); --length-unit is the unit of a CSV's marker columns (--markers).
+column. Every column that declares deg, mm, deg/s or mm/s (a header's [deg], a C3D's
+ANALOG:UNITS) is written in rad, m, rad/s or m/s; a CSV column in a unit posturelab neither
+reads nor converts (e.g. [furlong]) is refused. --angle-columns names angle columns that
+declare no unit, --angle-unit deg their unit; --length-unit mm is the unit of a CSV's
+marker columns (--markers) that declare none. Either flag where it would do nothing is
+refused.
 
 --sway METHOD writes com_angle: segments (ankle, knee, hip, shoulder markers; Winter 2009
 Table 4.1), two-marker (hip and shoulder; the knee on the ankle–hip line: posturelab's
@@ -47,6 +51,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    "declare (ANALOG:UNITS, a CSV header's [deg]) or else --angle-unit.")
     add_recording_arguments(p, sway=False)
     add_sway_arguments(p)
+    p.set_defaults(angle_unit=None, length_unit=None)  # given where it does nothing: refused
 
 
 def run(args: argparse.Namespace) -> int:

@@ -22,11 +22,11 @@ estimate its FRF, as posturelab frf does), the JSON that posturelab frf --json w
 table as JSON: {{"frequency": [Hz], "gain": [...], "phase_deg": [...]}} with optional
 "gain_se" and "phase_se_deg" (standard errors of gain [-] and phase [deg], as published
 group means give them), or "frf_se" (standard error of the complex value), "dof" and
-"coherence". A trial's header may declare units, e.g. com [rad]; posturelab reads SI (time
-in s, a tilt in rad, a translation in m) and refuses a column in another unit. --free
+"coherence". A trial's header may declare units, e.g. tilt [deg]: deg and mm are converted
+to rad and m, another unit refused (time in s). The same file given twice is refused. --free
 NAMES (comma separated) are shared by the conditions, --per-condition NAMES take one value
 per condition, NAME#1, NAME#2, … in the order of --data (the output lists the conditions:
-"conditions" in --json, each --data path and its kind, trial or table, and for a trial
+"conditions" in --json, each --data path and its kind, trial, frf --json or table, and for a trial
 resampled or cut its "resampling" and "trimming"; without --json one line each on stderr).
 A trial is read with posturelab frf's recording options (--resample, --angle-unit,
 --length-unit, --time-unit, --start, --drop-partial, and --sway with its markers to compute
@@ -264,6 +264,9 @@ def run(args: argparse.Namespace) -> int:
     else:
         check_fit_request(muscles, free, per, _bounds(args.bounds))
     readings: dict = {}
+    from ._recording import refuse_repeated_files
+
+    refuse_repeated_files(args.data)
     found = [c for path in args.data for c in _conditions(path, args, readings)]
     conditions = [c for c, _, _ in found]
     names = [label for _, _, label in found]
@@ -309,7 +312,7 @@ def run(args: argparse.Namespace) -> int:
 
         for w in sign_warnings:
             print(f"warning: {w}", file=sys.stderr)
-    kinds = [{"data": p, "kind": "trial" if isinstance(c, FRFEstimate) else "table",
+    kinds = [{"data": p, "kind": "trial" if isinstance(c, FRFEstimate) else c.kind,
               **(readings[p].report_dict() if p in readings else {})}
              for p, c in zip(names, conditions, strict=True)]
     if any(source != args.input for _, source, _ in found):  # (a visual tilt among them)

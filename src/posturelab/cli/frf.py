@@ -25,13 +25,19 @@ Estimate the frequency response function (FRF) of one column to another in a CSV
 periodic stimulus (a PRTS), by Peterka's (2002) method: the record is cut into cycles of
 --cycle-length s (--discard-cycles leading ones dropped), the DFT cross- and auto-spectra are
 averaged over cycles at the stimulus's odd harmonics and then over frequency bands, and the
-FRF is G_xy/G_xx, with the coherence and 95 % bounds on gain and phase.
+FRF is G_xy/G_xx, with the coherence and 95 % bounds on gain and phase. A stimulus that does
+not repeat every --cycle-length (its cycles differing by more than 25 % of its RMS; a
+measured tilt with sensor noise differs by a few %) is refused, naming the period its
+autocorrelation shows; so are a response with no variation and a response that is the
+stimulus's column.
 
 The file has a header row and a uniform time column, t or time [s] (the sample rate comes
 from it); --resample HZ puts an uneven one on a uniform grid (cubic spline; a gap over
---max-gap refused). A header may declare units, e.g. com [rad]; posturelab reads SI (time
-in s, angles in rad, translations in m) and refuses a column in another unit (deg, ms,
-mm, ...) unless declared with --angle-unit deg / --length-unit mm / --time-unit ms. A .c3d
+--max-gap refused). A header may declare units, e.g. tilt [deg]: a declared deg or mm is
+converted to rad or m, another unit refused (time [ms] needs --time-unit ms). Columns that
+declare no unit are read in SI (angles in rad, translations in m, time in s) unless
+--angle-unit deg / --length-unit mm / --time-unit ms says otherwise (these apply only to
+columns without a declared unit). A .c3d
 is read directly (columns as posturelab convert names them). --sway METHOD with its markers
 (--hip-marker LABEL --shoulder-marker LABEL, ...) computes com_angle from a C3D's or a lab
 CSV's markers as posturelab convert --sway does; then --response com_angle, --length-unit
@@ -171,6 +177,10 @@ def run(args: argparse.Namespace) -> int:
     if not stimuli:
         raise ParameterError(f"--data {args.data!r} has no tilt or visual_tilt column: give "
                              "--stimulus COLUMN")
+    if resp in stimuli or len(set(stimuli)) < len(stimuli):
+        raise ParameterError(f"--stimulus {args.stimulus or ','.join(stimuli)!r} and --response "
+                             f"{resp!r} name the same column twice; an FRF relates two "
+                             "different columns")
     kinds = {k: v for s in stimuli
              for k, v in trial_kinds(s, resp, args.length_unit,
                                      "tilt" if args.sway else None).items()}

@@ -51,6 +51,9 @@ def run(args: argparse.Namespace) -> int:
     from .compare_frf import read_frfs
 
     refuse_input_as_output({"--data": args.data}, {"--out": args.out})
+    from ._recording import refuse_repeated_files
+
+    refuse_repeated_files(args.data)
     check_writable([args.out], {args.out: (".json",)})
     weights = parse_float_list(args.weights, "--weights") if args.weights.strip() else None
     reference = build_likeness_reference(read_frfs(args.data, args), weights=weights,

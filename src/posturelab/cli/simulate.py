@@ -406,8 +406,10 @@ def _platform_tables(path: str) -> dict[str, dict]:
     type profile (x_acceleration, y_acceleration) and [tilt] of type profile (tilt [rad]);
     a file with neither is read as a translation profile (whose error says so)."""
     from .._files import csv_rows, read_text
+    from .._parquet import is_parquet, parquet_rows
 
-    first = next(csv_rows(read_text(path, "platform profile"), repr(path)), None)
+    first = next(parquet_rows(path, repr(path)) if is_parquet(path)
+                 else csv_rows(read_text(path, "platform profile"), repr(path)), None)
     header = first[1] if first is not None else []
     names = {h.split("[")[0].strip().lower() for h in header}
     tables: dict[str, dict] = {}

@@ -339,6 +339,12 @@ def estimate_frf(stimulus, response, sample_rate: float, cycle_length: float, *,
     step = int(harmonic_step)
     n_odd = L // (4 * step)  # odd bins step·(1, 3, …) below the Nyquist bin L/2
     chosen = resolve_bands(bands, n_odd)
+    check_repeats(cx, xs, fs, T)
+    yall = np.concatenate(cy)
+    if np.ptp(yall) <= 1e-12 * np.max(np.abs(yall)):
+        raise ParameterError(f"the response is constant ({float(yall.flat[0]) + 0.0:g} "
+                             "throughout): it has no variation to relate to the stimulus "
+                             "(a dead channel, or the wrong column?)")
     bins = [np.array([step * (2 * k - 1) for k in band]) for band in chosen]
     Gxx_h = np.mean(np.abs(X) ** 2, axis=0)
     Gyy_h = np.mean(np.abs(Y) ** 2, axis=0)
@@ -376,6 +382,78 @@ def estimate_frf(stimulus, response, sample_rate: float, cycle_length: float, *,
                       variance, dof, float(response_sign), covariance)
     warning = sign_warning(est)
     return replace(est, warnings=(warning,)) if warning else est
+
+
+#: Largest RMS cycle-to-cycle change of the stimulus, relative to √2 × its RMS about its
+#: mean (what an unrelated next cycle gives), for it to count as periodic in the cycle
+#: length (ours: a measured tilt with sensor noise repeats within a few %, a wrong cycle
+#: length gives about 1, a PRTS's half cycle about 1.4). [-]
+MAX_CYCLE_CHANGE = 0.25
+
+
+def cycle_change(cycles: list[np.ndarray]) -> float:
+    """The RMS change of a stimulus from each cycle to the next within a trial, relative to
+    √2 × its RMS about its mean (0: it repeats exactly; about 1: unrelated cycles). [-]"""
+    diffs = [np.diff(c, axis=0).ravel() for c in cycles if c.shape[0] >= 2]
+    if not diffs:
+        return 0.0
+    every = np.concatenate([c.ravel() for c in cycles])
+    spread = float(np.sqrt(np.mean((every - every.mean()) ** 2)))
+    if spread == 0:
+        return 0.0  # a constant stimulus: refused for its missing power
+    d = np.concatenate(diffs)
+    return float(np.sqrt(np.mean(d ** 2))) / (np.sqrt(2.0) * spread)
+
+
+def repeat_period(x: np.ndarray, sample_rate: float) -> float | None:
+    """The period [s] a stimulus repeats with, from its autocorrelation (the first lag,
+    after it has fallen below 0.5, where it peaks above 0.9 and the record holds two such
+    periods that repeat within :data:`MAX_CYCLE_CHANGE`); None when none is found."""
+    x = np.asarray(x, dtype=float) - float(np.mean(x))
+    n = x.size
+    if n < 16 or not np.any(x):
+        return None
+    spec = np.fft.rfft(x, 2 * n)
+    acf = np.fft.irfft(np.abs(spec) ** 2)[:n // 2 + 1]
+    e = np.cumsum(x ** 2)
+    lag = np.arange(acf.size)
+    head = e[n - 1 - lag]  # energy of x[:n - lag]
+    tail = e[-1] - np.concatenate([[0.0], e[:acf.size - 1]])  # energy of x[lag:]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        r = np.where(head * tail > 0, acf / np.sqrt(head * tail), 0.0)
+    low = np.flatnonzero(r < 0.5)
+    if not low.size:
+        return None
+    high = np.flatnonzero((r >= 0.9) & (lag > low[0]))
+    if not high.size:
+        return None
+    start = int(high[0])
+    end = start
+    while end + 1 < r.size and r[end + 1] >= 0.9:
+        end += 1
+    P = start + int(np.argmax(r[start:end + 1]))
+    whole = (n // P) * P
+    if whole // P < 2 or cycle_change([x[:whole].reshape(-1, P)]) > MAX_CYCLE_CHANGE:
+        return None
+    return P / sample_rate
+
+
+def check_repeats(cycles: list[np.ndarray], trials: list[np.ndarray], sample_rate: float,
+                  cycle_length: float) -> None:
+    """Refuse a stimulus that does not repeat from cycle to cycle (:func:`cycle_change`
+    above :data:`MAX_CYCLE_CHANGE`): the cycle length is not the stimulus's period, and the
+    FRF would look plausible and be wrong. The period found by autocorrelation
+    (:func:`repeat_period`), if any, is suggested."""
+    change = cycle_change(cycles)
+    if change <= MAX_CYCLE_CHANGE:
+        return
+    found = repeat_period(max(trials, key=np.size), sample_rate)
+    hint = (f"; it repeats every {found:.6g} s (autocorrelation)" if found is not None
+            and abs(found - cycle_length) > 0.5 / sample_rate else "")
+    raise ParameterError(f"the stimulus does not repeat every --cycle-length {cycle_length:g}"
+                         f" s: its cycles differ by {100 * change:.0f} % of its RMS (at most "
+                         f"{100 * MAX_CYCLE_CHANGE:.0f} %){hint}; give the stimulus's period "
+                         "as --cycle-length")
 
 
 def band_variance(X: np.ndarray, Y: np.ndarray, bins) -> tuple[np.ndarray, ...]:

@@ -60,6 +60,9 @@ class FRFTable:
     harmonic_frequency, harmonic_weight : tuple of numpy.ndarray
         Per band, its harmonics [Hz] and their share of the band's stimulus power [-], when
         given: the fit then averages the model over them as the estimate did.
+    kind : str
+        What the table is: ``"frf --json"`` (an estimate ``posturelab frf --json`` wrote:
+        it gives frf_se or the bands' harmonics) or ``"table"`` (gain and phase per band).
     """
 
     frequency: np.ndarray
@@ -73,6 +76,7 @@ class FRFTable:
     harmonic_frequency: tuple = ()
     harmonic_weight: tuple = ()
     frf_covariance: np.ndarray | None = None
+    kind: str = "table"
 
     def band_average(self, frf_at) -> np.ndarray:
         """Σ w H(f) / Σ w over each band's harmonics when the table gives them (``posturelab
@@ -94,6 +98,7 @@ class FRFTable:
                                  "length (use FRFTable.from_gain_phase)")
         if not (np.all(np.isfinite(f)) and np.all(f > 0) and np.all(np.isfinite(H))):
             raise ParameterError("FRFTable: frequency must be finite and > 0, frf finite")
+        _refuse_repeated_frequency(f, "FRFTable")
         for name in ("gain_se", "phase_se_deg", "frf_se", "dof", "coherence"):
             v = getattr(self, name)
             if v is not None and (np.shape(v) != f.shape or not np.all(np.isfinite(v))):
@@ -141,6 +146,16 @@ class FRFTable:
         return cls(f, H, gs, ps, fs, nu, coh, response_sign)
 
 
+def _refuse_repeated_frequency(f: np.ndarray, what: str) -> None:
+    """Each band's frequency given once (a band given twice would count twice in a fit)."""
+    values, counts = np.unique(f, return_counts=True)
+    if np.any(counts > 1):
+        twice = float(values[np.argmax(counts > 1)])
+        where = [str(k + 1) for k in np.flatnonzero(f == twice)]
+        raise ParameterError(f"{what}: the frequency {twice:g} Hz is given {len(where)} "
+                             f"times (bands {', '.join(where)}); give each band once")
+
+
 def _numbers(name: str, values, size: int | None, low: float, high: float, *,
              low_open: bool = False) -> np.ndarray:
     """A flat list of finite numbers (no booleans, no strings) within [low, high]."""
@@ -179,6 +194,7 @@ def frf_table_from_json(obj, what: str = "FRF JSON") -> FRFTable:
         raise ParameterError(f"{what} has no 'frequency'; it needs frequency and either frf "
                              "or gain and phase_deg")
     f = _numbers("frequency [Hz]", obj["frequency"], None, 0.0, MAX_FREQUENCY, low_open=True)
+    _refuse_repeated_frequency(f, what)
     B = f.size
     if "frf" in obj:
         pairs = obj["frf"]
@@ -194,6 +210,8 @@ def frf_table_from_json(obj, what: str = "FRF JSON") -> FRFTable:
                                                -1e5, 1e5))))
     else:
         raise ParameterError(f"{what} needs frf, or gain and phase_deg")
+    if "frf" in obj:
+        _agrees_with_frf(what, obj, f, H)
     sign = obj.get("response_sign")
     if sign is not None and (isinstance(sign, bool) or sign not in (1, -1)):
         raise ParameterError(f"{what}: response_sign must be 1 or -1, got {sign!r}"[:200])
@@ -210,6 +228,10 @@ def frf_table_from_json(obj, what: str = "FRF JSON") -> FRFTable:
 
     table = FRFTable._with_precision(f, H, opt("gain_se"), opt("phase_se_deg"),
                                      opt("frf_se"), opt("dof"), opt("coherence"), sign)
+    if "harmonic_frequency" in obj or "frf_se" in obj:
+        from dataclasses import replace
+
+        table = replace(table, kind="frf --json")
     if ("harmonic_frequency" in obj) != ("harmonic_weight" in obj):
         raise ParameterError(f"{what}: give harmonic_frequency and harmonic_weight together")
     if "harmonic_frequency" in obj:
@@ -240,6 +262,35 @@ def frf_table_from_json(obj, what: str = "FRF JSON") -> FRFTable:
 
         table = replace(table, frf_covariance=V)
     return table
+
+
+#: How far a JSON's gain and phase_deg may stray from |frf| and arg frf (what rounding to
+#: 4 significant digits could do) before they contradict it: relative gain, phase [deg]. [-]
+GAIN_RTOL, PHASE_ATOL_DEG = 1e-3, 0.1
+
+
+def _agrees_with_frf(what: str, obj: dict, f: np.ndarray, H: np.ndarray) -> None:
+    """A JSON giving frf and also gain (phase_deg) must give |frf| (arg frf, modulo 360°)
+    within rounding; a contradiction is refused naming the band (the fit reads frf)."""
+    B = f.size
+    if "gain" in obj:
+        g = _numbers("gain [-]", obj["gain"], B, 0.0, MAX_GAIN)
+        bad = np.flatnonzero(np.abs(g - np.abs(H)) > GAIN_RTOL * np.maximum(np.abs(H), 1e-12))
+        if bad.size:
+            k = int(bad[0])
+            raise ParameterError(f"{what}: gain {g[k]:.6g} at band {k + 1} ({f[k]:.4g} Hz) "
+                                 f"contradicts |frf| = {abs(H[k]):.6g}; give one of them, "
+                                 "or both alike")
+    if "phase_deg" in obj:
+        p = _numbers("phase_deg [deg]", obj["phase_deg"], B, -1e5, 1e5)
+        off = np.abs((p - np.degrees(np.angle(H)) + 180.0) % 360.0 - 180.0)
+        bad = np.flatnonzero((off > PHASE_ATOL_DEG) & (np.abs(H) > 0))
+        if bad.size:
+            k = int(bad[0])
+            raise ParameterError(f"{what}: phase_deg {p[k]:.6g} at band {k + 1} ({f[k]:.4g} "
+                                 f"Hz) contradicts arg frf = "
+                                 f"{float(np.degrees(np.angle(H[k]))):.6g} deg; give one of "
+                                 "them, or both alike")
 
 
 def read_frf_json(path, what: str = "FRF JSON") -> FRFTable:
@@ -275,12 +326,24 @@ def _load_json(path, what: str):
     text = read_text(path, what, max_bytes=16 * 2**20, error=ParameterError)
     name = f"{what} {str(path)!r}"
     try:
-        obj = json.loads(text, parse_constant=_refuse_constant)
+        obj = json.loads(text, parse_constant=_refuse_constant,
+                         object_pairs_hook=_refuse_repeated_keys)
     except RecursionError:
         raise ParameterError(f"{name} is nested too deeply") from None
     except ValueError as exc:
         raise ParameterError(f"{name} is not valid JSON: {exc}"[:300]) from None
     return obj, name
+
+
+def _refuse_repeated_keys(pairs: list) -> dict:
+    """A JSON object whose keys are each given once (a repeated key would let the last one
+    win silently)."""
+    out: dict = {}
+    for key, value in pairs:
+        if key in out:
+            raise ValueError(f"the key {key!r} is given twice in one object")
+        out[key] = value
+    return out
 
 
 def _refuse_constant(name: str):

@@ -426,15 +426,44 @@ def combine(*parts: Disturbance) -> Disturbance:
 REQUIRED_COLUMNS = ("time", "x_acceleration")
 
 
+def refuse_named_twice(what: str, header: list[str], names: list[str]) -> None:
+    """Refuse a header naming one of ``names`` more than once (which is meant is not
+    guessed)."""
+    for name in names:
+        if header.count(name) > 1:
+            where = [str(j + 1) for j, h in enumerate(header) if h == name]
+            raise DataFileError(f"{what}: the header names {name!r} {len(where)} times "
+                                f"(columns {', '.join(where)}); which one is meant is not "
+                                "guessed")
+
+
+def refuse_time_in_ms(what: str, t: np.ndarray, header: str) -> None:
+    """Refuse a time column that declares no unit and steps by whole numbers of at least
+    1 s over 20 or more samples: milliseconds read as seconds (``time [s]`` in the header
+    reads it as it stands)."""
+    dt = np.diff(t)
+    if "[" in header or t.size < 20 or not dt.size:
+        return
+    step = float(np.median(dt))
+    if step >= 1.0 and np.all(np.abs(dt - np.round(dt)) <= 1e-9 * np.maximum(1.0, dt)):
+        raise DataFileError(f"{what}: the time column steps by {step:g} (a {1 / step:.3g} Hz "
+                            "recording if in s): is it in ms? a profile's time is in s: "
+                            f"divide it by 1000 (or declare '{header.strip()} [s]' in the "
+                            "header to read it in s)")
+
+
 def read_profile_csv(path: str | Path) -> MeasuredProfile:
-    """Read a measured platform profile from CSV.
+    """Read a measured platform profile from CSV or Parquet (a column's unit in its name,
+    as a CSV header gives it, or in its field's metadata).
 
     The file has a header row. Columns, by header name: ``time`` [s],
     ``x_acceleration`` [m/s²] and optionally ``y_acceleration`` [m/s²]
     (the aliases ``t``, ``ax``/``xdd`` and ``ay``/``ydd`` are accepted; a
     ``[unit]`` suffix must be that unit: ``time [ms]`` is refused). Time must be strictly
     increasing, no value may be NaN or missing, and every acceleration lies within
-    ±:data:`MAX_PLATFORM_ACCELERATION` (1000 m/s²). The first time is >= 0 (a run starts
+    ±:data:`MAX_PLATFORM_ACCELERATION` (1000 m/s²); a column named twice is refused, and so
+    is a time column without a unit stepping by whole seconds (ms read as s). The first
+    time is >= 0 (a run starts
     at 0; a negative time is refused, not dropped). The acceleration is zero after the last
     sample (and before the first): the platform goes on at the velocity it has reached.
 
@@ -444,10 +473,12 @@ def read_profile_csv(path: str | Path) -> MeasuredProfile:
         With the file name, row and column of the first problem.
     """
     from .._files import check_column_unit, csv_rows, header_words, read_text
+    from .._parquet import is_parquet, parquet_rows
 
     path = Path(path)
     what = f"platform profile {str(path)!r}"
-    numbered = list(csv_rows(read_text(path, "platform profile"), what))
+    numbered = list(parquet_rows(path, what) if is_parquet(path)
+                    else csv_rows(read_text(path, "platform profile"), what))
     rows = [r for _, r in numbered]
     lines = [n for n, _ in numbered]
     if len(rows) < 3:
@@ -469,6 +500,7 @@ def read_profile_csv(path: str | Path) -> MeasuredProfile:
         )
     idx = {name: header.index(name) for name in ("time", "x_acceleration", "y_acceleration")
            if name in header}
+    refuse_named_twice(what, header, list(idx))
     for name, j in idx.items():
         accepted = ("s",) if name == "time" else ("m/s²", "m/s^2", "m/s2")
         check_column_unit(what, rows[0][j], accepted, "accelerations in m/s² and time in s")
@@ -494,6 +526,7 @@ def read_profile_csv(path: str | Path) -> MeasuredProfile:
                 )
             data[name].append(v)
     t = np.array(data["time"])
+    refuse_time_in_ms(what, t, rows[0][idx["time"]])
     if t[0] < 0:
         raise DataFileError(
             f"platform profile {str(path)!r} line {lines[1]}: time {t[0]:g} s is before 0; "

@@ -456,8 +456,10 @@ class MeasuredTilt(Tilt):
 
 
 def read_tilt_csv(path) -> MeasuredTilt:
-    """A measured tilt from a CSV file with a header row and the columns ``time`` [s] and
-    ``tilt`` [rad] (by name, a ``[unit]`` suffix must be that one; other columns are ignored, so a
+    """A measured tilt from a CSV (or Parquet) file with a header row and the columns
+    ``time`` [s] and ``tilt`` [rad] (by name; a ``[unit]`` suffix must be that one, or
+    ``[deg]``, converted; a column
+    named twice is refused; other columns are ignored, so a
     measured platform profile may carry its tilt). The first time is >= 0 (a run starts at
     0; a negative time is refused, not dropped).
 
@@ -469,11 +471,14 @@ def read_tilt_csv(path) -> MeasuredTilt:
     from pathlib import Path
 
     from .._files import check_column_unit, csv_rows, read_text
+    from .._parquet import is_parquet, parquet_rows
     from ..errors import DataFileError
+    from .platform import refuse_named_twice, refuse_time_in_ms
 
     path = Path(path)
-    numbered = list(csv_rows(read_text(path, "tilt profile"),
-                             f"tilt profile {str(path)!r}"))
+    what = f"tilt profile {str(path)!r}"
+    numbered = list(parquet_rows(path, what) if is_parquet(path)
+                    else csv_rows(read_text(path, "tilt profile"), what))
     rows = [r for _, r in numbered]
     if len(rows) < 5:
         raise DataFileError(f"tilt profile {str(path)!r} needs a header row and at least 4 "
@@ -484,10 +489,15 @@ def read_tilt_csv(path) -> MeasuredTilt:
         if name not in header:
             raise DataFileError(f"tilt profile {str(path)!r} lacks column {name!r}; needs "
                                 "time [s] and tilt [rad]")
+    refuse_named_twice(what, header, ["time", "tilt"])
     it, ia = header.index("time"), header.index("tilt")
+    tilt_scale = 1.0
     for j, unit in ((it, "s"), (ia, "rad")):
+        if j == ia and rows[0][j].partition("[")[2].rstrip("] ").strip().lower() == "deg":
+            tilt_scale = math.pi / 180.0  # a declared unit is honoured
+            continue
         check_column_unit(f"tilt profile {str(path)!r}", rows[0][j], (unit,),
-                          "a tilt in rad and time in s")
+                          "a tilt in rad (or deg, converted) and time in s")
     values = np.empty((len(rows) - 1, 2))
     for row_index, (lineno, r) in enumerate(numbered[1:]):
         for col, j, name in ((0, it, "time"), (1, ia, "tilt")):
@@ -500,6 +510,8 @@ def read_tilt_csv(path) -> MeasuredTilt:
                 raise DataFileError(f"tilt profile {str(path)!r} line {lineno}: column "
                                     f"{name!r} is not finite")
             values[row_index, col] = v
+    refuse_time_in_ms(what, values[:, 0], rows[0][it])
+    values[:, 1] *= tilt_scale
     if values[0, 0] < 0:
         raise DataFileError(f"tilt profile {str(path)!r} line {numbered[1][0]}: time "
                             f"{values[0, 0]:g} s is before 0; a profile starts at t >= 0 "

@@ -25,8 +25,9 @@ import numpy as np
 from .._files import check_column_unit, column_unit
 from ..errors import DataFileError, ParameterError
 
-__all__ = ["read_table", "check_time", "check_start", "SI_UNITS", "ANGLE_UNITS", "LENGTH_UNITS",
-           "TIME_UNITS", "MAX_ROWS", "SCALE"]
+__all__ = ["read_table", "check_time", "check_start", "check_time_steps", "SI_UNITS",
+           "ANGLE_UNITS", "LENGTH_UNITS",
+           "TIME_UNITS", "MAX_ROWS", "SCALE", "TO_SI", "KNOWN_SI"]
 
 #: Most data rows a series file may have. [-]
 MAX_ROWS = 2_000_000  # posturelab._files.MAX_DATA_ROWS
@@ -40,6 +41,12 @@ LENGTH_UNITS = ("m", "mm")
 TIME_UNITS = ("s", "ms")
 #: Factor to SI of each declarable unit. [SI unit per unit]
 SCALE = {"rad": 1.0, "deg": math.pi / 180.0, "m": 1.0, "mm": 1e-3, "s": 1.0, "ms": 1e-3}
+#: Units a column may declare that ``convert`` turns into SI: unit -> (SI unit, factor). [-]
+TO_SI = {"deg": ("rad", SCALE["deg"]), "mm": ("m", SCALE["mm"]),
+         "deg/s": ("rad/s", SCALE["deg"]), "mm/s": ("m/s", SCALE["mm"])}
+#: SI (and dimensionless) units a column may declare as they stand. [-]
+KNOWN_SI = SI_UNITS + ("s", "m/s²", "m/s^2", "m/s2", "rad/s²", "rad/s^2", "kg", "V", "-",
+                       "1", "%")
 
 
 def _name(header: str) -> str:
@@ -176,22 +183,9 @@ def _read_csv(path: Path, columns: list[str] | None, skipped: list[str] | None =
         wanted_cols = list(columns)
     if first_row is not None:
         rows_in = itertools.chain([first_row], rows_in)
-    for c in ["time", *wanted_cols]:
-        if c not in names:
-            raise DataFileError(f"{what} has no column {c!r}; {header_words(first[1])}")
-        if names.count(c) > 1:
-            where = [j + 1 for j, n in enumerate(names) if n == c]
-            raise DataFileError(f"{what}: the header names {c!r} {len(where)} times (columns "
-                                f"{', '.join(map(str, where))}); which one is meant is not "
-                                "guessed")
     wanted = ["time", *wanted_cols]
-    index = [names.index(c) for c in wanted]
-    time_header = column_unit(first[1][index[0]])
-    if time_header == "ms" and time_unit != "ms":
-        raise DataFileError(f"{what}: column {first[1][index[0]].strip()!r} is in ms; "
-                            "posturelab reads time in s: give --time-unit ms to read it "
-                            "(converted to s)")
-    check_column_unit(what, first[1][index[0]], (time_unit,))
+    index = _indices(what, first[1], names, wanted, header_words(first[1]))
+    _check_time_header(what, first[1][index[0]], time_unit)
     rows = []
     for lineno, row in rows_in:
         values = []
@@ -215,72 +209,94 @@ def _read_csv(path: Path, columns: list[str] | None, skipped: list[str] | None =
     data = np.array(rows, dtype=float).reshape(len(rows), len(wanted))
     units = {c: column_unit(first[1][j]) for c, j in zip(wanted, index, strict=True)}
     units.pop("time")
+    check_time_steps(what, data[:, 0], first[1][index[0]], time_unit)
     return (data[:, 0] * SCALE[time_unit],
             {c: data[:, k + 1] for k, c in enumerate(wanted_cols)}, units)
+
+
+def _indices(what: str, header: list[str], names: list[str], wanted: list[str],
+             listing: str) -> list[int]:
+    """The header index of each wanted column; a missing one or one named twice refused
+    (CSV and Parquet alike)."""
+    for c in wanted:
+        if c not in names:
+            raise DataFileError(f"{what} has no column {c!r}; {listing}")
+        if names.count(c) > 1:
+            where = [j + 1 for j, n in enumerate(names) if n == c]
+            raise DataFileError(f"{what}: the header names {c!r} {len(where)} times (columns "
+                                f"{', '.join(map(str, where))}); which one is meant is not "
+                                "guessed")
+    return [names.index(c) for c in wanted]
+
+
+def _check_time_header(what: str, header: str, time_unit: str) -> None:
+    """The time column's declared unit agrees with ``time_unit`` (ms needs --time-unit ms)."""
+    if column_unit(header) == "ms" and time_unit != "ms":
+        raise DataFileError(f"{what}: column {header.strip()!r} is in ms; posturelab reads "
+                            "time in s: give --time-unit ms to read it (converted to s)")
+    check_column_unit(what, header, (time_unit,))
+
+
+#: Fewest samples before a time column's steps are judged (:func:`check_time_steps`). [-]
+MIN_SAMPLES_JUDGED = 20
+
+
+def check_time_steps(what: str, time: np.ndarray, header: str, time_unit: str = "s") -> None:
+    """Refuse a time column that declares no unit, is read in s, and steps by whole numbers
+    of at least 1 s (a recording at 1 Hz or slower): a lab recording's time in ms read as s.
+    Declaring the unit in the header (``time [s]``) reads it as it stands."""
+    if column_unit(header) or time_unit != "s" or time.size < MIN_SAMPLES_JUDGED:
+        return
+    dt = np.diff(time)
+    step = float(np.median(dt))
+    if step >= 1.0 and np.all(np.abs(dt - np.round(dt)) <= 1e-9 * np.maximum(1.0, dt)):
+        raise DataFileError(f"{what}: the time column steps by {step:g} (a {1 / step:.3g} Hz "
+                            "recording if in s): is it in ms? give --time-unit ms (or "
+                            f"declare '{header.strip()} [s]' in the header to read it in s)")
 
 
 def _read_parquet(path: Path, columns: list[str] | None, skipped: list[str] | None = None,
                   time_unit: str = "s"):
     """A Parquet table (as ``convert``, ``simulate`` and ``sweep`` write it: each field's
-    unit in its metadata ``unit``), read like a CSV: a ``time`` or ``t`` column, nulls as
-    NaN (missing samples), NaN or inf values refused."""
-    from .._files import MAX_DATA_ROWS, MAX_INPUT_BYTES
+    unit in its metadata ``unit``, or in its name as a CSV header declares it), read like a
+    CSV (:mod:`posturelab._parquet` gives its header): a ``time`` or ``t`` column, nulls as
+    NaN (missing samples), NaN or inf values refused, a column named twice refused."""
+    from .._parquet import read_parquet
 
     what = repr(str(path))
-    try:
-        import pyarrow as pa
-        import pyarrow.parquet as pq
-    except ImportError:
-        raise DataFileError(f"reading {what} (Parquet) needs pyarrow: pip install pyarrow, "
-                            "or give a CSV") from None
-    try:
-        size = path.stat().st_size
-        if size > MAX_INPUT_BYTES:
-            raise DataFileError(f"{what} is {size:,} bytes; at most {MAX_INPUT_BYTES:,}")
-        meta = pq.read_metadata(path)
-        if meta.num_rows > MAX_DATA_ROWS:
-            raise DataFileError(f"{what} has {meta.num_rows:,} rows; at most "
-                                f"{MAX_DATA_ROWS:,}")
-        table = pq.read_table(path)
-    except (OSError, pa.ArrowException) as exc:
-        first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
-        raise DataFileError(f"cannot read {what} as Parquet: {first}") from None
-    fields = {_name(f.name): f for f in table.schema}
-    if "time" not in fields:
-        raise DataFileError(f"{what} has no time column (named t or time, in s); columns: "
-                            f"{_listing(list(fields))}")
-
-    def numeric(f) -> bool:
-        return pa.types.is_floating(f.type) or pa.types.is_integer(f.type)
-
+    header, data, types = read_parquet(path, what)
+    names = [_name(h) for h in header]
+    listing = f"columns: {_listing(names)}"
+    if "time" not in names:
+        raise DataFileError(f"{what} has no time column (named t or time, in s); {listing}")
     if columns is None:
-        wanted_cols = [n for n, f in fields.items() if n != "time" and numeric(f)]
-        if skipped is not None:
-            skipped.extend(n for n, f in fields.items() if n != "time" and not numeric(f))
+        wanted_cols = []
+        for n, d in zip(names, data, strict=True):
+            if n == "time" or n in wanted_cols:
+                continue
+            if d.dtype != object:
+                wanted_cols.append(n)
+            elif skipped is not None:
+                skipped.append(n)
     else:
         wanted_cols = list(columns)
-    units = {}
-    out = {}
-    for c in ["time", *wanted_cols]:
-        if c not in fields:
-            raise DataFileError(f"{what} has no column {c!r}; columns: "
-                                f"{_listing(list(fields))}")
-        f = fields[c]
-        if not numeric(f):
-            raise DataFileError(f"{what}: column {c!r} is {f.type}, not a number")
-        values = table.column(f.name).to_numpy(zero_copy_only=False).astype(float)
+    wanted = ["time", *wanted_cols]
+    index = _indices(what, header, names, wanted, listing)
+    _check_time_header(what, header[index[0]], time_unit)
+    units, out = {}, {}
+    for c, j in zip(wanted, index, strict=True):
+        values = data[j]
+        if values.dtype == object:
+            raise DataFileError(f"{what}: column {c!r} is {types[j]}, not a number")
         bad = np.flatnonzero(np.isinf(values) | (np.isnan(values) & (c == "time")))
         if bad.size:
             raise DataFileError(f"{what} row {int(bad[0]) + 1}: column {c!r} is "
                                 f"{values[bad[0]]}; NaN and inf are not allowed")
-        meta_unit = (f.metadata or {}).get(b"unit", b"").decode("utf-8", "replace")
-        units[c], out[c] = meta_unit, values
-    time_declared = units.pop("time")
-    if time_declared and time_declared != time_unit:
-        raise DataFileError(f"{what}: the time column is in {time_declared}; posturelab reads "
-                            f"it in {time_unit}" + (": give --time-unit ms" if
-                                                   time_declared == "ms" else ""))
-    return out.pop("time") * SCALE[time_unit], out, units
+        units[c], out[c] = column_unit(header[j]), values
+    units.pop("time")
+    time = out.pop("time")
+    check_time_steps(what, time, header[index[0]], time_unit)
+    return time * SCALE[time_unit], out, units
 
 
 def check_time(time: np.ndarray, what: str) -> None:

@@ -9,7 +9,15 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import DataFileError, ParameterError
-from .columns import ANGLE_UNITS, LENGTH_UNITS, SCALE, check_start, check_time
+from .columns import (
+    ANGLE_UNITS,
+    KNOWN_SI,
+    LENGTH_UNITS,
+    SCALE,
+    TO_SI,
+    check_start,
+    check_time,
+)
 from .resample import ResampleReport
 from .sway import AXES, SwaySpec
 
@@ -85,11 +93,12 @@ def _axis(table: dict, label: str, axis: str, what: str,
 
 def convert_recording(path: str | Path, *, rate: float | None = None,
                       resample: float | None = None, max_gap: float | None = None,
-                      angle_unit: str = "rad", length_unit: str = "m", time_unit: str = "s",
-                      angle_columns: tuple[str, ...] = (), sway: str | None = None,
-                      markers: dict[str, str] | None = None, plate: int = 1,
-                      forward: str = "x", up: str = "z", height: float | None = None,
-                      mass: float | None = None, start: float | None = None
+                      angle_unit: str | None = None, length_unit: str | None = None,
+                      time_unit: str = "s", angle_columns: tuple[str, ...] = (),
+                      sway: str | None = None, markers: dict[str, str] | None = None,
+                      plate: int = 1, forward: str = "x", up: str = "z",
+                      height: float | None = None, mass: float | None = None,
+                      start: float | None = None, refuse_unknown_units: bool = True
                       ) -> ConvertedRecording:
     """Read a recording and return it as a posturelab table, with ``com_angle`` if asked.
 
@@ -103,9 +112,11 @@ def convert_recording(path: str | Path, *, rate: float | None = None,
         Put an uneven time column on a uniform grid at this rate [Hz] (cubic spline).
     max_gap : float, optional
         Longest gap the resampling accepts. [s]
-    angle_unit, length_unit : str
-        The unit of ``angle_columns`` that declare none (rad, deg), and (CSV) of the marker
-        columns (m, mm); converted to rad and m.
+    angle_unit, length_unit : str, optional
+        The unit of ``angle_columns`` that declare none (rad, deg; default rad), and (CSV) of
+        the marker columns that declare none (m, mm; default m); converted to rad and m.
+        Given where it applies to no column (no ``angle_columns`` without a declared unit;
+        a C3D's or no marker columns), it is refused: it would do nothing.
     time_unit : str
         The unit of a CSV's time column (s, ms); converted to s.
     angle_columns : tuple of str
@@ -124,6 +135,10 @@ def convert_recording(path: str | Path, *, rate: float | None = None,
         The subject's height [m] and mass [kg] (``cop``; ``two-marker`` on forward positions).
     start : float, optional
         Drop the samples before this time. [s]
+    refuse_unknown_units : bool
+        Refuse a CSV or Parquet column declaring a unit that is neither SI
+        (:data:`~.columns.KNOWN_SI`) nor converted (:data:`~.columns.TO_SI`). Every column
+        declaring deg, mm, deg/s or mm/s is converted to SI (said in ``notes``).
 
     Returns
     -------
@@ -137,6 +152,16 @@ def convert_recording(path: str | Path, *, rate: float | None = None,
     path = Path(path)
     what = repr(str(path))
     start = check_start(start)
+    angle_given, length_given = angle_unit is not None, length_unit is not None
+    angle_unit, length_unit = angle_unit or "rad", length_unit or "m"
+    if angle_given and not angle_columns:
+        raise ParameterError("--angle-unit is the unit of the --angle-columns whose header "
+                             "declares none (a declared unit is always converted); give "
+                             "--angle-columns COL,... or leave --angle-unit out")
+    if length_given and (path.suffix.lower() == ".c3d" or not markers):
+        raise ParameterError("--length-unit is the unit of a CSV's marker columns (--markers) "
+                             "whose header declares none; it does nothing here (a C3D's "
+                             "markers are scaled from POINT:UNITS): leave it out")
     if angle_unit not in ANGLE_UNITS or length_unit not in LENGTH_UNITS:
         raise ParameterError(f"angle unit must be one of {', '.join(ANGLE_UNITS)} and length "
                              f"unit one of {', '.join(LENGTH_UNITS)}")
@@ -175,6 +200,13 @@ def convert_recording(path: str | Path, *, rate: float | None = None,
                         cols[name] = cols[name] * SCALE["mm"]
                         units[name] = "m"
             notes.append("marker columns from mm to m")
+    if angle_given and all(units.get(c) for c in angle_columns if c in cols):
+        c = next(c for c in angle_columns if c in cols) if any(
+            c in cols for c in angle_columns) else None
+        if c is not None:
+            raise ParameterError(f"--angle-unit {angle_unit} does nothing: every "
+                                 f"--angle-columns column declares its unit ({c!r} is in "
+                                 f"{units[c]}, converted as declared); leave it out")
     for c in angle_columns:
         if c not in cols:
             raise DataFileError(f"{what} has no column {c!r} (--angle-columns); columns: "
@@ -187,6 +219,8 @@ def convert_recording(path: str | Path, *, rate: float | None = None,
             cols[c] = cols[c] * SCALE["deg"]
             notes.append(f"{c} from deg to rad")
         units[c] = "rad"
+    _declared_to_si(cols, units, notes, what,
+                    refuse_unknown_units and path.suffix.lower() != ".c3d")
     check_time(time, what)
     dropped = 0
     if start is not None:
@@ -218,6 +252,26 @@ def convert_recording(path: str | Path, *, rate: float | None = None,
         notes.append("left out: " + "; ".join(f"{k} ({v})" for k, v in unusable.items()))
     return ConvertedRecording(time=time, columns=cols, units=units, rate=1.0 / step,
                               notes=tuple(notes), resampling=report, dropped_before=dropped)
+
+
+def _declared_to_si(cols: dict, units: dict, notes: list, what: str, strict: bool) -> None:
+    """Every column declaring deg, mm, deg/s or mm/s converted to SI (a note each); with
+    ``strict`` a unit neither SI nor converted is refused (a C3D's other units, e.g. an
+    analog channel's V, are kept as declared)."""
+    for c in list(cols):
+        unit = units.get(c, "")
+        if not unit:
+            continue
+        si, factor = TO_SI.get(unit, TO_SI.get(unit.lower(), ("", 1.0)))
+        if si:
+            cols[c] = cols[c] * factor
+            units[c] = si
+            notes.append(f"{c} from {unit} to {si}")
+        elif strict and unit not in KNOWN_SI:
+            raise DataFileError(f"{what}: column {f'{c} [{unit}]'!r} is in {unit}, which "
+                                "posturelab neither reads nor converts (it converts deg, mm, "
+                                "deg/s and mm/s; reads " + ", ".join(KNOWN_SI[:9])
+                                + "): convert the column to SI")
 
 
 def _sway(method, cols, markers, plate, forward, up, height, mass, rate, what, unusable):

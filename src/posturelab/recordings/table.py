@@ -4,8 +4,9 @@ Every command that takes a recording (``frf``, ``fit-frf``, ``cohort``, ``fit``,
 ``likeness``, ``compare-frf``, ``likeness-reference``) reads it by :func:`read_recording`:
 it finds the time column and the named columns
 (:func:`~posturelab.recordings.columns.read_table`, also importable from here), converts
-the units the user declared (angles ``deg`` → rad, lengths ``mm`` → m, time ``ms`` → s;
-never guessed), refuses a time column that repeats or goes backwards, either checks that
+the units a header declares (``tilt [deg]``) and, for columns that declare none, the units
+the user declared (angles ``deg`` → rad, lengths ``mm`` → m, time ``ms`` → s; never
+guessed), refuses a time column that repeats or goes backwards, either checks that
 the time column is uniform or, with ``resample``, puts the recording on a uniform grid
 (:func:`posturelab.recordings.resample.resample_uniform`), cuts it to the stimulus's whole
 cycles, and with ``sway`` computes ``com_angle`` as ``posturelab convert`` does. It prints
@@ -168,9 +169,10 @@ def read_recording(path: str | Path, columns: list[str],
     kinds : dict of str -> str, optional
         ``"angle"`` or ``"length"`` per column: which declared unit applies to it.
     angle_unit, length_unit : str
-        The unit of the angle (``rad``, ``deg``) and length (``m``, ``mm``) columns, as the
-        user declares it; converted to rad and m. A header that declares another unit is
-        refused.
+        The unit of the angle (``rad``, ``deg``) and length (``m``, ``mm``) columns whose
+        header declares no unit, as the user declares it; converted to rad and m. A unit a
+        header declares is honoured (deg and mm converted; one ``units`` does not accept
+        and cannot convert refused).
     time_unit : str
         The unit of a CSV's time column (``s``, ``ms``); converted to s.
     resample : float, optional
@@ -210,13 +212,18 @@ def read_recording(path: str | Path, columns: list[str],
                              f"{length_unit!r}")
     path = Path(path)
     what = repr(str(path))
+    twice = next((c for k, c in enumerate(columns) if c in columns[:k]), None)
+    if twice is not None:
+        raise ParameterError(f"the column {twice!r} is asked for twice (a stimulus and a "
+                             "response must be different columns)")
     notes: list[str] = []
     resampling = None
     if sway is not None:
         from .convert import convert_recording
 
         conv = convert_recording(path, resample=resample, max_gap=max_gap,
-                                 length_unit=length_unit, time_unit=time_unit,
+                                 length_unit=None if length_unit == "m" else length_unit,
+                                 time_unit=time_unit, refuse_unknown_units=False,
                                  start=start, **sway.options())
         missing = [c for c in columns if c not in conv.columns]
         if missing:
@@ -237,7 +244,7 @@ def read_recording(path: str | Path, columns: list[str],
         if sway is not None and c == "com_angle":
             continue
         cols[c] = _to_si(what, c, cols[c], declared[c], kinds.get(c), angle_unit,
-                         length_unit, (units or {}).get(c, SI_UNITS))
+                         length_unit, (units or {}).get(c, SI_UNITS), notes)
     if sway is None:
         check_time(time, what)
         dropped_before = 0
@@ -291,21 +298,33 @@ def read_series(path: str | Path, columns: list[str],
     return rec.rate, rec.columns, rec.resampling
 
 
+#: Units a header may declare that are converted to SI: unit -> (SI unit, factor). [-]
+CONVERTIBLE = {"deg": ("rad", SCALE["deg"]), "mm": ("m", SCALE["mm"])}
+
+
 def _to_si(what: str, c: str, values: np.ndarray, header: str, kind: str | None,
-           angle_unit: str, length_unit: str, accepted: tuple[str, ...]) -> np.ndarray:
-    """One column in SI: scaled from the unit the user declared (which its header, if it
-    declares one, must agree with), else checked to be in ``accepted``."""
+           angle_unit: str, length_unit: str, accepted: tuple[str, ...],
+           notes: list[str] | None = None) -> np.ndarray:
+    """One column in SI. A unit its header declares is honoured: kept when in ``accepted``,
+    converted when it is deg or mm and rad or m is accepted, else refused. A column that
+    declares none is in the unit the user declared for its kind (``angle_unit``,
+    ``length_unit``: these apply only to columns without a declared unit)."""
+    if header:
+        unit = header.lower()
+        if unit in {a.lower() for a in accepted}:
+            return values
+        si, factor = CONVERTIBLE.get(unit, ("", 1.0))
+        if si in accepted and si == {"angle": "rad", "length": "m"}.get(kind or "", si):
+            if notes is not None:
+                notes.append(f"{c} from {unit} (its header) to {si}")
+            return values * factor
+        check_column_unit(what, f"{c} [{header}]", accepted)
+        return values
     given = {"angle": angle_unit, "length": length_unit}.get(kind or "")
-    if given is not None and given not in ("rad", "m") and header in ("", given):
-        return values * SCALE[given]  # declared by the user (the header agrees)
-    hint = {("deg", "angle"): "; give --angle-unit deg to read degrees",
-            ("mm", "length"): "; give --length-unit mm to read millimetres"}.get(
-                (header.lower(), kind or {"deg": "angle", "mm": "length"}.get(
-                    header.lower(), "")), "")
-    if header and header.lower() not in {a.lower() for a in accepted} and hint:
-        raise DataFileError(f"{what}: column {f'{c} [{header}]'!r} is in {header}; "
-                            f"posturelab reads {' or '.join(accepted)}{hint}")
-    check_column_unit(what, f"{c} [{header}]" if header else c, accepted)
+    if given is not None and given not in ("rad", "m"):
+        if notes is not None:
+            notes.append(f"{c} from {given} (--{kind}-unit) to {CONVERTIBLE[given][0]}")
+        return values * SCALE[given]
     return values
 
 

@@ -346,8 +346,8 @@ del _name, _shape, _meaning
 
 
 def read_run_csv(path: str | Path) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """A run saved by ``posturelab simulate --out``: time ``t`` [s], ``theta1..N`` [rad] and
-    ``omega1..N`` [rad/s] (other columns ignored; N from the header).
+    """A run saved by ``posturelab simulate --out`` (CSV or Parquet): time ``t`` [s],
+    ``theta1..N`` [rad] and ``omega1..N`` [rad/s] (other columns ignored; N from the header).
 
     Returns
     -------
@@ -359,10 +359,12 @@ def read_run_csv(path: str | Path) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         Not such a file (the file and the problem named).
     """
     from .._files import csv_rows, read_text
+    from .._parquet import is_parquet, parquet_rows
     from ..errors import DataFileError
 
     what = f"run {str(path)!r}"
-    rows = list(csv_rows(read_text(path, "run"), what))
+    rows = list(parquet_rows(path, what) if is_parquet(path)
+                else csv_rows(read_text(path, "run"), what))
     if len(rows) < 3:
         raise DataFileError(f"{what} needs a header row and at least 2 samples")
     header = [h.split("[")[0].strip() for h in rows[0][1]]

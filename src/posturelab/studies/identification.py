@@ -495,8 +495,8 @@ def fit_stiffness(
 
 
 def read_trajectory_csv(path: str | Path, n_links: int) -> tuple[np.ndarray, np.ndarray]:
-    """Read measured link angles: columns ``t`` (or ``time``) [s] and ``theta1`` …
-    ``thetaN`` [rad].
+    """Read measured link angles (CSV or Parquet): columns ``t`` (or ``time``) [s] and
+    ``theta1`` … ``thetaN`` [rad] (a header's ``[deg]`` is converted to rad).
 
     ``posturelab simulate --out`` writes this format; other columns are ignored.
 
@@ -508,9 +508,11 @@ def read_trajectory_csv(path: str | Path, n_links: int) -> tuple[np.ndarray, np.
         [rad]
     """
     from .._files import check_column_unit, csv_rows, read_text
+    from .._parquet import is_parquet, parquet_rows
 
     path = Path(path)
-    rows = [r for _, r in csv_rows(read_text(path, "trajectory"), repr(str(path)))]
+    rows = [r for _, r in (parquet_rows(path, repr(str(path))) if is_parquet(path) else
+                           csv_rows(read_text(path, "trajectory"), repr(str(path))))]
     if len(rows) < 3:
         raise DataFileError(f"{str(path)!r} needs a header row and at least 2 samples")
     header = [h.split("[")[0].strip().lower() for h in rows[0]]
@@ -521,15 +523,16 @@ def read_trajectory_csv(path: str | Path, n_links: int) -> tuple[np.ndarray, np.
         raise DataFileError(f"{str(path)!r} lacks column {missing[0]!r}; needs a time "
                             f"column (t or time) and {', '.join(need[1:])}")
     idx = [header.index(c) for c in need]
-    hints = {"deg": "give --angle-unit deg to read degrees",
-             "ms": "give --time-unit ms to read milliseconds"}
-    for c, j in zip(need, idx, strict=True):
+    scale = np.ones(len(need))
+    for k, (c, j) in enumerate(zip(need, idx, strict=True)):
         unit = rows[0][j].partition("[")[2].rstrip("] ").strip().lower()
-        if unit == ("ms" if c == clock else "deg"):
-            raise DataFileError(f"{str(path)!r}: column {rows[0][j].strip()!r} is in {unit}; "
-                                "posturelab reads "
-                                f"{'time in s' if c == clock else 'angles in rad'}: "
-                                f"{hints[unit]}")
+        if c == clock and unit == "ms":
+            raise DataFileError(f"{str(path)!r}: column {rows[0][j].strip()!r} is in ms; "
+                                "posturelab reads time in s: give --time-unit ms to read "
+                                "milliseconds")
+        if c != clock and unit == "deg":  # a declared unit is honoured
+            scale[k] = np.pi / 180.0
+            continue
         check_column_unit(repr(str(path)), rows[0][j], ("s",) if c == clock else ("rad",),
                           "angles in rad and time in s")
     try:
@@ -540,6 +543,7 @@ def read_trajectory_csv(path: str | Path, n_links: int) -> tuple[np.ndarray, np.
         raise DataFileError(f"{str(path)!r} contains NaN or inf")
     if np.any(np.diff(data[:, 0]) <= 0):
         raise DataFileError(f"{str(path)!r}: t must be strictly increasing")
+    data = data * scale
     return data[:, 0], data[:, 1:]
 
 
