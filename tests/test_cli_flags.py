@@ -96,3 +96,16 @@ def test_add_flag_wants_the_detail_its_help_leaves_open():
         add_flag(p, "--plot")
     with pytest.raises(TypeError, match="--json: detail not taken"):
         add_flag(p, "--json", "more")
+
+
+@pytest.mark.parametrize("command", ["cohort", "fit-frf", "likeness-reference"])
+def test_data_takes_several_files_either_way(command):
+    """--data A B and --data A --data B give the same files, in order (likeness-reference
+    once kept only the last --data)."""
+    parser = _subparser(command)
+    required = {"cohort": ["--out", "o.csv", "--free", "feedback_delay"],
+                "likeness-reference": ["--out", "r.json"],
+                "fit-frf": ["--free", "feedback_delay"]}[command]
+    one, _ = parser.parse_known_args(["--data", "a.json", "b.json", *required])
+    two, _ = parser.parse_known_args(["--data", "a.json", "--data", "b.json", *required])
+    assert one.data == two.data == ["a.json", "b.json"]

@@ -11,7 +11,7 @@ from ._common import (
     model_from_args,
     print_json,
 )
-from ._flags import add_flag, add_flags
+from ._flags import add_data_files, add_flag, add_flags
 from .fit_frf import _bounds, _names, add_fit_arguments, reader_options
 
 DESCRIPTION = """\
@@ -46,9 +46,7 @@ proprioceptive_weight --out cohort.csv --plot cohort.png
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     """The options of ``posturelab cohort``."""
-    p.add_argument("--data", required=True, action="extend", nargs="+", metavar="FILE",
-                   help="subjects, one file each: trial.csv or frf.json (several after one "
-                   "--data, as a shell pattern gives them, or --data repeated).")
+    add_data_files(p, "subjects, one file each: trial.csv or frf.json")
     add_fit_arguments(p, per_condition=False)
     p.add_argument("--out", required=True, metavar="TABLE.csv|TABLE.parquet",
                    help="the table: one row per subject and parameter (.csv or .parquet).")

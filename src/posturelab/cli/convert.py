@@ -44,8 +44,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("recording", metavar="FILE.c3d|FILE.csv", help="the recording.")
     p.add_argument("--out", required=True, metavar="OUT.csv|OUT.parquet",
                    help="the table to write.")
-    p.add_argument("--rate", type=float, metavar="HZ",
-                   help="C3D: the table's sample rate (default the marker rate).")
+    p.add_argument("--sample-rate", "--rate", dest="rate", type=float, metavar="HZ",
+                   help="C3D: the table's sample rate (default the marker rate; --rate is "
+                   "the same flag).")
     p.add_argument("--angle-columns", default="", metavar="COL,...",
                    help="columns that are angles: converted to rad from the unit they "
                    "declare (ANALOG:UNITS, a CSV header's [deg]) or else --angle-unit.")

@@ -13,7 +13,7 @@ from ._common import (
     model_from_args,
     print_json,
 )
-from ._flags import MODEL_OUTPUTS, add_flag, add_flags, add_options
+from ._flags import MODEL_OUTPUTS, add_data_files, add_flag, add_flags, add_options
 
 DESCRIPTION = f"""\
 Fit the linearised model's FRF to one or several measured FRFs. Each --data is a condition:
@@ -90,8 +90,7 @@ Example: posturelab fit-frf --data trial.csv --stimulus tilt --response com_angl
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     """The options of ``posturelab fit-frf``."""
-    p.add_argument("--data", required=True, action="append", metavar="FILE",
-                   help="a condition: trial.csv or frf.json (repeat for several).")
+    add_data_files(p, "the conditions, one file each: trial.csv or frf.json")
     add_fit_arguments(p, per_condition=True)
     add_flags(p, "--json")
     add_flag(p, "--plot", "a Bode plot of every condition with its fitted model",

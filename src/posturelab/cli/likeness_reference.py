@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import argparse
 
+from ._flags import add_data_files
+
 DESCRIPTION = """\
 Build a reference for posturelab likeness from a cohort: each --data FILE is one
 subject's FRF (frf.json as posturelab frf --json writes it, a table as fit-frf reads, or
@@ -28,8 +30,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     """The options of ``posturelab likeness-reference``."""
     from .compare_frf import add_recording_flags, add_trial_arguments
 
-    p.add_argument("--data", required=True, nargs="+", metavar="FILE",
-                   help="the cohort: one FRF file (or trial CSV) per subject.")
+    add_data_files(p, "the cohort: one FRF file (or trial CSV) per subject")
     p.add_argument("--out", required=True, metavar="REF.json",
                    help="the reference to write (JSON).")
     p.add_argument("--weights", default="", metavar="S1,S2,...",

@@ -116,7 +116,7 @@ def add_experiment_arguments(p: argparse.ArgumentParser) -> None:
                      "platform moves back, the body sways forward).")
     src.add_argument("--speed", type=float, default=None,
                      help="size of the velocity step [m/s] (default 1).")
-    src.add_argument("--platform-profile", metavar="FILE.csv",
+    src.add_argument("--platform-profile", metavar="FILE.csv|FILE.parquet",
                      help="measured platform acceleration (time [s], x_acceleration [m/s²], "
                      "optional y_acceleration [m/s²]; each within ±1000 m/s²), linearly "
                      "interpolated and 0 after the last sample (the platform goes on at the "
