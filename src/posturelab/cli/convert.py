@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 
 from ._common import check_writable
+from ._flags import add_flag
 from ._recording import add_recording_arguments, add_sway_arguments
 
 DESCRIPTION = """\
@@ -44,9 +45,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("recording", metavar="FILE.c3d|FILE.csv", help="the recording.")
     p.add_argument("--out", required=True, metavar="OUT.csv|OUT.parquet",
                    help="the table to write.")
-    p.add_argument("--sample-rate", "--rate", dest="rate", type=float, metavar="HZ",
-                   help="C3D: the table's sample rate (default the marker rate; --rate is "
-                   "the same flag).")
+    add_flag(p, "--sample-rate", "a C3D's marker rate", former=("--rate",), dest="rate",
+             default=None)
     p.add_argument("--angle-columns", default="", metavar="COL,...",
                    help="columns that are angles: converted to rad from the unit they "
                    "declare (ANALOG:UNITS, a CSV header's [deg]) or else --angle-unit.")
