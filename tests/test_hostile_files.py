@@ -88,3 +88,9 @@ def test_too_many_rows_is_one_error_naming_the_bound():
     with pytest.raises(DataFileError, match="more than 10 data rows; at most 10 are read"):
         list(csv_rows(text, "f.csv", max_rows=10))
     assert len(list(csv_rows(text, "f.csv", max_rows=12))) == 13
+    # refused before the first row is parsed (the generator raises on its first next()),
+    # while blank lines do not count against the bound
+    with pytest.raises(DataFileError, match="more than 10 data rows"):
+        next(csv_rows(text, "f.csv", max_rows=10))
+    spaced = "time,x\n" + "".join(f"{k},0\n\n" for k in range(12))
+    assert len(list(csv_rows(spaced, "f.csv", max_rows=12))) == 13

@@ -84,6 +84,13 @@ def csv_rows(text: str, what: str, *, max_rows: int = MAX_DATA_ROWS
     DataFileError in one line for a malformed row, a row with more fields than the header
     (empty trailing fields aside), a field over :data:`MAX_FIELD_CHARS` characters or more
     than ``max_rows`` data rows."""
+    # Counted before any parsing, so that an oversized table is refused at once rather than
+    # after seconds of parsing (a quoted field with a line break can only over-count).
+    if text.count("\n") > max_rows + 1:
+        lines = sum(1 for line in text.splitlines() if line.strip())
+        if lines > max_rows + 1:
+            raise DataFileError(f"{what} has more than {max_rows:,} data rows; at most "
+                                f"{max_rows:,} are read")
     reader = csv.reader(io.StringIO(text, newline=""))
     count = 0
     width = 0
