@@ -119,6 +119,21 @@ def test_a_noisy_measured_stimulus_still_counts_as_periodic():
     np.testing.assert_allclose(est.gain, GAIN, rtol=1e-9)
 
 
+@pytest.mark.parametrize("wrong", [10.0, 5.0])
+def test_broadband_noise_counts_only_in_the_bands_and_a_wrong_length_is_still_refused(wrong):
+    """Sensor noise of 30 % of the stimulus's RMS spread over every frequency: judged over
+    the analysed bands only, the stimulus repeats every cycle (the whole-signal change is
+    about 0.3, above the bound); a wrong cycle length is refused all the same."""
+    from posturelab.frequency.estimate import MAX_CYCLE_CHANGE, cycle_change
+
+    _, x = stimulus(noise=0.3)
+    assert cycle_change([x.reshape(-1, int(CYCLE * RATE))]) > MAX_CYCLE_CHANGE
+    est = estimate_frf(x, -GAIN * x, RATE, CYCLE, response_sign=-1)
+    np.testing.assert_allclose(est.gain, GAIN, rtol=1e-9)
+    with pytest.raises(ParameterError, match="does not repeat every --cycle-length"):
+        estimate_frf(x, -GAIN * x, RATE, wrong, bands="harmonics")
+
+
 def test_unrelated_cycles_give_a_change_near_one_and_no_period():
     from posturelab.frequency.estimate import MAX_CYCLE_CHANGE, cycle_change, repeat_period
 

@@ -308,7 +308,7 @@ def test_the_foot_keeps_the_centre_of_pressure_on_it(thresholds):
     """With the ankle limited by the functional foot both ways the centre of pressure stays on
     it but for the vertical force's departure from m g (millimetres: the caps are static)."""
     for r in thresholds.values():
-        assert r.cop_overrun <= 0.003
+        assert r.cop_overrun <= 0.004
         # (strength left after the stance's tonic moment is above m g × toe: both caps are
         # the foot's)
         weight = r.ankle_moment_cap / r.toe  # m g of the body above the ankles [N]
@@ -317,6 +317,20 @@ def test_the_foot_keeps_the_centre_of_pressure_on_it(thresholds):
             weight * r.com_height * math.sin(math.radians(4.17)), rel=1e-3)
         assert r.dorsiflexion_cap / r.ankle_moment_cap == pytest.approx(-r.heel / r.toe,
                                                                        rel=1e-12)
+
+
+def test_the_threshold_is_the_xcom_with_the_planned_path_not_a_stopped_run(thresholds):
+    """At the default T the XCoM (with Δ over the platform's whole planned move) decides: the
+    run withstood comes within 2 mm of the toe, and the step at the next size is needed late
+    in the move, not in the first tens of milliseconds (as when Δ was taken from a run that
+    had stopped at a fall, its platform supposed to keep its last velocity)."""
+    import re
+
+    for r in thresholds.values():
+        assert r.reason.startswith("the XCoM reached") and "in front of the toe" in r.reason
+        assert 0.0 <= r.minimum_margin < 0.002
+        when = float(re.search(r"at t = ([\d.]+) s", r.reason).group(1))
+        assert when > r.feedback_delay + 0.1
 
 
 def test_the_anatomical_foot_and_the_platform_velocity_frame_are_stricter(thresholds):
@@ -456,6 +470,12 @@ def test_bad_study_input_is_refused():
         step_threshold(HEIGHT, MASS, "young", "sideways")
     with pytest.raises(ParameterError, match="feedback_delay"):
         step_threshold(HEIGHT, MASS, "young", feedback_delay=-0.1)
+    with pytest.raises(ParameterError, match="cop_criterion must be True or False"):
+        step_threshold(HEIGHT, MASS, cop_criterion="no")
+    with pytest.raises(ParameterError, match="position"):
+        xcom("0.1", 0.1, 3.0)
+    with pytest.raises(ParameterError, match="platform_velocity"):
+        platform_path_offset([0.0, 1.0], ["a", "b"], 3.0)
 
 
 # ---- the command ------------------------------------------------------------------------
@@ -481,6 +501,8 @@ def test_cli_prints_one_json_object_with_the_threshold():
      ("ankle_strength", "20", "51 N·m")),
     (("--height", "2.5", "--mass", "300"), ("young population's ankle strength", "264")),
     (("--height", "1.7", "--mass", "75", "--foot", "flat"), ("--foot", "functional")),
+    (("--height", "1.7", "--mass", "75", "--translation", "sideways"),
+     ("--translation", "backward, forward")),
 ])
 def test_cli_bad_input_is_one_line_exit_2(args, words):
     one_line_exit_2(cli("step-threshold", *args), *words)

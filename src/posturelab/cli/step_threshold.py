@@ -70,14 +70,19 @@ def run(args: argparse.Namespace) -> int:
     from dataclasses import replace
 
     from .._validation import float_in_range
+    from ..errors import UnknownNameError
     from ..studies.stepping import (
         COP_TOLERANCE,
+        DIRECTIONS,
         PROTOCOL,
         UNITS,
         get_population,
         step_threshold,
     )
 
+    if args.translation not in DIRECTIONS:
+        raise UnknownNameError(f"--translation {args.translation!r} is not known; known: "
+                               f"{', '.join(DIRECTIONS)}")
     population = get_population(args.population)
     protocol = PROTOCOL if args.move_duration is None else replace(
         PROTOCOL, move_duration=float_in_range("--move-duration [s]", args.move_duration,

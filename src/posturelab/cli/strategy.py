@@ -63,7 +63,7 @@ def _grid(text: str, flag: str, unit: str = "", low: float = 0.0, high: float | 
         raise UsageError(f"{flag} HI must be at most {high:g} {unit}, got {parts[1].strip()} "
                          f"in {text!r}")
     if lo < low:
-        raise UsageError(f"{flag} LO must be at least {low:.4g} {unit}{why}, got "
+        raise UsageError(f"{flag} LO must be at least {low:.9g} {unit}{why}, got "
                          f"{parts[0].strip()} in {text!r}")
     import numpy as np
 

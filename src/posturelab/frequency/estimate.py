@@ -339,13 +339,13 @@ def estimate_frf(stimulus, response, sample_rate: float, cycle_length: float, *,
     step = int(harmonic_step)
     n_odd = L // (4 * step)  # odd bins step·(1, 3, …) below the Nyquist bin L/2
     chosen = resolve_bands(bands, n_odd)
-    check_repeats(cx, xs, fs, T)
+    bins = [np.array([step * (2 * k - 1) for k in band]) for band in chosen]
+    check_repeats(cx, xs, fs, T, np.concatenate(bins))
     yall = np.concatenate(cy)
     if np.ptp(yall) <= 1e-12 * np.max(np.abs(yall)):
         raise ParameterError(f"the response is constant ({float(yall.flat[0]) + 0.0:g} "
                              "throughout): it has no variation to relate to the stimulus "
                              "(a dead channel, or the wrong column?)")
-    bins = [np.array([step * (2 * k - 1) for k in band]) for band in chosen]
     Gxx_h = np.mean(np.abs(X) ** 2, axis=0)
     Gyy_h = np.mean(np.abs(Y) ** 2, axis=0)
     Gxy_h = np.mean(np.conj(X) * Y, axis=0)
@@ -438,13 +438,31 @@ def repeat_period(x: np.ndarray, sample_rate: float) -> float | None:
     return P / sample_rate
 
 
+def band_cycle_change(cycles: list[np.ndarray], bins: np.ndarray) -> float:
+    """:func:`cycle_change` over the analysed DFT bins only (the bands' harmonics of the cycle
+    length): broadband sensor noise on a periodic stimulus counts only by its share in
+    those bins, while a wrong cycle length changes them from cycle to cycle. [-]"""
+    steps, power = [], []
+    for c in cycles:
+        spectra = np.fft.rfft(c, axis=1)[:, bins]
+        power.append(np.sum(np.abs(spectra) ** 2, axis=1))
+        if c.shape[0] >= 2:
+            steps.append(np.sum(np.abs(np.diff(spectra, axis=0)) ** 2, axis=1))
+    if not steps:
+        return 0.0
+    total = float(np.mean(np.concatenate(power)))
+    if total == 0:
+        return 0.0  # no power in the bands: refused with its own message
+    return float(np.sqrt(np.mean(np.concatenate(steps)) / (2.0 * total)))
+
+
 def check_repeats(cycles: list[np.ndarray], trials: list[np.ndarray], sample_rate: float,
-                  cycle_length: float) -> None:
-    """Refuse a stimulus that does not repeat from cycle to cycle (:func:`cycle_change`
-    above :data:`MAX_CYCLE_CHANGE`): the cycle length is not the stimulus's period, and the
-    FRF would look plausible and be wrong. The period found by autocorrelation
-    (:func:`repeat_period`), if any, is suggested."""
-    change = cycle_change(cycles)
+                  cycle_length: float, bins: np.ndarray | None = None) -> None:
+    """Refuse a stimulus that does not repeat from cycle to cycle (:func:`cycle_change`, or
+    :func:`band_cycle_change` over ``bins``, above :data:`MAX_CYCLE_CHANGE`): the cycle
+    length is not the stimulus's period, and the FRF would look plausible and be wrong. The
+    period found by autocorrelation (:func:`repeat_period`), if any, is suggested."""
+    change = cycle_change(cycles) if bins is None else band_cycle_change(cycles, bins)
     if change <= MAX_CYCLE_CHANGE:
         return
     found = repeat_period(max(trials, key=np.size), sample_rate)

@@ -39,7 +39,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._validation import positive_float
+from .._validation import finite_array, positive_float
 from ..errors import ParameterError
 
 __all__ = ["pendulum_frequency", "xcom", "margin_of_stability", "ankle_moment_cap",
@@ -64,7 +64,7 @@ def pendulum_frequency(com_height, gravity=9.81) -> np.ndarray:
     3.1623
     """
     positive_float("gravity [m/s²]", gravity)
-    length = np.asarray(com_height, dtype=float)
+    length = finite_array("com_height [m]", com_height)
     if not np.all(np.isfinite(length)) or np.any(length <= 0.0):
         raise ParameterError(f"com_height [m] must be finite and > 0, got {com_height!r}")
     return np.sqrt(gravity / length)
@@ -93,9 +93,9 @@ def xcom(position, velocity, omega0) -> np.ndarray:
     >>> float(xcom(0.02, 0.1, 4.0))  # 0.02 m + (0.1 m/s)/(4 1/s) [m]
     0.045
     """
-    x = np.asarray(position, dtype=float)
-    v = np.asarray(velocity, dtype=float)
-    return x + v / np.asarray(omega0, dtype=float)
+    x = finite_array("position [m]", position)
+    v = finite_array("velocity [m/s]", velocity)
+    return x + v / finite_array("omega0 [1/s]", omega0)
 
 
 def margin_of_stability(xcom_position, heel, toe, side: str = "nearer") -> np.ndarray:
@@ -123,10 +123,12 @@ def margin_of_stability(xcom_position, heel, toe, side: str = "nearer") -> np.nd
     >>> round(float(margin_of_stability(-0.08, -0.06, 0.19)), 6)  # 2 cm behind the heel [m]
     -0.02
     """
-    if not float(heel) < float(toe):
+    heel = float(finite_array("heel [m]", heel))
+    toe = float(finite_array("toe [m]", toe))
+    if not heel < toe:
         raise ParameterError(f"heel [m] must be behind toe [m], got heel = {heel!r}, "
                              f"toe = {toe!r}")
-    xi = np.asarray(xcom_position, dtype=float)
+    xi = finite_array("xcom_position [m]", xcom_position)
     if side == "toe":
         return float(toe) - xi
     if side == "heel":
@@ -199,8 +201,8 @@ def platform_path_offset(time, platform_velocity, omega0: float) -> np.ndarray:
     >>> round(float(platform_path_offset([0, 1, 1 + 1e-9, 3], [0.3, 0.3, 0, 0], 3.0)[0]), 6)
     0.004979
     """
-    t = np.asarray(time, dtype=float)
-    v = np.asarray(platform_velocity, dtype=float)
+    t = finite_array("time [s]", time)
+    v = finite_array("platform_velocity [m/s]", platform_velocity)
     w = positive_float("omega0 [1/s]", omega0)
     if t.ndim != 1 or v.shape[-1:] != t.shape or t.size < 1:
         raise ParameterError(f"time must be 1-D with one sample per platform_velocity sample, "

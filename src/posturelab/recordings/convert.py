@@ -188,7 +188,8 @@ def convert_recording(path: str | Path, *, rate: float | None = None,
         unusable = dict(rec.unusable)
     else:
         if rate is not None:
-            raise ParameterError("--rate is for C3D files; give --resample HZ for a CSV")
+            raise ParameterError("--sample-rate (--rate) is for C3D files; give --resample HZ "
+                                 "for a CSV")
         skipped: list[str] = []
         time, cols, units = read_table(path, skipped=skipped, time_unit=time_unit)
         if skipped:

@@ -7,8 +7,9 @@ foot). For the linear inverted pendulum that is the extrapolated centre of mass
 ξ = x + v/ω0 (x, v relative to the ankle, ω0 = √(g/l), l the centre of mass's height)
 leaving the foot, once the platform's path still to come is counted: ξ + Δ with
 Δ(t) = ṗ(t)/ω0 − ∫_t^∞ e^{−ω0 (s − t)} ṗ(s) ds
-(:func:`~posturelab.model.stepping.platform_path_offset`; Δ = 0 for a platform at rest or at
-a constant velocity, where this is Hof's condition). The subjects compared with were asked not
+(:func:`~posturelab.model.stepping.platform_path_offset`, over the platform's whole planned
+move, also after a run that falls has stopped; Δ = 0 for a platform at rest or at a constant
+velocity, where this is Hof's condition). The subjects compared with were asked not
 to step, so what is measured is whether they could stand the whole move, its deceleration
 included (``criterion="platform-path"``, the default); ``"platform-velocity"`` judges ξ in the
 frame that keeps the platform's current velocity, as if the move never ended (stricter during
@@ -20,7 +21,8 @@ measured from the quiet-standing centre of pressure, which the upright model sta
 quiet stance's lean is a shift of the operating point: its tonic ankle moment m g l sin(lean)
 is not available to the response). Its ends bound the ankle moment each way, m g × toe and
 m g × heel (a flat foot cannot press its centre of pressure beyond them; a heel rise or a toe
-lift is not modelled), and the XCoM. ``foot="anatomical"`` takes the whole foot from the ankle
+lift is not modelled), and the XCoM; the body falls (the foot tips) only when its centre of
+gravity leaves the whole foot. ``foot="anatomical"`` takes the whole foot from the ankle
 (0.152 × height, :func:`posturelab.simulation.base_of_support_for_height`) with the centre of
 mass over the ankle. Plantarflexion is also bounded by the strength left after the tonic
 moment (:func:`~posturelab.model.stepping.ankle_moment_cap`); the dorsiflexors' own strength is
@@ -344,6 +346,9 @@ def step_threshold(height: float, mass: float, population: str | Population = "y
     )
     from ..simulation.engines import simulate
 
+    for flag, value in (("cop_criterion", cop_criterion), ("heel_limit", heel_limit)):
+        if not isinstance(value, bool | np.bool_):
+            raise ParameterError(f"{flag} must be True or False, got {value!r:.40}")
     h = check_value("height", height)
     m = check_value("mass", mass)
     if direction not in DIRECTIONS:
@@ -363,13 +368,18 @@ def step_threshold(height: float, mass: float, population: str | Population = "y
     weight = body.total_mass * body.gravity
     com_height = float(body.gravity_coefficients.sum() / body.total_mass)
     omega0 = float(pendulum_frequency(com_height, body.gravity))
+    whole = base_of_support_for_height(h)
     if foot == "functional":
         foot_bos = BaseOfSupport(*pop.functional_foot(h), source=(
             f"the functional base of support of the {pop.name} (King et al. 1994) from the "
             "quiet-standing centre of pressure"))
         tonic = weight * com_height * math.sin(pop.stance_lean)
+        # the body falls (the foot tips) when its centre of gravity leaves the whole foot,
+        # seen from the quiet-standing centre of pressure the model stands on
+        lean = com_height * math.sin(pop.stance_lean)
+        tipping = BaseOfSupport(whole.heel - lean, whole.toe - lean, source=whole.source)
     else:
-        foot_bos, tonic = base_of_support_for_height(h), 0.0
+        foot_bos, tonic, tipping = whole, 0.0, whole
     if strength <= tonic:
         whose = ("ankle_strength" if ankle_strength is not None
                  else f"the {pop.name} population's ankle strength")
@@ -384,21 +394,32 @@ def step_threshold(height: float, mass: float, population: str | Population = "y
     _check_upright_stable(body, muscles, delay)
     sign = -1.0 if direction == "backward" else 1.0
     count = 0
+    duration = protocol.move_duration + protocol.settle_time
+    # Δ from the platform's whole planned path (a run that falls stops early; its last
+    # velocity is not how the platform goes on)
+    plan_time = np.arange(int(round(duration * SAMPLE_RATE)) + 1) / SAMPLE_RATE
+
+    def path_offset(size: float, time):
+        from scipy.integrate import cumulative_trapezoid
+
+        move = protocol.disturbance(sign * size)
+        velocity = cumulative_trapezoid(move.acceleration(plan_time)[:, 0], plan_time,
+                                        initial=0.0)
+        return np.interp(time, plan_time, platform_path_offset(plan_time, velocity, omega0))
 
     def trial(size: float):
         nonlocal count
         count += 1
-        run = simulate(body, muscles, protocol.disturbance(sign * size),
-                          duration=protocol.move_duration + protocol.settle_time,
+        run = simulate(body, muscles, protocol.disturbance(sign * size), duration=duration,
                           feedback_delay=delay, proprioceptive_weight=pop.proprioceptive_weight,
                           torque_limits=((heel_cap, cap),),
-                          fall=FallCriteria(base_of_support=foot_bos),
+                          fall=FallCriteria(base_of_support=tipping),
                           sample_rate=SAMPLE_RATE, engine=engine)
         if run.status == "failed":
             raise PostureLabError(f"the run at a {size:g} m translation failed: {run.message}")
         xi = xcom(run.cog_position[:, 0], run.cog_velocity[:, 0], omega0)
         if criterion == "platform-path":
-            xi = xi + platform_path_offset(run.time, run.platform_velocity[:, 0], omega0)
+            xi = xi + path_offset(size, run.time)
         verdict = step_verdict(run.time, xi, foot_bos.heel, foot_bos.toe, run.fell,
                                run.fall_reason, run.fall_time)
         if cop_criterion and not verdict.needs_step:
