@@ -83,7 +83,7 @@ def test_stability_map_replaces_its_own_earlier_csv(tmp_path, capsys):
 
 @pytest.mark.parametrize("argv, words", [
     (("--oscillation", "0.05", "--frequencies", "0.002:0.002:1"),
-     ("--frequencies", "0.0025 Hz", "got 0.002")),
+     ("--frequencies", "0.00250000125 Hz", "got 0.002")),
     (("--translation", "backward", "--speeds", "0.05:100:8"), ("--speeds", "10 m/s", "got 100")),
     (("--oscillation", "0.05", "--frequencies", "0.1:100:6"),
      ("--frequencies", "20 Hz", "got 100")),
@@ -316,3 +316,17 @@ def test_a_real_dask_scheduler_passes_the_probe():
             return scheduler.address
 
     assert asyncio.run(main()).startswith("tcp://127.0.0.1:")
+
+
+@pytest.mark.parametrize("argv, words", [
+    (["--translation", "backward", "--speeds", "1:10:4"],
+     ("--speeds up to 10 m/s", "--displacement 0.06 m", "at most 6.18 m/s")),
+    (["--oscillation", "0.2", "--frequencies", "1:12:3"],
+     ("--frequencies up to 12 Hz", "--oscillation 0.2 m", "at most 11.25 Hz")),
+])
+def test_strategy_names_the_grid_the_platform_cannot_move(argv, words):
+    """A grid beyond the platform's ±1000 m/s² names its option, the other that sets the
+    acceleration and the largest value allowed (it said 'peak acceleration 2πD/T² ...')."""
+    from _cli import cli, one_line_exit_2
+
+    one_line_exit_2(cli("strategy", *argv, "--json"), *words)

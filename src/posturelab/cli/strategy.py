@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import functools
+import math
 
 from . import UsageError
 from ._common import print_json
@@ -68,6 +69,22 @@ def _grid(text: str, flag: str, unit: str = "", low: float = 0.0, high: float | 
     import numpy as np
 
     return np.linspace(lo, hi, n)
+
+
+def _within_platform_acceleration(flag: str, top: float, unit: str, other: str,
+                                  other_value: float, other_unit: str, peak, largest
+                                  ) -> None:
+    """Refuse, naming ``flag`` and ``other``, a grid whose largest value ``top`` needs a peak
+    platform acceleration ``peak(top)`` beyond ±MAX_PLATFORM_ACCELERATION [m/s²];
+    ``largest(acceleration)`` is the largest value that acceleration allows [``unit``]."""
+    from ..model.disturbance import MAX_PLATFORM_ACCELERATION
+
+    if not peak(top) <= MAX_PLATFORM_ACCELERATION:
+        raise UsageError(f"{flag} up to {top:g} {unit} with {other} {other_value:g} "
+                         f"{other_unit} needs a peak platform acceleration of "
+                         f"{peak(top):.4g} m/s²; at most {MAX_PLATFORM_ACCELERATION:g} m/s² "
+                         f"(at most {largest(MAX_PLATFORM_ACCELERATION):.4g} {unit} with "
+                         f"this {other})")
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -161,10 +178,16 @@ def _run(args: argparse.Namespace) -> int:
     common = dict(engine=args.engine, **controller.run_options())
     if args.translation is not None:
         values = _grid(args.speeds, "--speeds", "m/s", high=MAX_SPEED)
+        displacement = 0.06 if args.displacement is None else args.displacement
+        _within_platform_acceleration(
+            "--speeds", float(values.max()), "m/s", "--displacement", displacement, "m",
+            # ramp-and-hold: peak speed 2D/T, peak acceleration 2πD/T² = π v² / (2D)
+            lambda v: math.pi * v * v / (2.0 * displacement),
+            lambda most: math.sqrt(2.0 * displacement * most / math.pi)
+            if displacement > 0 else math.inf)
         make = functools.partial(translation_map, body, controller.muscles,
                                  values, direction=args.translation,
-                                 displacement=(0.06 if args.displacement is None
-                                               else args.displacement), **common)
+                                 displacement=displacement, **common)
     else:
         rate = 1000.0  # [Hz] (simulate's default sample rate, the runs')
         least = lowest_frequency(rate)
@@ -172,6 +195,12 @@ def _run(args: argparse.Namespace) -> int:
                        f" (each run lasts {SETTLE_CYCLES + STEADY_CYCLES} cycles, "
                        f"{SETTLE_CYCLES + STEADY_CYCLES}/LO s, at most {MAX_OUTPUT_SAMPLES:,} "
                        f"samples at {rate:g} Hz)")
+        amplitude = args.oscillation
+        _within_platform_acceleration(
+            "--frequencies", float(values.max()), "Hz", "--oscillation", amplitude, "m",
+            lambda f: amplitude * (2.0 * math.pi * f) ** 2,  # A (2πf)²
+            lambda most: math.sqrt(most / amplitude) / (2.0 * math.pi)
+            if amplitude > 0 else math.inf)
         make = functools.partial(oscillation_map, body, controller.muscles, args.oscillation,
                                  values, **common)
     limits = (None if args.ankle_torque_limits is None else
