@@ -108,8 +108,10 @@ def run(args: argparse.Namespace) -> int:
         print("no step needed up to the largest translation searched "
               f"({result.largest_searched * cm:.1f} cm): no threshold found")
     else:
-        print(f"largest translation without a step: {result.largest_translation * cm:.1f} cm "
-              f"(a step at {result.smallest_stepping * cm:.1f} cm: {result.reason})")
+        low, high = result.largest_translation * cm, result.smallest_stepping * cm
+        digits = 1 if f"{low:.1f}" != f"{high:.1f}" else 2  # the bracket, never "9.6 … 9.6"
+        print(f"largest translation without a step: {low:.{digits}f} cm "
+              f"(a step at {high:.{digits}f} cm: {result.reason})")
     print(f"  platform move over {result.move_duration:g} s: peak {result.peak_velocity:.2f} "
           f"m/s, {result.peak_acceleration:.2f} m/s² at "
           + ("the largest searched" if result.reached_search_limit else "the threshold"))
