@@ -351,3 +351,18 @@ def test_a_gain_contradicting_frf_is_refused_naming_the_band():
         frf_table_from_json(obj)
     unwrapped = _frf_object() | {"gain": [2.00004, 1.0], "phase_deg": [-10.0, -400.0]}
     np.testing.assert_allclose(frf_table_from_json(unwrapped).gain, [2.0, 1.0])
+
+
+@pytest.mark.parametrize("spelling", ["°", "degrees", "Degree"])
+def test_other_spellings_of_degrees_are_read_as_deg(spelling):
+    """A header [°] or [degrees] is the unit [deg] (it was refused as unknown)."""
+    from posturelab._files import column_unit
+
+    assert column_unit(f"tilt [{spelling}]") == "deg"
+    assert column_unit("t [sec]") == "s" and column_unit("x [furlong]") == "furlong"
+
+
+def test_a_trial_not_a_whole_number_of_cycles_is_told_the_flags_that_fix_it():
+    _, x = stimulus()
+    with pytest.raises(ParameterError, match="--drop-partial .* --start"):
+        estimate_frf(x[:-7], -GAIN * x[:-7], RATE, CYCLE)

@@ -174,11 +174,23 @@ def refuse_input_as_output(inputs: dict[str, str | Path | list | tuple | None],
                                      f"{in_path!r}; an output never overwrites an input")
 
 
+#: Other spellings of the units posturelab reads, by their lower-case form.
+UNIT_SPELLINGS = {"°": "deg", "degree": "deg", "degrees": "deg", "radian": "rad",
+                  "radians": "rad", "°/s": "deg/s", "degrees/s": "deg/s", "rad/sec": "rad/s",
+                  "sec": "s", "second": "s", "seconds": "s", "msec": "ms",
+                  "millisecond": "ms", "milliseconds": "ms", "meter": "m", "meters": "m",
+                  "metre": "m", "metres": "m", "millimeter": "mm", "millimeters": "mm",
+                  "millimetre": "mm", "millimetres": "mm"}
+
+
 def column_unit(header: str) -> str:
-    """The unit a header cell declares in brackets (``"stim [deg]"`` → ``"deg"``), or ``""``."""
+    """The unit a header cell declares in brackets (``"stim [deg]"`` → ``"deg"``; other
+    spellings of a unit, ``[°]``, ``[degrees]``, ``[sec]``, as :data:`UNIT_SPELLINGS`), or
+    ``""``."""
     if "[" not in header:
         return ""
-    return header.split("[", 1)[1].split("]", 1)[0].strip()
+    unit = header.split("[", 1)[1].split("]", 1)[0].strip()
+    return UNIT_SPELLINGS.get(unit.lower(), unit)
 
 
 def check_column_unit(what: str, header: str, accepted: tuple[str, ...],

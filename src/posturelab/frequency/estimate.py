@@ -316,7 +316,9 @@ def estimate_frf(stimulus, response, sample_rate: float, cycle_length: float, *,
                                  f"{MAX_SAMPLES:,}")
         if x.size % L:
             raise ParameterError(f"trial {i + 1}: {x.size} samples are not a whole number of "
-                                 f"cycles of {L} samples ({T:g} s at {fs:g} Hz)")
+                                 f"cycles of {L} samples ({T:g} s at {fs:g} Hz); on the "
+                                 "command line --drop-partial leaves out the part cycle, "
+                                 "--start sets where the first cycle begins")
         cycles = x.size // L - discard_cycles
         if cycles < 1:
             raise ParameterError(f"trial {i + 1} has {x.size // L} cycles; discarding "
