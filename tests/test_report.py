@@ -161,6 +161,30 @@ def test_sigterm_leaves_nothing(tmp_path):
     assert list(tmp_path.iterdir()) == []
 
 
+def test_a_sigterm_python_ignored_in_a_callback_is_delivered_again():
+    """A SIGTERM whose Terminated is raised while a weakref callback runs (as inside an
+    import's module lock) is ignored by Python; posturelab's unraisable hook sends it again,
+    so the program still stops (this once let `reproduce` finish after a SIGTERM)."""
+    script = (
+        "import signal, sys, time, weakref\n"
+        "from posturelab import cli\n"
+        "sys.unraisablehook = cli._unraisable(sys.unraisablehook)\n"
+        "signal.signal(signal.SIGTERM, cli._on_sigterm)\n"
+        "class A: pass\n"
+        "a = A()\n"
+        "def cb(ref): raise cli.Terminated()\n"
+        "r = weakref.ref(a, cb)\n"
+        "try:\n"
+        "    del a\n"
+        "    time.sleep(5)\n"
+        "    print('not terminated')\n"
+        "except cli.Terminated:\n"
+        "    print('terminated')\n")
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                          timeout=60)
+    assert done.stdout.strip() == "terminated", done.stderr
+
+
 def test_cli_unwritable_location(tmp_path, capsys):
     blocker = tmp_path / "regular-file"
     blocker.write_text("")

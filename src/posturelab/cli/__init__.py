@@ -173,6 +173,27 @@ def _on_sigterm(signum, frame) -> None:
     raise Terminated()
 
 
+def _unraisable(hook):
+    """``sys.unraisablehook`` that re-delivers a :class:`Terminated` Python had to ignore
+    (raised while a weakref callback ran, e.g. inside an import's module lock): SIGTERM is
+    sent again to this process a moment later, from a timer thread, so that its handler
+    raises it where the program then is, outside the callback; anything else goes to
+    ``hook``."""
+    import os
+    import signal
+    import threading
+
+    def handle(info) -> None:
+        if isinstance(info.exc_value, Terminated):
+            again = threading.Timer(0.01, os.kill, (os.getpid(), signal.SIGTERM))
+            again.daemon = True
+            again.start()
+            return
+        hook(info)
+
+    return handle
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``posturelab`` console script; returns the exit code (2 for bad
     input, 130 when interrupted, 143 when terminated).
@@ -185,8 +206,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     import signal
     import threading
 
+    hook = sys.unraisablehook
     if threading.current_thread() is threading.main_thread():
         previous = signal.signal(signal.SIGTERM, _on_sigterm)
+        sys.unraisablehook = _unraisable(hook)
     else:  # (signals can only be handled on the main thread)
         previous = None
     try:
@@ -197,6 +220,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     finally:
         if previous is not None:
             signal.signal(signal.SIGTERM, previous)
+            sys.unraisablehook = hook
         if argv is None:
             import gc
 
